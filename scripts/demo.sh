@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# The main job until mission execution exists: compile Listing 2 into deployment folders
+# and render its AMT, MEG and each drone's MDG as SVG (out/listing2/).
+set -euo pipefail
+BUILD=${1:-build}
+EAMOS="$BUILD/src/cli/eamos"
+MISSION=examples/listing2.eamos
+OUT=out/listing2
+
+mkdir -p "$OUT/graphs"
+"$EAMOS" check "$MISSION"
+"$EAMOS" compile "$MISSION" -o "$OUT/deploy"
+"$EAMOS" graph "$MISSION" --kind amt --format svg -o "$OUT/graphs/amt.svg"
+"$EAMOS" graph "$MISSION" --kind meg --format svg -o "$OUT/graphs/meg.svg"
+for drone in Drone1 Drone2 Drone3; do
+  "$EAMOS" graph "$MISSION" --kind mdg --drone "$drone" --format svg -o "$OUT/graphs/mdg-$drone.svg"
+done
+"$EAMOS" stats "$MISSION" -o "$OUT/stats.json"
+echo
+echo "demo: deployment in $OUT/deploy/, graphs in $OUT/graphs/, statistics in $OUT/stats.json"
+ls "$OUT/deploy" "$OUT/graphs"

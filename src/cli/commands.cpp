@@ -1,0 +1,182 @@
+#include "cli/commands.h"
+
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+
+#include "deploy/synthesize.h"
+#include "graph/export.h"
+#include "graph/pipeline.h"
+#include "stress/generator.h"
+
+namespace eamos::cli {
+
+namespace {
+
+/// Compiles and prints diagnostics; returns true when the graphs are usable.
+bool compile_and_report(const CommonOptions& o, graph::Compilation& c) {
+  Diagnostics diags;
+  diags.max_errors = o.max_errors;
+  bool ok = graph::compile_file(o.mission, o.fleet, diags, c);
+  Diagnostics shown;
+  for (const auto& d : diags.items()) {
+    if (d.severity == Severity::warning && o.quiet) continue;
+    shown.max_errors = 0;
+    if (d.severity == Severity::warning && o.werror)
+      shown.error(d.file, d.loc, d.message + " [-Werror]");
+    else if (d.severity == Severity::warning)
+      shown.warning(d.file, d.loc, d.message);
+    else if (d.severity == Severity::note)
+      shown.note(d.file, d.loc, d.message);
+    else
+      shown.error(d.file, d.loc, d.message);
+  }
+  std::cerr << shown.format();
+  std::size_t dropped = diags.error_count() - (diags.error_count() > 0 && diags.saturated() ? 0 : 0);
+  (void)dropped;
+  if (diags.saturated() && diags.max_errors != 0)
+    std::cerr << "error: stopped listing after " << diags.max_errors
+              << " errors; raise the limit with --max-errors N (0 for no limit)\n";
+  if (diags.has_errors()) {
+    std::cerr << diags.error_count() << " error(s), " << diags.warning_count() << " warning(s)\n";
+    return false;
+  }
+  if (o.werror && diags.warning_count() > 0) {
+    std::cerr << diags.warning_count() << " warning(s) treated as errors\n";
+    return false;
+  }
+  return ok;
+}
+
+}  // namespace
+
+bool write_output(const std::string& path, const std::string& text) {
+  if (path.empty() || path == "-") {
+    std::cout << text;
+    return static_cast<bool>(std::cout);
+  }
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << text;
+  out.close();
+  if (!out) {
+    std::cerr << "eamos: error: cannot write '" << path << "'; check the path and permissions\n";
+    return false;
+  }
+  return true;
+}
+
+int cmd_check(const CommonOptions& o, bool list_capabilities) {
+  graph::Compilation c;
+  if (!compile_and_report(o, c)) return 1;
+  std::cout << o.mission << ": ok — " << c.drone_count() << " drones, " << c.amt.nodes.size()
+            << " AMT nodes, " << c.meg.nodes.size() << " MEG nodes\n";
+  if (list_capabilities) {
+    for (int d = 0; d < c.drone_count(); ++d) {
+      const auto& t = c.checked.drone_types[d];
+      std::cout << c.drone_name(d) << " (" << t.name << ", adapter " << t.adapter << ")\n  actions:";
+      for (const auto& a : t.actions) std::cout << " " << a.name << "(" << a.params << ")";
+      std::cout << "\n  properties:";
+      for (const auto& p : t.properties) std::cout << " " << p.name << "()";
+      std::cout << "\n";
+    }
+  }
+  return 0;
+}
+
+int cmd_compile(const CommonOptions& o, const std::string& out_dir) {
+  graph::Compilation c;
+  if (!compile_and_report(o, c)) return 1;
+  Diagnostics diags;
+  if (!deploy::write_deployment(c, out_dir, diags)) {
+    std::cerr << diags.format();
+    return 1;
+  }
+  std::cout << "compiled " << o.mission << " → " << out_dir << "/ (" << c.drone_count()
+            << " drones, " << c.meg.nodes.size() << " MEG nodes)\n";
+  return 0;
+}
+
+bool render_svg(const std::string& dot, std::string& svg, std::string& error) {
+  char tmpl[] = "/tmp/eamos-graph-XXXXXX";
+  int fd = mkstemp(tmpl);
+  if (fd < 0) {
+    error = "cannot create a temporary file";
+    return false;
+  }
+  FILE* f = fdopen(fd, "w");
+  std::fwrite(dot.data(), 1, dot.size(), f);
+  std::fclose(f);
+  std::string cmd = std::string("dot -Tsvg '") + tmpl + "' 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) {
+    std::remove(tmpl);
+    error = "cannot run Graphviz 'dot'";
+    return false;
+  }
+  char buf[65536];
+  std::size_t n;
+  svg.clear();
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) svg.append(buf, n);
+  int status = pclose(p);
+  std::remove(tmpl);
+  if (status != 0) {
+    error = status == 127 * 256 || svg.find("not found") != std::string::npos
+                ? "Graphviz 'dot' not found; install it with `apt-get install graphviz` (or run `make deps`)"
+                : "Graphviz 'dot' failed: " + svg.substr(0, 500);
+    return false;
+  }
+  return true;
+}
+
+int cmd_graph(const CommonOptions& o, const std::string& kind, const std::string& drone,
+              const std::string& format, const std::string& output) {
+  graph::Compilation c;
+  if (!compile_and_report(o, c)) return 1;
+  int d = -1;
+  if (kind == "mdg") {
+    if (drone.empty()) {
+      std::cerr << "eamos: error: --kind mdg needs --drone NAME; drones:";
+      for (int i = 0; i < c.drone_count(); ++i) std::cerr << " " << c.drone_name(i);
+      std::cerr << "\n";
+      return 1;
+    }
+    d = c.find_drone(drone);
+    if (d < 0) {
+      std::cerr << "eamos: error: no drone '" << drone << "' in " << o.mission << "; drones:";
+      for (int i = 0; i < c.drone_count(); ++i) std::cerr << " " << c.drone_name(i);
+      std::cerr << "\n";
+      return 1;
+    }
+  } else if (!drone.empty()) {
+    std::cerr << "eamos: error: --drone only applies to --kind mdg\n";
+    return 1;
+  }
+  if (format == "json") {
+    nlohmann::json j = kind == "amt" ? graph::amt_json(c) : kind == "meg" ? graph::meg_json(c) : graph::mdg_json(c, d);
+    return write_output(output, j.dump(2) + "\n") ? 0 : 1;
+  }
+  std::string dot = kind == "amt" ? graph::amt_dot(c) : kind == "meg" ? graph::meg_dot(c) : graph::mdg_dot(c, d);
+  if (format == "dot") return write_output(output, dot) ? 0 : 1;
+  std::string svg, error;
+  if (!render_svg(dot, svg, error)) {
+    std::cerr << "eamos: error: " << error << "\n";
+    return 1;
+  }
+  return write_output(output, svg) ? 0 : 1;
+}
+
+int cmd_stats(const CommonOptions& o, const std::string& output) {
+  graph::Compilation c;
+  if (!compile_and_report(o, c)) return 1;
+  return write_output(output, graph::stats_json(c).dump(2) + "\n") ? 0 : 1;
+}
+
+int cmd_gen_stress(long long nodes, int drones, unsigned seed, const std::string& output) {
+  stress::StressOptions opt;
+  opt.target_nodes = nodes;
+  opt.drones = drones;
+  opt.seed = seed;
+  return write_output(output, stress::generate_mission(opt)) ? 0 : 1;
+}
+
+}  // namespace eamos::cli

@@ -1,0 +1,28 @@
+#pragma once
+// The `eamos` subcommands. Each returns the process exit status: 0 success, 1 when the
+// input had errors (all of them printed) or a file could not be read or written.
+#include <string>
+
+namespace eamos::cli {
+
+struct CommonOptions {
+  std::string mission;        ///< the .eamos file
+  std::string fleet;          ///< optional fleet YAML
+  std::size_t max_errors = 200;
+  bool werror = false;        ///< treat warnings as errors
+  bool quiet = false;         ///< no warnings
+};
+
+int cmd_check(const CommonOptions& o, bool list_capabilities);
+int cmd_compile(const CommonOptions& o, const std::string& out_dir);
+int cmd_graph(const CommonOptions& o, const std::string& kind, const std::string& drone,
+              const std::string& format, const std::string& output);
+int cmd_stats(const CommonOptions& o, const std::string& output);
+int cmd_gen_stress(long long nodes, int drones, unsigned seed, const std::string& output);
+
+/// Renders DOT to SVG with Graphviz `dot`; returns false with `error` set on failure.
+bool render_svg(const std::string& dot, std::string& svg, std::string& error);
+/// Writes text to a file, or to stdout when path is "" or "-".
+bool write_output(const std::string& path, const std::string& text);
+
+}  // namespace eamos::cli

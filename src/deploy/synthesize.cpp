@@ -1,0 +1,170 @@
+#include "deploy/synthesize.h"
+
+#include <openssl/evp.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+#include "graph/export.h"
+#include "version.h"
+
+namespace eamos::deploy {
+
+using nlohmann::json;
+
+namespace {
+
+json vec3(const fleet::Vec3& v) { return json::array({v.x, v.y, v.z}); }
+
+json limits_json(const fleet::Limits& l) {
+  return {{"max_speed", l.max_speed_mps}, {"max_climb", l.max_climb_mps},
+          {"max_descent", l.max_descent_mps}, {"max_accel", l.max_accel_mps2},
+          {"max_altitude", l.max_altitude_m}};
+}
+
+json settings_json(const fleet::DroneSettings& s, int index) {
+  json sensors = json::object();
+  for (const auto& [name, model] : s.sensors)
+    sensors[name] = {{"value", model.base}, {"gradient", vec3(model.gradient)}};
+  json j = {{"name", s.name},
+            {"index", index},
+            {"type", s.type},
+            {"adapter", s.adapter},
+            {"home", vec3(s.home)},
+            {"battery", s.battery_percent},
+            {"failsafe", fleet::failsafe_name(s.failsafe)},
+            {"limits", limits_json(s.limits)},
+            {"sensors", sensors},
+            {"timeouts", s.timeouts_s}};
+  if (!s.connection.empty()) j["connection"] = s.connection;
+  if (s.sysid > 0) j["sysid"] = s.sysid;
+  return j;
+}
+
+const char* class_name(fleet::ActionClass k) {
+  switch (k) {
+    case fleet::ActionClass::motion: return "motion";
+    case fleet::ActionClass::payload: return "payload";
+    case fleet::ActionClass::system: return "system";
+  }
+  return "";
+}
+
+json type_json(const fleet::DroneType& t) {
+  json actions = json::array();
+  for (const auto& a : t.actions)
+    actions.push_back({{"name", a.name}, {"arities", a.arities}, {"class", class_name(a.action_class)}});
+  json props = json::array();
+  for (const auto& p : t.properties)
+    props.push_back({{"name", p.name}, {"type", p.type == fleet::ValueType::boolean ? "boolean" : "number"}});
+  return {{"name", t.name}, {"adapter", t.adapter}, {"sensors", t.sensors},
+          {"actions", actions}, {"properties", props}};
+}
+
+struct DigestDeleter {
+  void operator()(EVP_MD_CTX* c) const { EVP_MD_CTX_free(c); }
+};
+
+}  // namespace
+
+std::string mission_hash(const graph::Compilation& c) {
+  std::unique_ptr<EVP_MD_CTX, DigestDeleter> ctx(EVP_MD_CTX_new());
+  EVP_DigestInit_ex(ctx.get(), EVP_sha256(), nullptr);
+  auto feed = [&](const std::string& s) {
+    EVP_DigestUpdate(ctx.get(), s.data(), s.size());
+    EVP_DigestUpdate(ctx.get(), "\n", 1);
+  };
+  // Node by node, so hashing a large mission never holds the whole MEG as JSON.
+  feed("eamos-mission " + std::to_string(kMissionFormatVersion));
+  for (int d = 0; d < c.drone_count(); ++d) {
+    feed(settings_json(c.settings[d], d).dump());
+    feed(type_json(c.checked.drone_types[d]).dump());
+  }
+  for (const auto& n : c.meg.nodes) feed(graph::meg_node_json(c, n).dump());
+  for (const auto& a : c.meg.arcs)
+    feed(std::to_string(a.from) + " " + std::to_string(a.to) + " " + graph::arc_kind_name(a.kind) +
+         " " + graph::branch_name(a.branch));
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int length = 0;
+  EVP_DigestFinal_ex(ctx.get(), digest, &length);
+  static const char* hex = "0123456789abcdef";
+  std::string out;
+  for (unsigned int i = 0; i < length; ++i) {
+    out += hex[digest[i] >> 4];
+    out += hex[digest[i] & 15];
+  }
+  return out;
+}
+
+json drone_mission(const graph::Compilation& c, int drone, const std::string& hash) {
+  json fleet_names = json::array();
+  for (int d = 0; d < c.drone_count(); ++d) fleet_names.push_back(c.drone_name(d));
+  json mdg = graph::mdg_json(c, drone);
+  return {{"format", "eamos-mission"},
+          {"format_version", kMissionFormatVersion},
+          {"compiler", std::string("eamos ") + EAMOS_VERSION},
+          {"mission_hash", hash},
+          {"source", {{"path", c.source->path}, {"package", c.mission.package}}},
+          {"drone", settings_json(c.settings[drone], drone)},
+          {"type", type_json(c.checked.drone_types[drone])},
+          {"fleet", fleet_names},
+          {"reads", mdg["reads"]},
+          {"nodes", std::move(mdg["nodes"])},
+          {"arcs", std::move(mdg["arcs"])}};
+}
+
+json manifest(const graph::Compilation& c, const std::string& hash) {
+  json drones = json::array();
+  for (int d = 0; d < c.drone_count(); ++d)
+    drones.push_back({{"name", c.drone_name(d)},
+                      {"type", c.settings[d].type},
+                      {"adapter", c.settings[d].adapter},
+                      {"folder", c.drone_name(d)},
+                      {"mission", c.drone_name(d) + "/mission.json"}});
+  return {{"format", "eamos-deployment"},
+          {"format_version", kMissionFormatVersion},
+          {"compiler", std::string("eamos ") + EAMOS_VERSION},
+          {"mission_hash", hash},
+          {"source", c.source->path},
+          {"drones", drones}};
+}
+
+namespace {
+bool write_text(const std::filesystem::path& path, const std::string& text, Diagnostics& diags) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << text;
+  out.close();
+  if (!out) {
+    diags.error(nullptr, {}, "cannot write '" + path.string() + "'; check the output folder's permissions");
+    return false;
+  }
+  return true;
+}
+}  // namespace
+
+bool write_deployment(const graph::Compilation& c, const std::string& dir, Diagnostics& diags) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) {
+    diags.error(nullptr, {}, "cannot create output folder '" + dir + "': " + ec.message());
+    return false;
+  }
+  std::string hash = mission_hash(c);
+  if (!write_text(fs::path(dir) / "manifest.json", manifest(c, hash).dump(2) + "\n", diags)) return false;
+  for (int d = 0; d < c.drone_count(); ++d) {
+    fs::path folder = fs::path(dir) / c.drone_name(d);
+    fs::create_directories(folder, ec);
+    if (ec) {
+      diags.error(nullptr, {}, "cannot create '" + folder.string() + "': " + ec.message());
+      return false;
+    }
+    // One drone at a time: the JSON of a drone is dropped before the next is built.
+    if (!write_text(folder / "mission.json", drone_mission(c, d, hash).dump(1) + "\n", diags))
+      return false;
+  }
+  return true;
+}
+
+}  // namespace eamos::deploy

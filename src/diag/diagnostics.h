@@ -1,0 +1,52 @@
+#pragma once
+// Errors and warnings as values. Every stage appends to one Diagnostics list instead of
+// stopping at the first problem, so a single run reports everything wrong with a file.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "diag/source.h"
+
+namespace eamos {
+
+enum class Severity { error, warning, note };
+
+struct Diagnostic {
+  Severity severity = Severity::error;
+  const SourceFile* file = nullptr;  ///< nullptr: not tied to a file (e.g. a CLI problem)
+  SourceLocation loc;
+  std::string message;  ///< "what; how to fix" — no trailing newline
+};
+
+class Diagnostics {
+ public:
+  /// After this many errors further ones are counted but not kept; 0 keeps all.
+  std::size_t max_errors = 200;
+
+  void error(const SourceFile* file, SourceLocation loc, std::string message);
+  void warning(const SourceFile* file, SourceLocation loc, std::string message);
+  void note(const SourceFile* file, SourceLocation loc, std::string message);
+
+  bool has_errors() const { return error_count_ > 0; }
+  std::size_t error_count() const { return error_count_; }
+  std::size_t warning_count() const { return warning_count_; }
+  /// True once max_errors is reached: stages may stop early to bound the work on garbage.
+  bool saturated() const { return max_errors != 0 && error_count_ >= max_errors; }
+  const std::vector<Diagnostic>& items() const { return items_; }
+
+  /// GCC-style text: `file:line:col: error: message`, then the source line and a caret,
+  /// ordered by file position; ends with a count line when anything was dropped.
+  std::string format() const;
+
+ private:
+  void add(Severity severity, const SourceFile* file, SourceLocation loc, std::string message);
+  std::vector<Diagnostic> items_;
+  std::size_t error_count_ = 0;
+  std::size_t warning_count_ = 0;
+  std::size_t dropped_ = 0;
+};
+
+/// The closest candidate by edit distance, or "" when none is close enough to suggest.
+std::string closest_match(const std::string& word, const std::vector<std::string>& candidates);
+
+}  // namespace eamos

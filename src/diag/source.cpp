@@ -1,0 +1,49 @@
+#include "diag/source.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace eamos {
+
+SourceFile::SourceFile(std::string p, std::string t) : path(std::move(p)), text(std::move(t)) {
+  line_starts.push_back(0);
+  for (std::size_t i = 0; i < text.size(); ++i)
+    if (text[i] == '\n') line_starts.push_back(i + 1);
+}
+
+std::string_view SourceFile::line(int line_number) const {
+  if (line_number < 1 || static_cast<std::size_t>(line_number) > line_starts.size()) return {};
+  std::size_t begin = line_starts[line_number - 1];
+  std::size_t end = text.find('\n', begin);
+  if (end == std::string::npos) end = text.size();
+  if (end > begin && text[end - 1] == '\r') --end;
+  return std::string_view(text).substr(begin, end - begin);
+}
+
+SourceLocation SourceFile::location_of(std::size_t offset) const {
+  auto it = std::upper_bound(line_starts.begin(), line_starts.end(), offset);
+  int line = static_cast<int>(it - line_starts.begin());
+  std::size_t begin = line_starts[line - 1];
+  return {line, static_cast<int>(offset - begin) + 1};
+}
+
+bool read_source_file(const std::string& path, SourceFile& out, std::string& error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    error = std::strerror(errno);
+    return false;
+  }
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  if (in.bad()) {
+    error = "read error";
+    return false;
+  }
+  out = SourceFile(path, buffer.str());
+  return true;
+}
+
+}  // namespace eamos

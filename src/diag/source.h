@@ -1,0 +1,35 @@
+#pragma once
+// A loaded text file (mission or fleet) and positions in it. Every later stage points
+// back here, so a node in any graph can name the line and column that produced it.
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace eamos {
+
+/// 1-based line and byte column; {0, 0} means "no position" (e.g. a generated node).
+struct SourceLocation {
+  int line = 0;
+  int col = 0;
+  bool known() const { return line > 0; }
+};
+
+struct SourceFile {
+  std::string path;  ///< as given by the user; printed in diagnostics
+  std::string text;  ///< whole content, raw bytes (may be binary garbage)
+  std::vector<std::size_t> line_starts;  ///< byte offset of each line's first byte
+
+  SourceFile() = default;
+  SourceFile(std::string path, std::string text);
+
+  /// The text of a 1-based line without its newline; empty when out of range.
+  std::string_view line(int line_number) const;
+  /// Line and column of a byte offset.
+  SourceLocation location_of(std::size_t offset) const;
+};
+
+/// Reads a whole file; returns false and sets `error` (strerror text) on failure.
+bool read_source_file(const std::string& path, SourceFile& out, std::string& error);
+
+}  // namespace eamos

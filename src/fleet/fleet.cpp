@@ -1,0 +1,71 @@
+#include "fleet/fleet.h"
+
+namespace eamos::fleet {
+
+const char* failsafe_name(Failsafe f) {
+  switch (f) {
+    case Failsafe::land: return "land";
+    case Failsafe::return_home: return "return_home";
+    case Failsafe::hover: return "hover";
+  }
+  return "land";
+}
+
+void LimitOverrides::apply(Limits& limits) const {
+  if (max_speed_mps) limits.max_speed_mps = *max_speed_mps;
+  if (max_climb_mps) limits.max_climb_mps = *max_climb_mps;
+  if (max_descent_mps) limits.max_descent_mps = *max_descent_mps;
+  if (max_accel_mps2) limits.max_accel_mps2 = *max_accel_mps2;
+  if (max_altitude_m) limits.max_altitude_m = *max_altitude_m;
+}
+
+DroneType Fleet::type_for(const std::string& type_name) const {
+  auto it = types.find(type_name);
+  return it != types.end() ? it->second : generic_multirotor(type_name);
+}
+
+DroneSettings Fleet::settings_for(const std::string& drone, const std::string& type_name,
+                                  int index) const {
+  DroneType type = type_for(type_name);
+  DroneSettings s;
+  auto it = drones.find(drone);
+  if (it != drones.end()) s = it->second;
+  const DroneOverrides* o = nullptr;
+  if (auto oit = overrides.find(drone); oit != overrides.end()) o = &oit->second;
+
+  s.name = drone;
+  s.type = type_name;
+  // Five metres apart along y keeps undescribed drones from starting on top of each other.
+  if (!o || !o->home) s.home = {0.0, 5.0 * index, 0.0};
+  if (!o || !o->adapter) s.adapter = type.adapter;
+  s.limits = type.limits;
+  if (o) o->limits.apply(s.limits);
+  // A sensor the type lacks can never be read (the checker rejects it); check_drone
+  // reports it, and dropping it keeps the mission file to what the drone can do.
+  std::erase_if(s.sensors, [&](const auto& kv) { return sensor_index(kv.first, type.sensors) == 0; });
+  return s;
+}
+
+void Fleet::check_drone(const std::string& drone, const DroneType& type, Diagnostics& diags) const {
+  auto it = overrides.find(drone);
+  if (it == overrides.end()) return;
+  for (const auto& [sensor, loc] : it->second.sensor_locations)
+    if (sensor_index(sensor, type.sensors) == 0)
+      diags.error(source.get(), loc,
+                  "drone '" + drone + "' is of type '" + type.name + "', which has " +
+                      std::to_string(type.sensors) + " sensors, so it has no " + sensor +
+                      "; remove it or raise `sensors:` in type '" + type.name + "'");
+}
+
+bool load_fleet(const std::string& path, Fleet& out, Diagnostics& diags) {
+  auto source = std::make_shared<SourceFile>();
+  std::string error;
+  if (!read_source_file(path, *source, error)) {
+    diags.error(nullptr, {}, "cannot read fleet file '" + path + "': " + error +
+                                 "; check the path given with --fleet");
+    return false;
+  }
+  return parse_fleet(std::move(source), out, diags);
+}
+
+}  // namespace eamos::fleet

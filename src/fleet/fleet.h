@@ -1,0 +1,91 @@
+#pragma once
+// The fleet file (YAML): drone types with their capability sets, and per-drone settings
+// (home, sensors, limits, failsafe, adapter and connection). Without a file every type
+// is the generic multirotor and drone i starts at (0, 5·i, 0) with all sensors at 0.
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "diag/diagnostics.h"
+#include "fleet/catalog.h"
+
+namespace eamos::fleet {
+
+struct Vec3 {
+  double x = 0, y = 0, z = 0;
+};
+
+/// A simulated sensor: value = base + gradient · position (a constant when gradient = 0).
+struct SensorModel {
+  double base = 0.0;
+  Vec3 gradient;
+};
+
+/// What an airborne drone does when the mission fails.
+enum class Failsafe { land, return_home, hover };
+const char* failsafe_name(Failsafe f);
+
+struct DroneSettings {
+  std::string name;
+  std::string type;
+  Vec3 home;                                 ///< local frame: x east, y north, z up (m)
+  std::map<std::string, SensorModel> sensors;  ///< "Sensor1" → model; missing = 0
+  Limits limits;                             ///< the type's limits, overridden per drone
+  Failsafe failsafe = Failsafe::land;
+  std::string adapter = "sim";
+  std::string connection;                    ///< adapter URL, e.g. udp://:14540; "" for sim
+  int sysid = 0;                             ///< MAVLink system id; 0 = not set
+  double battery_percent = 100.0;            ///< charge at mission start
+  std::map<std::string, double> timeouts_s;  ///< per action name; overrides derived ones
+};
+
+/// Limits a fleet file sets; the unset ones keep the value they override (the defaults for
+/// a type, the type's for a drone).
+struct LimitOverrides {
+  std::optional<double> max_speed_mps;
+  std::optional<double> max_climb_mps;
+  std::optional<double> max_descent_mps;
+  std::optional<double> max_accel_mps2;
+  std::optional<double> max_altitude_m;
+
+  void apply(Limits& limits) const;
+};
+
+/// The settings of a drone entry that fall back to something only known once the mission
+/// names the drone's type and position: settings_for uses the entry's value only when set.
+struct DroneOverrides {
+  bool home = false;     ///< false: (0, 5·index, 0)
+  bool adapter = false;  ///< false: the type's adapter
+  LimitOverrides limits;  ///< unset: the type's limits
+  std::map<std::string, SourceLocation> sensor_locations;  ///< where each SensorK is set
+};
+
+struct Fleet {
+  std::string path;                          ///< "" when no file was given
+  std::map<std::string, DroneType> types;    ///< types described by the file
+  std::map<std::string, DroneSettings> drones;  ///< drones described by the file, as written
+                                                ///< (type "": the mission names it)
+  std::map<std::string, DroneOverrides> overrides;  ///< per described drone: what it sets
+  std::map<std::string, SourceLocation> drone_locations;  ///< where each drone is described
+  std::shared_ptr<SourceFile> source;        ///< keeps the file text for diagnostics
+
+  /// The type for a name in the mission; an undescribed name is the generic multirotor.
+  DroneType type_for(const std::string& type_name) const;
+  /// Settings of the `index`-th declared drone (declaration order, from 0), with defaults
+  /// for everything the file does not say.
+  DroneSettings settings_for(const std::string& drone, const std::string& type_name,
+                             int index) const;
+  /// Reports sensors the file gives `drone` that its mission type `type` lacks; only the
+  /// mission knows the type, so the checker calls this once per declared drone.
+  void check_drone(const std::string& drone, const DroneType& type, Diagnostics& diags) const;
+};
+
+/// Loads and validates a fleet file; problems go to `diags` as file:line:col errors.
+/// Returns false when the file could not be used.
+bool load_fleet(const std::string& path, Fleet& out, Diagnostics& diags);
+/// The same from text already in memory (tests, fuzzing).
+bool parse_fleet(std::shared_ptr<SourceFile> source, Fleet& out, Diagnostics& diags);
+
+}  // namespace eamos::fleet

@@ -1,0 +1,312 @@
+// parse_fleet: the fleet file's schema (docs/fleet.md), one function per map in it.
+#include <algorithm>
+
+#include "fleet/fleet.h"
+#include "fleet/yaml_reader.h"
+
+namespace eamos::fleet {
+
+namespace {
+
+const std::vector<std::string> kRootKeys = {"types", "drones"};
+const std::vector<std::string> kTypeKeys = {"adapter", "capabilities", "sensors", "limits"};
+const std::vector<std::string> kDroneKeys = {"home",     "battery",  "sensors",
+                                             "limits",   "failsafe", "adapter",
+                                             "connection", "sysid",  "timeouts"};
+const std::vector<std::string> kLimitKeys = {"max_speed", "max_climb", "max_descent",
+                                             "max_accel", "max_altitude"};
+const std::vector<std::string> kSensorKeys = {"value", "gradient"};
+const std::vector<std::string> kAdapters = {"sim", "mavlink"};
+const std::vector<std::string> kFailsafes = {"land", "return_home", "hover"};
+
+std::vector<std::string> standard_action_names() {
+  std::vector<std::string> names;
+  for (const auto& a : standard_actions()) names.push_back(a.name);
+  return names;
+}
+
+bool is_standard_property(const std::string& name) {
+  const auto& props = standard_properties();
+  return std::any_of(props.begin(), props.end(), [&](const PropertySpec& p) { return p.name == name; });
+}
+
+Failsafe failsafe_from(const std::string& name) {
+  if (name == "return_home") return Failsafe::return_home;
+  if (name == "hover") return Failsafe::hover;
+  return Failsafe::land;
+}
+
+class FleetParser {
+ public:
+  FleetParser(const SourceFile* file, Fleet& out, Diagnostics& diags)
+      : r_{file, diags}, out_(out) {}
+  void parse(const YAML::Node& root);
+
+ private:
+  void types(const YAML::Node& node);
+  void type(const std::string& name, const YAML::Node& node);
+  void capabilities(const YAML::Node& node, const std::string& where, DroneType& type);
+  void limits(const YAML::Node& node, const std::string& where, LimitOverrides& out);
+  void drones(const YAML::Node& node);
+  void drone(const std::string& name, const YAML::Node& node);
+  void sensors(const YAML::Node& node, const std::string& where, DroneSettings& settings,
+               DroneOverrides& overrides);
+  void sensor(const YAML::Node& node, const std::string& what, SensorModel& out);
+  void timeouts(const YAML::Node& node, const std::string& where, DroneSettings& settings);
+  bool saturated() const { return r_.diags.saturated(); }
+
+  YamlReader r_;
+  Fleet& out_;
+  /// The most sensors any type a drone may turn out to have: the generic 8 or a described
+  /// type's count. The drone's own type is known only once a mission names it.
+  int max_sensors_ = 8;
+};
+
+void FleetParser::parse(const YAML::Node& root) {
+  if (!r_.map(root, "the fleet file")) return;
+  // Types first wherever they are written: a drone's sensors are checked against them.
+  YAML::Node types_node, drones_node;
+  std::set<std::string> seen;
+  for (const auto& kv : root) {
+    std::string key = r_.field(kv.first, kRootKeys, seen, "the fleet file");
+    if (key == "types") types_node = kv.second;
+    if (key == "drones") drones_node = kv.second;
+  }
+  if (types_node) types(types_node);
+  if (drones_node) drones(drones_node);
+}
+
+void FleetParser::types(const YAML::Node& node) {
+  if (!r_.map(node, "types")) return;
+  std::set<std::string> seen;
+  for (const auto& kv : node) {
+    if (saturated()) return;
+    std::string name = r_.name(kv.first, seen, "types");
+    if (!name.empty()) type(name, kv.second);
+  }
+}
+
+void FleetParser::type(const std::string& name, const YAML::Node& node) {
+  DroneType t = generic_multirotor(name);
+  t.generic = false;
+  long long sensor_count = t.sensors;
+  const std::string where = "type '" + name + "'";
+  std::set<std::string> seen;
+  if (r_.map(node, where)) {
+    for (const auto& kv : node) {
+      std::string key = r_.field(kv.first, kTypeKeys, seen, where);
+      const YAML::Node& v = kv.second;
+      if (key == "adapter") r_.choice(v, "adapter", kAdapters, t.adapter);
+      if (key == "capabilities") capabilities(v, where, t);
+      if (key == "limits") {
+        LimitOverrides set;
+        limits(v, where, set);
+        set.apply(t.limits);
+      }
+      if (key == "sensors" && r_.whole_number(v, "sensors of " + where, sensor_count) &&
+          (sensor_count < 0 || sensor_count > kMaxSensors)) {
+        r_.error(v, "sensors of " + where + " must be from 0 to " + std::to_string(kMaxSensors) +
+                        "; got " + describe(v));
+        sensor_count = t.sensors;
+      }
+    }
+  }
+  set_sensors(t, static_cast<int>(sensor_count));
+  max_sensors_ = std::max(max_sensors_, t.sensors);
+  out_.types[name] = std::move(t);
+}
+
+void FleetParser::capabilities(const YAML::Node& node, const std::string& where, DroneType& type) {
+  if (!node.IsSequence()) {
+    r_.error(node, "capabilities of " + where + " must be a list of action names, e.g. "
+                   "[Arm, Takeoff, Land]; got " + describe(node));
+    return;
+  }
+  const std::vector<std::string> actions = standard_action_names();
+  std::set<std::string> listed;
+  for (const auto& item : node) {
+    std::string name;
+    if (!r_.text(item, "a capability of " + where, name)) continue;
+    if (std::find(actions.begin(), actions.end(), name) != actions.end()) {
+      if (!listed.insert(name).second)
+        r_.diags.warning(r_.file, location_of(item.Mark()),
+                         "capability '" + name + "' is listed twice in " + where + "; remove one");
+    } else if (sensor_index(name, kMaxSensors) > 0) {
+      r_.error(item, "'" + name + "' is not listed in capabilities; set the number of sensors "
+                     "with `sensors: N` in " + where);
+    } else if (is_standard_property(name)) {
+      r_.error(item, "'" + name + "' is a property, and every type has all properties; list only "
+                     "actions in capabilities");
+    } else {
+      std::string near = closest_match(name, actions);
+      r_.error(item, "unknown capability " + describe(item) + " in " + where +
+                         (near.empty() ? "; the actions are " + one_of(actions)
+                                       : "; did you mean '" + near + "'?"));
+    }
+  }
+  // Keep the catalog's order so every listing of a type reads the same way.
+  std::erase_if(type.actions, [&](const ActionSpec& a) { return !listed.count(a.name); });
+}
+
+void FleetParser::limits(const YAML::Node& node, const std::string& where, LimitOverrides& out) {
+  if (!r_.map(node, "limits of " + where)) return;
+  std::set<std::string> seen;
+  for (const auto& kv : node) {
+    std::string key = r_.field(kv.first, kLimitKeys, seen, "limits of " + where);
+    if (key.empty()) continue;
+    double value = 0;
+    std::string what = key + " of " + where;
+    if (!r_.number(kv.second, what, value)) continue;
+    if (value <= 0) {
+      r_.error(kv.second, what + " must be positive; got " + describe(kv.second) +
+                              "; limits are magnitudes in m, m/s or m/s²");
+      continue;
+    }
+    if (key == "max_speed") out.max_speed_mps = value;
+    if (key == "max_climb") out.max_climb_mps = value;
+    if (key == "max_descent") out.max_descent_mps = value;
+    if (key == "max_accel") out.max_accel_mps2 = value;
+    if (key == "max_altitude") out.max_altitude_m = value;
+  }
+}
+
+void FleetParser::drones(const YAML::Node& node) {
+  if (!r_.map(node, "drones")) return;
+  std::set<std::string> seen;
+  for (const auto& kv : node) {
+    if (saturated()) return;
+    std::string name = r_.name(kv.first, seen, "drones");
+    if (name.empty()) continue;
+    out_.drone_locations[name] = location_of(kv.first.Mark());
+    drone(name, kv.second);
+  }
+}
+
+void FleetParser::drone(const std::string& name, const YAML::Node& node) {
+  DroneSettings s;
+  s.name = name;
+  s.type = "";  // the mission names the type; settings_for fills it in
+  DroneOverrides o;
+  const std::string where = "drone '" + name + "'";
+  std::set<std::string> seen;
+  if (r_.map(node, where)) {
+    for (const auto& kv : node) {
+      std::string key = r_.field(kv.first, kDroneKeys, seen, where);
+      const YAML::Node& v = kv.second;
+      std::string what = key + " of " + where;
+      if (key == "home") o.home = r_.vec3(v, what, s.home);
+      if (key == "battery" && r_.number(v, what, s.battery_percent) &&
+          (s.battery_percent < 0 || s.battery_percent > 100)) {
+        r_.error(v, what + " must be a charge from 0 to 100 (%); got " + describe(v));
+        s.battery_percent = 100;
+      }
+      if (key == "sensors") sensors(v, where, s, o);
+      if (key == "limits") limits(v, where, o.limits);
+      std::string failsafe;
+      if (key == "failsafe" && r_.choice(v, "failsafe", kFailsafes, failsafe))
+        s.failsafe = failsafe_from(failsafe);
+      if (key == "adapter") o.adapter = r_.choice(v, "adapter", kAdapters, s.adapter);
+      if (key == "connection") r_.text(v, what, s.connection);
+      long long sysid = 0;
+      if (key == "sysid" && r_.whole_number(v, what, sysid)) {
+        if (sysid >= 1 && sysid <= 255) s.sysid = static_cast<int>(sysid);
+        else r_.error(v, what + " must be a MAVLink system id from 1 to 255; got " + describe(v));
+      }
+      if (key == "timeouts") timeouts(v, where, s);
+    }
+  }
+  out_.drones[name] = std::move(s);
+  out_.overrides[name] = std::move(o);
+}
+
+void FleetParser::sensors(const YAML::Node& node, const std::string& where,
+                          DroneSettings& settings, DroneOverrides& overrides) {
+  if (!r_.map(node, "sensors of " + where)) return;
+  std::set<std::string> seen;
+  for (const auto& kv : node) {
+    std::string name = r_.key(kv.first, seen, "sensors of " + where);
+    if (name.empty()) continue;
+    if (sensor_index(name, kMaxSensors) == 0) {
+      r_.error(kv.first, "unknown sensor " + describe(kv.first) + " in " + where +
+                             "; sensors are named Sensor1, Sensor2, ... up to the type's `sensors:`");
+      continue;
+    }
+    if (sensor_index(name, max_sensors_) == 0) {
+      r_.error(kv.first, "'" + name + "' of " + where + " is beyond every type's sensor count (at most " +
+                             std::to_string(max_sensors_) + "); raise `sensors:` in the drone's type");
+      continue;
+    }
+    overrides.sensor_locations[name] = location_of(kv.first.Mark());
+    sensor(kv.second, name + " of " + where, settings.sensors[name]);
+  }
+}
+
+void FleetParser::sensor(const YAML::Node& node, const std::string& what, SensorModel& out) {
+  if (!node.IsMap()) {
+    if (!r_.number(node, what, out.base))
+      r_.diags.note(r_.file, location_of(node.Mark()),
+                    "write a sensor as a number, or as {value: V, gradient: [gx, gy, gz]}");
+    return;
+  }
+  std::set<std::string> seen;
+  for (const auto& kv : node) {
+    std::string key = r_.field(kv.first, kSensorKeys, seen, what);
+    if (key == "value") r_.number(kv.second, "value of " + what, out.base);
+    if (key == "gradient") r_.vec3(kv.second, "gradient of " + what, out.gradient);
+  }
+}
+
+void FleetParser::timeouts(const YAML::Node& node, const std::string& where, DroneSettings& settings) {
+  const std::string what = "timeouts of " + where;
+  if (!r_.map(node, what)) return;
+  std::set<std::string> seen;
+  for (const auto& kv : node) {
+    std::string action = r_.key(kv.first, seen, what);
+    if (action.empty()) continue;
+    std::vector<std::string> names = standard_action_names();
+    if (std::find(names.begin(), names.end(), action) == names.end()) {
+      std::string near = closest_match(action, names);
+      r_.error(kv.first, "unknown action " + describe(kv.first) + " in " + what +
+                             (near.empty() ? "; the actions are " + one_of(names)
+                                           : "; did you mean '" + near + "'?"));
+      continue;
+    }
+    double seconds = 0;
+    if (!r_.number(kv.second, action + " in " + what, seconds)) continue;
+    if (seconds <= 0) {
+      r_.error(kv.second, action + " in " + what + " must be a positive number of seconds; got " +
+                              describe(kv.second));
+      continue;
+    }
+    settings.timeouts_s[action] = seconds;
+  }
+}
+
+}  // namespace
+
+bool parse_fleet(std::shared_ptr<SourceFile> source, Fleet& out, Diagnostics& diags) {
+  out = Fleet{};
+  if (!source) source = std::make_shared<SourceFile>();
+  out.path = source->path;
+  out.source = source;
+  const SourceFile* file = source.get();
+  std::size_t errors_before = diags.error_count();
+  // yaml-cpp reports by exception; here they become diagnostics, so nothing escapes.
+  try {
+    std::vector<YAML::Node> documents = YAML::LoadAll(source->text);
+    if (documents.size() > 1)
+      diags.error(file, location_of(documents[1].Mark()),
+                  "a fleet file holds one YAML document; remove the `---` and merge the rest into the first");
+    if (!documents.empty()) FleetParser(file, out, diags).parse(documents[0]);
+  } catch (const YAML::ParserException& e) {
+    diags.error(file, location_of(e.mark),
+                "YAML syntax error: " + e.msg + "; check the indentation, colons and brackets here");
+  } catch (const YAML::Exception& e) {
+    diags.error(file, location_of(e.mark), "cannot read the fleet file: " + e.msg);
+  } catch (const std::exception& e) {
+    diags.error(file, {}, std::string("cannot read the fleet file: ") + e.what());
+  }
+  return diags.error_count() == errors_before;
+}
+
+}  // namespace eamos::fleet

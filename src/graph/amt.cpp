@@ -1,0 +1,149 @@
+#include "graph/amt.h"
+
+namespace eamos::graph {
+
+const char* amt_kind_name(AmtKind k) {
+  switch (k) {
+    case AmtKind::init: return "init";
+    case AmtKind::seq: return "seq";
+    case AmtKind::par: return "par";
+    case AmtKind::async: return "async";
+    case AmtKind::control: return "control";
+    case AmtKind::action: return "action";
+    case AmtKind::pause: return "pause";
+  }
+  return "";
+}
+
+const char* role_name(Role r) {
+  switch (r) {
+    case Role::none: return "";
+    case Role::then_: return "then";
+    case Role::else_: return "else";
+    case Role::wait: return "wait";
+    case Role::repeat: return "repeat";
+    case Role::after: return "after";
+    case Role::do_: return "do";
+    case Role::done: return "done";
+  }
+  return "";
+}
+
+namespace {
+
+using lang::ControlKind;
+
+std::vector<Role> branch_roles(ControlKind k) {
+  switch (k) {
+    case ControlKind::If: return {Role::then_, Role::else_};
+    case ControlKind::WaitUntil:
+    case ControlKind::WaitWhile: return {Role::wait};
+    case ControlKind::RepeatUntil:
+    case ControlKind::RepeatWhile:
+    case ControlKind::RepeatFor: return {Role::repeat, Role::after};
+    case ControlKind::DoUntilAsync:
+    case ControlKind::DoWhileAsync:
+    case ControlKind::DoUntilSync:
+    case ControlKind::DoWhileSync: return {Role::do_, Role::done};
+    default: return {};
+  }
+}
+
+class AmtBuilder {
+ public:
+  explicit AmtBuilder(const lang::Mission& m) : m_(m) {}
+
+  Amt build() {
+    const lang::Function& init = m_.functions[m_.init_function];
+    int root = add(AmtKind::init, init.loc, init.name, -1);
+    expand_body(root, init);
+    return std::move(amt_);
+  }
+
+ private:
+  int add(AmtKind kind, SourceLocation loc, const std::string& name, int parent) {
+    AmtNode n;
+    n.id = static_cast<int>(amt_.nodes.size());
+    n.kind = kind;
+    n.loc = loc;
+    n.name = name;
+    n.parent = parent;
+    if (parent >= 0) {
+      amt_.nodes[parent].children.push_back(n.id);
+      n.in_block = block_name_of(parent);
+    }
+    amt_.nodes.push_back(std::move(n));
+    return amt_.nodes.back().id;
+  }
+
+  std::string block_name_of(int node) const {
+    for (int p = node; p >= 0; p = amt_.nodes[p].parent) {
+      AmtKind k = amt_.nodes[p].kind;
+      if (k == AmtKind::seq || k == AmtKind::par || k == AmtKind::init) return amt_.nodes[p].name;
+    }
+    return "";
+  }
+
+  void expand_body(int parent, const lang::Function& f) {
+    for (const auto& s : f.body) expand_statement(parent, s);
+  }
+
+  int expand_block(int parent, int function, SourceLocation call_loc) {
+    const lang::Function& f = m_.functions[function];
+    AmtKind kind = f.block == lang::BlockKind::par ? AmtKind::par : AmtKind::seq;
+    int id = add(kind, call_loc, f.name, parent);
+    expand_body(id, f);
+    return id;
+  }
+
+  void expand_statement(int parent, const lang::Statement& s) {
+    switch (s.kind) {
+      case lang::StatementKind::action: {
+        int id = add(AmtKind::action, s.loc, s.callee, parent);
+        amt_.nodes[id].drone = s.drone_index;
+        for (const auto& a : s.args) amt_.nodes[id].args.push_back(a.get());
+        return;
+      }
+      case lang::StatementKind::async_call: {
+        int id = add(AmtKind::async, s.loc, "async", parent);
+        expand_block(id, s.function_index, s.callee_loc);
+        return;
+      }
+      case lang::StatementKind::call:
+        if (s.control == ControlKind::none) {
+          expand_block(parent, s.function_index, s.loc);
+          return;
+        }
+        expand_control(parent, s);
+        return;
+    }
+  }
+
+  void expand_control(int parent, const lang::Statement& s) {
+    if (s.control == ControlKind::PauseFor) {
+      int id = add(AmtKind::pause, s.loc, "PauseFor", parent);
+      amt_.nodes[id].seconds = s.args[0]->number;
+      return;
+    }
+    int id = add(AmtKind::control, s.loc, lang::control_name(s.control), parent);
+    amt_.nodes[id].control = s.control;
+    amt_.nodes[id].condition = s.args[0].get();
+    if (s.control == ControlKind::RepeatFor)
+      amt_.nodes[id].count = static_cast<long long>(s.args[3]->number);
+    std::vector<Role> roles = branch_roles(s.control);
+    // Branch arguments follow the condition: args[1], args[2].
+    for (std::size_t b = 0; b < roles.size() && b < s.branch_functions.size(); ++b) {
+      int child = expand_block(id, s.branch_functions[b], s.args[b + 1]->loc);
+      amt_.nodes[child].role = roles[b];
+    }
+  }
+
+  const lang::Mission& m_;
+  Amt amt_;
+};
+
+}  // namespace
+
+Amt build_amt(const lang::Mission& mission) { return AmtBuilder(mission).build(); }
+
+}  // namespace eamos::graph

@@ -1,0 +1,36 @@
+#include "graph/pipeline.h"
+
+#include "lang/parser.h"
+
+namespace eamos::graph {
+
+bool compile(std::shared_ptr<SourceFile> source, const fleet::Fleet& fleet, Diagnostics& diags,
+             Compilation& out, const lang::CheckLimits& limits) {
+  out.source = std::move(source);
+  out.fleet = fleet;
+  out.mission = lang::parse_mission(*out.source, diags);
+  out.checked = lang::check_mission(out.mission, out.fleet, diags, limits);
+  if (diags.has_errors()) return false;
+  for (int d = 0; d < out.drone_count(); ++d)
+    out.settings.push_back(out.fleet.settings_for(out.mission.drones[d].name,
+                                                  out.mission.drones[d].type, d));
+  out.amt = build_amt(out.mission);
+  out.meg = build_meg(out.amt, out.mission);
+  out.mdgs = build_mdgs(out.meg);
+  return true;
+}
+
+bool compile_file(const std::string& path, const std::string& fleet_path, Diagnostics& diags,
+                  Compilation& out) {
+  fleet::Fleet fleet;
+  if (!fleet_path.empty() && !fleet::load_fleet(fleet_path, fleet, diags)) return false;
+  auto source = std::make_shared<SourceFile>();
+  std::string error;
+  if (!read_source_file(path, *source, error)) {
+    diags.error(nullptr, {}, "cannot read mission file '" + path + "': " + error);
+    return false;
+  }
+  return compile(std::move(source), fleet, diags, out);
+}
+
+}  // namespace eamos::graph

@@ -1,0 +1,118 @@
+#include "lang/ast.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace eamos::lang {
+
+const char* op_text(Op op) {
+  switch (op) {
+    case Op::none: return "";
+    case Op::neg: return "-";
+    case Op::not_: return "!";
+    case Op::add: return "+";
+    case Op::sub: return "-";
+    case Op::mul: return "*";
+    case Op::div: return "/";
+    case Op::lt: return "<";
+    case Op::le: return "<=";
+    case Op::gt: return ">";
+    case Op::ge: return ">=";
+    case Op::eq: return "==";
+    case Op::ne: return "!=";
+    case Op::and_: return "&&";
+    case Op::or_: return "||";
+  }
+  return "";
+}
+
+namespace {
+struct ControlEntry {
+  ControlKind kind;
+  const char* name;
+};
+constexpr ControlEntry kControls[] = {
+    {ControlKind::If, "If"},
+    {ControlKind::WaitUntil, "WaitUntil"},
+    {ControlKind::WaitWhile, "WaitWhile"},
+    {ControlKind::RepeatUntil, "RepeatUntil"},
+    {ControlKind::RepeatWhile, "RepeatWhile"},
+    {ControlKind::RepeatFor, "RepeatFor"},
+    {ControlKind::PauseUntil, "PauseUntil"},
+    {ControlKind::PauseWhile, "PauseWhile"},
+    {ControlKind::PauseFor, "PauseFor"},
+    {ControlKind::DoUntilAsync, "DoUntilAsync"},
+    {ControlKind::DoWhileAsync, "DoWhileAsync"},
+    {ControlKind::DoUntilSync, "DoUntilSync"},
+    {ControlKind::DoWhileSync, "DoWhileSync"},
+};
+}  // namespace
+
+const char* control_name(ControlKind kind) {
+  for (const auto& e : kControls)
+    if (e.kind == kind) return e.name;
+  return "";
+}
+
+ControlKind control_from_name(const std::string& name) {
+  for (const auto& e : kControls)
+    if (name == e.name) return e.kind;
+  return ControlKind::none;
+}
+
+int Mission::find_drone(const std::string& name) const {
+  for (std::size_t i = 0; i < drones.size(); ++i)
+    if (drones[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+int Mission::find_function(const std::string& name) const {
+  for (std::size_t i = 0; i < functions.size(); ++i)
+    if (functions[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+namespace {
+std::string number_text(double v) {
+  if (std::isfinite(v) && v == std::floor(v) && std::fabs(v) < 1e15) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.0f", v);
+    return buf;
+  }
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+// Go's binary precedence, used to print parentheses only where needed.
+int precedence(Op op) {
+  switch (op) {
+    case Op::or_: return 1;
+    case Op::and_: return 2;
+    case Op::lt: case Op::le: case Op::gt: case Op::ge: case Op::eq: case Op::ne: return 3;
+    case Op::add: case Op::sub: return 4;
+    case Op::mul: case Op::div: return 5;
+    default: return 6;
+  }
+}
+
+std::string text_of(const Expr& e, int parent_precedence) {
+  switch (e.kind) {
+    case ExprKind::number: return number_text(e.number);
+    case ExprKind::boolean: return e.boolean ? "true" : "false";
+    case ExprKind::property: return e.drone + "." + e.property + "()";
+    case ExprKind::name: return e.drone;
+    case ExprKind::unary: return std::string(op_text(e.op)) + text_of(*e.lhs, 6);
+    case ExprKind::binary: {
+      int p = precedence(e.op);
+      std::string s = text_of(*e.lhs, p) + " " + op_text(e.op) + " " + text_of(*e.rhs, p + 1);
+      return p < parent_precedence ? "(" + s + ")" : s;
+    }
+  }
+  return "";
+}
+}  // namespace
+
+std::string expr_text(const Expr& e) { return text_of(e, 0); }
+
+}  // namespace eamos::lang

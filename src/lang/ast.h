@@ -1,0 +1,103 @@
+#pragma once
+// The abstract syntax tree of one mission file, as parsed, plus the names the checker
+// resolves into it (drone indices, function indices, control-structure kinds). Plain
+// structs owned by a Mission; later stages point into it and never copy expressions.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "diag/source.h"
+
+namespace eamos::lang {
+
+enum class ExprKind {
+  number,    ///< 3, 4.5
+  boolean,   ///< true, false
+  property,  ///< Drone1.X() — a property read of a declared drone
+  name,      ///< a bare identifier: a block name inside a control structure's arguments
+  unary,     ///< -e, !e
+  binary,    ///< e op e
+};
+
+enum class Op { none, neg, not_, add, sub, mul, div, lt, le, gt, ge, eq, ne, and_, or_ };
+const char* op_text(Op op);
+
+enum class ValueType { unknown, number, boolean };
+
+struct Expr {
+  ExprKind kind = ExprKind::number;
+  SourceLocation loc;
+  double number = 0.0;
+  bool integer_literal = false;  ///< written without '.' or exponent
+  bool boolean = false;
+  std::string drone;     ///< property: the drone; name: the identifier
+  std::string property;  ///< property: the property name
+  Op op = Op::none;
+  std::unique_ptr<Expr> lhs;  ///< unary operand or left operand
+  std::unique_ptr<Expr> rhs;
+  // Filled by the checker:
+  int drone_index = -1;  ///< property: index into Mission::drones
+  ValueType type = ValueType::unknown;
+};
+
+/// The 13 mission control structures of the paper, rules (9)–(19).
+enum class ControlKind {
+  none,
+  If, WaitUntil, WaitWhile, RepeatUntil, RepeatWhile, RepeatFor,
+  PauseUntil, PauseWhile, PauseFor, DoUntilAsync, DoWhileAsync, DoUntilSync, DoWhileSync,
+};
+const char* control_name(ControlKind kind);
+ControlKind control_from_name(const std::string& name);
+
+enum class StatementKind {
+  action,     ///< Drone.Capability(args)
+  call,       ///< SEQ_x() / PAR_x(), or a control structure If(...) once resolved
+  async_call, ///< async(SEQ_x)
+};
+
+struct Statement {
+  StatementKind kind = StatementKind::action;
+  SourceLocation loc;         ///< first token
+  SourceLocation callee_loc;  ///< the capability or function name
+  std::string drone;          ///< action only
+  std::string callee;         ///< capability name, or block / control structure name
+  std::vector<std::unique_ptr<Expr>> args;
+  // Filled by the checker:
+  int drone_index = -1;                      ///< action
+  int function_index = -1;                   ///< call / async_call of a block
+  ControlKind control = ControlKind::none;   ///< call of a control structure
+  std::vector<int> branch_functions;         ///< control: functions named in the args, in order
+};
+
+enum class BlockKind { seq, par };
+
+struct Function {
+  std::string name;
+  SourceLocation loc;  ///< the name after `func`
+  BlockKind block = BlockKind::seq;  ///< INIT and SEQ_* run in sequence, PAR_* in parallel
+  std::vector<Statement> body;
+  bool called = false;  ///< filled by the checker
+};
+
+struct DroneDecl {
+  std::string name;
+  std::string type;
+  SourceLocation loc;
+  SourceLocation type_loc;
+};
+
+struct Mission {
+  const SourceFile* file = nullptr;
+  std::string package;
+  std::vector<DroneDecl> drones;
+  std::vector<Function> functions;
+  int init_function = -1;  ///< index of INIT, filled by the checker
+
+  int find_drone(const std::string& name) const;
+  int find_function(const std::string& name) const;
+};
+
+/// Source text of an expression, normalised ("Drone1.X() >= 5"), for labels and logs.
+std::string expr_text(const Expr& e);
+
+}  // namespace eamos::lang

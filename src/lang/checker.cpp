@@ -1,0 +1,502 @@
+#include "lang/checker.h"
+
+#include <algorithm>
+#include <map>
+#include <set>
+#include <string>
+
+#include "lang/concurrency.h"
+
+namespace eamos::lang {
+
+bool is_block_name(const std::string& name) {
+  return (name.rfind("SEQ_", 0) == 0 || name.rfind("PAR_", 0) == 0) && name.size() > 4;
+}
+
+namespace {
+
+enum class Param { condition, block, count, seconds };
+
+struct Signature {
+  ControlKind kind;
+  std::vector<Param> params;
+  const char* usage;
+};
+
+const std::vector<Signature>& signatures() {
+  using P = Param;
+  static const std::vector<Signature> table = {
+      {ControlKind::If, {P::condition, P::block, P::block}, "If(condition, SEQ_then, SEQ_else)"},
+      {ControlKind::WaitUntil, {P::condition, P::block}, "WaitUntil(condition, SEQ_then)"},
+      {ControlKind::WaitWhile, {P::condition, P::block}, "WaitWhile(condition, SEQ_then)"},
+      {ControlKind::RepeatUntil, {P::condition, P::block, P::block},
+       "RepeatUntil(condition, SEQ_repeat, SEQ_after)"},
+      {ControlKind::RepeatWhile, {P::condition, P::block, P::block},
+       "RepeatWhile(condition, SEQ_repeat, SEQ_after)"},
+      {ControlKind::RepeatFor, {P::condition, P::block, P::block, P::count},
+       "RepeatFor(condition, SEQ_repeat, SEQ_after, count)"},
+      {ControlKind::PauseUntil, {P::condition}, "PauseUntil(condition)"},
+      {ControlKind::PauseWhile, {P::condition}, "PauseWhile(condition)"},
+      {ControlKind::PauseFor, {P::seconds}, "PauseFor(seconds)"},
+      {ControlKind::DoUntilAsync, {P::condition, P::block, P::block},
+       "DoUntilAsync(condition, SEQ_do, SEQ_done)"},
+      {ControlKind::DoWhileAsync, {P::condition, P::block, P::block},
+       "DoWhileAsync(condition, SEQ_do, SEQ_done)"},
+      {ControlKind::DoUntilSync, {P::condition, P::block, P::block},
+       "DoUntilSync(condition, SEQ_do, SEQ_done)"},
+      {ControlKind::DoWhileSync, {P::condition, P::block, P::block},
+       "DoWhileSync(condition, SEQ_do, SEQ_done)"},
+  };
+  return table;
+}
+
+const Signature* signature_of(ControlKind kind) {
+  for (const auto& s : signatures())
+    if (s.kind == kind) return &s;
+  return nullptr;
+}
+
+const char* type_name(ValueType t) {
+  switch (t) {
+    case ValueType::number: return "number";
+    case ValueType::boolean: return "boolean";
+    default: return "unknown";
+  }
+}
+
+class Checker {
+ public:
+  Checker(Mission& m, const fleet::Fleet& fleet, Diagnostics& diags, const CheckLimits& limits)
+      : m_(m), fleet_(fleet), diags_(diags), limits_(limits), file_(m.file) {}
+
+  CheckedMission run();
+
+ private:
+  void check_drones();
+  void check_functions();
+  void check_statement(Function& f, Statement& s);
+  void check_action(Statement& s);
+  void check_block_call(Statement& s);
+  void check_control(Statement& s);
+  int resolve_block(const Expr& e);
+  ValueType type_of(Expr& e);
+  void expect_type(Expr& e, ValueType want, const std::string& what);
+  void check_call_graph();
+  void check_unused();
+  void error(SourceLocation loc, const std::string& msg) { diags_.error(file_, loc, msg); }
+  void warning(SourceLocation loc, const std::string& msg) { diags_.warning(file_, loc, msg); }
+  std::vector<std::string> function_names() const;
+  std::vector<std::string> drone_names() const;
+
+  Mission& m_;
+  const fleet::Fleet& fleet_;
+  Diagnostics& diags_;
+  CheckLimits limits_;
+  const SourceFile* file_;
+  CheckedMission out_;
+};
+
+CheckedMission Checker::run() {
+  check_drones();
+  check_functions();
+  for (auto& f : m_.functions)
+    for (auto& s : f.body) check_statement(f, s);
+  check_call_graph();
+  if (!diags_.has_errors()) {
+    check_unused();
+    warn_concurrent_motion(m_, out_.drone_types, diags_);
+  }
+  return std::move(out_);
+}
+
+std::vector<std::string> Checker::function_names() const {
+  std::vector<std::string> names;
+  for (const auto& f : m_.functions) names.push_back(f.name);
+  return names;
+}
+
+std::vector<std::string> Checker::drone_names() const {
+  std::vector<std::string> names;
+  for (const auto& d : m_.drones) names.push_back(d.name);
+  return names;
+}
+
+void Checker::check_drones() {
+  if (m_.drones.empty())
+    error({1, 1}, "mission declares no drones; declare each with `var Drone1 DroneType` before the functions");
+  std::map<std::string, const DroneDecl*> seen;
+  for (const auto& d : m_.drones) {
+    auto [it, fresh] = seen.emplace(d.name, &d);
+    if (!fresh)
+      error(d.loc, "drone '" + d.name + "' is declared twice (first at line " +
+                       std::to_string(it->second->loc.line) + "); rename or remove one");
+    if (m_.find_function(d.name) >= 0)
+      error(d.loc, "'" + d.name + "' is both a drone and a function; rename one");
+    out_.drone_types.push_back(fleet_.type_for(d.type));
+  }
+  for (const auto& [name, loc] : fleet_.drone_locations)
+    if (m_.find_drone(name) < 0 && fleet_.source)
+      diags_.warning(fleet_.source.get(), loc,
+                     "fleet file describes drone '" + name + "' which the mission does not declare");
+}
+
+void Checker::check_functions() {
+  std::map<std::string, const Function*> seen;
+  for (std::size_t i = 0; i < m_.functions.size(); ++i) {
+    Function& f = m_.functions[i];
+    auto [it, fresh] = seen.emplace(f.name, &f);
+    if (!fresh) {
+      error(f.loc, "function '" + f.name + "' is defined twice (first at line " +
+                       std::to_string(it->second->loc.line) + "); rename or remove one");
+      continue;
+    }
+    if (f.name == "INIT") {
+      m_.init_function = static_cast<int>(i);
+      continue;
+    }
+    if (!is_block_name(f.name)) {
+      std::string hint = "SEQ_" + f.name;
+      error(f.loc, "block name '" + f.name +
+                       "' must start with SEQ_ (run in sequence) or PAR_ (run in parallel); "
+                       "rename it, e.g. '" + hint + "'");
+    }
+  }
+  if (m_.init_function < 0) {
+    SourceLocation at = m_.functions.empty() ? SourceLocation{1, 1} : m_.functions.front().loc;
+    error(at, "mission has no entry point; add `func INIT() { ... }`");
+  }
+}
+
+void Checker::check_statement(Function& f, Statement& s) {
+  (void)f;
+  switch (s.kind) {
+    case StatementKind::action: check_action(s); break;
+    case StatementKind::call:
+      s.control = control_from_name(s.callee);
+      if (s.control != ControlKind::none) check_control(s);
+      else check_block_call(s);
+      break;
+    case StatementKind::async_call: {
+      int fi = m_.find_function(s.callee);
+      if (fi < 0) {
+        std::string near = closest_match(s.callee, function_names());
+        error(s.callee_loc, "undefined block '" + s.callee + "' in async(...)" +
+                                (near.empty() ? "; define it with `func " + s.callee + "() { ... }`"
+                                              : "; did you mean '" + near + "'?"));
+      } else if (!is_block_name(s.callee)) {
+        error(s.callee_loc, "async(...) needs a SEQ_ or PAR_ block, not '" + s.callee + "'");
+      } else {
+        s.function_index = fi;
+      }
+      break;
+    }
+  }
+}
+
+void Checker::check_action(Statement& s) {
+  s.drone_index = m_.find_drone(s.drone);
+  if (s.drone_index < 0) {
+    std::string near = closest_match(s.drone, drone_names());
+    error(s.loc, "unknown drone '" + s.drone + "'" +
+                     (near.empty() ? "; declare it with `var " + s.drone + " DroneType`"
+                                   : "; did you mean '" + near + "'?"));
+    for (auto& a : s.args) type_of(*a);
+    return;
+  }
+  const fleet::DroneType& type = out_.drone_types[s.drone_index];
+  const fleet::ActionSpec* spec = type.find_action(s.callee);
+  if (!spec) {
+    const fleet::PropertySpec* prop = type.find_property(s.callee);
+    if (prop) {
+      error(s.callee_loc, "'" + s.drone + "." + s.callee +
+                              "()' is a property, not an action; read it inside a condition or argument");
+    } else {
+      std::string near = closest_match(s.callee, type.capability_names());
+      error(s.callee_loc, "drone '" + s.drone + "' of type '" + type.name + "' has no capability '" +
+                              s.callee + "'" +
+                              (near.empty() ? "; see `eamos check --list-capabilities`"
+                                            : "; did you mean '" + near + "'?"));
+    }
+    for (auto& a : s.args) type_of(*a);
+    return;
+  }
+  int n = static_cast<int>(s.args.size());
+  if (std::find(spec->arities.begin(), spec->arities.end(), n) == spec->arities.end()) {
+    std::string accepted;
+    for (std::size_t i = 0; i < spec->arities.size(); ++i)
+      accepted += (i ? " or " : "") + std::to_string(spec->arities[i]);
+    error(s.callee_loc, s.callee + " takes " + accepted + " argument(s), " + std::to_string(n) +
+                            " given; write " + s.drone + "." + s.callee + "(" + spec->params + ")");
+  }
+  for (auto& a : s.args) expect_type(*a, ValueType::number, "argument of " + s.callee);
+}
+
+void Checker::check_block_call(Statement& s) {
+  int fi = m_.find_function(s.callee);
+  if (fi < 0) {
+    std::vector<std::string> candidates = function_names();
+    for (const auto& sig : signatures()) candidates.push_back(control_name(sig.kind));
+    std::string near = closest_match(s.callee, candidates);
+    if (m_.find_drone(s.callee) >= 0)
+      error(s.callee_loc, "'" + s.callee + "' is a drone; call one of its actions, e.g. " +
+                              s.callee + ".Takeoff(5)");
+    else
+      error(s.callee_loc, "undefined function '" + s.callee + "'" +
+                              (near.empty() ? "; define it with `func " + s.callee + "() { ... }`"
+                                            : "; did you mean '" + near + "'?"));
+    return;
+  }
+  if (s.callee == "INIT") {
+    error(s.callee_loc, "INIT is the entry point and cannot be called; move its body into a SEQ_ block");
+    return;
+  }
+  if (!s.args.empty())
+    error(s.args.front()->loc, "blocks take no arguments; write " + s.callee + "()");
+  s.function_index = fi;
+}
+
+int Checker::resolve_block(const Expr& e) {
+  if (e.kind != ExprKind::name) {
+    error(e.loc, "expected a block name (SEQ_... or PAR_...) here, found '" + expr_text(e) + "'");
+    return -1;
+  }
+  int fi = m_.find_function(e.drone);
+  if (fi < 0) {
+    std::string near = closest_match(e.drone, function_names());
+    error(e.loc, "undefined block '" + e.drone + "'" +
+                     (near.empty() ? "; define it with `func " + e.drone + "() { ... }`"
+                                   : "; did you mean '" + near + "'?"));
+    return -1;
+  }
+  if (!is_block_name(e.drone)) {
+    error(e.loc, "'" + e.drone + "' cannot be a branch; branches are SEQ_ or PAR_ blocks");
+    return -1;
+  }
+  return fi;
+}
+
+void Checker::check_control(Statement& s) {
+  const Signature* sig = signature_of(s.control);
+  if (s.args.size() != sig->params.size()) {
+    error(s.callee_loc, std::string(control_name(s.control)) + " takes " +
+                            std::to_string(sig->params.size()) + " argument(s), " +
+                            std::to_string(s.args.size()) + " given; write " + sig->usage);
+  }
+  std::size_t n = std::min(s.args.size(), sig->params.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    Expr& a = *s.args[i];
+    switch (sig->params[i]) {
+      case Param::condition:
+        expect_type(a, ValueType::boolean, std::string("condition of ") + control_name(s.control));
+        break;
+      case Param::block: {
+        int fi = resolve_block(a);
+        s.branch_functions.push_back(fi);
+        break;
+      }
+      case Param::count:
+        if (a.kind != ExprKind::number || !a.integer_literal || a.number < 1 || a.number > 1e9)
+          error(a.loc, "RepeatFor count must be a positive integer literal (1 to 1000000000), found '" +
+                           expr_text(a) + "'");
+        break;
+      case Param::seconds:
+        if (a.kind != ExprKind::number || a.number < 0 || a.number > 1e7)
+          error(a.loc, "PauseFor takes a non-negative number of seconds as a literal, found '" +
+                           expr_text(a) + "'");
+        break;
+    }
+  }
+  // A repeat branch without statements would loop without mission time passing.
+  bool is_repeat = s.control == ControlKind::RepeatUntil || s.control == ControlKind::RepeatWhile ||
+                   s.control == ControlKind::RepeatFor;
+  if (is_repeat && !s.branch_functions.empty() && s.branch_functions[0] >= 0 &&
+      m_.functions[s.branch_functions[0]].body.empty())
+    error(s.args[1]->loc, "repeat branch '" + m_.functions[s.branch_functions[0]].name +
+                              "' is empty; an empty loop would spin without mission time passing, "
+                              "use PauseUntil/PauseWhile to wait instead");
+}
+
+ValueType Checker::type_of(Expr& e) {
+  switch (e.kind) {
+    case ExprKind::number: return e.type = ValueType::number;
+    case ExprKind::boolean: return e.type = ValueType::boolean;
+    case ExprKind::name: {
+      std::string hint = m_.find_drone(e.drone) >= 0
+                             ? "; read a property, e.g. " + e.drone + ".X()"
+                             : m_.find_function(e.drone) >= 0
+                                   ? "; a block cannot be used as a value"
+                                   : "; property reads are written Drone.Property()";
+      error(e.loc, "unknown name '" + e.drone + "' in expression" + hint);
+      return e.type = ValueType::unknown;
+    }
+    case ExprKind::property: {
+      e.drone_index = m_.find_drone(e.drone);
+      if (e.drone_index < 0) {
+        std::string near = closest_match(e.drone, drone_names());
+        error(e.loc, "unknown drone '" + e.drone + "'" +
+                         (near.empty() ? "; declare it with `var " + e.drone + " DroneType`"
+                                       : "; did you mean '" + near + "'?"));
+        return e.type = ValueType::unknown;
+      }
+      const fleet::DroneType& type = out_.drone_types[e.drone_index];
+      const fleet::PropertySpec* p = type.find_property(e.property);
+      if (!p) {
+        std::vector<std::string> props;
+        for (const auto& q : type.properties) props.push_back(q.name);
+        std::string near = closest_match(e.property, props);
+        error(e.loc, "drone '" + e.drone + "' of type '" + type.name + "' has no property '" +
+                         e.property + "'" + (near.empty() ? "" : "; did you mean '" + near + "'?"));
+        return e.type = ValueType::unknown;
+      }
+      return e.type = p->type == fleet::ValueType::boolean ? ValueType::boolean : ValueType::number;
+    }
+    case ExprKind::unary: {
+      ValueType t = type_of(*e.lhs);
+      ValueType want = e.op == Op::neg ? ValueType::number : ValueType::boolean;
+      if (t != ValueType::unknown && t != want) {
+        error(e.loc, std::string("operator '") + op_text(e.op) + "' needs a " + type_name(want) +
+                         ", found " + type_name(t));
+        return e.type = ValueType::unknown;
+      }
+      return e.type = want;
+    }
+    case ExprKind::binary: {
+      ValueType l = type_of(*e.lhs);
+      ValueType r = type_of(*e.rhs);
+      if (l == ValueType::unknown || r == ValueType::unknown) return e.type = ValueType::unknown;
+      ValueType operand = ValueType::number;
+      ValueType result = ValueType::number;
+      switch (e.op) {
+        case Op::add: case Op::sub: case Op::mul: case Op::div: break;
+        case Op::lt: case Op::le: case Op::gt: case Op::ge: result = ValueType::boolean; break;
+        case Op::and_: case Op::or_: operand = result = ValueType::boolean; break;
+        case Op::eq: case Op::ne:
+          if (l != r) {
+            error(e.loc, std::string("cannot compare ") + type_name(l) + " with " + type_name(r) +
+                             " using '" + op_text(e.op) + "'");
+            return e.type = ValueType::unknown;
+          }
+          return e.type = ValueType::boolean;
+        default: break;
+      }
+      if (l != operand || r != operand) {
+        error(e.loc, std::string("operator '") + op_text(e.op) + "' needs " + type_name(operand) +
+                         "s, found " + type_name(l) + " and " + type_name(r));
+        return e.type = ValueType::unknown;
+      }
+      return e.type = result;
+    }
+  }
+  return ValueType::unknown;
+}
+
+void Checker::expect_type(Expr& e, ValueType want, const std::string& what) {
+  ValueType t = type_of(e);
+  if (t == ValueType::unknown || t == want) return;
+  if (want == ValueType::boolean)
+    error(e.loc, what + " must be boolean, found " + type_name(t) + " '" + expr_text(e) +
+                     "'; compare it, e.g. '" + expr_text(e) + " > 0'");
+  else
+    error(e.loc, what + " must be a number, found " + type_name(t) + " '" + expr_text(e) + "'");
+}
+
+// Callees of a function: blocks it calls, launches with async, or names as a branch.
+std::vector<std::pair<int, SourceLocation>> callees(const Function& f) {
+  std::vector<std::pair<int, SourceLocation>> out;
+  for (const auto& s : f.body) {
+    if (s.function_index >= 0) out.push_back({s.function_index, s.callee_loc});
+    for (std::size_t i = 0, b = 0; i < s.args.size() && b < s.branch_functions.size(); ++i) {
+      if (s.args[i]->kind != ExprKind::name) continue;
+      if (s.branch_functions[b] >= 0) out.push_back({s.branch_functions[b], s.args[i]->loc});
+      ++b;
+    }
+  }
+  return out;
+}
+
+// Iterative DFS over the call graph: finds cycles (recursion), the expanded size and the
+// depth, without recursing in C++ (a 100,000-deep call chain must not overflow the stack).
+void Checker::check_call_graph() {
+  std::size_t n = m_.functions.size();
+  enum Color { white, grey, black };
+  std::vector<Color> color(n, white);
+  std::vector<long long> size(n, 0);
+  std::vector<int> depth(n, 0);
+  std::vector<std::vector<std::pair<int, SourceLocation>>> edges(n);
+  for (std::size_t i = 0; i < n; ++i) edges[i] = callees(m_.functions[i]);
+  std::set<int> reported;
+  for (std::size_t root = 0; root < n; ++root) {
+    if (color[root] != white) continue;
+    struct Frame { int fn; std::size_t next; };
+    std::vector<Frame> stack{{static_cast<int>(root), 0}};
+    color[root] = grey;
+    while (!stack.empty()) {
+      Frame& top = stack.back();
+      if (top.next < edges[top.fn].size()) {
+        auto [callee, loc] = edges[top.fn][top.next++];
+        if (color[callee] == grey) {
+          if (reported.insert(callee).second)
+            error(loc, "recursion: '" + m_.functions[callee].name + "' reaches itself through '" +
+                           m_.functions[top.fn].name +
+                           "'; blocks are expanded inline, write loops with RepeatUntil/RepeatWhile/RepeatFor");
+        } else if (color[callee] == white) {
+          color[callee] = grey;
+          stack.push_back({callee, 0});
+        }
+        continue;
+      }
+      int fn = top.fn;
+      long long total = 1;
+      int d = 0;
+      for (const auto& s : m_.functions[fn].body) total += 1 + static_cast<long long>(s.args.size() > 0);
+      for (const auto& [callee, loc] : edges[fn]) {
+        total = std::min(total + size[callee], limits_.max_expanded_nodes * 4);
+        d = std::max(d, depth[callee] + 1);
+      }
+      size[fn] = total;
+      depth[fn] = d;
+      color[fn] = black;
+      stack.pop_back();
+    }
+  }
+  if (diags_.has_errors() || m_.init_function < 0) return;
+  const Function& init = m_.functions[m_.init_function];
+  out_.expanded_statements = size[m_.init_function];
+  if (size[m_.init_function] > limits_.max_expanded_nodes)
+    error(init.loc, "mission expands to more than " + std::to_string(limits_.max_expanded_nodes) +
+                        " nodes (every call instantiates its block); call fewer blocks or split the mission");
+  if (depth[m_.init_function] > limits_.max_call_depth)
+    error(init.loc, "blocks nest more than " + std::to_string(limits_.max_call_depth) +
+                        " calls deep; flatten the call chain");
+}
+
+void Checker::check_unused() {
+  if (m_.init_function < 0) return;
+  std::vector<bool> reached(m_.functions.size(), false);
+  std::vector<int> work{m_.init_function};
+  reached[m_.init_function] = true;
+  while (!work.empty()) {
+    int fn = work.back();
+    work.pop_back();
+    for (const auto& [callee, loc] : callees(m_.functions[fn]))
+      if (!reached[callee]) {
+        reached[callee] = true;
+        work.push_back(callee);
+      }
+  }
+  for (std::size_t i = 0; i < m_.functions.size(); ++i) {
+    m_.functions[i].called = reached[i];
+    if (!reached[i])
+      warning(m_.functions[i].loc, "block '" + m_.functions[i].name +
+                                       "' is never called from INIT; call it or remove it");
+  }
+}
+
+}  // namespace
+
+CheckedMission check_mission(Mission& mission, const fleet::Fleet& fleet, Diagnostics& diags,
+                             const CheckLimits& limits) {
+  return Checker(mission, fleet, diags, limits).run();
+}
+
+}  // namespace eamos::lang

@@ -1,0 +1,144 @@
+// Reading valid fleet files: what each key of docs/fleet.md turns into.
+#include <gtest/gtest.h>
+
+#include "helpers.h"
+
+namespace eamos::fleet {
+namespace {
+
+using test::parse;
+
+const std::string kExample = std::string(EAMOS_TEST_DATA) + "/data/example.yaml";
+
+TEST(Parse, DocumentedExampleLoadsWithoutDiagnostics) {
+  Fleet fleet;
+  Diagnostics diags;
+  ASSERT_TRUE(load_fleet(kExample, fleet, diags)) << diags.format();
+  EXPECT_TRUE(diags.items().empty()) << diags.format();
+  EXPECT_EQ(fleet.path, kExample);
+  EXPECT_EQ(fleet.types.size(), 2u);
+  EXPECT_EQ(fleet.drones.size(), 3u);
+  ASSERT_NE(fleet.source, nullptr);
+}
+
+TEST(Parse, MissingFileIsAnErrorNamingThePath) {
+  Fleet fleet;
+  Diagnostics diags;
+  EXPECT_FALSE(load_fleet("/nonexistent/fleet.yaml", fleet, diags));
+  ASSERT_EQ(diags.error_count(), 1u);
+  EXPECT_NE(diags.items()[0].message.find("/nonexistent/fleet.yaml"), std::string::npos);
+}
+
+TEST(Parse, EmptyFileIsAnEmptyFleet) {
+  for (const char* text : {"", "\n# only a comment\n", "types:\ndrones:\n"}) {
+    auto p = parse(text);
+    EXPECT_TRUE(p.ok) << p.diags.format();
+    EXPECT_TRUE(p.fleet.types.empty());
+    EXPECT_TRUE(p.fleet.drones.empty());
+  }
+}
+
+TEST(Parse, CapabilitySubsetRemovesOtherActions) {
+  auto p = parse("types:\n  Scout:\n    capabilities: [Arm, FlyTo, Hover]\n    sensors: 2\n");
+  ASSERT_TRUE(p.ok) << p.diags.format();
+  const DroneType& t = p.fleet.types.at("Scout");
+  EXPECT_NE(t.find_action("Arm"), nullptr);
+  EXPECT_NE(t.find_action("FlyTo"), nullptr);
+  EXPECT_NE(t.find_action("Hover"), nullptr);
+  EXPECT_EQ(t.find_action("Land"), nullptr);
+  EXPECT_EQ(t.find_action("TakePicture"), nullptr);
+  EXPECT_NE(t.find_action("Sensor2"), nullptr);
+  EXPECT_EQ(t.actions.size(), 3u + 2u);
+}
+
+TEST(Parse, EveryPropertyStaysWhateverTheCapabilities) {
+  auto p = parse("types:\n  Scout:\n    capabilities: []\n    sensors: 1\n");
+  ASSERT_TRUE(p.ok) << p.diags.format();
+  const DroneType& t = p.fleet.types.at("Scout");
+  for (const auto& prop : standard_properties()) EXPECT_NE(t.find_property(prop.name), nullptr);
+  EXPECT_NE(t.find_property("Sensor1"), nullptr);
+  ASSERT_EQ(t.actions.size(), 1u);
+  EXPECT_EQ(t.actions[0].name, "Sensor1");
+}
+
+TEST(Parse, TypeWithoutCapabilitiesHasAllStandardActions) {
+  auto p = parse("types:\n  Scout:\n    sensors: 3\n");
+  ASSERT_TRUE(p.ok) << p.diags.format();
+  const DroneType& t = p.fleet.types.at("Scout");
+  EXPECT_FALSE(t.generic);
+  EXPECT_EQ(t.name, "Scout");
+  EXPECT_EQ(t.actions.size(), standard_actions().size() + 3);
+}
+
+TEST(Parse, EmptyTypeEntryIsAStandardTypeDescribedByTheFile) {
+  auto p = parse("types:\n  Scout:\n");
+  ASSERT_TRUE(p.ok) << p.diags.format();
+  EXPECT_FALSE(p.fleet.types.at("Scout").generic);
+  EXPECT_EQ(p.fleet.types.at("Scout").sensors, 8);
+}
+
+TEST(Parse, TypeLimitsOverrideTheDefaultsOnlyWhereSet) {
+  auto p = parse("types:\n  Lifter:\n    adapter: mavlink\n    limits:\n      max_speed: 4\n");
+  ASSERT_TRUE(p.ok) << p.diags.format();
+  const DroneType& t = p.fleet.types.at("Lifter");
+  EXPECT_EQ(t.adapter, "mavlink");
+  EXPECT_DOUBLE_EQ(t.limits.max_speed_mps, 4);
+  EXPECT_DOUBLE_EQ(t.limits.max_climb_mps, Limits{}.max_climb_mps);
+}
+
+TEST(Parse, AllFiveLimitsAreRead) {
+  auto p = parse("types:\n  S:\n    limits: {max_speed: 8, max_climb: 2.5, max_descent: 1.5, "
+                 "max_accel: 3, max_altitude: 100}\n");
+  ASSERT_TRUE(p.ok) << p.diags.format();
+  const Limits& l = p.fleet.types.at("S").limits;
+  EXPECT_DOUBLE_EQ(l.max_speed_mps, 8);
+  EXPECT_DOUBLE_EQ(l.max_climb_mps, 2.5);
+  EXPECT_DOUBLE_EQ(l.max_descent_mps, 1.5);
+  EXPECT_DOUBLE_EQ(l.max_accel_mps2, 3);
+  EXPECT_DOUBLE_EQ(l.max_altitude_m, 100);
+}
+
+TEST(Parse, SensorGradientParsed) {
+  auto p = parse("drones:\n  Drone1:\n    sensors:\n      Sensor2: {value: 10, gradient: [0.5, -1, 2]}\n");
+  ASSERT_TRUE(p.ok) << p.diags.format();
+  const SensorModel& m = p.fleet.drones.at("Drone1").sensors.at("Sensor2");
+  EXPECT_DOUBLE_EQ(m.base, 10);
+  EXPECT_DOUBLE_EQ(m.gradient.x, 0.5);
+  EXPECT_DOUBLE_EQ(m.gradient.y, -1);
+  EXPECT_DOUBLE_EQ(m.gradient.z, 2);
+}
+
+TEST(Parse, PlainSensorNumberIsAConstant) {
+  auto p = parse("drones:\n  Drone1:\n    sensors: {Sensor1: 120}\n");
+  ASSERT_TRUE(p.ok) << p.diags.format();
+  const SensorModel& m = p.fleet.drones.at("Drone1").sensors.at("Sensor1");
+  EXPECT_DOUBLE_EQ(m.base, 120);
+  EXPECT_DOUBLE_EQ(m.gradient.x, 0);
+  EXPECT_DOUBLE_EQ(m.gradient.y, 0);
+  EXPECT_DOUBLE_EQ(m.gradient.z, 0);
+}
+
+TEST(Parse, TypesAreReadBeforeDronesWhateverTheOrderInTheFile) {
+  auto p = parse("drones:\n  Drone1:\n    sensors: {Sensor12: 1}\ntypes:\n  Big:\n    sensors: 12\n");
+  EXPECT_TRUE(p.ok) << p.diags.format();
+  EXPECT_EQ(p.fleet.drones.at("Drone1").sensors.count("Sensor12"), 1u);
+}
+
+TEST(Parse, DroneLocationsPointAtTheirNames) {
+  auto p = parse("drones:\n  Drone1:\n    battery: 50\n  Drone2:\n");
+  ASSERT_TRUE(p.ok) << p.diags.format();
+  EXPECT_EQ(p.fleet.drone_locations.at("Drone1").line, 2);
+  EXPECT_EQ(p.fleet.drone_locations.at("Drone1").col, 3);
+  EXPECT_EQ(p.fleet.drone_locations.at("Drone2").line, 4);
+  EXPECT_EQ(p.fleet.drones.count("Drone2"), 1u);
+}
+
+TEST(Parse, NegativeHomeCoordinatesAndFractionsAreFine) {
+  auto p = parse("drones:\n  Drone1:\n    home: [-10.5, 1e1, 0]\n");
+  ASSERT_TRUE(p.ok) << p.diags.format();
+  EXPECT_DOUBLE_EQ(p.fleet.drones.at("Drone1").home.x, -10.5);
+  EXPECT_DOUBLE_EQ(p.fleet.drones.at("Drone1").home.y, 10);
+}
+
+}  // namespace
+}  // namespace eamos::fleet

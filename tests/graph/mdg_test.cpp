@@ -1,0 +1,117 @@
+// MDG construction (paper IV.C): forks cloned per drone, conditions held by one drone and
+// seen by the others as external nodes, every cross-drone arc in both drones' MDGs.
+#include "helpers.h"
+
+namespace eamos {
+namespace {
+
+using graph::MegKind;
+using test::compile_text;
+using test::node;
+
+const char* kThree =
+    "var A Quad\nvar B Quad\nvar C Quad\n"
+    "func INIT() { PAR_arm(); PAR_go() }\n"
+    "func PAR_arm() { A.Arm(); B.Arm(); C.Arm() }\n"
+    "func PAR_go() { SEQ_a(); SEQ_b() }\n"
+    "func SEQ_a() { A.Takeoff(3) }\n"
+    "func SEQ_b() { WaitUntil(A.Z() > 2, SEQ_bw) }\n"
+    "func SEQ_bw() { B.Takeoff(3) }\n";
+
+TEST(Mdg, ForkIsClonedOntoEachDroneItStarts) {
+  auto c = compile_text(kThree);
+  ASSERT_TRUE(c);
+  int fork = node(*c, "fork PAR_go");
+  // PAR_go starts A's takeoff and the WaitUntil, which A evaluates (it reads A.Z()).
+  EXPECT_GE(c->mdgs[0].find(fork, 0), 0);
+  EXPECT_LT(c->mdgs[1].find(fork, 1), 0);
+  EXPECT_LT(c->mdgs[2].find(fork, 2), 0);
+  int arm_fork = node(*c, "fork PAR_arm");
+  for (int d = 0; d < 3; ++d) EXPECT_GE(c->mdgs[d].find(arm_fork, d), 0) << d;
+}
+
+TEST(Mdg, EachPredecessorTriggersEveryCloneOfAFork) {
+  auto c = compile_text(kThree);
+  ASSERT_TRUE(c);
+  int fork = node(*c, "fork PAR_go");
+  int b_arm = node(*c, "B.Arm()");
+  const graph::Mdg& b = c->mdgs[1];
+  int from = b.find(b_arm, 1), to = b.find(fork, 0);
+  ASSERT_GE(from, 0);
+  ASSERT_GE(to, 0);
+  EXPECT_FALSE(b.nodes[to].internal);
+  bool found = false;
+  for (const auto& a : b.arcs) found |= a.from == from && a.to == to && b.external(a);
+  EXPECT_TRUE(found);
+}
+
+TEST(Mdg, ConditionIsInternalToItsEvaluatorAndExternalToFollowers) {
+  auto c = compile_text(kThree);
+  ASSERT_TRUE(c);
+  int cond = node(*c, "WaitUntil A.Z() > 2");
+  ASSERT_EQ(c->meg.nodes[cond].drone, 0);
+  int in_a = c->mdgs[0].find(cond, 0), in_b = c->mdgs[1].find(cond, 0);
+  ASSERT_GE(in_a, 0);
+  ASSERT_GE(in_b, 0);
+  EXPECT_TRUE(c->mdgs[0].nodes[in_a].internal);
+  EXPECT_FALSE(c->mdgs[1].nodes[in_b].internal);
+  EXPECT_EQ(c->mdgs[1].nodes[in_b].drone, 0);  // B follows A's outcome
+  EXPECT_LT(c->mdgs[2].find(cond, 0), 0);      // C has nothing to do with it
+}
+
+TEST(Mdg, EveryMegArcAppearsInTheMdgOfBothEnds) {
+  auto c = compile_text(kThree);
+  ASSERT_TRUE(c);
+  auto clones = graph::sync_clones(c->meg);
+  for (const auto& a : c->meg.arcs) {
+    const auto& u = c->meg.nodes[a.from];
+    const auto& v = c->meg.nodes[a.to];
+    std::vector<std::pair<int, int>> pairs;  // (from holder, to holder)
+    if (!graph::is_sync_point(v.kind)) {
+      pairs.push_back({graph::is_sync_point(u.kind) ? v.drone : u.drone, v.drone});
+    } else {
+      for (int k : clones[v.id]) pairs.push_back({graph::is_sync_point(u.kind) ? k : u.drone, k});
+    }
+    for (auto [du, dv] : pairs)
+      for (int holder : {du, dv}) {
+        const graph::Mdg& g = c->mdgs[holder];
+        int f = g.find(u.id, du), t = g.find(v.id, dv);
+        bool found = false;
+        for (const auto& m : g.arcs) found |= m.from == f && m.to == t && m.kind == a.kind;
+        EXPECT_TRUE(found) << "arc n" << a.from << "->n" << a.to << " missing in MDG of drone " << holder;
+      }
+  }
+}
+
+TEST(Mdg, DoConditionListsTheNodesItCancelsOnEachDrone) {
+  auto c = compile_text(
+      "var A Quad\nvar B Quad\n"
+      "func INIT() { DoWhileSync(A.Battery() > 30, PAR_do, SEQ_done) }\n"
+      "func PAR_do() { A.Orbit(); B.Orbit() }\nfunc SEQ_done() { A.Land() }\n");
+  ASSERT_TRUE(c);
+  int cond = node(*c, "DoWhileSync A.Battery() > 30");
+  int b_orbit = node(*c, "B.Orbit()");
+  const graph::Mdg& b = c->mdgs[1];
+  int cond_in_b = b.find(cond, 0);
+  ASSERT_GE(cond_in_b, 0);
+  const auto& cancels = b.nodes[cond_in_b].cancels;
+  EXPECT_NE(std::find(cancels.begin(), cancels.end(), b.find(b_orbit, 1)), cancels.end());
+}
+
+TEST(Mdg, MissionEndIsHeldByTheFirstDrone) {
+  auto c = compile_text(kThree);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->meg.nodes[c->meg.end].drone, 0);
+  EXPECT_TRUE(c->mdgs[0].nodes[c->mdgs[0].find(c->meg.end, 0)].internal);
+}
+
+TEST(Mdg, DroneRecordsWhoseTelemetryItReads) {
+  auto c = compile_text(
+      "var A Quad\nvar B Quad\nfunc INIT() { A.Arm(); B.Arm(); B.FlyByX(A.X()) }\n");
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->mdgs[1].reads, std::vector<int>{0});
+  EXPECT_TRUE(c->mdgs[0].reads.empty());
+}
+
+}  // namespace
+}  // namespace eamos
