@@ -61,10 +61,20 @@ std::string caret_line(std::string_view line, int col) {
 }  // namespace
 
 std::string Diagnostics::format() const {
+  // Files in the order they were first reported, then by position within each file.
+  std::vector<const SourceFile*> file_order;
+  auto rank = [&](const SourceFile* f) {
+    auto it = std::find(file_order.begin(), file_order.end(), f);
+    return static_cast<std::size_t>(it - file_order.begin());
+  };
+  for (const auto& d : items_)
+    if (std::find(file_order.begin(), file_order.end(), d.file) == file_order.end())
+      file_order.push_back(d.file);
   std::vector<const Diagnostic*> sorted;
   for (const auto& d : items_) sorted.push_back(&d);
-  std::stable_sort(sorted.begin(), sorted.end(), [](const Diagnostic* a, const Diagnostic* b) {
-    if (a->file != b->file) return false;  // keep files in the order they were reported
+  std::stable_sort(sorted.begin(), sorted.end(), [&](const Diagnostic* a, const Diagnostic* b) {
+    std::size_t ra = rank(a->file), rb = rank(b->file);
+    if (ra != rb) return ra < rb;
     if (a->loc.line != b->loc.line) return a->loc.line < b->loc.line;
     return a->loc.col < b->loc.col;
   });

@@ -133,6 +133,7 @@ void Checker::check_drones() {
     if (m_.find_function(d.name) >= 0)
       error(d.loc, "'" + d.name + "' is both a drone and a function; rename one");
     out_.drone_types.push_back(fleet_.type_for(d.type));
+    fleet_.check_drone(d.name, out_.drone_types.back(), diags_);
   }
   for (const auto& [name, loc] : fleet_.drone_locations)
     if (m_.find_drone(name) < 0 && fleet_.source)
@@ -211,7 +212,9 @@ void Checker::check_action(Statement& s) {
       error(s.callee_loc, "'" + s.drone + "." + s.callee +
                               "()' is a property, not an action; read it inside a condition or argument");
     } else {
-      std::string near = closest_match(s.callee, type.capability_names());
+      std::vector<std::string> actions;
+      for (const auto& spec_ : type.actions) actions.push_back(spec_.name);
+      std::string near = closest_match(s.callee, actions);
       error(s.callee_loc, "drone '" + s.drone + "' of type '" + type.name + "' has no capability '" +
                               s.callee + "'" +
                               (near.empty() ? "; see `eamos check --list-capabilities`"
@@ -237,9 +240,18 @@ void Checker::check_block_call(Statement& s) {
     std::vector<std::string> candidates = function_names();
     for (const auto& sig : signatures()) candidates.push_back(control_name(sig.kind));
     std::string near = closest_match(s.callee, candidates);
+    bool is_action = false;
+    for (const auto& a : fleet::standard_actions()) is_action |= a.name == s.callee;
     if (m_.find_drone(s.callee) >= 0)
       error(s.callee_loc, "'" + s.callee + "' is a drone; call one of its actions, e.g. " +
                               s.callee + ".Takeoff(5)");
+    else if (is_action)
+      error(s.callee_loc, "'" + s.callee + "' is an action; call it on a drone, e.g. " +
+                              (m_.drones.empty() ? std::string("Drone1") : m_.drones.front().name) + "." +
+                              s.callee + "(...)");
+    else if (near.empty() && !is_block_name(s.callee))
+      error(s.callee_loc, "undefined function '" + s.callee +
+                              "'; blocks are named SEQ_... or PAR_..., control structures are If, WaitUntil, RepeatWhile, …");
     else
       error(s.callee_loc, "undefined function '" + s.callee + "'" +
                               (near.empty() ? "; define it with `func " + s.callee + "() { ... }`"
@@ -344,8 +356,13 @@ ValueType Checker::type_of(Expr& e) {
         std::vector<std::string> props;
         for (const auto& q : type.properties) props.push_back(q.name);
         std::string near = closest_match(e.property, props);
-        error(e.loc, "drone '" + e.drone + "' of type '" + type.name + "' has no property '" +
-                         e.property + "'" + (near.empty() ? "" : "; did you mean '" + near + "'?"));
+        if (type.find_action(e.property))
+          error(e.loc, "'" + e.property + "' is an action, not a property; conditions read properties such as " +
+                           e.drone + ".Landed() or " + e.drone + ".Z()");
+        else
+          error(e.loc, "drone '" + e.drone + "' of type '" + type.name + "' has no property '" +
+                           e.property + "'" +
+                           (near.empty() ? "; see `eamos check --list-capabilities`" : "; did you mean '" + near + "'?"));
         return e.type = ValueType::unknown;
       }
       return e.type = p->type == fleet::ValueType::boolean ? ValueType::boolean : ValueType::number;
@@ -436,9 +453,10 @@ void Checker::check_call_graph() {
         auto [callee, loc] = edges[top.fn][top.next++];
         if (color[callee] == grey) {
           if (reported.insert(callee).second)
-            error(loc, "recursion: '" + m_.functions[callee].name + "' reaches itself through '" +
-                           m_.functions[top.fn].name +
-                           "'; blocks are expanded inline, write loops with RepeatUntil/RepeatWhile/RepeatFor");
+            error(loc, "recursion: '" + m_.functions[callee].name +
+                           (callee == top.fn ? "' calls itself"
+                                             : "' reaches itself through '" + m_.functions[top.fn].name + "'") +
+                           "; blocks are expanded inline, write loops with RepeatUntil/RepeatWhile/RepeatFor");
         } else if (color[callee] == white) {
           color[callee] = grey;
           stack.push_back({callee, 0});

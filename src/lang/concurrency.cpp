@@ -32,8 +32,8 @@ class MotionAnalysis {
     MotionSet launched;  // motions still running from async work started earlier in a SEQ
     for (const auto& s : f.body) {
       MotionSet mine = of_statement(s);
-      if (f.block == BlockKind::par) report_overlap(all, mine, s);
-      else report_overlap(launched, mine, s);
+      if (f.block == BlockKind::par) report_overlap(all, mine, s, f.name, false);
+      else report_overlap(launched, mine, s, f.name, true);
       if (s.kind == StatementKind::async_call || s.control == ControlKind::DoUntilAsync ||
           s.control == ControlKind::DoWhileAsync)
         launched.insert(mine.begin(), mine.end());
@@ -61,15 +61,21 @@ class MotionAnalysis {
     return out;
   }
 
-  void report_overlap(const MotionSet& running, const MotionSet& next, const Statement& s) {
+  void report_overlap(const MotionSet& running, const MotionSet& next, const Statement& s,
+                      const std::string& block, bool after_async) {
     for (const auto& [drone, site] : next) {
       auto it = running.find(drone);
       if (it == running.end()) continue;
+      std::string a = site.action + " (line " + std::to_string(site.loc.line) + ")";
+      std::string b = it->second.action + " (line " + std::to_string(it->second.loc.line) + ")";
       diags_.warning(m_.file, s.loc,
-                     "drone '" + m_.drones[drone].name + "' may run two motion actions at the same time: " +
-                         site.action + " (line " + std::to_string(site.loc.line) + ") and " +
-                         it->second.action + " (line " + std::to_string(it->second.loc.line) +
-                         "); the later one preempts the running one");
+                     after_async
+                         ? "drone '" + m_.drones[drone].name + "' may run two motion actions at the same time: " +
+                               a + " may start while " + b + ", launched asynchronously earlier in " + block +
+                               ", still runs; it would preempt it"
+                         : "drone '" + m_.drones[drone].name + "' may run two motion actions at the same time: " +
+                               a + " and " + b + " are in parallel branches of " + block +
+                               "; whichever starts later preempts the other");
     }
   }
 

@@ -137,7 +137,7 @@ Token Lexer::lex_number(std::size_t begin) {
     while (std::isalnum(static_cast<unsigned char>(peek())) || peek() == '_') ++pos_;
     diags_.error(&file_, file_.location_of(begin),
                  "malformed number '" + std::string(file_.text.substr(begin, pos_ - begin)) +
-                     "'; a name cannot start with a digit");
+                     "'; a number cannot be followed by letters (units are implied: metres, seconds)");
     return make(TokenKind::invalid, begin, pos_);
   }
   return make(is_decimal ? TokenKind::decimal : TokenKind::integer, begin, pos_);
@@ -197,16 +197,18 @@ Token Lexer::lex_operator(std::size_t begin) {
   }
   std::string shown;
   unsigned char first = static_cast<unsigned char>(c);
-  if (c == '=') shown = "'=' (assignment does not exist; compare with '==')";
-  else if (c == '&' || c == '|') shown = std::string("'") + c + "' (use '" + c + c + "')";
-  else if (c == '"') shown = "'\"' (the language has no strings)";
+  std::string fix = "; remove it";
+  if (c == '=') { shown = "'='"; fix = "; the language has no assignment, write '==' to compare"; }
+  else if (c == '&' || c == '|') { shown = std::string("'") + c + "'"; fix = std::string("; write '") + c + c + "'"; }
+  else if (c == '"') { shown = "'\"'"; fix = "; the language has no strings"; }
   else if (first >= 0x21 && first < 0x7f) shown = std::string("'") + c + "'";
   else {
     char buf[8];
     std::snprintf(buf, sizeof buf, "0x%02x", first);
     shown = std::string("byte ") + buf;
+    if (first >= 0x80) fix = "; only ASCII is allowed outside comments (a typographic dash or quote?)";
   }
-  diags_.error(&file_, file_.location_of(begin), "unexpected " + shown + "; remove it");
+  diags_.error(&file_, file_.location_of(begin), "unexpected " + shown + fix);
   return make(TokenKind::invalid, begin, pos_);
 }
 

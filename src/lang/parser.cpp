@@ -106,6 +106,7 @@ void Parser::parse_package(Mission& m) {
     advance();
   } else {
     error_here("expected package name after 'package', found " + describe(tok_));
+    return;
   }
   if (tok_.kind != TokenKind::semicolon && tok_.kind != TokenKind::end_of_file) {
     error_here("expected newline after package name, found " + describe(tok_));
@@ -255,17 +256,19 @@ bool Parser::parse_statement(Statement& s) {
     s.callee_loc = first_loc;
   }
   if (tok_.kind != TokenKind::lparen) {
+    std::string call = (s.kind == StatementKind::action ? s.drone + "." : std::string()) + s.callee + "()";
     error_here("expected '(' after '" + s.callee + "', found " + describe(tok_) +
-               "; calls are written " + s.callee + "()");
+               "; calls are written " + call);
     skip_to_statement_end();
     return false;
   }
-  parse_arguments(s.args);
-  return true;
+  return parse_arguments(s.args);
 }
 
 // args = [ expr { "," expr } [ "," ] ]   (within parentheses)
-void Parser::parse_arguments(std::vector<std::unique_ptr<Expr>>& args) {
+// Returns false after a syntax error: the statement is dropped, so the checker does not
+// add a follow-on "wrong number of arguments" for an argument list that was cut short.
+bool Parser::parse_arguments(std::vector<std::unique_ptr<Expr>>& args) {
   ++paren_depth_;
   advance();  // '('
   while (tok_.kind != TokenKind::rparen) {
@@ -273,7 +276,7 @@ void Parser::parse_arguments(std::vector<std::unique_ptr<Expr>>& args) {
     if (!e) {
       --paren_depth_;
       skip_to_statement_end();
-      return;
+      return false;
     }
     args.push_back(std::move(e));
     if (tok_.kind == TokenKind::comma) {
@@ -281,14 +284,19 @@ void Parser::parse_arguments(std::vector<std::unique_ptr<Expr>>& args) {
       continue;
     }
     if (tok_.kind != TokenKind::rparen) {
-      error_here("expected ',' or ')' in argument list, found " + describe(tok_));
+      if (tok_.kind == TokenKind::end_of_file || tok_.loc.line > prev_.loc.line)
+        diags_.error(&file_, {prev_.loc.line, prev_.loc.col + static_cast<int>(prev_.text.size())},
+                     "expected ')' to close the argument list, found " + describe(tok_));
+      else
+        error_here("expected ',' or ')' in argument list, found " + describe(tok_));
       --paren_depth_;
       skip_to_statement_end();
-      return;
+      return false;
     }
   }
   --paren_depth_;
   advance();  // ')'
+  return true;
 }
 
 namespace {

@@ -34,7 +34,7 @@ class Parser {
   void parse_function(Mission& m);
   void parse_block(Function& f);
   bool parse_statement(Statement& s);
-  void parse_arguments(std::vector<std::unique_ptr<Expr>>& args);
+  bool parse_arguments(std::vector<std::unique_ptr<Expr>>& args);
   std::unique_ptr<Expr> parse_expression(int min_precedence = 1);
   std::unique_ptr<Expr> parse_unary();
   std::unique_ptr<Expr> parse_primary();

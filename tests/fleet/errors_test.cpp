@@ -230,6 +230,38 @@ TEST(Errors, GarbageInputIsAnErrorNotACrash) {
   }
 }
 
+TEST(Errors, GarbledFleetFileIsReportedNotACrash) {
+  const std::string example = R"(types:
+  Scout:
+    adapter: sim
+    capabilities: [Arm, Takeoff, FlyTo]
+    sensors: 2
+    limits: {max_speed: 8, max_climb: 2.5}
+drones:
+  Drone1:
+    home: [0, 0, 0]
+    sensors: {Sensor1: 120, Sensor2: {value: 10, gradient: [0.5, 0, 0]}}
+    limits: {max_speed: 5}
+    failsafe: land
+    timeouts: {Takeoff: 40}
+)";
+  ASSERT_TRUE(parse(example).ok);
+  std::mt19937 random(777);
+  const std::string alphabet = " :-[]{},#&*!|>'\"%@`\n\t0123456789abcXYZ";
+  for (int round = 0; round < 500; ++round) {
+    std::string text = example;
+    for (int edits = 1 + random() % 4; edits > 0; --edits)
+      text[random() % text.size()] = alphabet[random() % alphabet.size()];
+    auto p = parse(text);
+    // ok and "no errors" must agree: a caller trusts the return value alone.
+    EXPECT_EQ(p.ok, !p.diags.has_errors()) << text;
+    for (const auto& d : p.diags.items()) {
+      EXPECT_LE(d.loc.line, static_cast<int>(p.fleet.source->line_starts.size())) << text;
+      EXPECT_FALSE(d.message.empty()) << text;
+    }
+  }
+}
+
 TEST(Errors, GarbageInsideAValidShapeIsAnErrorNotACrash) {
   auto p = parse(std::string("drones:\n  Drone1:\n    connection: \"\x01\x02\"\n    battery: \"\xff\xfe\"\n"));
   EXPECT_FALSE(p.ok);
