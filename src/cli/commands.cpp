@@ -18,10 +18,11 @@ bool compile_and_report(const CommonOptions& o, graph::Compilation& c) {
   Diagnostics diags;
   diags.max_errors = o.max_errors;
   bool ok = graph::compile_file(o.mission, o.fleet, diags, c);
+  // Re-list what the run found: -q drops warnings, --werror turns them into errors.
   Diagnostics shown;
+  shown.max_errors = 0;
   for (const auto& d : diags.items()) {
     if (d.severity == Severity::warning && o.quiet) continue;
-    shown.max_errors = 0;
     if (d.severity == Severity::warning && o.werror)
       shown.error(d.file, d.loc, d.message + " [-Werror]");
     else if (d.severity == Severity::warning)
@@ -32,9 +33,7 @@ bool compile_and_report(const CommonOptions& o, graph::Compilation& c) {
       shown.error(d.file, d.loc, d.message);
   }
   std::cerr << shown.format();
-  std::size_t dropped = diags.error_count() - (diags.error_count() > 0 && diags.saturated() ? 0 : 0);
-  (void)dropped;
-  if (diags.saturated() && diags.max_errors != 0)
+  if (diags.saturated())
     std::cerr << "error: stopped listing after " << diags.max_errors
               << " errors; raise the limit with --max-errors N (0 for no limit)\n";
   if (diags.has_errors()) {

@@ -1,10 +1,7 @@
 #include "deploy/synthesize.h"
 
-#include <openssl/evp.h>
-
 #include <filesystem>
 #include <fstream>
-#include <memory>
 
 #include "graph/export.h"
 #include "version.h"
@@ -62,40 +59,7 @@ json type_json(const fleet::DroneType& t) {
           {"actions", actions}, {"properties", props}};
 }
 
-struct DigestDeleter {
-  void operator()(EVP_MD_CTX* c) const { EVP_MD_CTX_free(c); }
-};
-
 }  // namespace
-
-std::string mission_hash(const graph::Compilation& c) {
-  std::unique_ptr<EVP_MD_CTX, DigestDeleter> ctx(EVP_MD_CTX_new());
-  EVP_DigestInit_ex(ctx.get(), EVP_sha256(), nullptr);
-  auto feed = [&](const std::string& s) {
-    EVP_DigestUpdate(ctx.get(), s.data(), s.size());
-    EVP_DigestUpdate(ctx.get(), "\n", 1);
-  };
-  // Node by node, so hashing a large mission never holds the whole MEG as JSON.
-  feed("eamos-mission " + std::to_string(kMissionFormatVersion));
-  for (int d = 0; d < c.drone_count(); ++d) {
-    feed(settings_json(c.settings[d], d).dump());
-    feed(type_json(c.checked.drone_types[d]).dump());
-  }
-  for (const auto& n : c.meg.nodes) feed(graph::meg_node_json(c, n).dump());
-  for (const auto& a : c.meg.arcs)
-    feed(std::to_string(a.from) + " " + std::to_string(a.to) + " " + graph::arc_kind_name(a.kind) +
-         " " + graph::branch_name(a.branch));
-  unsigned char digest[EVP_MAX_MD_SIZE];
-  unsigned int length = 0;
-  EVP_DigestFinal_ex(ctx.get(), digest, &length);
-  static const char* hex = "0123456789abcdef";
-  std::string out;
-  for (unsigned int i = 0; i < length; ++i) {
-    out += hex[digest[i] >> 4];
-    out += hex[digest[i] & 15];
-  }
-  return out;
-}
 
 json drone_mission(const graph::Compilation& c, int drone, const std::string& hash) {
   json fleet_names = json::array();
@@ -131,16 +95,19 @@ json manifest(const graph::Compilation& c, const std::string& hash) {
 }
 
 namespace {
+
+bool cannot_write(const std::filesystem::path& path, Diagnostics& diags) {
+  diags.error(nullptr, {}, "cannot write '" + path.string() + "'; check the output folder's permissions");
+  return false;
+}
+
 bool write_text(const std::filesystem::path& path, const std::string& text, Diagnostics& diags) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out << text;
   out.close();
-  if (!out) {
-    diags.error(nullptr, {}, "cannot write '" + path.string() + "'; check the output folder's permissions");
-    return false;
-  }
-  return true;
+  return out ? true : cannot_write(path, diags);
 }
+
 }  // namespace
 
 bool write_deployment(const graph::Compilation& c, const std::string& dir, Diagnostics& diags) {
@@ -160,9 +127,13 @@ bool write_deployment(const graph::Compilation& c, const std::string& dir, Diagn
       diags.error(nullptr, {}, "cannot create '" + folder.string() + "': " + ec.message());
       return false;
     }
-    // One drone at a time: the JSON of a drone is dropped before the next is built.
-    if (!write_text(folder / "mission.json", drone_mission(c, d, hash).dump(1) + "\n", diags))
-      return false;
+    // Streamed straight into the file: no drone's mission is ever held in memory.
+    fs::path file = folder / "mission.json";
+    std::ofstream out(file, std::ios::binary | std::ios::trunc);
+    bool written = out && write_drone_mission(out, c, d, hash);
+    out << "\n";
+    out.close();
+    if (!written || !out) return cannot_write(file, diags);
   }
   return true;
 }

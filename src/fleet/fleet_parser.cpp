@@ -1,5 +1,6 @@
 // parse_fleet: the fleet file's schema (docs/fleet.md), one function per map in it.
 #include <algorithm>
+#include <optional>
 
 #include "fleet/fleet.h"
 #include "fleet/yaml_reader.h"
@@ -65,15 +66,15 @@ class FleetParser {
 void FleetParser::parse(const YAML::Node& root) {
   if (!r_.map(root, "the fleet file")) return;
   // Types first wherever they are written: a drone's sensors are checked against them.
-  YAML::Node types_node, drones_node;
+  std::optional<YAML::Node> types_node, drones_node;
   std::set<std::string> seen;
   for (const auto& kv : root) {
     std::string key = r_.field(kv.first, kRootKeys, seen, "the fleet file");
     if (key == "types") types_node = kv.second;
     if (key == "drones") drones_node = kv.second;
   }
-  if (types_node) types(types_node);
-  if (drones_node) drones(drones_node);
+  if (types_node) types(*types_node);
+  if (drones_node) drones(*drones_node);
 }
 
 void FleetParser::types(const YAML::Node& node) {
@@ -132,8 +133,8 @@ void FleetParser::capabilities(const YAML::Node& node, const std::string& where,
         r_.diags.warning(r_.file, location_of(item.Mark()),
                          "capability '" + name + "' is listed twice in " + where + "; remove one");
     } else if (sensor_index(name, kMaxSensors) > 0) {
-      r_.error(item, "'" + name + "' is not listed in capabilities; set the number of sensors "
-                     "with `sensors: N` in " + where);
+      r_.error(item, "'" + name + "' does not belong in capabilities; sensors come from "
+                     "`sensors: N` in " + where);
     } else if (is_standard_property(name)) {
       r_.error(item, "'" + name + "' is a property, and every type has all properties; list only "
                      "actions in capabilities");
@@ -282,6 +283,18 @@ void FleetParser::timeouts(const YAML::Node& node, const std::string& where, Dro
   }
 }
 
+// yaml-cpp names the grammar rule, not the mistake; the commonest one, a tab in the
+// indentation, gives "illegal map value", so say what to do about it.
+std::string syntax_hint(const SourceFile& file, SourceLocation loc) {
+  for (int line = std::max(1, loc.line - 1); line <= loc.line; ++line) {
+    std::string_view text = file.line(line);
+    std::size_t indent = text.find_first_not_of(" \t");
+    if (text.substr(0, indent).find('\t') != std::string_view::npos)
+      return "YAML does not allow tabs in indentation; indent with spaces";
+  }
+  return "check the indentation, colons and brackets here";
+}
+
 }  // namespace
 
 bool parse_fleet(std::shared_ptr<SourceFile> source, Fleet& out, Diagnostics& diags) {
@@ -293,14 +306,11 @@ bool parse_fleet(std::shared_ptr<SourceFile> source, Fleet& out, Diagnostics& di
   std::size_t errors_before = diags.error_count();
   // yaml-cpp reports by exception; here they become diagnostics, so nothing escapes.
   try {
-    std::vector<YAML::Node> documents = YAML::LoadAll(source->text);
-    if (documents.size() > 1)
-      diags.error(file, location_of(documents[1].Mark()),
-                  "a fleet file holds one YAML document; remove the `---` and merge the rest into the first");
-    if (!documents.empty()) FleetParser(file, out, diags).parse(documents[0]);
+    YAML::Node root;
+    if (load_one_document(source->text, root, file, diags)) FleetParser(file, out, diags).parse(root);
   } catch (const YAML::ParserException& e) {
-    diags.error(file, location_of(e.mark),
-                "YAML syntax error: " + e.msg + "; check the indentation, colons and brackets here");
+    SourceLocation loc = location_of(e.mark);
+    diags.error(file, loc, "YAML syntax error: " + e.msg + "; " + syntax_hint(*file, loc));
   } catch (const YAML::Exception& e) {
     diags.error(file, location_of(e.mark), "cannot read the fleet file: " + e.msg);
   } catch (const std::exception& e) {

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
+
+#include <yaml-cpp/eventhandler.h>
 
 namespace eamos::fleet {
 
@@ -53,6 +56,62 @@ std::string one_of(const std::vector<std::string>& choices) {
     out += choices[i];
   }
   return out;
+}
+
+namespace {
+
+// Only where each document starts matters: a document that starts where the previous one
+// did means the parser consumed nothing.
+struct DocumentStarts : YAML::EventHandler {
+  std::vector<YAML::Mark> starts;
+  void OnDocumentStart(const YAML::Mark& mark) override { starts.push_back(mark); }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+};
+
+}  // namespace
+
+bool load_one_document(const std::string& text, YAML::Node& out, const SourceFile* file,
+                       Diagnostics& diags) {
+  // yaml-cpp 0.7 does not consume a token that cannot start a node (a leading ',' or ']'):
+  // it reports an empty document there, again and again, so YAML::LoadAll never returns
+  // (jbeder/yaml-cpp#1040, fixed upstream after 0.8). Walking at most three documents
+  // bounds that loop, and a start that did not move names the stray token.
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  DocumentStarts documents;
+  for (int i = 0; i < 3 && parser.HandleNextDocument(documents); ++i) {
+  }
+  const auto& starts = documents.starts;
+  for (std::size_t i = 1; i < starts.size(); ++i) {
+    if (starts[i].pos != starts[i - 1].pos) continue;
+    std::size_t pos = static_cast<std::size_t>(std::max(starts[i].pos, 0));
+    diags.error(file, location_of(starts[i]),
+                "YAML syntax error: unexpected '" + printable(text.substr(pos, 1)) +
+                    "'; remove it or quote the text it belongs to");
+    return false;
+  }
+  if (starts.size() > 1) {
+    std::size_t pos = static_cast<std::size_t>(std::max(starts[1].pos, 0));
+    // Without a `---` the first document ended early: text the parser could not fit in.
+    bool separator = text.compare(pos, 3, "---") == 0;
+    diags.error(file, location_of(starts[1]),
+                separator ? "a fleet file holds one YAML document; remove the `---` and merge "
+                            "the rest into the first"
+                          : "YAML syntax error: the file should have ended before this text; "
+                            "check the indentation and brackets above");
+    return false;
+  }
+  out = YAML::Load(text);
+  return true;
 }
 
 void YamlReader::error(const YAML::Node& at, const std::string& message) {

@@ -20,6 +20,12 @@ std::string describe(const YAML::Node& node);
 /// "a or b", "a, b or c": the choices a message offers.
 std::string one_of(const std::vector<std::string>& choices);
 
+/// Parses `text`, which must hold at most one YAML document, into `out` (null when empty).
+/// Reports a stray token or a second document and returns false; syntax errors are thrown
+/// as YAML::ParserException.
+bool load_one_document(const std::string& text, YAML::Node& out, const SourceFile* file,
+                       Diagnostics& diags);
+
 /// Every `what` below names the value in messages, e.g. "battery of drone 'Drone1'".
 struct YamlReader {
   const SourceFile* file = nullptr;

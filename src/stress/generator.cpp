@@ -27,6 +27,7 @@ class Generator {
   explicit Generator(const StressOptions& o) : o_(o), rng_{o.seed} {
     o_.drones = std::max(1, o_.drones);
     o_.squad_size = std::max(1, o_.squad_size);
+    o_.work_per_step = std::max(1, o_.work_per_step);
   }
 
   std::string run() {
@@ -43,7 +44,11 @@ class Generator {
     }
     for (int round = 0; nodes_ < o_.target_nodes; ++round)
       for (int g = 0; g < squads && nodes_ < o_.target_nodes; ++g)
-        squad_steps_[g].push_back(step(g, "s" + std::to_string(round), [&](int d) { return work(d); }));
+        squad_steps_[g].push_back(step(g, "s" + std::to_string(round), [&](int d) {
+          std::string body;
+          for (int i = 0; i < o_.work_per_step; ++i) body += work(d);
+          return body;
+        }));
     for (int g = 0; g < squads; ++g)
       squad_steps_[g].push_back(step(g, "land", [&](int d) { return land(d); }));
 

@@ -10,6 +10,7 @@ struct StressOptions {
   long long target_nodes = 5000;  ///< stop adding steps once the MEG has about this many nodes
   int drones = 20;
   int squad_size = 10;            ///< drones per squad; squads synchronise only internally
+  int work_per_step = 4;          ///< work items per drone between two squad barriers
   unsigned seed = 1;              ///< same seed, same text
 };
 

@@ -189,6 +189,33 @@ TEST(Errors, YamlSyntaxErrorIsReportedAtItsMark) {
   EXPECT_TRUE(contains(d.message, "YAML syntax error")) << d.message;
 }
 
+TEST(Errors, TabIndentationIsASyntaxErrorThatSaysSo) {
+  auto p = parse("types:\n\tScout:\n");
+  EXPECT_FALSE(p.ok);
+  EXPECT_EQ(first_error(p.diags).loc.line, 2);
+  EXPECT_TRUE(contains(first_error(p.diags).message, "indent with spaces")) << p.diags.format();
+}
+
+TEST(Errors, StrayCommaIsASyntaxErrorNotAHang) {
+  // yaml-cpp 0.7's own LoadAll loops forever allocating on this input.
+  auto p = parse(",ypes:\n  Scout: {}\n");
+  EXPECT_FALSE(p.ok);
+  ASSERT_EQ(p.diags.error_count(), 1u);
+  EXPECT_EQ(first_error(p.diags).message,
+            "YAML syntax error: unexpected ','; remove it or quote the text it belongs to");
+  EXPECT_EQ(first_error(p.diags).loc.col, 1);
+}
+
+TEST(Errors, TextAfterAnEarlyEndOfTheDocumentIsASyntaxError) {
+  // yaml-cpp ends the document at the unindented "/b" and would start another there.
+  auto p = parse("- macro: x\n  condition:\n    (a in (\n\"/b\",\n    \"-c\"\n    )  )\n");
+  EXPECT_FALSE(p.ok);
+  Diagnostic d = first_error(p.diags);
+  EXPECT_EQ(d.loc.line, 4);
+  EXPECT_EQ(d.loc.col, 1);
+  EXPECT_TRUE(contains(d.message, "the file should have ended before this text")) << d.message;
+}
+
 TEST(Errors, SecondYamlDocumentIsAnError) {
   auto p = parse("types: {}\n---\ndrones: {}\n");
   EXPECT_FALSE(p.ok);

@@ -21,6 +21,19 @@ TEST(Parse, DocumentedExampleLoadsWithoutDiagnostics) {
   ASSERT_NE(fleet.source, nullptr);
 }
 
+TEST(Parse, ExampleFileIsTheOneDocsFleetMdShows) {
+  SourceFile doc, example;
+  std::string error;
+  ASSERT_TRUE(read_source_file(std::string(EAMOS_SOURCE_DIR) + "/docs/fleet.md", doc, error)) << error;
+  ASSERT_TRUE(read_source_file(kExample, example, error)) << error;
+  std::size_t begin = doc.text.find("```yaml\n");
+  ASSERT_NE(begin, std::string::npos);
+  begin += 8;
+  std::string shown = doc.text.substr(begin, doc.text.find("```", begin) - begin);
+  // The data file starts with one comment line pointing back at the doc.
+  EXPECT_EQ(example.text.substr(example.text.find('\n') + 1), shown);
+}
+
 TEST(Parse, MissingFileIsAnErrorNamingThePath) {
   Fleet fleet;
   Diagnostics diags;

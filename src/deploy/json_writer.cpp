@@ -1,0 +1,179 @@
+#include "deploy/json_writer.h"
+
+#include <charconv>
+#include <cmath>
+
+namespace eamos::deploy {
+
+namespace {
+
+/// Buffered output reaches the stream in pieces of about this size.
+constexpr std::size_t kFlushAt = 64 * 1024;
+
+/// Length of the well-formed UTF-8 sequence at the start of `s` (1 to 4), or 0 when the
+/// bytes there are not one (a stray continuation byte, an overlong form, a surrogate, a
+/// code point above U+10FFFF, or a sequence cut short).
+std::size_t utf8_length(std::string_view s) {
+  auto byte = [&](std::size_t i) { return static_cast<unsigned char>(s[i]); };
+  unsigned char b = byte(0);
+  std::size_t length = 0;
+  unsigned char low = 0x80, high = 0xBF;  // allowed range of the second byte
+  if (b < 0x80) return 1;
+  if (b >= 0xC2 && b <= 0xDF) length = 2;
+  else if (b >= 0xE0 && b <= 0xEF) length = 3;
+  else if (b >= 0xF0 && b <= 0xF4) length = 4;
+  else return 0;
+  if (b == 0xE0) low = 0xA0;   // overlong
+  if (b == 0xED) high = 0x9F;  // UTF-16 surrogates
+  if (b == 0xF0) low = 0x90;   // overlong
+  if (b == 0xF4) high = 0x8F;  // above U+10FFFF
+  if (s.size() < length) return 0;
+  if (byte(1) < low || byte(1) > high) return 0;
+  for (std::size_t i = 2; i < length; ++i)
+    if (byte(i) < 0x80 || byte(i) > 0xBF) return 0;
+  return length;
+}
+
+}  // namespace
+
+JsonWriter::JsonWriter(std::ostream& out, int wrap_depth) : out_(out), wrap_depth_(wrap_depth) {
+  buffer_.reserve(kFlushAt + 1024);
+}
+
+JsonWriter::~JsonWriter() { flush(); }
+
+bool JsonWriter::flush() {
+  out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+  buffer_.clear();
+  return static_cast<bool>(out_);
+}
+
+void JsonWriter::line_break(std::size_t depth) {
+  buffer_ += '\n';
+  buffer_.append(depth, ' ');
+}
+
+void JsonWriter::begin_value() {
+  if (buffer_.size() >= kFlushAt) flush();
+  if (after_key_) {
+    after_key_ = false;
+    return;
+  }
+  if (has_items_.empty()) return;  // the document's top-level value
+  if (has_items_.back()) buffer_ += ',';
+  has_items_.back() = true;
+  if (has_items_.size() <= static_cast<std::size_t>(wrap_depth_)) line_break(has_items_.size());
+}
+
+void JsonWriter::open(char bracket) {
+  begin_value();
+  buffer_ += bracket;
+  has_items_.push_back(false);
+}
+
+void JsonWriter::close(char bracket) {
+  bool had_items = has_items_.back();
+  has_items_.pop_back();
+  if (had_items && has_items_.size() < static_cast<std::size_t>(wrap_depth_))
+    line_break(has_items_.size());
+  buffer_ += bracket;
+}
+
+void JsonWriter::begin_object() { open('{'); }
+void JsonWriter::end_object() { close('}'); }
+void JsonWriter::begin_array() { open('['); }
+void JsonWriter::end_array() { close(']'); }
+
+void JsonWriter::key(std::string_view name) {
+  begin_value();
+  write_string(name);
+  buffer_ += ':';
+  after_key_ = true;
+}
+
+void JsonWriter::value(std::string_view s) {
+  begin_value();
+  write_string(s);
+}
+
+void JsonWriter::value(const char* s) { value(std::string_view(s)); }
+
+void JsonWriter::value(double v) {
+  if (!std::isfinite(v)) {
+    null();
+    return;
+  }
+  begin_value();
+  char text[64];
+  // Without a format, to_chars writes the shortest text that reads back to exactly v.
+  auto [end, ec] = std::to_chars(text, text + sizeof text, v);
+  (void)ec;  // 64 characters always suffice for a double
+  std::string_view written(text, static_cast<std::size_t>(end - text));
+  buffer_ += written;
+  // nlohmann::json marks integral doubles with ".0" so they read back as floating point.
+  if (written.find_first_of(".e") == std::string_view::npos) buffer_ += ".0";
+}
+
+void JsonWriter::value(int v) { value(static_cast<long long>(v)); }
+
+void JsonWriter::value(long long v) {
+  begin_value();
+  char text[24];
+  auto [end, ec] = std::to_chars(text, text + sizeof text, v);
+  (void)ec;
+  buffer_.append(text, end);
+}
+
+void JsonWriter::value(bool v) {
+  begin_value();
+  buffer_ += v ? "true" : "false";
+}
+
+void JsonWriter::null() {
+  begin_value();
+  buffer_ += "null";
+}
+
+// The escapes nlohmann::json writes (without ensure_ascii): quote, backslash and control
+// characters; other UTF-8 passes through. Bytes that are not UTF-8 become U+FFFD, so the
+// output is always valid JSON whatever a fleet file or path contained.
+void JsonWriter::write_string(std::string_view s) {
+  static const char* hex = "0123456789abcdef";
+  buffer_ += '"';
+  std::size_t i = 0;
+  while (i < s.size()) {
+    unsigned char c = static_cast<unsigned char>(s[i]);
+    if (c >= 0x80) {
+      std::size_t n = utf8_length(s.substr(i));
+      if (n == 0) {
+        buffer_ += "\xEF\xBF\xBD";
+        ++i;
+      } else {
+        buffer_.append(s.substr(i, n));
+        i += n;
+      }
+      continue;
+    }
+    switch (c) {
+      case '"': buffer_ += "\\\""; break;
+      case '\\': buffer_ += "\\\\"; break;
+      case '\b': buffer_ += "\\b"; break;
+      case '\f': buffer_ += "\\f"; break;
+      case '\n': buffer_ += "\\n"; break;
+      case '\r': buffer_ += "\\r"; break;
+      case '\t': buffer_ += "\\t"; break;
+      default:
+        if (c < 0x20) {
+          buffer_ += "\\u00";
+          buffer_ += hex[c >> 4];
+          buffer_ += hex[c & 15];
+        } else {
+          buffer_ += static_cast<char>(c);
+        }
+    }
+    ++i;
+  }
+  buffer_ += '"';
+}
+
+}  // namespace eamos::deploy

@@ -1,0 +1,62 @@
+#pragma once
+// A streaming JSON writer: values go straight to an output stream, so a large mission file
+// is never held in memory as a document tree. Values print the way nlohmann::json prints
+// them (strings escaped the same way, doubles in their shortest form that reads back to the
+// same value, integral doubles with ".0"), so a file written here parses to exactly the
+// nlohmann::json the graph exporters build.
+#include <ostream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace eamos::deploy {
+
+class JsonWriter {
+ public:
+  /// Members and elements of containers nested less than `wrap_depth` deep start on a line
+  /// of their own, indented one space per level; deeper ones stay on their parent's line.
+  /// 0 writes the whole document on one line: the canonical form the mission hash reads.
+  explicit JsonWriter(std::ostream& out, int wrap_depth = 0);
+  ~JsonWriter();  ///< flushes
+
+  void begin_object();
+  void end_object();
+  void begin_array();
+  void end_array();
+  /// The name of the next object member; its value follows with value() or begin_*().
+  void key(std::string_view name);
+
+  void value(std::string_view s);
+  void value(const char* s);  ///< so that a string literal is not taken for a bool
+  void value(double v);       ///< NaN and infinities are written as null, as nlohmann does
+  void value(int v);
+  void value(long long v);
+  void value(bool v);
+  void null();
+
+  /// key() then value(), for the common one-line member.
+  void member(std::string_view name, std::string_view s) { key(name); value(s); }
+  void member(std::string_view name, const char* s) { key(name); value(s); }
+  void member(std::string_view name, double v) { key(name); value(v); }
+  void member(std::string_view name, int v) { key(name); value(v); }
+  void member(std::string_view name, long long v) { key(name); value(v); }
+  void member(std::string_view name, bool v) { key(name); value(v); }
+
+  /// Hands what is buffered to the stream; false when the stream has failed.
+  bool flush();
+
+ private:
+  void begin_value();  ///< separator and line break before a member or an element
+  void open(char bracket);
+  void close(char bracket);
+  void write_string(std::string_view s);
+  void line_break(std::size_t depth);
+
+  std::ostream& out_;
+  std::string buffer_;          ///< written to out_ in large pieces
+  int wrap_depth_;
+  std::vector<bool> has_items_;  ///< per open container: whether anything is in it yet
+  bool after_key_ = false;       ///< a key was written; the next value is its member's
+};
+
+}  // namespace eamos::deploy

@@ -1,0 +1,355 @@
+// The mission file and the mission hash, written as a stream: node by node from the
+// compiled graphs to the file (or the digest), never as a document in memory. The content
+// is exactly drone_mission()'s (synthesize.cpp builds the same file as nlohmann::json, and
+// tests/deploy checks both agree), in an order a reader can use: format and version first.
+#include <openssl/evp.h>
+
+#include <memory>
+#include <streambuf>
+#include <unordered_map>
+
+#include "deploy/json_writer.h"
+#include "deploy/synthesize.h"
+#include "graph/export.h"
+#include "version.h"
+
+namespace eamos::deploy {
+
+namespace {
+
+using graph::Compilation;
+using graph::MegKind;
+using graph::MegNode;
+
+/// Mission files break lines down to each member of a node or arc: one node per line.
+constexpr int kMissionFileWrap = 2;
+
+void write_vec3(JsonWriter& w, const fleet::Vec3& v) {
+  w.begin_array();
+  w.value(v.x);
+  w.value(v.y);
+  w.value(v.z);
+  w.end_array();
+}
+
+void write_limits(JsonWriter& w, const fleet::Limits& l) {
+  w.begin_object();
+  w.member("max_speed", l.max_speed_mps);
+  w.member("max_climb", l.max_climb_mps);
+  w.member("max_descent", l.max_descent_mps);
+  w.member("max_accel", l.max_accel_mps2);
+  w.member("max_altitude", l.max_altitude_m);
+  w.end_object();
+}
+
+void write_settings(JsonWriter& w, const fleet::DroneSettings& s, int index) {
+  w.begin_object();
+  w.member("name", s.name);
+  w.member("index", index);
+  w.member("type", s.type);
+  w.member("adapter", s.adapter);
+  if (!s.connection.empty()) w.member("connection", s.connection);
+  if (s.sysid > 0) w.member("sysid", s.sysid);
+  w.key("home");
+  write_vec3(w, s.home);
+  w.member("battery", s.battery_percent);
+  w.member("failsafe", fleet::failsafe_name(s.failsafe));
+  w.key("limits");
+  write_limits(w, s.limits);
+  w.key("sensors");
+  w.begin_object();
+  for (const auto& [name, model] : s.sensors) {
+    w.key(name);
+    w.begin_object();
+    w.member("value", model.base);
+    w.key("gradient");
+    write_vec3(w, model.gradient);
+    w.end_object();
+  }
+  w.end_object();
+  w.key("timeouts");
+  w.begin_object();
+  for (const auto& [action, seconds] : s.timeouts_s) w.member(action, seconds);
+  w.end_object();
+  w.end_object();
+}
+
+const char* class_name(fleet::ActionClass k) {
+  switch (k) {
+    case fleet::ActionClass::motion: return "motion";
+    case fleet::ActionClass::payload: return "payload";
+    case fleet::ActionClass::system: return "system";
+  }
+  return "";
+}
+
+void write_type(JsonWriter& w, const fleet::DroneType& t) {
+  w.begin_object();
+  w.member("name", t.name);
+  w.member("adapter", t.adapter);
+  w.member("sensors", t.sensors);
+  w.key("actions");
+  w.begin_array();
+  for (const auto& a : t.actions) {
+    w.begin_object();
+    w.member("name", a.name);
+    w.key("arities");
+    w.begin_array();
+    for (int n : a.arities) w.value(n);
+    w.end_array();
+    w.member("class", class_name(a.action_class));
+    w.end_object();
+  }
+  w.end_array();
+  w.key("properties");
+  w.begin_array();
+  for (const auto& p : t.properties) {
+    w.begin_object();
+    w.member("name", p.name);
+    w.member("type", p.type == fleet::ValueType::boolean ? "boolean" : "number");
+    w.end_object();
+  }
+  w.end_array();
+  w.end_object();
+}
+
+/// graph::expr_json as a stream.
+void write_expr(JsonWriter& w, const lang::Expr& e) {
+  w.begin_object();
+  switch (e.kind) {
+    case lang::ExprKind::number: w.member("num", e.number); break;
+    case lang::ExprKind::boolean: w.member("bool", e.boolean); break;
+    case lang::ExprKind::property:
+      w.member("prop", e.property);
+      w.member("drone", e.drone);
+      break;
+    case lang::ExprKind::name: w.member("name", e.drone); break;
+    case lang::ExprKind::unary:
+    case lang::ExprKind::binary:
+      w.member("op", lang::op_text(e.op));
+      w.key("args");
+      w.begin_array();
+      write_expr(w, *e.lhs);
+      if (e.kind == lang::ExprKind::binary) write_expr(w, *e.rhs);
+      w.end_array();
+      break;
+  }
+  w.end_object();
+}
+
+void write_ints(JsonWriter& w, const std::vector<int>& values) {
+  w.begin_array();
+  for (int v : values) w.value(v);
+  w.end_array();
+}
+
+void write_drone_names(JsonWriter& w, const Compilation& c, const std::vector<int>& drones) {
+  w.begin_array();
+  for (int d : drones) w.value(c.drone_name(d));
+  w.end_array();
+}
+
+/// The members of a MEG node that every copy of it shares, in the MEG and in each MDG:
+/// what it is, where it came from, and what executing it needs.
+void write_node_content(JsonWriter& w, const Compilation& c, const MegNode& n) {
+  w.member("kind", graph::meg_kind_name(n.kind));
+  w.member("name", n.name);
+  w.member("line", n.loc.line);
+  w.member("col", n.loc.col);
+  if (n.kind == MegKind::action) {
+    w.key("args");
+    w.begin_array();
+    for (const lang::Expr* a : n.args) write_expr(w, *a);
+    w.end_array();
+    w.member("text", graph::meg_node_label(c, n));
+  }
+  if (n.kind == MegKind::condition) {
+    w.member("control", lang::control_name(n.control));
+    w.key("condition");
+    write_expr(w, *n.condition);
+    w.member("text", lang::expr_text(*n.condition));
+    if (n.control == lang::ControlKind::RepeatFor) w.member("count", n.count);
+  }
+  if (!n.reads.empty()) {
+    w.key("reads");
+    write_drone_names(w, c, n.reads);
+  }
+  if (n.kind == MegKind::terminal && n.role != graph::Role::none)
+    w.member("role", graph::role_name(n.role));
+  if (n.kind == MegKind::pause) w.member("seconds", n.seconds);
+}
+
+void write_arc(JsonWriter& w, int from, int to, graph::ArcKind kind, graph::Branch branch) {
+  w.member("from", from);
+  w.member("to", to);
+  w.member("kind", graph::arc_kind_name(kind));
+  if (branch != graph::Branch::any) w.member("branch", graph::branch_name(branch));
+}
+
+/// The drone's MDG: graph::mdg_json's nodes and arcs, node by node.
+void write_mdg(JsonWriter& w, const Compilation& c, const graph::Mdg& g) {
+  // A terminal names its condition by index in this MDG. Conditions are never cloned, so
+  // their MEG id finds them.
+  std::unordered_map<int, int> condition_index;
+  for (std::size_t i = 0; i < g.nodes.size(); ++i)
+    if (c.meg.nodes[g.nodes[i].meg].kind == MegKind::condition)
+      condition_index.emplace(g.nodes[i].meg, static_cast<int>(i));
+
+  w.key("nodes");
+  w.begin_array();
+  for (std::size_t i = 0; i < g.nodes.size(); ++i) {
+    const graph::MdgNode& mn = g.nodes[i];
+    const MegNode& n = c.meg.nodes[mn.meg];
+    w.begin_object();
+    w.member("index", static_cast<long long>(i));
+    w.member("meg", mn.meg);
+    w.member("drone", c.drone_name(mn.drone));
+    w.member("internal", mn.internal);
+    if (graph::is_sync_point(n.kind)) w.member("clone", true);
+    write_node_content(w, c, n);
+    if (n.kind == MegKind::condition) w.member("evaluated_by", c.drone_name(n.drone));
+    if (!mn.cancels.empty()) {
+      w.key("cancels");
+      write_ints(w, mn.cancels);
+    }
+    if (n.kind == MegKind::terminal && n.owner_condition >= 0) {
+      auto it = condition_index.find(n.owner_condition);
+      if (it != condition_index.end()) w.member("condition", it->second);
+    }
+    w.end_object();
+  }
+  w.end_array();
+
+  w.key("arcs");
+  w.begin_array();
+  for (const graph::MdgArc& a : g.arcs) {
+    w.begin_object();
+    write_arc(w, a.from, a.to, a.kind, a.branch);
+    w.member("external", g.external(a));
+    w.end_object();
+  }
+  w.end_array();
+}
+
+/// A stream whose bytes go into a SHA-256 digest.
+class DigestBuffer : public std::streambuf {
+ public:
+  explicit DigestBuffer(EVP_MD_CTX* ctx) : ctx_(ctx) {}
+
+ protected:
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    EVP_DigestUpdate(ctx_, s, static_cast<std::size_t>(n));
+    return n;
+  }
+  int_type overflow(int_type ch) override {
+    if (!traits_type::eq_int_type(ch, traits_type::eof())) {
+      char c = traits_type::to_char_type(ch);
+      EVP_DigestUpdate(ctx_, &c, 1);
+    }
+    return traits_type::not_eof(ch);
+  }
+
+ private:
+  EVP_MD_CTX* ctx_;
+};
+
+struct DigestDeleter {
+  void operator()(EVP_MD_CTX* c) const { EVP_MD_CTX_free(c); }
+};
+
+}  // namespace
+
+bool write_drone_mission(std::ostream& out, const Compilation& c, int drone, const std::string& hash) {
+  JsonWriter w(out, kMissionFileWrap);
+  w.begin_object();
+  w.member("format", "eamos-mission");
+  w.member("format_version", kMissionFormatVersion);
+  w.member("compiler", std::string("eamos ") + EAMOS_VERSION);
+  w.member("mission_hash", hash);
+  w.key("source");
+  w.begin_object();
+  w.member("path", c.source->path);
+  w.member("package", c.mission.package);
+  w.end_object();
+  w.key("drone");
+  write_settings(w, c.settings[drone], drone);
+  w.key("type");
+  write_type(w, c.checked.drone_types[drone]);
+  w.key("fleet");
+  w.begin_array();
+  for (int d = 0; d < c.drone_count(); ++d) w.value(c.drone_name(d));
+  w.end_array();
+  const graph::Mdg& g = c.mdgs[drone];
+  w.key("reads");
+  write_drone_names(w, c, g.reads);
+  write_mdg(w, c, g);
+  w.end_object();
+  return w.flush();
+}
+
+// The canonical form hashed is one line of JSON: every drone's settings and type, then
+// every MEG node with all of its content and every arc. The digest reads it as it is
+// written, so a large mission is hashed without being held in memory.
+std::string mission_hash(const Compilation& c) {
+  std::unique_ptr<EVP_MD_CTX, DigestDeleter> ctx(EVP_MD_CTX_new());
+  EVP_DigestInit_ex(ctx.get(), EVP_sha256(), nullptr);
+  {
+    DigestBuffer digest(ctx.get());
+    std::ostream out(&digest);
+    JsonWriter w(out);
+    w.begin_object();
+    w.member("format", "eamos-mission");
+    w.member("format_version", kMissionFormatVersion);
+    w.key("drones");
+    w.begin_array();
+    for (int d = 0; d < c.drone_count(); ++d) {
+      w.begin_array();
+      write_settings(w, c.settings[d], d);
+      write_type(w, c.checked.drone_types[d]);
+      w.end_array();
+    }
+    w.end_array();
+    w.member("init", c.meg.init);
+    w.member("end", c.meg.end);
+    w.key("nodes");
+    w.begin_array();
+    for (const MegNode& n : c.meg.nodes) {
+      w.begin_object();
+      w.member("id", n.id);
+      if (n.drone >= 0) w.member("drone", c.drone_name(n.drone));
+      write_node_content(w, c, n);
+      if (n.kind == MegKind::condition) {
+        w.key("terminals");
+        write_ints(w, n.terminals);
+        if (!n.cancels.empty()) {
+          w.key("cancels");
+          write_ints(w, n.cancels);
+        }
+      }
+      if (n.kind == MegKind::terminal) w.member("condition", n.owner_condition);
+      w.end_object();
+    }
+    w.end_array();
+    w.key("arcs");
+    w.begin_array();
+    for (const graph::MegArc& a : c.meg.arcs) {
+      w.begin_object();
+      write_arc(w, a.from, a.to, a.kind, a.branch);
+      w.end_object();
+    }
+    w.end_array();
+    w.end_object();
+  }  // the writer flushes into the digest here
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int length = 0;
+  EVP_DigestFinal_ex(ctx.get(), digest, &length);
+  static const char* hex = "0123456789abcdef";
+  std::string out;
+  for (unsigned int i = 0; i < length; ++i) {
+    out += hex[digest[i] >> 4];
+    out += hex[digest[i] & 15];
+  }
+  return out;
+}
+
+}  // namespace eamos::deploy

@@ -1,0 +1,169 @@
+// The `eamos` binary end to end: exit status, output files and what a user sees.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Output {
+  int status = -1;
+  std::string out;  ///< stdout and stderr together
+};
+
+Output eamos(const std::string& args) {
+  std::string cmd = std::string(EAMOS_BINARY) + " " + args + " 2>&1";
+  Output r;
+  FILE* p = popen(cmd.c_str(), "r");
+  char buf[4096];
+  std::size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  int raw = pclose(p);
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  return r;
+}
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+const std::string kListing2 = std::string(EAMOS_SOURCE_DIR) + "/examples/listing2.eamos";
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("eamos-cli-" + std::to_string(::getpid()) + "-" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+TEST_F(Cli, CheckAcceptsListing2AndPrintsItsWarning) {
+  Output r = eamos("check " + kListing2);
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("ok — 3 drones"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("warning: drone 'Drone2' may run two motion actions"), std::string::npos);
+}
+
+TEST_F(Cli, CheckFailsWithExitOneAndEveryErrorGccStyle) {
+  fs::path m = dir_ / "bad.eamos";
+  std::ofstream(m) << "var A Quad\nfunc INIT() {\n  A.Tkeoff(3)\n  B.Land()\n}\n";
+  Output r = eamos("check " + m.string());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find(m.string() + ":3:5: error: drone 'A' of type 'Quad' has no capability 'Tkeoff'; did you mean 'Takeoff'?"),
+            std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(m.string() + ":4:3: error: unknown drone 'B'"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("2 error(s)"), std::string::npos);
+}
+
+TEST_F(Cli, WerrorTurnsWarningsIntoFailure) {
+  EXPECT_EQ(eamos("check --werror " + kListing2).status, 1);
+  EXPECT_EQ(eamos("check -q " + kListing2).out.find("warning"), std::string::npos);
+}
+
+TEST_F(Cli, MissingFileIsAClearErrorNotACrash) {
+  Output r = eamos("check " + (dir_ / "nope.eamos").string());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("nope.eamos"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, CompileWritesManifestAndOneMissionFilePerDrone) {
+  Output r = eamos("compile -q " + kListing2 + " -o " + (dir_ / "deploy").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  auto manifest = nlohmann::json::parse(read_file(dir_ / "deploy" / "manifest.json"));
+  ASSERT_EQ(manifest["drones"].size(), 3u);
+  std::string hash = manifest["mission_hash"];
+  EXPECT_EQ(hash.size(), 64u);
+  for (const char* drone : {"Drone1", "Drone2", "Drone3"}) {
+    auto m = nlohmann::json::parse(read_file(dir_ / "deploy" / drone / "mission.json"));
+    EXPECT_EQ(m["format"], "eamos-mission");
+    EXPECT_EQ(m["format_version"], 1);
+    EXPECT_EQ(m["mission_hash"], hash);
+    EXPECT_EQ(m["drone"]["name"], drone);
+    EXPECT_FALSE(m["nodes"].empty());
+  }
+}
+
+TEST_F(Cli, FleetFileChangesTheMissionHash) {
+  fs::path fleet = dir_ / "fleet.yaml";
+  std::ofstream(fleet) << "drones:\n  Drone1:\n    sensors:\n      Sensor1: 120\n";
+  ASSERT_EQ(eamos("compile -q " + kListing2 + " -o " + (dir_ / "a").string()).status, 0);
+  Output r = eamos("compile -q " + kListing2 + " --fleet " + fleet.string() + " -o " + (dir_ / "b").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  auto a = nlohmann::json::parse(read_file(dir_ / "a" / "manifest.json"));
+  auto b = nlohmann::json::parse(read_file(dir_ / "b" / "manifest.json"));
+  EXPECT_NE(a["mission_hash"], b["mission_hash"]);
+  auto d1 = nlohmann::json::parse(read_file(dir_ / "b" / "Drone1" / "mission.json"));
+  EXPECT_EQ(d1["drone"]["sensors"]["Sensor1"]["value"], 120.0);
+}
+
+TEST_F(Cli, GraphRendersSvgThroughGraphviz) {
+  fs::path svg = dir_ / "meg.svg";
+  Output r = eamos("graph -q " + kListing2 + " --kind meg --format svg -o " + svg.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::string text = read_file(svg);
+  EXPECT_NE(text.find("<svg"), std::string::npos);
+  EXPECT_NE(text.find("Drone1.Takeoff(3)"), std::string::npos);
+}
+
+TEST_F(Cli, GraphOfMdgNeedsAKnownDrone) {
+  Output r = eamos("graph -q " + kListing2 + " --kind mdg --drone Drone9 --format dot");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("no drone 'Drone9'"), std::string::npos) << r.out;
+  Output ok = eamos("graph -q " + kListing2 + " --kind mdg --drone Drone2 --format json");
+  ASSERT_EQ(ok.status, 0);
+  EXPECT_EQ(nlohmann::json::parse(ok.out)["drone"], "Drone2");
+}
+
+TEST_F(Cli, StatsCountsNodesPerDrone) {
+  Output r = eamos("stats -q " + kListing2);
+  ASSERT_EQ(r.status, 0) << r.out;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["drones"], 3);
+  EXPECT_EQ(j["mdg"]["per_drone"].size(), 3u);
+  EXPECT_EQ(j["meg"]["nodes"].get<int>(), j["meg"]["by_kind"]["action"].get<int>() +
+                                              j["meg"]["by_kind"]["condition"].get<int>() +
+                                              j["meg"]["by_kind"]["terminal"].get<int>() +
+                                              j["meg"]["by_kind"]["fork"].get<int>() +
+                                              j["meg"]["by_kind"]["pause"].get<int>() + 2);
+}
+
+TEST_F(Cli, GenStressMissionCompilesWithoutWarningsAndIsDeterministic) {
+  fs::path a = dir_ / "a.eamos", b = dir_ / "b.eamos";
+  ASSERT_EQ(eamos("gen-stress --nodes 2000 --drones 12 -o " + a.string()).status, 0);
+  ASSERT_EQ(eamos("gen-stress --nodes 2000 --drones 12 -o " + b.string()).status, 0);
+  EXPECT_EQ(read_file(a), read_file(b));
+  Output r = eamos("check --werror " + a.string());
+  EXPECT_EQ(r.status, 0) << r.out.substr(0, 2000);
+  auto stats = nlohmann::json::parse(eamos("stats " + a.string()).out);
+  int nodes = stats["meg"]["nodes"];
+  EXPECT_GE(nodes, 2000);
+  EXPECT_LT(nodes, 2400);
+}
+
+TEST_F(Cli, HelpAndVersion) {
+  Output v = eamos("--version");
+  EXPECT_EQ(v.status, 0);
+  EXPECT_NE(v.out.find("eamos 0."), std::string::npos);
+  for (const char* sub : {"check", "compile", "graph", "stats", "gen-stress"}) {
+    Output h = eamos(std::string(sub) + " --help");
+    EXPECT_EQ(h.status, 0) << sub;
+    EXPECT_NE(h.out.find("Usage"), std::string::npos) << sub;
+  }
+  EXPECT_EQ(eamos("frobnicate").status, 1);
+}
+
+}  // namespace
