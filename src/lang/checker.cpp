@@ -4,6 +4,8 @@
 #include <map>
 #include <set>
 #include <string>
+#include <string_view>
+#include <unordered_map>
 
 #include "lang/concurrency.h"
 
@@ -87,6 +89,9 @@ class Checker {
   void warning(SourceLocation loc, const std::string& msg) { diags_.warning(file_, loc, msg); }
   std::vector<std::string> function_names() const;
   std::vector<std::string> drone_names() const;
+  void index_names();
+  int find_function(const std::string& name) const;
+  int find_drone(const std::string& name) const;
 
   Mission& m_;
   const fleet::Fleet& fleet_;
@@ -94,9 +99,14 @@ class Checker {
   CheckLimits limits_;
   const SourceFile* file_;
   CheckedMission out_;
+  // Name → index of the first function and drone of that name. A large mission names
+  // thousands of blocks, and Mission::find_* would compare against every one per call.
+  std::unordered_map<std::string_view, int> function_index_;
+  std::unordered_map<std::string_view, int> drone_index_;
 };
 
 CheckedMission Checker::run() {
+  index_names();
   check_drones();
   check_functions();
   for (auto& f : m_.functions)
@@ -107,6 +117,23 @@ CheckedMission Checker::run() {
     warn_concurrent_motion(m_, out_.drone_types, diags_);
   }
   return std::move(out_);
+}
+
+void Checker::index_names() {
+  for (std::size_t i = 0; i < m_.functions.size(); ++i)
+    function_index_.emplace(m_.functions[i].name, static_cast<int>(i));
+  for (std::size_t i = 0; i < m_.drones.size(); ++i)
+    drone_index_.emplace(m_.drones[i].name, static_cast<int>(i));
+}
+
+int Checker::find_function(const std::string& name) const {
+  auto it = function_index_.find(name);
+  return it == function_index_.end() ? -1 : it->second;
+}
+
+int Checker::find_drone(const std::string& name) const {
+  auto it = drone_index_.find(name);
+  return it == drone_index_.end() ? -1 : it->second;
 }
 
 std::vector<std::string> Checker::function_names() const {
@@ -123,20 +150,21 @@ std::vector<std::string> Checker::drone_names() const {
 
 void Checker::check_drones() {
   if (m_.drones.empty())
-    error({1, 1}, "mission declares no drones; declare each with `var Drone1 DroneType` before the functions");
+    error(m_.functions.empty() ? SourceLocation{1, 1} : m_.functions.front().loc,
+          "mission declares no drones; declare each with `var Drone1 DroneType` before the functions");
   std::map<std::string, const DroneDecl*> seen;
   for (const auto& d : m_.drones) {
     auto [it, fresh] = seen.emplace(d.name, &d);
     if (!fresh)
       error(d.loc, "drone '" + d.name + "' is declared twice (first at line " +
                        std::to_string(it->second->loc.line) + "); rename or remove one");
-    if (m_.find_function(d.name) >= 0)
+    if (find_function(d.name) >= 0)
       error(d.loc, "'" + d.name + "' is both a drone and a function; rename one");
     out_.drone_types.push_back(fleet_.type_for(d.type));
     fleet_.check_drone(d.name, out_.drone_types.back(), diags_);
   }
   for (const auto& [name, loc] : fleet_.drone_locations)
-    if (m_.find_drone(name) < 0 && fleet_.source)
+    if (find_drone(name) < 0 && fleet_.source)
       diags_.warning(fleet_.source.get(), loc,
                      "fleet file describes drone '" + name + "' which the mission does not declare");
 }
@@ -178,7 +206,7 @@ void Checker::check_statement(Function& f, Statement& s) {
       else check_block_call(s);
       break;
     case StatementKind::async_call: {
-      int fi = m_.find_function(s.callee);
+      int fi = find_function(s.callee);
       if (fi < 0) {
         std::string near = closest_match(s.callee, function_names());
         error(s.callee_loc, "undefined block '" + s.callee + "' in async(...)" +
@@ -195,7 +223,7 @@ void Checker::check_statement(Function& f, Statement& s) {
 }
 
 void Checker::check_action(Statement& s) {
-  s.drone_index = m_.find_drone(s.drone);
+  s.drone_index = find_drone(s.drone);
   if (s.drone_index < 0) {
     std::string near = closest_match(s.drone, drone_names());
     error(s.loc, "unknown drone '" + s.drone + "'" +
@@ -235,14 +263,14 @@ void Checker::check_action(Statement& s) {
 }
 
 void Checker::check_block_call(Statement& s) {
-  int fi = m_.find_function(s.callee);
+  int fi = find_function(s.callee);
   if (fi < 0) {
     std::vector<std::string> candidates = function_names();
     for (const auto& sig : signatures()) candidates.push_back(control_name(sig.kind));
     std::string near = closest_match(s.callee, candidates);
     bool is_action = false;
     for (const auto& a : fleet::standard_actions()) is_action |= a.name == s.callee;
-    if (m_.find_drone(s.callee) >= 0)
+    if (find_drone(s.callee) >= 0)
       error(s.callee_loc, "'" + s.callee + "' is a drone; call one of its actions, e.g. " +
                               s.callee + ".Takeoff(5)");
     else if (is_action)
@@ -272,7 +300,7 @@ int Checker::resolve_block(const Expr& e) {
     error(e.loc, "expected a block name (SEQ_... or PAR_...) here, found '" + expr_text(e) + "'");
     return -1;
   }
-  int fi = m_.find_function(e.drone);
+  int fi = find_function(e.drone);
   if (fi < 0) {
     std::string near = closest_match(e.drone, function_names());
     error(e.loc, "undefined block '" + e.drone + "'" +
@@ -333,16 +361,16 @@ ValueType Checker::type_of(Expr& e) {
     case ExprKind::number: return e.type = ValueType::number;
     case ExprKind::boolean: return e.type = ValueType::boolean;
     case ExprKind::name: {
-      std::string hint = m_.find_drone(e.drone) >= 0
+      std::string hint = find_drone(e.drone) >= 0
                              ? "; read a property, e.g. " + e.drone + ".X()"
-                             : m_.find_function(e.drone) >= 0
+                             : find_function(e.drone) >= 0
                                    ? "; a block cannot be used as a value"
                                    : "; property reads are written Drone.Property()";
       error(e.loc, "unknown name '" + e.drone + "' in expression" + hint);
       return e.type = ValueType::unknown;
     }
     case ExprKind::property: {
-      e.drone_index = m_.find_drone(e.drone);
+      e.drone_index = find_drone(e.drone);
       if (e.drone_index < 0) {
         std::string near = closest_match(e.drone, drone_names());
         error(e.loc, "unknown drone '" + e.drone + "'" +

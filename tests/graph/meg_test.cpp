@@ -104,13 +104,18 @@ TEST(Meg, RepeatForCarriesItsIterationLimit) {
   EXPECT_TRUE(has_arc(*c, node(*c, "T repeat RepeatFor"), cond, ArcKind::back));
 }
 
-TEST(Meg, PauseUntilContinuesOnGoWithoutTerminal) {
-  auto c = compile_text(mission("func INIT() { A.Arm(); PauseUntil(B.Armed()); A.Takeoff(3) }\n"));
-  ASSERT_TRUE(c);
-  int cond = node(*c, "PauseUntil B.Armed()");
-  EXPECT_TRUE(has_arc(*c, node(*c, "A.Arm()"), cond));
-  EXPECT_TRUE(has_arc(*c, cond, node(*c, "A.Takeoff(3)"), ArcKind::exec, Branch::go));
-  EXPECT_TRUE(c->meg.nodes[cond].terminals.empty());
+TEST(Meg, PauseUntilAndPauseWhileContinueOnGoWithoutTerminal) {
+  for (const char* kind : {"PauseUntil", "PauseWhile"}) {
+    auto c = compile_text(mission(std::string("func INIT() { A.Arm(); ") + kind +
+                                  "(B.Armed()); A.Takeoff(3) }\n"));
+    ASSERT_TRUE(c);
+    int cond = node(*c, std::string(kind) + " B.Armed()");
+    ASSERT_GE(cond, 0) << kind;
+    EXPECT_EQ(c->meg.nodes[cond].drone, 1) << kind;  // B's property: B evaluates
+    EXPECT_TRUE(has_arc(*c, node(*c, "A.Arm()"), cond)) << kind;
+    EXPECT_TRUE(has_arc(*c, cond, node(*c, "A.Takeoff(3)"), ArcKind::exec, Branch::go)) << kind;
+    EXPECT_TRUE(c->meg.nodes[cond].terminals.empty()) << kind;
+  }
 }
 
 TEST(Meg, PauseForIsATimerOnTheDroneThatRanBefore) {
