@@ -11,13 +11,10 @@
 
 namespace eamos::cli {
 
-namespace {
-
-/// Compiles and prints diagnostics; returns true when the graphs are usable.
-bool compile_and_report(const CommonOptions& o, graph::Compilation& c) {
+bool compile_and_report(const CommonOptions& o, graph::Compilation& c, graph::Keep keep) {
   Diagnostics diags;
   diags.max_errors = o.max_errors;
-  bool ok = graph::compile_file(o.mission, o.fleet, diags, c);
+  bool ok = graph::compile_file(o.mission, o.fleet, diags, c, keep);
   // Re-list what the run found: -q drops warnings, --werror turns them into errors.
   Diagnostics shown;
   shown.max_errors = 0;
@@ -47,7 +44,6 @@ bool compile_and_report(const CommonOptions& o, graph::Compilation& c) {
   return ok;
 }
 
-}  // namespace
 
 bool write_output(const std::string& path, const std::string& text) {
   if (path.empty() || path == "-") {
@@ -84,7 +80,7 @@ int cmd_check(const CommonOptions& o, bool list_capabilities) {
 
 int cmd_compile(const CommonOptions& o, const std::string& out_dir) {
   graph::Compilation c;
-  if (!compile_and_report(o, c)) return 1;
+  if (!compile_and_report(o, c, graph::Keep::deployment_graphs)) return 1;
   Diagnostics diags;
   if (!deploy::write_deployment(c, out_dir, diags)) {
     std::cerr << diags.format();

@@ -3,6 +3,8 @@
 // input had errors (all of them printed) or a file could not be read or written.
 #include <string>
 
+#include "graph/pipeline.h"
+
 namespace eamos::cli {
 
 struct CommonOptions {
@@ -18,7 +20,20 @@ int cmd_compile(const CommonOptions& o, const std::string& out_dir);
 int cmd_graph(const CommonOptions& o, const std::string& kind, const std::string& drone,
               const std::string& format, const std::string& output);
 int cmd_stats(const CommonOptions& o, const std::string& output);
+struct RunCommandOptions {
+  std::string trace;      ///< JSON Lines trace file; "" = none
+  std::string summary;    ///< summary JSON file; "" = none
+  bool realtime = false;
+  double speed = 0.0;     ///< > 0: real time scaled by this factor
+  double time_limit = 3600.0;
+  bool log = true;        ///< print the live log
+};
+int cmd_run(const CommonOptions& o, const RunCommandOptions& r);
 int cmd_gen_stress(long long nodes, int drones, unsigned seed, const std::string& output);
+
+/// Compiles and prints every diagnostic; true when the graphs are usable.
+bool compile_and_report(const CommonOptions& o, graph::Compilation& c,
+                        graph::Keep keep = graph::Keep::all_graphs);
 
 /// Renders DOT to SVG with Graphviz `dot`; returns false with `error` set on failure.
 bool render_svg(const std::string& dot, std::string& svg, std::string& error);

@@ -51,6 +51,17 @@ int main(int argc, char** argv) {
   std::string stats_out;
   stats->add_option("-o,--output", stats_out, "Output file (default: standard output)");
 
+  auto* run = app.add_subcommand("run", "Compile and fly a mission in the built-in simulator; exit 0 only when it completed");
+  add_common(run, o);
+  eamos::cli::RunCommandOptions run_opts;
+  run->add_option("--trace", run_opts.trace, "Write the trace as JSON Lines to this file");
+  run->add_option("--summary", run_opts.summary, "Write the summary JSON to this file");
+  auto* realtime = run->add_flag("--realtime", run_opts.realtime, "Run in real time instead of virtual time");
+  run->add_option("--speed", run_opts.speed, "Real time scaled by X (2 = twice as fast)")
+      ->check(CLI::PositiveNumber)->excludes(realtime);
+  run->add_option("--time-limit", run_opts.time_limit, "Fail a mission still running after this many mission seconds")
+      ->check(CLI::PositiveNumber);
+
   auto* gen = app.add_subcommand("gen-stress", "Generate a large valid mission for scaling tests");
   long long nodes = 5000;
   int drones = 20;
@@ -73,6 +84,7 @@ int main(int argc, char** argv) {
     if (*compile) return eamos::cli::cmd_compile(o, out_dir);
     if (*graph) return eamos::cli::cmd_graph(o, kind, drone, format, graph_out);
     if (*stats) return eamos::cli::cmd_stats(o, stats_out);
+    if (*run) return eamos::cli::cmd_run(o, run_opts);
     if (*gen) return eamos::cli::cmd_gen_stress(nodes, drones, seed, gen_out);
   } catch (const std::exception& e) {
     std::cerr << "eamos: error: " << e.what() << "\n";

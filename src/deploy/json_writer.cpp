@@ -61,14 +61,14 @@ void JsonWriter::begin_value() {
   }
   if (has_items_.empty()) return;  // the document's top-level value
   if (has_items_.back()) buffer_ += ',';
-  has_items_.back() = true;
+  has_items_.back() = 1;
   if (has_items_.size() <= static_cast<std::size_t>(wrap_depth_)) line_break(has_items_.size());
 }
 
 void JsonWriter::open(char bracket) {
   begin_value();
   buffer_ += bracket;
-  has_items_.push_back(false);
+  has_items_.push_back(0);
 }
 
 void JsonWriter::close(char bracket) {
@@ -136,24 +136,27 @@ void JsonWriter::null() {
 
 // The escapes nlohmann::json writes (without ensure_ascii): quote, backslash and control
 // characters; other UTF-8 passes through. Bytes that are not UTF-8 become U+FFFD, so the
-// output is always valid JSON whatever a fleet file or path contained.
+// output is always valid JSON whatever a fleet file or path contained. Runs of bytes that
+// need nothing are copied in one piece.
 void JsonWriter::write_string(std::string_view s) {
   static const char* hex = "0123456789abcdef";
   buffer_ += '"';
+  std::size_t copied = 0;  // s[0, copied) is in the buffer
   std::size_t i = 0;
   while (i < s.size()) {
     unsigned char c = static_cast<unsigned char>(s[i]);
-    if (c >= 0x80) {
-      std::size_t n = utf8_length(s.substr(i));
-      if (n == 0) {
-        buffer_ += "\xEF\xBF\xBD";
-        ++i;
-      } else {
-        buffer_.append(s.substr(i, n));
-        i += n;
-      }
+    if (c >= 0x20 && c < 0x80 && c != '"' && c != '\\') {
+      ++i;
       continue;
     }
+    if (c >= 0x80) {
+      std::size_t n = utf8_length(s.substr(i));
+      if (n > 0) {
+        i += n;
+        continue;
+      }
+    }
+    buffer_.append(s.substr(copied, i - copied));
     switch (c) {
       case '"': buffer_ += "\\\""; break;
       case '\\': buffer_ += "\\\\"; break;
@@ -163,16 +166,18 @@ void JsonWriter::write_string(std::string_view s) {
       case '\r': buffer_ += "\\r"; break;
       case '\t': buffer_ += "\\t"; break;
       default:
-        if (c < 0x20) {
+        if (c >= 0x80) {
+          buffer_ += "\xEF\xBF\xBD";  // not UTF-8: U+FFFD
+        } else {
           buffer_ += "\\u00";
           buffer_ += hex[c >> 4];
           buffer_ += hex[c & 15];
-        } else {
-          buffer_ += static_cast<char>(c);
         }
     }
     ++i;
+    copied = i;
   }
+  buffer_.append(s.substr(copied));
   buffer_ += '"';
 }
 

@@ -55,7 +55,7 @@ class JsonWriter {
   std::ostream& out_;
   std::string buffer_;          ///< written to out_ in large pieces
   int wrap_depth_;
-  std::vector<bool> has_items_;  ///< per open container: whether anything is in it yet
+  std::vector<char> has_items_;  ///< per open container: 1 once something is in it
   bool after_key_ = false;       ///< a key was written; the next value is its member's
 };
 

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
-#include <sstream>
 
 namespace eamos {
 
@@ -36,13 +36,19 @@ bool read_source_file(const std::string& path, SourceFile& out, std::string& err
     error = std::strerror(errno);
     return false;
   }
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
+  // Read straight into one string: a large mission is read without extra copies.
+  std::string text;
+  std::error_code size_error;
+  auto size = std::filesystem::file_size(path, size_error);
+  if (!size_error) text.reserve(size);
+  char buffer[64 * 1024];
+  while (in.read(buffer, sizeof buffer) || in.gcount() > 0)
+    text.append(buffer, static_cast<std::size_t>(in.gcount()));
   if (in.bad()) {
     error = "read error";
     return false;
   }
-  out = SourceFile(path, buffer.str());
+  out = SourceFile(path, std::move(text));
   return true;
 }
 

@@ -100,9 +100,9 @@ void FleetParser::type(const std::string& name, const YAML::Node& node) {
       if (key == "adapter") r_.choice(v, "adapter", kAdapters, t.adapter);
       if (key == "capabilities") capabilities(v, where, t);
       if (key == "limits") {
-        LimitOverrides set;
-        limits(v, where, set);
-        set.apply(t.limits);
+        LimitOverrides given;
+        limits(v, where, given);
+        given.apply(t.limits);
       }
       if (key == "sensors" && r_.whole_number(v, "sensors of " + where, sensor_count) &&
           (sensor_count < 0 || sensor_count > kMaxSensors)) {

@@ -51,16 +51,42 @@ std::vector<Role> branch_roles(ControlKind k) {
 
 class AmtBuilder {
  public:
-  explicit AmtBuilder(const lang::Mission& m) : m_(m) {}
+  explicit AmtBuilder(const lang::Mission& m) : m_(m), block_sizes_(m.functions.size(), 0) {}
 
   Amt build() {
     const lang::Function& init = m_.functions[m_.init_function];
+    amt_.nodes.reserve(block_size(m_.init_function));
     int root = add(AmtKind::init, init.loc, init.name, -1);
     expand_body(root, init);
     return std::move(amt_);
   }
 
  private:
+  /// At most the nodes that expanding function `f` adds (its own node and everything
+  /// below it). Reserving them up front keeps the node vector from being copied as it
+  /// grows, which at 500,000 nodes costs time and a transient half of the AMT's memory.
+  std::size_t block_size(int f) {
+    if (block_sizes_[f] == 0) {
+      std::size_t size = 1;
+      for (const auto& s : m_.functions[f].body) size += statement_size(s);
+      block_sizes_[f] = size;
+    }
+    return block_sizes_[f];
+  }
+
+  std::size_t statement_size(const lang::Statement& s) {
+    switch (s.kind) {
+      case lang::StatementKind::action: return 1;
+      case lang::StatementKind::async_call: return 1 + block_size(s.function_index);
+      case lang::StatementKind::call: break;
+    }
+    if (s.control == ControlKind::none) return block_size(s.function_index);
+    std::size_t size = 1;
+    for (int branch : s.branch_functions)
+      if (branch >= 0) size += block_size(branch);
+    return size;
+  }
+
   int add(AmtKind kind, SourceLocation loc, const std::string& name, int parent) {
     AmtNode n;
     n.id = static_cast<int>(amt_.nodes.size());
@@ -68,20 +94,9 @@ class AmtBuilder {
     n.loc = loc;
     n.name = name;
     n.parent = parent;
-    if (parent >= 0) {
-      amt_.nodes[parent].children.push_back(n.id);
-      n.in_block = block_name_of(parent);
-    }
+    if (parent >= 0) amt_.nodes[parent].children.push_back(n.id);
     amt_.nodes.push_back(std::move(n));
     return amt_.nodes.back().id;
-  }
-
-  std::string block_name_of(int node) const {
-    for (int p = node; p >= 0; p = amt_.nodes[p].parent) {
-      AmtKind k = amt_.nodes[p].kind;
-      if (k == AmtKind::seq || k == AmtKind::par || k == AmtKind::init) return amt_.nodes[p].name;
-    }
-    return "";
   }
 
   void expand_body(int parent, const lang::Function& f) {
@@ -139,6 +154,7 @@ class AmtBuilder {
   }
 
   const lang::Mission& m_;
+  std::vector<std::size_t> block_sizes_;  ///< per function, 0 until computed
   Amt amt_;
 };
 

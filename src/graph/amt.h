@@ -41,8 +41,6 @@ struct AmtNode {
   const lang::Expr* condition = nullptr;
   long long count = 0;     ///< RepeatFor
   double seconds = 0.0;    ///< PauseFor
-  // where the statement came from, for tools: the block that contains it
-  std::string in_block;
 };
 
 struct Amt {

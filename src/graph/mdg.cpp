@@ -59,8 +59,15 @@ class MdgBuilder {
  public:
   explicit MdgBuilder(const Meg& meg) : meg_(meg), clones_(sync_clones(meg)) {
     mdgs_.resize(meg.drone_count);
-    index_.resize(meg.drone_count);
     for (int d = 0; d < meg.drone_count; ++d) mdgs_[d].drone = d;
+    first_instance_.resize(meg.nodes.size());
+    int instances = 0;
+    for (const MegNode& n : meg.nodes) {
+      first_instance_[n.id] = instances;
+      instances += is_sync_point(n.kind) ? static_cast<int>(clones_[n.id].size()) : 1;
+    }
+    internal_index_.assign(instances, -1);
+    external_index_.resize(meg.drone_count);
   }
 
   std::vector<Mdg> build() {
@@ -78,18 +85,29 @@ class MdgBuilder {
   }
 
  private:
-  static std::uint64_t key(Instance i, int drone_count) {
-    return static_cast<std::uint64_t>(i.meg) * static_cast<std::uint64_t>(drone_count) + i.drone;
+  /// Dense id of an instance: its MEG node's first id, plus the clone's position among
+  /// the node's (sorted) clone holders for a sync point.
+  int instance_id(Instance i) const {
+    int id = first_instance_[i.meg];
+    if (!is_sync_point(meg_.nodes[i.meg].kind)) return id;
+    const std::vector<int>& holders = clones_[i.meg];
+    return id + static_cast<int>(std::lower_bound(holders.begin(), holders.end(), i.drone) - holders.begin());
   }
 
   /// Index of instance `i` in the MDG of drone `d`, added (internal or external) if new.
   int node(int d, Instance i) {
-    auto [it, fresh] = index_[d].emplace(key(i, meg_.drone_count), 0);
-    if (fresh) {
-      it->second = static_cast<int>(mdgs_[d].nodes.size());
+    int id = instance_id(i);
+    int* index = nullptr;
+    if (i.drone == d) {
+      index = &internal_index_[id];
+    } else {
+      index = &external_index_[d].emplace(id, -1).first->second;
+    }
+    if (*index < 0) {
+      *index = static_cast<int>(mdgs_[d].nodes.size());
       mdgs_[d].nodes.push_back({i.meg, i.drone, i.drone == d, {}});
     }
-    return it->second;
+    return *index;
   }
 
   void arc(Instance from, Instance to, const MegArc& a) {
@@ -143,7 +161,12 @@ class MdgBuilder {
   const Meg& meg_;
   std::vector<std::vector<int>> clones_;
   std::vector<Mdg> mdgs_;
-  std::vector<std::unordered_map<std::uint64_t, int>> index_;
+  // Where each instance sits in the MDGs that hold it. Every instance is internal to its
+  // holder's MDG, so that index is a plain array; the other drones' instances an MDG
+  // holds (its external nodes) are found in a small hash map per MDG.
+  std::vector<int> first_instance_;  ///< per MEG node: id of its first instance
+  std::vector<int> internal_index_;  ///< per instance: index in its holder's MDG, -1 not yet
+  std::vector<std::unordered_map<int, int>> external_index_;  ///< per MDG: instance → index
 };
 
 }  // namespace

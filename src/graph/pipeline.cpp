@@ -5,7 +5,7 @@
 namespace eamos::graph {
 
 bool compile(std::shared_ptr<SourceFile> source, const fleet::Fleet& fleet, Diagnostics& diags,
-             Compilation& out, const lang::CheckLimits& limits) {
+             Compilation& out, const lang::CheckLimits& limits, Keep keep) {
   out.source = std::move(source);
   out.fleet = fleet;
   out.mission = lang::parse_mission(*out.source, diags);
@@ -16,12 +16,13 @@ bool compile(std::shared_ptr<SourceFile> source, const fleet::Fleet& fleet, Diag
                                                   out.mission.drones[d].type, d));
   out.amt = build_amt(out.mission);
   out.meg = build_meg(out.amt, out.mission);
+  if (keep == Keep::deployment_graphs) out.amt = Amt{};
   out.mdgs = build_mdgs(out.meg);
   return true;
 }
 
 bool compile_file(const std::string& path, const std::string& fleet_path, Diagnostics& diags,
-                  Compilation& out) {
+                  Compilation& out, Keep keep) {
   fleet::Fleet fleet;
   if (!fleet_path.empty() && !fleet::load_fleet(fleet_path, fleet, diags)) return false;
   auto source = std::make_shared<SourceFile>();
@@ -30,7 +31,7 @@ bool compile_file(const std::string& path, const std::string& fleet_path, Diagno
     diags.error(nullptr, {}, "cannot read mission file '" + path + "': " + error);
     return false;
   }
-  return compile(std::move(source), fleet, diags, out);
+  return compile(std::move(source), fleet, diags, out, {}, keep);
 }
 
 }  // namespace eamos::graph

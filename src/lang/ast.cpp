@@ -1,5 +1,6 @@
 #include "lang/ast.h"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 
@@ -75,9 +76,11 @@ int Mission::find_function(const std::string& name) const {
 namespace {
 std::string number_text(double v) {
   if (std::isfinite(v) && v == std::floor(v) && std::fabs(v) < 1e15) {
+    // What "%.0f" prints, without printf's cost: labels print a number per argument.
+    if (v == 0 && std::signbit(v)) return "-0";
     char buf[32];
-    std::snprintf(buf, sizeof buf, "%.0f", v);
-    return buf;
+    auto end = std::to_chars(buf, buf + sizeof buf, static_cast<long long>(v)).ptr;
+    return std::string(buf, end);
   }
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);

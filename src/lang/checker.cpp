@@ -82,7 +82,8 @@ class Checker {
   void check_control(Statement& s);
   int resolve_block(const Expr& e);
   ValueType type_of(Expr& e);
-  void expect_type(Expr& e, ValueType want, const std::string& what);
+  /// `what` and `whose` name the value in a message: "argument of" "FlyTo".
+  void expect_type(Expr& e, ValueType want, const char* what, const std::string& whose);
   void check_call_graph();
   void check_unused();
   void error(SourceLocation loc, const std::string& msg) { diags_.error(file_, loc, msg); }
@@ -103,6 +104,8 @@ class Checker {
   // thousands of blocks, and Mission::find_* would compare against every one per call.
   std::unordered_map<std::string_view, int> function_index_;
   std::unordered_map<std::string_view, int> drone_index_;
+  /// Per function, the blocks it calls (check_call_graph fills it, check_unused reads it).
+  std::vector<std::vector<std::pair<int, SourceLocation>>> calls_;
 };
 
 CheckedMission Checker::run() {
@@ -120,6 +123,8 @@ CheckedMission Checker::run() {
 }
 
 void Checker::index_names() {
+  function_index_.reserve(m_.functions.size());
+  drone_index_.reserve(m_.drones.size());
   for (std::size_t i = 0; i < m_.functions.size(); ++i)
     function_index_.emplace(m_.functions[i].name, static_cast<int>(i));
   for (std::size_t i = 0; i < m_.drones.size(); ++i)
@@ -170,13 +175,12 @@ void Checker::check_drones() {
 }
 
 void Checker::check_functions() {
-  std::map<std::string, const Function*> seen;
   for (std::size_t i = 0; i < m_.functions.size(); ++i) {
     Function& f = m_.functions[i];
-    auto [it, fresh] = seen.emplace(f.name, &f);
-    if (!fresh) {
+    int first = find_function(f.name);
+    if (first != static_cast<int>(i)) {
       error(f.loc, "function '" + f.name + "' is defined twice (first at line " +
-                       std::to_string(it->second->loc.line) + "); rename or remove one");
+                       std::to_string(m_.functions[first].loc.line) + "); rename or remove one");
       continue;
     }
     if (f.name == "INIT") {
@@ -259,7 +263,7 @@ void Checker::check_action(Statement& s) {
     error(s.callee_loc, s.callee + " takes " + accepted + " argument(s), " + std::to_string(n) +
                             " given; write " + s.drone + "." + s.callee + "(" + spec->params + ")");
   }
-  for (auto& a : s.args) expect_type(*a, ValueType::number, "argument of " + s.callee);
+  for (auto& a : s.args) expect_type(*a, ValueType::number, "argument of", s.callee);
 }
 
 void Checker::check_block_call(Statement& s) {
@@ -327,7 +331,7 @@ void Checker::check_control(Statement& s) {
     Expr& a = *s.args[i];
     switch (sig->params[i]) {
       case Param::condition:
-        expect_type(a, ValueType::boolean, std::string("condition of ") + control_name(s.control));
+        expect_type(a, ValueType::boolean, "condition of", control_name(s.control));
         break;
       case Param::block: {
         int fi = resolve_block(a);
@@ -435,9 +439,11 @@ ValueType Checker::type_of(Expr& e) {
   return ValueType::unknown;
 }
 
-void Checker::expect_type(Expr& e, ValueType want, const std::string& what) {
+void Checker::expect_type(Expr& e, ValueType want, const char* what_text, const std::string& whose) {
   ValueType t = type_of(e);
   if (t == ValueType::unknown || t == want) return;
+  // Built only here: a large mission checks hundreds of thousands of values.
+  std::string what = std::string(what_text) + " " + whose;
   if (want == ValueType::boolean)
     error(e.loc, what + " must be boolean, found " + type_name(t) + " '" + expr_text(e) +
                      "'; compare it, e.g. '" + expr_text(e) + " > 0'");
@@ -467,7 +473,8 @@ void Checker::check_call_graph() {
   std::vector<Color> color(n, white);
   std::vector<long long> size(n, 0);
   std::vector<int> depth(n, 0);
-  std::vector<std::vector<std::pair<int, SourceLocation>>> edges(n);
+  std::vector<std::vector<std::pair<int, SourceLocation>>>& edges = calls_;
+  edges.resize(n);
   for (std::size_t i = 0; i < n; ++i) edges[i] = callees(m_.functions[i]);
   std::set<int> reported;
   for (std::size_t root = 0; root < n; ++root) {
@@ -524,7 +531,7 @@ void Checker::check_unused() {
   while (!work.empty()) {
     int fn = work.back();
     work.pop_back();
-    for (const auto& [callee, loc] : callees(m_.functions[fn]))
+    for (const auto& [callee, loc] : calls_[fn])
       if (!reached[callee]) {
         reached[callee] = true;
         work.push_back(callee);

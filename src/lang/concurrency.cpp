@@ -2,6 +2,7 @@
 
 #include <map>
 #include <string>
+#include <string_view>
 
 namespace eamos::lang {
 
@@ -10,7 +11,7 @@ namespace {
 /// Drone index → one motion action it may run (for the message).
 struct MotionSite {
   SourceLocation loc;
-  std::string action;
+  std::string_view action;  ///< the statement's callee, in the AST
 };
 using MotionSet = std::map<int, MotionSite>;
 
@@ -66,8 +67,8 @@ class MotionAnalysis {
     for (const auto& [drone, site] : next) {
       auto it = running.find(drone);
       if (it == running.end()) continue;
-      std::string a = site.action + " (line " + std::to_string(site.loc.line) + ")";
-      std::string b = it->second.action + " (line " + std::to_string(it->second.loc.line) + ")";
+      std::string a = std::string(site.action) + " (line " + std::to_string(site.loc.line) + ")";
+      std::string b = std::string(it->second.action) + " (line " + std::to_string(it->second.loc.line) + ")";
       diags_.warning(m_.file, s.loc,
                      after_async
                          ? "drone '" + m_.drones[drone].name + "' may run two motion actions at the same time: " +

@@ -47,8 +47,17 @@ char Lexer::peek(std::size_t ahead) const {
   return at < file_.text.size() ? file_.text[at] : '\0';
 }
 
-Token Lexer::make(TokenKind kind, std::size_t begin, std::size_t end) const {
-  return {kind, std::string_view(file_.text).substr(begin, end - begin), file_.location_of(begin)};
+Token Lexer::make(TokenKind kind, std::size_t begin, std::size_t end) {
+  return {kind, std::string_view(file_.text).substr(begin, end - begin), location_of(begin)};
+}
+
+// Tokens come in order, so the line of the previous token is where to start looking; a
+// search over all lines per token was a tenth of the parse.
+SourceLocation Lexer::location_of(std::size_t offset) {
+  const std::vector<std::size_t>& starts = file_.line_starts;
+  if (starts.empty() || offset < starts[line_]) return file_.location_of(offset);
+  while (line_ + 1 < starts.size() && starts[line_ + 1] <= offset) ++line_;
+  return {static_cast<int>(line_) + 1, static_cast<int>(offset - starts[line_]) + 1};
 }
 
 bool Lexer::skip_space_and_comments() {

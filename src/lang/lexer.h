@@ -19,7 +19,8 @@ class Lexer {
   /// Skips blanks and comments; returns true when a newline (or a comment spanning one)
   /// was crossed, which may insert a semicolon.
   bool skip_space_and_comments();
-  Token make(TokenKind kind, std::size_t begin, std::size_t end) const;
+  Token make(TokenKind kind, std::size_t begin, std::size_t end);
+  SourceLocation location_of(std::size_t offset);
   Token lex_number(std::size_t begin);
   Token lex_identifier(std::size_t begin);
   Token lex_operator(std::size_t begin);
@@ -29,6 +30,7 @@ class Lexer {
   const SourceFile& file_;
   Diagnostics& diags_;
   std::size_t pos_ = 0;
+  std::size_t line_ = 0;  ///< index into file_.line_starts of the last token's line
   /// Go's rule: a newline after these tokens ends the statement.
   bool semicolon_may_follow_ = false;
 };

@@ -1,0 +1,364 @@
+#include "dex/engine.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace eamos::dex {
+
+using graph::ArcKind;
+using graph::Branch;
+using graph::MegKind;
+using lang::ControlKind;
+
+Engine::Engine(const Mission& mission, mid::Drone& drone, mid::EventLoop& loop, EngineHooks hooks)
+    : m_(mission), drone_(drone), loop_(loop), hooks_(std::move(hooks)), state_(mission.nodes.size()) {
+  for (std::size_t i = 0; i < m_.nodes.size(); ++i) {
+    state_[i].exec_pending = m_.nodes[i].exec_in;
+    state_[i].back_pending = m_.nodes[i].back_in;
+  }
+}
+
+void Engine::start() {
+  for (std::size_t i = 0; i < m_.nodes.size(); ++i) {
+    const Node& n = m_.nodes[i];
+    if (n.internal && n.kind == MegKind::init) {
+      queue_.push_back({static_cast<int>(i), ArcKind::exec, false});
+      ++state_[i].exec_pending;  // the start itself is init's one prerequisite
+    }
+  }
+  drain();
+}
+
+double Engine::property(int drone, const std::string& name) const {
+  if (drone != m_.self) return hooks_.remote_property ? hooks_.remote_property(drone, name) : NAN;
+  mid::DroneState s = drone_.state();
+  if (name == "X") return s.x;
+  if (name == "Y") return s.y;
+  if (name == "Z") return s.z;
+  if (name == "Battery") return s.battery;
+  if (name == "Armed") return s.armed ? 1 : 0;
+  if (name == "Landed") return s.landed ? 1 : 0;
+  auto it = s.sensors.find(name);
+  return it == s.sensors.end() ? 0.0 : it->second;
+}
+
+void Engine::trace(const Node& n, const std::string& event, const std::string& outcome) {
+  if (!hooks_.trace) return;
+  TraceEvent e;
+  e.t = loop_.now();
+  e.drone = m_.fleet[m_.self];
+  e.event = event;
+  e.name = n.kind == MegKind::condition ? lang::control_name(n.control) : n.name;
+  e.line = n.line;
+  e.text = n.text;
+  e.outcome = outcome;
+  hooks_.trace->record(e);
+}
+
+// Local triggers go through a queue, not recursion: a long chain of instantaneous nodes
+// (forks, terminals) must not deepen the stack.
+void Engine::deliver(int node, ArcKind kind, bool from_terminal) {
+  queue_.push_back({node, kind, from_terminal});
+  drain();
+}
+
+void Engine::drain() {
+  if (draining_) return;
+  draining_ = true;
+  while (!queue_.empty() && !halted_) {
+    Delivery d = queue_.front();
+    queue_.pop_front();
+    State& s = state_[d.node];
+    const Node& n = m_.nodes[d.node];
+    switch (d.kind) {
+      case ArcKind::exec:
+        if (--s.exec_pending <= 0) {
+          s.exec_pending = n.exec_in;  // ready for the next activation (loops)
+          activate(d.node, false);
+        }
+        break;
+      case ArcKind::back:
+        if (--s.back_pending <= 0) {
+          s.back_pending = n.back_in;
+          activate(d.node, true);
+        }
+        break;
+      case ArcKind::partner:
+        // A released terminal ends without its branch; it releases its own partner only
+        // when a condition released it (Do's skip), never back to the partner that did.
+        s.exec_pending = n.exec_in;
+        end(d.node, Branch::any, d.from_terminal);
+        break;
+      case ArcKind::stop: stop_watching(d.node); break;
+    }
+  }
+  draining_ = false;
+}
+
+void Engine::receive(const Message& msg) {
+  if (halted_ || msg.mission_hash != m_.hash) return;
+  int from = m_.find(msg.meg, msg.from);
+  if (from < 0) return;
+  if (msg.kind == Message::Kind::cancel) {
+    cancel_local(m_.nodes[from].cancels);
+    return;
+  }
+  for (int a : m_.nodes[from].out) {
+    const Arc& arc = m_.arcs[a];
+    if (arc.branch != Branch::any && arc.branch != msg.branch) continue;
+    if (!m_.nodes[arc.to].internal) continue;
+    queue_.push_back({arc.to, arc.kind, false});
+  }
+  drain();
+}
+
+void Engine::activate(int node, bool by_back_arc) {
+  ++activations_;
+  const Node& n = m_.nodes[node];
+  switch (n.kind) {
+    case MegKind::init:
+    case MegKind::fork:
+    case MegKind::terminal: end(node, Branch::any); return;
+    case MegKind::end:
+      if (hooks_.on_end) hooks_.on_end();
+      return;
+    case MegKind::action: activate_action(node); return;
+    case MegKind::pause: {
+      State& s = state_[node];
+      ++active_;
+      s.timer = loop_.after(n.seconds, [this, node] {
+        state_[node].timer = mid::kNoTimer;
+        --active_;
+        end(node, Branch::any);
+        drain();
+      });
+      return;
+    }
+    case MegKind::condition: activate_condition(node, by_back_arc); return;
+  }
+}
+
+void Engine::activate_action(int node) {
+  const Node& n = m_.nodes[node];
+  mid::ActionRequest req;
+  req.name = n.name;
+  auto read = [this](int d, const std::string& p) { return property(d, p); };
+  for (const Expr& a : n.args) req.args.push_back(evaluate(a, read).number);
+  trace(n, "start");
+  ++active_;
+  state_[node].action = drone_.start(req, [this, node](const mid::ActionEnd& e) { on_action_end(node, e); });
+}
+
+void Engine::on_action_end(int node, const mid::ActionEnd& e) {
+  const Node& n = m_.nodes[node];
+  state_[node].action = mid::kNoAction;
+  --active_;
+  if (hooks_.trace) {
+    TraceEvent t;
+    t.t = loop_.now();
+    t.drone = m_.fleet[m_.self];
+    t.event = "end";
+    t.name = n.name;
+    t.line = n.line;
+    t.text = n.text;
+    t.outcome = mid::outcome_name(e.outcome);
+    t.reason = e.reason;
+    hooks_.trace->record(t);
+    if (e.value && e.outcome == mid::Outcome::succeeded) {
+      t.event = "sensor";
+      t.outcome.clear();
+      t.reading = e.value;
+      hooks_.trace->record(t);
+    }
+  }
+  switch (e.outcome) {
+    case mid::Outcome::succeeded:
+    case mid::Outcome::preempted:
+      end(node, Branch::any);
+      drain();
+      return;
+    case mid::Outcome::cancelled: return;  // cancelled by a Do flip or the failsafe: no successors
+    case mid::Outcome::failed:
+      if (hooks_.on_failure) hooks_.on_failure({m_.fleet[m_.self], n.name, n.line, e.reason});
+      return;
+  }
+}
+
+bool Engine::condition_value(int node) {
+  const Node& n = m_.nodes[node];
+  auto read = [this](int d, const std::string& p) { return property(d, p); };
+  bool v = evaluate(n.condition, read).boolean;
+  // Watched conditions are re-evaluated at the telemetry rate: trace a value once, then
+  // only when it changes, so the trace shows decisions, not samples.
+  State& s = state_[node];
+  bool changed = s.last_value != static_cast<int>(v);
+  s.last_value = s.watching ? static_cast<int>(v) : -1;
+  if (hooks_.trace && changed) {
+    TraceEvent t;
+    t.t = loop_.now();
+    t.drone = m_.fleet[m_.self];
+    t.event = "condition";
+    t.name = lang::control_name(n.control);
+    t.line = n.line;
+    t.text = n.text;
+    t.value = v;
+    hooks_.trace->record(t);
+  }
+  return v;
+}
+
+void Engine::activate_condition(int node, bool by_back_arc) {
+  const Node& n = m_.nodes[node];
+  State& s = state_[node];
+  switch (n.control) {
+    case ControlKind::If: end(node, condition_value(node) ? Branch::true_ : Branch::false_); return;
+    case ControlKind::WaitUntil:
+    case ControlKind::WaitWhile:
+    case ControlKind::PauseUntil:
+    case ControlKind::PauseWhile:
+      s.watching = true;
+      ++active_;
+      watched_.push_back(node);
+      evaluate_watch(node);
+      return;
+    case ControlKind::RepeatUntil:
+    case ControlKind::RepeatWhile:
+    case ControlKind::RepeatFor: {
+      if (!by_back_arc) s.iterations = 0;
+      bool v = condition_value(node);
+      bool again = n.control == ControlKind::RepeatUntil ? !v
+                   : n.control == ControlKind::RepeatWhile ? v
+                                                           : v && s.iterations < n.count;
+      if (again) ++s.iterations;
+      end(node, again ? Branch::repeat : Branch::exit);
+      return;
+    }
+    case ControlKind::DoUntilSync:
+    case ControlKind::DoWhileSync:
+    case ControlKind::DoUntilAsync:
+    case ControlKind::DoWhileAsync: {
+      bool v = condition_value(node);
+      bool is_while = n.control == ControlKind::DoWhileSync || n.control == ControlKind::DoWhileAsync;
+      bool async = n.control == ControlKind::DoUntilAsync || n.control == ControlKind::DoWhileAsync;
+      bool do_it = is_while ? v : !v;
+      if (do_it) {
+        s.watching = true;
+        ++active_;
+        watched_.push_back(node);
+        end(node, Branch::do_);
+      } else {
+        end(node, Branch::skip);
+      }
+      if (async) end(node, Branch::continue_);
+      return;
+    }
+    default: end(node, Branch::any); return;
+  }
+}
+
+// Wait* and Pause*: "go" once the awaited state holds (Until: true, While: false).
+void Engine::evaluate_watch(int node) {
+  const Node& n = m_.nodes[node];
+  bool v = condition_value(node);
+  bool until = n.control == ControlKind::WaitUntil || n.control == ControlKind::PauseUntil;
+  if (v == until) {
+    stop_watching(node);
+    end(node, Branch::go);
+  }
+}
+
+void Engine::flip_do(int node) {
+  const Node& n = m_.nodes[node];
+  stop_watching(node);
+  cancel_local(n.cancels);
+  Message msg{Message::Kind::cancel, m_.hash, m_.self, n.meg, Branch::any};
+  for (int d = 0; d < static_cast<int>(m_.fleet.size()); ++d)
+    if (d != m_.self && hooks_.transport) hooks_.transport->send(d, msg);
+  end(node, Branch::done);
+}
+
+void Engine::properties_changed(int drone) {
+  if (halted_ || watched_.empty()) return;
+  std::vector<int> now = watched_;  // ending a watch edits watched_
+  for (int node : now) {
+    if (!state_[node].watching) continue;
+    std::vector<int> reads;
+    collect_drones(m_.nodes[node].condition, reads);
+    if (std::find(reads.begin(), reads.end(), drone) == reads.end()) continue;
+    const Node& n = m_.nodes[node];
+    bool is_do = n.control == ControlKind::DoUntilSync || n.control == ControlKind::DoWhileSync ||
+                 n.control == ControlKind::DoUntilAsync || n.control == ControlKind::DoWhileAsync;
+    if (!is_do) {
+      evaluate_watch(node);
+      continue;
+    }
+    bool v = condition_value(node);
+    bool is_while = n.control == ControlKind::DoWhileSync || n.control == ControlKind::DoWhileAsync;
+    if ((is_while ? v : !v) == false) flip_do(node);
+  }
+  drain();
+}
+
+void Engine::stop_watching(int node) {
+  State& s = state_[node];
+  if (!s.watching) return;
+  s.watching = false;
+  s.last_value = -1;
+  --active_;
+  watched_.erase(std::remove(watched_.begin(), watched_.end(), node), watched_.end());
+}
+
+void Engine::cancel_local(const std::vector<int>& nodes) {
+  for (int node : nodes) {
+    State& s = state_[node];
+    const Node& n = m_.nodes[node];
+    if (s.action != mid::kNoAction) drone_.cancel(s.action);  // ends `cancelled` later
+    if (s.timer != mid::kNoTimer) {
+      loop_.cancel(s.timer);
+      s.timer = mid::kNoTimer;
+      --active_;
+    }
+    stop_watching(node);
+    s.exec_pending = n.exec_in;
+    s.back_pending = n.back_in;
+  }
+  // Triggers already queued for cancelled nodes must not start them.
+  queue_.erase(std::remove_if(queue_.begin(), queue_.end(),
+                              [&](const Delivery& d) {
+                                return std::find(nodes.begin(), nodes.end(), d.node) != nodes.end();
+                              }),
+               queue_.end());
+}
+
+void Engine::end(int node, Branch branch, bool released_by_partner) {
+  const Node& n = m_.nodes[node];
+  std::vector<int> remote;
+  for (int a : n.out) {
+    const Arc& arc = m_.arcs[a];
+    if (arc.branch != Branch::any && arc.branch != branch) continue;
+    if (released_by_partner && arc.kind == ArcKind::partner) continue;
+    if (m_.nodes[arc.to].internal) {
+      queue_.push_back({arc.to, arc.kind, n.kind == MegKind::terminal});
+    } else if (std::find(remote.begin(), remote.end(), m_.nodes[arc.to].drone) == remote.end()) {
+      remote.push_back(m_.nodes[arc.to].drone);
+    }
+  }
+  Message msg{Message::Kind::ended, m_.hash, m_.self, n.meg, branch};
+  for (int d : remote)
+    if (hooks_.transport) hooks_.transport->send(d, msg);
+}
+
+void Engine::halt() {
+  halted_ = true;
+  queue_.clear();
+  for (std::size_t i = 0; i < state_.size(); ++i) {
+    State& s = state_[i];
+    if (s.action != mid::kNoAction) drone_.cancel(s.action);
+    if (s.timer != mid::kNoTimer) loop_.cancel(s.timer);
+    s.timer = mid::kNoTimer;
+    s.watching = false;
+  }
+  watched_.clear();
+}
+
+}  // namespace eamos::dex

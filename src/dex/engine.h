@@ -1,0 +1,99 @@
+#pragma once
+// The DEX's execution engine for one drone (paper, section V): it runs the drone's MDG
+// event-driven on the event loop — a node starts when all its prerequisites have ended,
+// nothing polls, no thread per node. Control structures are condition nodes that choose
+// which successors to trigger; the engine keeps its run state apart from the Mission,
+// which it never changes (Taskflow: graph and executor apart).
+#include <deque>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "dex/bridge.h"
+#include "dex/mission.h"
+#include "dex/trace.h"
+#include "mid/drone_api.h"
+#include "mid/event_loop.h"
+
+namespace eamos::dex {
+
+/// Why a mission failed: the drone, the action and the source line.
+struct Failure {
+  std::string drone;
+  std::string action;
+  int line = 0;
+  std::string reason;
+};
+
+struct EngineHooks {
+  Transport* transport = nullptr;  ///< OutBridge's way out
+  TraceSink* trace = nullptr;
+  /// Newest known value of another drone's property (telemetry); NaN when unknown.
+  std::function<double(int drone, const std::string& property)> remote_property;
+  std::function<void(const Failure&)> on_failure;
+  std::function<void()> on_end;  ///< the mission's end node ran (this drone is the lead)
+};
+
+class Engine {
+ public:
+  Engine(const Mission& mission, mid::Drone& drone, mid::EventLoop& loop, EngineHooks hooks);
+
+  /// Starts the drone's init clone, if it holds one (mission start).
+  void start();
+  /// InBridge: a message from another drone.
+  void receive(const Message& m);
+  /// A property of `drone` changed: re-evaluate the conditions that wait on it.
+  void properties_changed(int drone);
+  /// The mission failed elsewhere or here: start nothing more, cancel what runs.
+  void halt();
+
+  /// Actions, timers or watched conditions still active on this drone.
+  bool busy() const { return active_ > 0; }
+  std::uint64_t activations() const { return activations_; }
+  /// Reads a property of any drone: own values from the drone, others' from telemetry.
+  double property(int drone, const std::string& name) const;
+
+ private:
+  struct State {
+    int exec_pending = 0;
+    int back_pending = 0;
+    mid::ActionId action = mid::kNoAction;
+    mid::TimerId timer = mid::kNoTimer;
+    bool watching = false;
+    long long iterations = 0;
+    int last_value = -1;  ///< watched conditions: last traced value (-1 none), to log changes only
+  };
+  struct Delivery {
+    int node;
+    graph::ArcKind kind;
+    bool from_terminal;  ///< a partner release sent by a terminal (not by a condition)
+  };
+
+  void deliver(int node, graph::ArcKind kind, bool from_terminal);
+  void drain();
+  void activate(int node, bool by_back_arc);
+  void activate_action(int node);
+  void activate_condition(int node, bool by_back_arc);
+  void end(int node, graph::Branch branch, bool released_by_partner = false);
+  void evaluate_watch(int node);
+  void flip_do(int node);
+  void cancel_local(const std::vector<int>& nodes);
+  void stop_watching(int node);
+  void on_action_end(int node, const mid::ActionEnd& e);
+  bool condition_value(int node);
+  void trace(const Node& n, const std::string& event, const std::string& outcome = "");
+
+  const Mission& m_;
+  mid::Drone& drone_;
+  mid::EventLoop& loop_;
+  EngineHooks hooks_;
+  std::vector<State> state_;
+  std::deque<Delivery> queue_;
+  bool draining_ = false;
+  bool halted_ = false;
+  int active_ = 0;
+  std::uint64_t activations_ = 0;
+  std::vector<int> watched_;  ///< condition nodes currently watching
+};
+
+}  // namespace eamos::dex

@@ -1,0 +1,67 @@
+#pragma once
+// A drone's mission file as the DEX holds it: the MDG with every node linked to its
+// arcs, expressions ready to evaluate, and the drone's settings. Loaded once at start-up
+// (the paper's "setup part", IV.D.1); the engine never changes it.
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "dex/expr.h"
+#include "fleet/fleet.h"
+#include "graph/meg.h"
+#include "lang/ast.h"
+
+namespace eamos::dex {
+
+struct Node {
+  int meg = 0;                 ///< MEG id: the node's name across drones
+  int drone = 0;               ///< holder (index into Mission::fleet)
+  bool internal = false;       ///< held by this drone
+  graph::MegKind kind = graph::MegKind::action;
+  std::string name;            ///< capability, control structure, block or terminal name
+  std::string text;            ///< human label for logs ("Drone1.Takeoff(3)")
+  int line = 0;
+  int col = 0;
+  std::vector<Expr> args;      ///< action arguments
+  Expr condition;              ///< condition nodes
+  lang::ControlKind control = lang::ControlKind::none;
+  long long count = 0;         ///< RepeatFor limit
+  double seconds = 0.0;        ///< PauseFor
+  int scope = -1;              ///< index of the innermost Repeat/Do condition whose body holds it
+  std::vector<int> cancels;    ///< Do conditions: local nodes a flip cancels
+  std::vector<int> out;        ///< indices into Mission::arcs
+  int exec_in = 0;             ///< number of exec arcs into this node
+  int back_in = 0;             ///< number of back arcs into this node
+};
+
+struct Arc {
+  int from = 0;  ///< index into Mission::nodes
+  int to = 0;
+  graph::ArcKind kind = graph::ArcKind::exec;
+  graph::Branch branch = graph::Branch::any;
+};
+
+struct Mission {
+  std::string hash;                    ///< SHA-256 of the whole compiled mission
+  std::string source;                  ///< mission file path, for messages
+  int self = 0;                        ///< this drone's index in `fleet`
+  std::vector<std::string> fleet;      ///< every drone's name, by index
+  fleet::DroneSettings settings;       ///< this drone's settings
+  fleet::DroneType type;               ///< its capabilities, as the compiler checked them
+  std::vector<int> reads;              ///< drones whose telemetry this drone needs
+  std::vector<Node> nodes;
+  std::vector<Arc> arcs;
+
+  /// Index of the node with MEG id `meg` held by `drone`, or -1.
+  int find(int meg, int drone) const;
+  std::map<std::pair<int, int>, int> index;  ///< (meg, drone) → node index
+};
+
+/// Builds a Mission from a mission file's JSON; false with `error` set (what and where)
+/// when the file is not a valid mission of a format version this DEX knows.
+bool load_mission(const nlohmann::json& file, Mission& out, std::string& error);
+bool load_mission_file(const std::string& path, Mission& out, std::string& error);
+
+}  // namespace eamos::dex

@@ -1,0 +1,42 @@
+#pragma once
+// Runs a whole compiled mission in one process: one DEX engine per drone, each with its
+// own drone from the Adapter Space, all on one event loop, talking through the in-process
+// transport. The mission completes when the end node ran and nothing is active on any
+// drone; the first failed action fails it, and every airborne drone runs its failsafe.
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dex/engine.h"
+#include "dex/mission.h"
+#include "mid/adapter_registry.h"
+#include "mid/event_loop.h"
+
+namespace eamos::dex {
+
+struct RunOptions {
+  mid::ClockOptions clock;
+  double time_limit_s = 3600.0;  ///< a mission still running then fails ("did not finish")
+};
+
+struct DroneSummary {
+  std::string name;
+  mid::DroneState state;
+};
+
+struct RunResult {
+  bool completed = false;
+  double duration = 0.0;              ///< mission seconds
+  std::optional<Failure> failure;     ///< set when the mission failed
+  std::string error;                  ///< human summary of the failure
+  std::vector<DroneSummary> drones;
+  std::uint64_t activations = 0;      ///< node activations over all drones
+};
+
+/// Runs `missions` (one per drone, same hash, index order = fleet order). Setup problems
+/// (unknown adapter, mismatched hashes) come back as a failed result before anything runs.
+RunResult run_in_process(const std::vector<Mission>& missions, const mid::AdapterRegistry& adapters,
+                         TraceSink* trace, const RunOptions& options = {});
+
+}  // namespace eamos::dex

@@ -1,0 +1,42 @@
+#include "dex/trace_writers.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include <nlohmann/json.hpp>
+
+namespace eamos::dex {
+
+namespace {
+// Times are rounded to the microsecond so that traces compare byte for byte.
+double rounded(double t) { return std::round(t * 1e6) / 1e6; }
+}  // namespace
+
+void JsonlTrace::record(const TraceEvent& e) {
+  nlohmann::ordered_json j;
+  j["t"] = rounded(e.t);
+  j["drone"] = e.drone;
+  j["event"] = e.event;
+  j["name"] = e.name;
+  j["line"] = e.line;
+  if (!e.text.empty()) j["text"] = e.text;
+  if (!e.outcome.empty()) j["outcome"] = e.outcome;
+  if (e.value) j["value"] = *e.value;
+  if (e.reading) j["value"] = *e.reading;
+  if (!e.reason.empty()) j["reason"] = e.reason;
+  out_ << j.dump() << '\n';
+}
+
+void LiveLog::record(const TraceEvent& e) {
+  char head[64];
+  std::snprintf(head, sizeof head, "%9.2f s  %-8s %-9s ", e.t, e.drone.c_str(), e.event.c_str());
+  out_ << head << (e.text.empty() ? e.name : e.text);
+  if (!e.outcome.empty()) out_ << "  " << e.outcome;
+  if (e.value) out_ << "  → " << (*e.value ? "true" : "false");
+  if (e.reading) out_ << "  = " << *e.reading;
+  if (!e.reason.empty()) out_ << "  (" << e.reason << ")";
+  if (e.line > 0) out_ << "   line " << e.line;
+  out_ << '\n';
+}
+
+}  // namespace eamos::dex

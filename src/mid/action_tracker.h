@@ -1,0 +1,67 @@
+#pragma once
+// The outcome rules as book-keeping, so every adapter keeps them the same way: action ids,
+// the one motion slot per drone (a new motion action preempts the old), delivery of each
+// end exactly once through the event loop, and timeouts. The adapter decides what an action
+// does to the vehicle; the tracker decides when and how it is reported.
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fleet/catalog.h"
+#include "mid/drone_api.h"
+#include "mid/event_loop.h"
+
+namespace eamos::mid {
+
+class ActionTracker {
+ public:
+  /// `on_timeout` is called when a running action passes its deadline, before it ends
+  /// `failed`, so the adapter can stop what the vehicle is doing for it.
+  ActionTracker(EventLoop& loop, std::function<void(ActionId)> on_timeout);
+  /// Ends what still runs as `cancelled` ("drone shut down"): every end is reported once.
+  ~ActionTracker();
+  ActionTracker(const ActionTracker&) = delete;
+  ActionTracker& operator=(const ActionTracker&) = delete;
+
+  /// Registers a running action with a deadline `timeout_s` after now (infinity: none). A
+  /// motion action takes the motion slot; the one holding it ends `preempted`.
+  ActionId begin(const ActionRequest& request, fleet::ActionClass action_class,
+                 EndCallback on_end, double timeout_s);
+  /// Registers an action that is refused: it ends `failed` with `reason` at once (reported
+  /// through the loop like every other end).
+  ActionId refuse(const ActionRequest& request, EndCallback on_end, std::string reason);
+  /// Ends a running action; false (and nothing reported) when it is not running.
+  bool end(ActionId id, Outcome outcome, std::string reason = "",
+           std::optional<double> value = std::nullopt);
+
+  bool running(ActionId id) const { return actions_.count(id) != 0; }
+  /// The running motion action; kNoAction when none.
+  ActionId motion() const { return motion_; }
+  /// Every running action, oldest first.
+  std::vector<ActionId> running_ids() const;
+  /// The request of a running action; nullptr when it is not running.
+  const ActionRequest* request(ActionId id) const;
+  /// Mission time a running action started; 0 when it is not running.
+  double started_at(ActionId id) const;
+
+ private:
+  struct Running {
+    ActionRequest request;
+    fleet::ActionClass action_class;
+    EndCallback on_end;
+    double started_at;
+    TimerId deadline;  ///< kNoTimer when the action has none
+  };
+
+  void report(EndCallback on_end, ActionEnd end);
+
+  EventLoop& loop_;
+  std::function<void(ActionId)> on_timeout_;
+  ActionId next_id_ = 1;
+  ActionId motion_ = kNoAction;
+  std::map<ActionId, Running> actions_;  ///< ordered: ids grow with start order
+};
+
+}  // namespace eamos::mid

@@ -1,0 +1,103 @@
+#pragma once
+// The Uniform Space's drone API (paper, section VI): one interface for every vehicle,
+// whatever flies it. The DEX starts actions and reads properties through it only; each
+// Adapter Space implementation (the simulator, later MAVLink) hides its platform behind it.
+//
+// Rules every adapter keeps (the DEX relies on them):
+//  - Every started action ends exactly once, as one Outcome, and its EndCallback always runs
+//    later through the event loop: never inside start(), cancel() or failsafe().
+//  - At most one motion action runs per drone: starting a motion action preempts the running
+//    one, which ends `preempted`. Payload actions run beside motion; system actions (Arm,
+//    Disarm) change the vehicle's state without moving it.
+//  - The drone refuses what a real autopilot refuses (Takeoff while disarmed, Disarm in the
+//    air, Arm with an empty battery, motion while disarmed): the action ends `failed` with
+//    the reason in words. An action that exceeds its timeout (mid/timeouts.h) ends `failed`.
+//  - Hover() and Orbit() have no end of their own: they run until preempted or cancelled.
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fleet/fleet.h"
+
+namespace eamos::mid {
+
+/// How an action ended.
+enum class Outcome {
+  succeeded,  ///< did what it was asked
+  preempted,  ///< a newer motion action took over the vehicle (not an error)
+  cancelled,  ///< stopped by cancel() or failsafe()
+  failed,     ///< refused by the vehicle, timed out, or the vehicle could not complete it
+};
+const char* outcome_name(Outcome o);
+
+/// A uniform action call, as the mission writes it: `FlyTo(1, 2, 3)` is {"FlyTo", {1, 2, 3}}.
+/// Names and arities are the platform catalog's (fleet/catalog.h); a sensor read is "SensorK".
+struct ActionRequest {
+  std::string name;
+  std::vector<double> args;
+};
+
+/// What an action's end reports.
+struct ActionEnd {
+  Outcome outcome = Outcome::succeeded;
+  std::string reason;           ///< words for people: why it failed / who preempted it; "" on success
+  std::optional<double> value;  ///< the reading of a succeeded SensorK action; empty otherwise
+};
+
+/// The newest known properties of a drone: what the broker publishes and state() returns.
+struct DroneState {
+  double t = 0.0;        ///< mission time of these values, s
+  double x = 0.0;        ///< m east of the mission origin
+  double y = 0.0;        ///< m north of the mission origin
+  double z = 0.0;        ///< m up, in the mission frame (ground at home is home.z, usually 0)
+  double battery = 0.0;  ///< %
+  bool armed = false;
+  bool landed = true;
+  std::map<std::string, double> sensors;  ///< "Sensor1" … "SensorN" of the drone's type
+  int pictures = 0;      ///< TakePicture actions that succeeded
+};
+
+/// Identifies one started action of one drone; 0 (kNoAction) is never issued.
+using ActionId = std::uint64_t;
+inline constexpr ActionId kNoAction = 0;
+/// Identifies one subscription to a drone's broker; 0 is never issued.
+using SubscriptionId = std::uint64_t;
+
+using EndCallback = std::function<void(const ActionEnd&)>;
+using StateCallback = std::function<void(const DroneState&)>;
+
+/// One vehicle. Adapters implement it; the DEX holds one per drone of the mission. All
+/// methods are called from the event loop's thread; the loop must outlive the drone.
+class Drone {
+ public:
+  virtual ~Drone() = default;
+
+  /// The mission's name of the drone, e.g. "Drone1".
+  virtual const std::string& name() const = 0;
+
+  /// Starts an action; `on_end` runs exactly once, later, through the event loop. A refused
+  /// action still gets an id and ends `failed`.
+  virtual ActionId start(const ActionRequest& request, EndCallback on_end) = 0;
+  /// Stops a running action, which ends `cancelled` (a stopped motion holds position).
+  /// False when the action already ended or is unknown: its outcome stands.
+  virtual bool cancel(ActionId id) = 0;
+  /// How far a running action got, 0…1; empty when it ended, is unknown, or has no end of
+  /// its own (Hover(), Orbit()).
+  virtual std::optional<double> progress(ActionId) const { return std::nullopt; }
+
+  /// The property broker's newest values.
+  virtual DroneState state() const = 0;
+  /// Calls `fn` with the state at the telemetry rate while the drone moves, and on every
+  /// change of armed, landed or pictures; never from inside subscribe().
+  virtual SubscriptionId subscribe(StateCallback fn) = 0;
+  virtual void unsubscribe(SubscriptionId id) = 0;
+
+  /// The mission failed: cancel every running action and land where the drone is, return
+  /// home and land, or hover. After it the drone refuses new actions.
+  virtual void failsafe(fleet::Failsafe what) = 0;
+};
+
+}  // namespace eamos::mid

@@ -1,0 +1,101 @@
+#pragma once
+// The executor's clock: one thread runs timed callbacks in time order. Nothing in the
+// execution stack owns a thread or polls; a drone's motion, an action's timeout and a
+// PauseFor are all timers here. Virtual time (tests, default runs) jumps from event to
+// event, so a 60 s mission takes as long as its callbacks; real time (the CLI's
+// --realtime/--speed) sleeps until each event's wall time.
+#include <cstdint>
+#include <functional>
+#include <queue>
+#include <unordered_map>
+#include <vector>
+
+namespace eamos::mid {
+
+/// Identifies one scheduled callback; 0 (kNoTimer) is never issued.
+using TimerId = std::uint64_t;
+inline constexpr TimerId kNoTimer = 0;
+
+/// The wall time source of real-time mode. Tests substitute a fake that records sleeps, so
+/// no test ever sleeps.
+class WallClock {
+ public:
+  virtual ~WallClock() = default;
+  virtual double now_s() = 0;                ///< seconds since an arbitrary epoch
+  virtual void sleep_until_s(double t) = 0;  ///< returns at or after wall time t
+};
+/// std::chrono::steady_clock and std::this_thread::sleep_until.
+WallClock& system_wall_clock();
+
+enum class ClockMode {
+  virtual_time,  ///< jump to the next event at once
+  real_time,     ///< wait until the wall time of the next event (scaled by `speed`)
+};
+
+struct ClockOptions {
+  ClockMode mode = ClockMode::virtual_time;
+  double speed = 1.0;          ///< real time only: 2 = mission time runs twice as fast as wall
+  WallClock* wall = nullptr;   ///< real time only: nullptr = system_wall_clock()
+};
+
+class EventLoop {
+ public:
+  explicit EventLoop(ClockOptions options = {});
+  EventLoop(const EventLoop&) = delete;
+  EventLoop& operator=(const EventLoop&) = delete;
+
+  /// Mission time in seconds: 0 at construction, the time of the running event during a
+  /// callback, the time reached after run_until(t).
+  double now() const { return now_; }
+
+  /// Schedules `fn` at mission time `t` (a time in the past means now). Callbacks with equal
+  /// times run in the order they were scheduled. A non-finite `t` schedules nothing and
+  /// returns kNoTimer.
+  TimerId at(double t, std::function<void()> fn);
+  /// at(now() + dt, fn).
+  TimerId after(double dt, std::function<void()> fn);
+  /// Unschedules a pending callback; false when it already ran, was cancelled or is unknown.
+  bool cancel(TimerId id);
+  bool pending(TimerId id) const { return callbacks_.count(id) != 0; }
+  /// Number of callbacks still scheduled.
+  std::size_t size() const { return callbacks_.size(); }
+
+  /// Runs callbacks until none is scheduled or stop() was called; returns how many ran.
+  /// Something that reschedules itself forever (an endless Orbit) keeps it from returning:
+  /// bound such runs with run_until.
+  std::size_t run_until_idle();
+  /// Runs every callback scheduled at or before `t`, then sets now() to `t` (unless stop()
+  /// was called first); returns how many ran.
+  std::size_t run_until(double t);
+  /// Makes the running run_until_idle/run_until return after the current callback.
+  void stop() { stop_requested_ = true; }
+
+  /// Callbacks run since construction (a cost measure: idle drones must not add to it).
+  std::uint64_t events_run() const { return events_run_; }
+
+ private:
+  struct Entry {
+    double time;
+    std::uint64_t seq;  ///< insertion order: breaks ties between equal times
+    bool operator>(const Entry& o) const {
+      return time != o.time ? time > o.time : seq > o.seq;
+    }
+  };
+
+  std::size_t run(double limit, bool bounded);
+  void start_wall_anchor();
+  void wait_for(double t);
+
+  ClockOptions options_;
+  double now_ = 0.0;
+  std::uint64_t next_seq_ = 1;
+  std::uint64_t events_run_ = 0;
+  bool stop_requested_ = false;
+  /// Cancelled timers stay in the heap and are skipped when popped: cancel is O(1).
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue_;
+  std::unordered_map<TimerId, std::function<void()>> callbacks_;
+  double wall_anchor_ = 0.0;     ///< real time: wall time at which mission time ...
+  double mission_anchor_ = 0.0;  ///< ... was this
+};
+
+}  // namespace eamos::mid

@@ -1,0 +1,30 @@
+#pragma once
+// What an action request means before any vehicle sees it: is it a capability of the drone's
+// type with the right number of arguments, and where does a goal-directed motion end. Every
+// adapter needs both, and they must agree with the compiler's catalog (fleet/catalog.h).
+#include <optional>
+#include <string>
+
+#include "fleet/catalog.h"
+#include "fleet/fleet.h"
+#include "mid/drone_api.h"
+
+namespace eamos::mid {
+
+struct RequestCheck {
+  const fleet::ActionSpec* spec = nullptr;  ///< the catalog entry; null when refused
+  std::string error;                        ///< why it is refused; "" when accepted
+};
+
+/// Checks `request` against the type's capabilities and arities, and that every argument is
+/// a finite number. The compiler checks the same for missions; this guards every other caller.
+RequestCheck check_request(const ActionRequest& request, const fleet::DroneType& type);
+
+/// Where a goal-directed motion action ends, from the drone's position when it starts:
+/// Takeoff (straight up to ground + alt), Land (straight down to the ground), FlyTo, FlyBy,
+/// FlyByX/Y/Z, ReturnHome (home, on the ground). The ground is at home.z (usually 0).
+/// Empty for the others (Hover, Orbit, payload and system actions).
+std::optional<fleet::Vec3> goal_position(const ActionRequest& request, fleet::Vec3 position,
+                                         fleet::Vec3 home);
+
+}  // namespace eamos::mid

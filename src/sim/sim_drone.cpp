@@ -1,0 +1,396 @@
+#include "sim/sim_drone.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "mid/requests.h"
+#include "mid/timeouts.h"
+#include "mid/vec.h"
+
+namespace eamos::sim {
+
+using fleet::Vec3;
+using mid::ActionId;
+using mid::Outcome;
+
+namespace {
+std::string metres(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f m", v);
+  return buf;
+}
+}  // namespace
+
+SimDrone::SimDrone(fleet::DroneSettings settings, fleet::DroneType type, mid::EventLoop& loop,
+                   SimOptions options)
+    : settings_(std::move(settings)),
+      type_(std::move(type)),
+      loop_(loop),
+      options_(options),
+      battery_(settings_.battery_percent, loop.now()),
+      tracker_(loop, [this](ActionId id) { stop_action(id); }) {
+  kin_.position = settings_.home;
+}
+
+SimDrone::~SimDrone() {
+  for (auto& [id, timer] : action_timers_) loop_.cancel(timer);
+  for (mid::TimerId t : {step_timer_, telemetry_timer_, empty_timer_, publish_timer_})
+    loop_.cancel(t);
+}
+
+// --- actions -------------------------------------------------------------------------------
+
+ActionId SimDrone::start(const mid::ActionRequest& request, mid::EndCallback on_end) {
+  if (!failsafe_reason_.empty())
+    return tracker_.refuse(request, std::move(on_end), "failsafe active (" + failsafe_reason_ + ")");
+  mid::RequestCheck check = mid::check_request(request, type_);
+  if (!check.spec) return tracker_.refuse(request, std::move(on_end), check.error);
+  if (std::string why = refusal(request, *check.spec); !why.empty())
+    return tracker_.refuse(request, std::move(on_end), why);
+
+  double timeout = mid::action_timeout(request, kin_.position, settings_);
+  fleet::ActionClass cls = check.spec->action_class;
+  if (cls == fleet::ActionClass::motion) clear_action_timer(tracker_.motion());  // preempted
+  ActionId id = tracker_.begin(request, cls, std::move(on_end), timeout);
+  switch (cls) {
+    case fleet::ActionClass::system: start_system(id, request); break;
+    case fleet::ActionClass::payload: start_payload(id, request); break;
+    case fleet::ActionClass::motion: start_motion(id, request); break;
+  }
+  update_timers();
+  return id;
+}
+
+std::string SimDrone::refusal(const mid::ActionRequest& r, const fleet::ActionSpec& spec) const {
+  const auto& a = r.args;
+  if (r.name == "Arm" && battery_.at(loop_.now()) <= 0.0) return "battery empty: cannot arm";
+  if (r.name == "Disarm") {
+    if (!landed_) return "in the air at z = " + metres(kin_.position.z) + ": land before disarming";
+    if (tracker_.motion() != mid::kNoAction)
+      return tracker_.request(tracker_.motion())->name + " is running: cannot disarm";
+  }
+  if (spec.action_class != fleet::ActionClass::motion) return "";
+
+  if (!armed_) return "disarmed: arm before " + r.name;
+  const double ceiling = ground_z() + settings_.limits.max_altitude_m;
+  if (r.name == "Takeoff") {
+    if (a[0] <= 0.0) return "takeoff altitude must be positive, got " + metres(a[0]);
+    if (a[0] > settings_.limits.max_altitude_m)
+      return "takeoff altitude " + metres(a[0]) + " is above max_altitude " +
+             metres(settings_.limits.max_altitude_m);
+    return "";
+  }
+  if (r.name == "Land") return "";
+  if (landed_) return "on the ground: take off before " + r.name;
+  if (r.name == "Orbit" && a.size() == 1 && a[0] <= 0.0)
+    return "orbit radius must be positive, got " + metres(a[0]);
+  if (r.name == "Hover" && a.size() == 1 && a[0] < 0.0) return "hover duration must not be negative";
+  if (r.name == "ReturnHome") return "";
+  if (auto goal = mid::goal_position(r, kin_.position, settings_.home)) {
+    if (goal->z <= ground_z())
+      return "target z = " + metres(goal->z) + " is not above the ground (z = " +
+             metres(ground_z()) + "); use Land to land";
+    if (goal->z > ceiling)
+      return "target z = " + metres(goal->z) + " is above max_altitude " +
+             metres(settings_.limits.max_altitude_m) + " over the ground";
+  }
+  return "";
+}
+
+void SimDrone::start_system(ActionId id, const mid::ActionRequest& r) {
+  // The autopilot acknowledges at once, but the change and the end both come from the loop:
+  // nothing a subscriber sees may happen inside start().
+  bool arm = r.name == "Arm";
+  action_timers_[id] = loop_.after(0.0, [this, id, arm] {
+    action_timers_.erase(id);
+    set_armed(arm);
+    publish();
+    tracker_.end(id, Outcome::succeeded);
+    update_timers();
+  });
+}
+
+void SimDrone::start_payload(ActionId id, const mid::ActionRequest& r) {
+  double duration = r.name == "TakePicture" ? options_.picture_s : options_.sensor_read_s;
+  action_timers_[id] = loop_.after(duration, [this, id, name = r.name] {
+    action_timers_.erase(id);
+    finish_payload(id, name);
+  });
+}
+
+void SimDrone::finish_payload(ActionId id, const std::string& name) {
+  if (name == "TakePicture") {
+    ++pictures_;
+    publish();
+    tracker_.end(id, Outcome::succeeded);
+    return;
+  }
+  // The reading is taken where the drone is when the read completes.
+  int k = fleet::sensor_index(name, type_.sensors);
+  tracker_.end(id, Outcome::succeeded, "", sensor_value(k));
+}
+
+void SimDrone::start_motion(ActionId id, const mid::ActionRequest& r) {
+  motion_owner_ = id;
+  const Vec3 here = kin_.position;
+  Motion m;
+  m.ground_z = ground_z();
+  if (auto goal = mid::goal_position(r, here, settings_.home)) {
+    if (r.name == "Land") {
+      if (landed_) {  // already down: nothing to fly
+        motion_owner_ = mid::kNoAction;
+        stop_motion();
+        tracker_.end(id, Outcome::succeeded);
+        return;
+      }
+      m.kind = MotionKind::land;
+      m.target = *goal;
+    } else if (r.name == "ReturnHome") {
+      // Back at the altitude it flies at, then straight down onto home.
+      m.kind = MotionKind::go;
+      m.target = {goal->x, goal->y, here.z};
+      m.land_after = true;
+      m.ground_z = goal->z;
+    } else {
+      m.kind = MotionKind::go;
+      m.target = *goal;
+    }
+    motion_ = m;
+    motion_.start_distance = remaining_distance(motion_, here);
+    return;
+  }
+  if (r.name == "Orbit") {
+    m.kind = MotionKind::orbit;
+    m.target = here;
+    m.radius = r.args.empty() ? 5.0 : r.args[0];
+    motion_ = m;
+    return;
+  }
+  // Hover: brake to a stop where it is and stay; Hover(s) ends after s seconds.
+  stop_motion();
+  motion_owner_ = id;
+  if (r.args.size() == 1) {
+    action_timers_[id] = loop_.after(r.args[0], [this, id] {
+      action_timers_.erase(id);
+      if (motion_owner_ == id) motion_owner_ = mid::kNoAction;
+      tracker_.end(id, Outcome::succeeded);
+    });
+  }
+}
+
+bool SimDrone::cancel(ActionId id) {
+  if (!tracker_.running(id)) return false;
+  stop_action(id);
+  tracker_.end(id, Outcome::cancelled, "cancelled");
+  return true;
+}
+
+void SimDrone::stop_action(ActionId id) {
+  clear_action_timer(id);
+  if (id == motion_owner_) {
+    motion_owner_ = mid::kNoAction;
+    stop_motion();
+  }
+  update_timers();
+}
+
+void SimDrone::stop_motion() {
+  bool still = kin_.velocity == Vec3{};
+  motion_ = Motion{};
+  motion_.ground_z = ground_z();
+  if (!still) {
+    motion_.kind = MotionKind::hold;
+    motion_.target = kin_.position;
+  }
+}
+
+void SimDrone::clear_action_timer(ActionId id) {
+  auto it = action_timers_.find(id);
+  if (it == action_timers_.end()) return;
+  loop_.cancel(it->second);
+  action_timers_.erase(it);
+}
+
+std::optional<double> SimDrone::progress(ActionId id) const {
+  const mid::ActionRequest* r = tracker_.request(id);
+  if (!r || mid::is_endless(*r)) return std::nullopt;
+  double elapsed = loop_.now() - tracker_.started_at(id);
+  double fraction = 0.0;
+  if (id == motion_owner_ && motion_.start_distance > 0.0) {
+    fraction = 1.0 - remaining_distance(motion_, kin_.position) / motion_.start_distance;
+  } else if (r->name == "Hover") {
+    fraction = r->args[0] > 0.0 ? elapsed / r->args[0] : 1.0;
+  } else if (r->name == "TakePicture") {
+    fraction = elapsed / options_.picture_s;
+  } else if (fleet::sensor_index(r->name, type_.sensors) > 0) {
+    fraction = elapsed / options_.sensor_read_s;
+  }
+  return std::clamp(fraction, 0.0, 1.0);
+}
+
+// --- failsafe ------------------------------------------------------------------------------
+
+void SimDrone::failsafe(fleet::Failsafe what) {
+  enter_failsafe(what, Outcome::cancelled, std::string("failsafe: ") + fleet::failsafe_name(what));
+}
+
+void SimDrone::enter_failsafe(fleet::Failsafe what, Outcome outcome, const std::string& reason) {
+  failsafe_reason_ = reason;
+  for (ActionId id : tracker_.running_ids()) {
+    clear_action_timer(id);
+    tracker_.end(id, outcome, reason);
+  }
+  motion_owner_ = mid::kNoAction;
+  if (landed_) {
+    // On the ground every failsafe means the same: motors off.
+    stop_motion();
+    if (armed_) {
+      set_armed(false);
+      post_publish();
+    }
+  } else if (what == fleet::Failsafe::hover) {
+    stop_motion();
+  } else {
+    Motion m;
+    m.ground_z = ground_z();
+    if (what == fleet::Failsafe::land) {
+      m.kind = MotionKind::land;
+      m.target = {kin_.position.x, kin_.position.y, ground_z()};
+    } else {
+      m.kind = MotionKind::go;
+      m.target = {settings_.home.x, settings_.home.y, kin_.position.z};
+      m.land_after = true;
+    }
+    m.start_distance = remaining_distance(m, kin_.position);
+    motion_ = m;
+  }
+  update_timers();
+}
+
+void SimDrone::battery_empty() {
+  empty_timer_ = mid::kNoTimer;
+  // What an autopilot does at critical charge: fail what it was doing and land where it is.
+  enter_failsafe(fleet::Failsafe::land, Outcome::failed, "battery empty");
+  publish();
+}
+
+// --- the model -----------------------------------------------------------------------------
+
+void SimDrone::step() {
+  step_timer_ = mid::kNoTimer;
+  ++steps_;
+  const double dt = 1.0 / options_.step_hz;
+  StepEvent event = step_motion(motion_, kin_, settings_.limits, dt);
+  if (kin_.position.z < ground_z()) {  // the ground stops a braking descent
+    kin_.position.z = ground_z();
+    kin_.velocity.z = std::max(0.0, kin_.velocity.z);
+  }
+  if (landed_ && kin_.position.z > ground_z()) set_landed(false);
+
+  ActionId owner = motion_owner_;
+  if (event == StepEvent::arrived || event == StepEvent::touched_down) motion_owner_ = mid::kNoAction;
+  if (event == StepEvent::touched_down) {
+    set_landed(true);
+    if (!failsafe_reason_.empty()) set_armed(false);  // a failsafe ends with motors off
+  }
+  publish();
+  if ((event == StepEvent::arrived || event == StepEvent::touched_down) && owner != mid::kNoAction)
+    tracker_.end(owner, Outcome::succeeded);
+  update_timers();
+}
+
+void SimDrone::set_armed(bool armed) {
+  if (armed_ == armed) return;
+  armed_ = armed;
+  phase_changed();
+}
+
+void SimDrone::set_landed(bool landed) {
+  if (landed_ == landed) return;
+  landed_ = landed;
+  phase_changed();
+}
+
+void SimDrone::phase_changed() {
+  battery_.set_rate(loop_.now(), drain_rate(armed_, landed_));
+  loop_.cancel(empty_timer_);
+  empty_timer_ = mid::kNoTimer;
+  // Only in the air does an empty battery force anything (a landing); on the ground the
+  // charge just stops at 0 and the next Arm is refused.
+  if (armed_ && !landed_) empty_timer_ = loop_.at(battery_.empty_at(), [this] { battery_empty(); });
+}
+
+void SimDrone::update_timers() {
+  bool moving = motion_.kind != MotionKind::idle;
+  if (moving && step_timer_ == mid::kNoTimer) {
+    // A run of steps starts one step from now; its later steps are counted from that origin,
+    // so their times do not drift by rounding.
+    if (steps_in_run_ == 0) steps_origin_ = loop_.now();
+    ++steps_in_run_;
+    step_timer_ = loop_.at(steps_origin_ + steps_in_run_ / options_.step_hz, [this] { step(); });
+  } else if (!moving) {
+    loop_.cancel(step_timer_);
+    step_timer_ = mid::kNoTimer;
+    steps_in_run_ = 0;
+  }
+
+  bool idle_telemetry = armed_ && !moving && !broker_.empty() && options_.idle_telemetry_hz > 0;
+  if (idle_telemetry && telemetry_timer_ == mid::kNoTimer) {
+    telemetry_timer_ = loop_.after(1.0 / options_.idle_telemetry_hz, [this] {
+      telemetry_timer_ = mid::kNoTimer;
+      publish();
+      update_timers();
+    });
+  } else if (!idle_telemetry) {
+    loop_.cancel(telemetry_timer_);
+    telemetry_timer_ = mid::kNoTimer;
+  }
+}
+
+// --- properties ----------------------------------------------------------------------------
+
+double SimDrone::sensor_value(int k) const {
+  auto it = settings_.sensors.find("Sensor" + std::to_string(k));
+  if (it == settings_.sensors.end()) return 0.0;
+  return it->second.base + dot(it->second.gradient, kin_.position);
+}
+
+mid::DroneState SimDrone::state() const {
+  mid::DroneState s;
+  s.t = loop_.now();
+  s.x = kin_.position.x;
+  s.y = kin_.position.y;
+  s.z = kin_.position.z;
+  s.battery = battery_.at(loop_.now());
+  s.armed = armed_;
+  s.landed = landed_;
+  for (int k = 1; k <= type_.sensors; ++k) s.sensors["Sensor" + std::to_string(k)] = sensor_value(k);
+  s.pictures = pictures_;
+  return s;
+}
+
+mid::SubscriptionId SimDrone::subscribe(mid::StateCallback fn) {
+  mid::SubscriptionId id = broker_.subscribe(std::move(fn));
+  update_timers();
+  return id;
+}
+
+void SimDrone::unsubscribe(mid::SubscriptionId id) {
+  broker_.unsubscribe(id);
+  update_timers();
+}
+
+void SimDrone::publish() {
+  if (!broker_.empty()) broker_.publish(state());
+}
+
+void SimDrone::post_publish() {
+  if (publish_timer_ != mid::kNoTimer) return;
+  publish_timer_ = loop_.after(0.0, [this] {
+    publish_timer_ = mid::kNoTimer;
+    publish();
+  });
+}
+
+}  // namespace eamos::sim

@@ -1,0 +1,102 @@
+#pragma once
+// The built-in simulator's drone: a kinematic multirotor behind the uniform drone API.
+// Each SimDrone is stepped by the event loop at a fixed rate only while it moves; a drone
+// standing still (on the ground or hovering) schedules nothing, so a fleet of idle drones
+// costs nothing and a run on virtual time is as fast as the moving drones' steps.
+// Deterministic: the same calls at the same mission times give the same states.
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "fleet/catalog.h"
+#include "fleet/fleet.h"
+#include "mid/action_tracker.h"
+#include "mid/drone_api.h"
+#include "mid/event_loop.h"
+#include "mid/mover.h"
+#include "mid/state_broker.h"
+#include "sim/battery.h"
+#include "sim/motion.h"
+
+namespace eamos::sim {
+
+struct SimOptions {
+  double step_hz = 20.0;           ///< motion steps while moving (positive); also the telemetry
+                                   ///< rate then
+  double idle_telemetry_hz = 1.0;  ///< telemetry while armed and still, only when subscribed
+                                   ///< (the battery drains); 0 = only on state changes
+  double picture_s = 0.5;          ///< TakePicture duration
+  double sensor_read_s = 0.1;      ///< SensorK read duration
+};
+
+class SimDrone final : public mid::Drone {
+ public:
+  SimDrone(fleet::DroneSettings settings, fleet::DroneType type, mid::EventLoop& loop,
+           SimOptions options = {});
+  ~SimDrone() override;
+
+  const std::string& name() const override { return settings_.name; }
+  mid::ActionId start(const mid::ActionRequest& request, mid::EndCallback on_end) override;
+  bool cancel(mid::ActionId id) override;
+  std::optional<double> progress(mid::ActionId id) const override;
+  mid::DroneState state() const override;
+  mid::SubscriptionId subscribe(mid::StateCallback fn) override;
+  void unsubscribe(mid::SubscriptionId id) override;
+  void failsafe(fleet::Failsafe what) override;
+
+  /// Motion steps taken so far: the simulator's cost (idle drones take none).
+  std::uint64_t steps() const { return steps_; }
+  /// Current velocity, m/s (for tests of the limits).
+  fleet::Vec3 velocity() const { return kin_.velocity; }
+
+ private:
+  std::string refusal(const mid::ActionRequest& r, const fleet::ActionSpec& spec) const;
+  void start_system(mid::ActionId id, const mid::ActionRequest& r);
+  void start_payload(mid::ActionId id, const mid::ActionRequest& r);
+  void start_motion(mid::ActionId id, const mid::ActionRequest& r);
+  void finish_payload(mid::ActionId id, const std::string& name);
+
+  void stop_action(mid::ActionId id);  ///< what cancel and timeouts do to the vehicle
+  void stop_motion();                  ///< brake and hold where it is
+  void clear_action_timer(mid::ActionId id);
+  void enter_failsafe(fleet::Failsafe what, mid::Outcome outcome, const std::string& reason);
+
+  void step();
+  void set_armed(bool armed);
+  void set_landed(bool landed);
+  void phase_changed();  ///< battery rate and depletion timer follow armed/landed
+  void battery_empty();
+  void publish();
+  void post_publish();   ///< publish from the loop (for changes made inside API calls)
+  void update_timers();  ///< steps while moving, idle telemetry while armed and still
+  double sensor_value(int k) const;
+  double ground_z() const { return settings_.home.z; }
+
+  fleet::DroneSettings settings_;
+  fleet::DroneType type_;
+  mid::EventLoop& loop_;
+  SimOptions options_;
+
+  mid::Kinematics kin_;
+  bool armed_ = false;
+  bool landed_ = true;
+  int pictures_ = 0;
+  Battery battery_;
+  std::string failsafe_reason_;  ///< "" = no failsafe; otherwise why new actions are refused
+
+  Motion motion_;
+  mid::ActionId motion_owner_ = mid::kNoAction;  ///< the action motion_ flies for; none in failsafe
+  mid::ActionTracker tracker_;
+  mid::StateBroker broker_;
+
+  std::map<mid::ActionId, mid::TimerId> action_timers_;  ///< ends of payload, system, Hover(s)
+  mid::TimerId step_timer_ = mid::kNoTimer;
+  double steps_origin_ = 0.0;     ///< mission time of step 0 of the current run of steps
+  std::uint64_t steps_in_run_ = 0;
+  std::uint64_t steps_ = 0;
+  mid::TimerId telemetry_timer_ = mid::kNoTimer;
+  mid::TimerId empty_timer_ = mid::kNoTimer;
+  mid::TimerId publish_timer_ = mid::kNoTimer;
+};
+
+}  // namespace eamos::sim

@@ -1,0 +1,106 @@
+// Mission files are streamed to disk, never built as a document; they must hold exactly
+// what drone_mission() describes. And the mission hash names the mission: the same for
+// the same compiled mission, different as soon as a drone's setting or one node differs.
+#include <sstream>
+
+#include "deploy/synthesize.h"
+#include "helpers.h"
+
+namespace eamos {
+namespace {
+
+using nlohmann::json;
+using test::compile_mission;
+
+/// Compares the streamed file of every drone with the document drone_mission() builds.
+void expect_streamed_files_equal_documents(const graph::Compilation& c) {
+  std::string hash = deploy::mission_hash(c);
+  for (int d = 0; d < c.drone_count(); ++d) {
+    std::ostringstream out;
+    ASSERT_TRUE(deploy::write_drone_mission(out, c, d, hash));
+    json streamed = json::parse(out.str());
+    json document = deploy::drone_mission(c, d, hash);
+    EXPECT_EQ(streamed, document) << "drone " << c.drone_name(d) << "\nstreamed:\n"
+                                  << streamed.dump(1) << "\ndocument:\n" << document.dump(1);
+  }
+}
+
+TEST(MissionFile, StreamedFileEqualsDroneMissionForEveryDroneOfListing2) {
+  auto c = compile_mission(test::listing2_text(), test::kListing2Fleet);
+  ASSERT_TRUE(c);
+  expect_streamed_files_equal_documents(*c);
+}
+
+TEST(MissionFile, StreamedFileEqualsDroneMissionForEveryDroneOfAStressMission) {
+  auto c = compile_mission(test::stress_text(3000, 23));
+  ASSERT_TRUE(c);
+  ASSERT_EQ(c->drone_count(), 23);
+  expect_streamed_files_equal_documents(*c);
+}
+
+TEST(MissionFile, StreamedFileEqualsDroneMissionForEveryControlStructure) {
+  // Do*, Pause*, async, RepeatFor counts, unary operators and property arguments.
+  auto c = compile_mission(
+      "var A Quad\nvar B Quad\n"
+      "func INIT() { SEQ_main() }\n"
+      "func SEQ_main() {\n"
+      "  PAR_up()\n"
+      "  async(SEQ_watch)\n"
+      "  DoWhileSync(A.Z() > 1 && !B.Landed(), SEQ_circle, SEQ_after)\n"
+      "  DoUntilAsync(-A.X() < 3, SEQ_circle2, SEQ_after2)\n"
+      "  PauseUntil(B.Z() >= 2)\n"
+      "  PauseFor(1.5)\n"
+      "  RepeatFor(A.Z() < 30, SEQ_climb, SEQ_after3, 4)\n"
+      "  B.FlyByX(A.X() * 2)\n"
+      "}\n"
+      "func PAR_up() { A.Takeoff(3); B.Takeoff(4.5) }\n"
+      "func SEQ_watch() { WaitWhile(A.Z() < 2, SEQ_pic) }\n"
+      "func SEQ_pic() { B.TakePicture() }\n"
+      "func SEQ_circle() { A.FlyByX(1); A.FlyByX(-1) }\n"
+      "func SEQ_after() { A.Hover(1) }\n"
+      "func SEQ_circle2() { B.TakePicture() }\n"
+      "func SEQ_after2() { B.Hover(2) }\n"
+      "func SEQ_climb() { A.FlyByZ(1) }\n"
+      "func SEQ_after3() { A.Land(); B.Land() }\n");
+  ASSERT_TRUE(c);
+  expect_streamed_files_equal_documents(*c);
+}
+
+TEST(MissionHash, IsTheSameForTwoCompilesOfTheSameMission) {
+  auto a = compile_mission(test::listing2_text(), test::kListing2Fleet);
+  auto b = compile_mission(test::listing2_text(), test::kListing2Fleet);
+  ASSERT_TRUE(a && b);
+  EXPECT_EQ(deploy::mission_hash(*a), deploy::mission_hash(*b));
+  EXPECT_EQ(deploy::mission_hash(*a).size(), 64u);
+}
+
+TEST(MissionHash, ChangesWhenADronesFleetSettingChanges) {
+  std::string fleet = test::kListing2Fleet;
+  std::string changed = fleet;
+  changed.replace(changed.find("sysid: 7"), 8, "sysid: 8");
+  auto a = compile_mission(test::listing2_text(), fleet);
+  auto b = compile_mission(test::listing2_text(), changed);
+  ASSERT_TRUE(a && b);
+  EXPECT_NE(deploy::mission_hash(*a), deploy::mission_hash(*b));
+}
+
+TEST(MissionHash, ChangesWhenOneNodeChanges) {
+  std::string text = test::listing2_text();
+  std::string changed = text;
+  changed.replace(changed.find("Drone2.Takeoff(10)"), 18, "Drone2.Takeoff(11)");
+  auto a = compile_mission(text);
+  auto b = compile_mission(changed);
+  ASSERT_TRUE(a && b);
+  EXPECT_NE(deploy::mission_hash(*a), deploy::mission_hash(*b));
+}
+
+TEST(MissionHash, DoesNotDependOnTheSourcePath) {
+  auto a = compile_mission(test::listing2_text());
+  auto b = compile_mission(test::listing2_text());
+  ASSERT_TRUE(a && b);
+  b->source->path = "elsewhere/listing2.eamos";
+  EXPECT_EQ(deploy::mission_hash(*a), deploy::mission_hash(*b));
+}
+
+}  // namespace
+}  // namespace eamos

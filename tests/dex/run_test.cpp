@@ -1,0 +1,150 @@
+// Missions flown in the simulator on virtual time, asserting on the trace: the first
+// semantic rules of docs/language.md as executed by the DEX (more follow with issue 3).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <sstream>
+
+#include "deploy/synthesize.h"
+#include "dex/runner.h"
+#include "dex/trace_writers.h"
+#include "graph/pipeline.h"
+#include "sim/sim_adapter.h"
+
+namespace eamos {
+namespace {
+
+struct Flight {
+  dex::RunResult result;
+  std::vector<dex::TraceEvent> events;
+  std::string jsonl;
+
+  /// Index of the first event matching, or -1.
+  int find(const std::string& event, const std::string& text, const std::string& outcome = "") const {
+    for (std::size_t i = 0; i < events.size(); ++i)
+      if (events[i].event == event && events[i].text == text && (outcome.empty() || events[i].outcome == outcome))
+        return static_cast<int>(i);
+    return -1;
+  }
+  double time_of(const std::string& event, const std::string& text) const {
+    int i = find(event, text);
+    return i < 0 ? -1.0 : events[i].t;
+  }
+};
+
+Flight fly(const std::string& text) {
+  graph::Compilation c;
+  Diagnostics diags;
+  Flight f;
+  if (!graph::compile(std::make_shared<SourceFile>("t.eamos", text), fleet::Fleet{}, diags, c)) {
+    ADD_FAILURE() << diags.format();
+    return f;
+  }
+  std::string hash = deploy::mission_hash(c);
+  std::vector<dex::Mission> missions(c.drone_count());
+  for (int d = 0; d < c.drone_count(); ++d) {
+    std::string error;
+    EXPECT_TRUE(dex::load_mission(deploy::drone_mission(c, d, hash), missions[d], error)) << error;
+  }
+  mid::AdapterRegistry adapters;
+  sim::register_adapter(adapters);
+  dex::MemoryTrace memory;
+  std::ostringstream out;
+  dex::JsonlTrace jsonl(out);
+  dex::TeeTrace tee;
+  tee.add(&memory);
+  tee.add(&jsonl);
+  dex::RunOptions options;
+  options.time_limit_s = 600;
+  f.result = dex::run_in_process(missions, adapters, &tee, options);
+  f.events = memory.events;
+  f.jsonl = out.str();
+  return f;
+}
+
+const char* kTwo = "var A Quad\nvar B Quad\n";
+
+TEST(Run, SequenceRunsItsStatementsOneAfterAnother) {
+  Flight f = fly(std::string(kTwo) + "func INIT() { A.Arm(); A.Takeoff(5); A.Land(); A.Disarm() }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_LE(f.time_of("end", "A.Takeoff(5)"), f.time_of("start", "A.Land()"));
+  EXPECT_LT(f.find("end", "A.Arm()"), f.find("start", "A.Takeoff(5)"));
+  EXPECT_TRUE(f.result.drones[0].state.landed);
+  EXPECT_FALSE(f.result.drones[0].state.armed);
+}
+
+TEST(Run, ParallelBlockStartsAllAndNextWaitsForAll) {
+  Flight f = fly(std::string(kTwo) +
+                 "func INIT() { PAR_up(); A.FlyByX(1) }\nfunc PAR_up() { SEQ_a(); SEQ_b() }\n"
+                 "func SEQ_a() { A.Arm(); A.Takeoff(2) }\nfunc SEQ_b() { B.Arm(); B.Takeoff(8) }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_EQ(f.time_of("start", "A.Arm()"), f.time_of("start", "B.Arm()"));
+  EXPECT_GE(f.time_of("start", "A.FlyByX(1)"), f.time_of("end", "B.Takeoff(8)"));
+  EXPECT_LT(f.time_of("end", "A.Takeoff(2)"), f.time_of("end", "B.Takeoff(8)"));
+}
+
+TEST(Run, IfRunsOnlyTheTakenBranch) {
+  Flight f = fly(std::string(kTwo) +
+                 "func INIT() { A.Arm(); If(A.Battery() > 50, SEQ_t, SEQ_f); B.Arm() }\n"
+                 "func SEQ_t() { A.Takeoff(3) }\nfunc SEQ_f() { A.Disarm() }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_GE(f.find("end", "A.Takeoff(3)", "succeeded"), 0);
+  EXPECT_LT(f.find("start", "A.Disarm()"), 0);
+  EXPECT_GE(f.time_of("start", "B.Arm()"), f.time_of("end", "A.Takeoff(3)"));
+}
+
+TEST(Run, WaitUntilStartsBranchWhenConditionTurnsTrue) {
+  Flight f = fly(std::string(kTwo) +
+                 "func INIT() { PAR_x() }\nfunc PAR_x() { SEQ_a(); WaitUntil(A.Z() >= 4, SEQ_b) }\n"
+                 "func SEQ_a() { A.Arm(); A.Takeoff(8) }\nfunc SEQ_b() { B.Arm() }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  double go = f.time_of("start", "B.Arm()");
+  EXPECT_GT(go, f.time_of("start", "A.Takeoff(8)"));
+  EXPECT_LT(go, f.time_of("end", "A.Takeoff(8)"));
+}
+
+TEST(Run, RepeatForStopsAfterItsCount) {
+  Flight f = fly(std::string(kTwo) +
+                 "func INIT() { A.Arm(); RepeatFor(true, SEQ_r, SEQ_n, 3) }\n"
+                 "func SEQ_r() { A.TakePicture() }\nfunc SEQ_n() { A.Disarm() }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_EQ(f.result.drones[0].state.pictures, 3);
+  EXPECT_FALSE(f.result.drones[0].state.armed);
+}
+
+TEST(Run, DoWhileSyncCancelsDoBranchWhenConditionFlips) {
+  Flight f = fly(std::string(kTwo) +
+                 "func INIT() { PAR_x(); A.Land() }\n"
+                 "func PAR_x() { SEQ_a(); SEQ_b() }\n"
+                 "func SEQ_a() { A.Arm(); A.Takeoff(5); DoWhileSync(B.Z() < 3, SEQ_do, SEQ_done) }\n"
+                 "func SEQ_b() { B.Arm(); PauseFor(10); B.Takeoff(6) }\n"
+                 "func SEQ_do() { A.Orbit() }\nfunc SEQ_done() { A.Hover(1) }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  int cancelled = f.find("end", "A.Orbit()", "cancelled");
+  EXPECT_GE(cancelled, 0);
+  EXPECT_GE(f.find("end", "A.Hover(1)", "succeeded"), cancelled);
+  EXPECT_LT(f.time_of("start", "A.Orbit()"), f.time_of("start", "B.Takeoff(6)"));  // B still low
+  EXPECT_GE(f.time_of("start", "A.Land()"), f.time_of("end", "A.Hover(1)"));
+}
+
+TEST(Run, TakeoffWhileDisarmedFailsTheMissionNamingDroneActionAndLine) {
+  Flight f = fly(std::string(kTwo) + "func INIT() {\n  A.Takeoff(5)\n}\n");
+  EXPECT_FALSE(f.result.completed);
+  ASSERT_TRUE(f.result.failure.has_value());
+  EXPECT_EQ(f.result.failure->drone, "A");
+  EXPECT_EQ(f.result.failure->action, "Takeoff");
+  EXPECT_EQ(f.result.failure->line, 4);
+}
+
+TEST(Run, SameMissionGivesByteIdenticalTrace) {
+  std::string m = std::string(kTwo) +
+                  "func INIT() { PAR_x() }\nfunc PAR_x() { SEQ_a(); SEQ_b() }\n"
+                  "func SEQ_a() { A.Arm(); A.Takeoff(5); A.FlyTo(10, 3, 5); A.Land() }\n"
+                  "func SEQ_b() { B.Arm(); B.Takeoff(3); B.Orbit(4); }\n";
+  Flight one = fly(m), two = fly(m);
+  EXPECT_FALSE(one.jsonl.empty());
+  EXPECT_EQ(one.jsonl, two.jsonl);
+}
+
+}  // namespace
+}  // namespace eamos

@@ -1,0 +1,154 @@
+// ActionTracker: the outcome rules every adapter shares. Ends are reported exactly once and
+// only through the loop; a motion action preempts the running one; deadlines fail actions.
+#include "mid/action_tracker.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "mid/state_broker.h"
+
+namespace eamos::mid {
+namespace {
+
+using fleet::ActionClass;
+
+struct Ends {
+  std::vector<std::pair<int, ActionEnd>> seen;  ///< (tag, end) in report order
+  EndCallback tag(int t) {
+    return [this, t](const ActionEnd& e) { seen.emplace_back(t, e); };
+  }
+};
+
+TEST(ActionTracker, EndIsReportedThroughTheLoopNotInline) {
+  EventLoop loop;
+  ActionTracker tracker(loop, [](ActionId) {});
+  Ends ends;
+  ActionId id = tracker.begin({"TakePicture", {}}, ActionClass::payload, ends.tag(1), 1e9);
+  EXPECT_TRUE(tracker.end(id, Outcome::succeeded));
+  EXPECT_TRUE(ends.seen.empty());
+  loop.run_until_idle();
+  ASSERT_EQ(ends.seen.size(), 1u);
+  EXPECT_EQ(ends.seen[0].second.outcome, Outcome::succeeded);
+}
+
+TEST(ActionTracker, EachActionEndsExactlyOnce) {
+  EventLoop loop;
+  ActionTracker tracker(loop, [](ActionId) {});
+  Ends ends;
+  ActionId id = tracker.begin({"FlyTo", {1, 2, 3}}, ActionClass::motion, ends.tag(1), 1e9);
+  EXPECT_TRUE(tracker.end(id, Outcome::cancelled, "cancelled"));
+  EXPECT_FALSE(tracker.end(id, Outcome::succeeded));
+  EXPECT_FALSE(tracker.running(id));
+  loop.run_until_idle();
+  ASSERT_EQ(ends.seen.size(), 1u);
+  EXPECT_EQ(ends.seen[0].second.outcome, Outcome::cancelled);
+}
+
+TEST(ActionTracker, NewMotionPreemptsTheRunningOne) {
+  EventLoop loop;
+  ActionTracker tracker(loop, [](ActionId) {});
+  Ends ends;
+  ActionId orbit = tracker.begin({"Orbit", {}}, ActionClass::motion, ends.tag(1), INFINITY);
+  ActionId land = tracker.begin({"Land", {}}, ActionClass::motion, ends.tag(2), 30);
+  EXPECT_FALSE(tracker.running(orbit));
+  EXPECT_EQ(tracker.motion(), land);
+  loop.run_until(1.0);
+  ASSERT_EQ(ends.seen.size(), 1u);
+  EXPECT_EQ(ends.seen[0].first, 1);
+  EXPECT_EQ(ends.seen[0].second.outcome, Outcome::preempted);
+  EXPECT_EQ(ends.seen[0].second.reason, "preempted by Land");
+}
+
+TEST(ActionTracker, PayloadAndSystemActionsDoNotPreemptMotion) {
+  EventLoop loop;
+  ActionTracker tracker(loop, [](ActionId) {});
+  Ends ends;
+  ActionId fly = tracker.begin({"FlyTo", {1, 2, 3}}, ActionClass::motion, ends.tag(1), 1e9);
+  tracker.begin({"TakePicture", {}}, ActionClass::payload, ends.tag(2), 1e9);
+  tracker.begin({"Sensor1", {}}, ActionClass::payload, ends.tag(3), 1e9);
+  EXPECT_TRUE(tracker.running(fly));
+  EXPECT_EQ(tracker.motion(), fly);
+  EXPECT_EQ(tracker.running_ids().size(), 3u);
+}
+
+TEST(ActionTracker, DeadlineStopsThenFailsTheAction) {
+  EventLoop loop;
+  std::vector<ActionId> stopped;
+  ActionTracker tracker(loop, [&](ActionId id) { stopped.push_back(id); });
+  Ends ends;
+  ActionId id = tracker.begin({"FlyTo", {1, 2, 3}}, ActionClass::motion, ends.tag(1), 2.5);
+  loop.run_until_idle();
+  EXPECT_EQ(stopped, std::vector<ActionId>{id});
+  ASSERT_EQ(ends.seen.size(), 1u);
+  EXPECT_EQ(ends.seen[0].second.outcome, Outcome::failed);
+  EXPECT_EQ(ends.seen[0].second.reason, "timed out after 2.5 s");
+  EXPECT_DOUBLE_EQ(loop.now(), 2.5);
+  EXPECT_EQ(tracker.motion(), kNoAction);
+}
+
+TEST(ActionTracker, EndedActionLeavesNoDeadlineBehind) {
+  EventLoop loop;
+  int stops = 0;
+  ActionTracker tracker(loop, [&](ActionId) { ++stops; });
+  Ends ends;
+  ActionId id = tracker.begin({"Hover", {5}}, ActionClass::motion, ends.tag(1), 17.5);
+  tracker.end(id, Outcome::succeeded);
+  loop.run_until_idle();
+  EXPECT_EQ(stops, 0);
+  EXPECT_EQ(loop.now(), 0.0);  // nothing was left scheduled at 17.5
+}
+
+TEST(ActionTracker, RefusedActionEndsFailedThroughTheLoop) {
+  EventLoop loop;
+  ActionTracker tracker(loop, [](ActionId) {});
+  Ends ends;
+  ActionId id = tracker.refuse({"Takeoff", {3}}, ends.tag(1), "disarmed: arm before Takeoff");
+  EXPECT_NE(id, kNoAction);
+  EXPECT_FALSE(tracker.running(id));
+  EXPECT_TRUE(ends.seen.empty());
+  loop.run_until_idle();
+  ASSERT_EQ(ends.seen.size(), 1u);
+  EXPECT_EQ(ends.seen[0].second.outcome, Outcome::failed);
+  EXPECT_EQ(ends.seen[0].second.reason, "disarmed: arm before Takeoff");
+}
+
+TEST(ActionTracker, ShutdownCancelsWhatStillRuns) {
+  EventLoop loop;
+  Ends ends;
+  {
+    ActionTracker tracker(loop, [](ActionId) {});
+    tracker.begin({"Orbit", {}}, ActionClass::motion, ends.tag(1), INFINITY);
+  }
+  loop.run_until_idle();
+  ASSERT_EQ(ends.seen.size(), 1u);
+  EXPECT_EQ(ends.seen[0].second.outcome, Outcome::cancelled);
+}
+
+TEST(ActionTracker, OutcomesHaveNames) {
+  EXPECT_STREQ(outcome_name(Outcome::succeeded), "succeeded");
+  EXPECT_STREQ(outcome_name(Outcome::preempted), "preempted");
+  EXPECT_STREQ(outcome_name(Outcome::cancelled), "cancelled");
+  EXPECT_STREQ(outcome_name(Outcome::failed), "failed");
+}
+
+TEST(StateBroker, PublishesToSubscribersInOrderAndSurvivesUnsubscribeInCallback) {
+  StateBroker broker;
+  std::vector<int> calls;
+  SubscriptionId first = 0;
+  first = broker.subscribe([&](const DroneState&) {
+    calls.push_back(1);
+    broker.unsubscribe(first);
+  });
+  broker.subscribe([&](const DroneState& s) { calls.push_back(static_cast<int>(s.t)); });
+  DroneState s;
+  s.t = 7;
+  broker.publish(s);
+  broker.publish(s);
+  EXPECT_EQ(calls, (std::vector<int>{1, 7, 7}));
+}
+
+}  // namespace
+}  // namespace eamos::mid

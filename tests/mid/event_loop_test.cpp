@@ -1,0 +1,162 @@
+// EventLoop: the executor's clock. Virtual time jumps from event to event; equal times run
+// in scheduling order; real time waits on a (here fake) wall clock scaled by the speed.
+#include "mid/event_loop.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+namespace eamos::mid {
+namespace {
+
+TEST(EventLoop, RunsCallbacksInTimeOrder) {
+  EventLoop loop;
+  std::vector<double> seen;
+  loop.at(3.0, [&] { seen.push_back(loop.now()); });
+  loop.at(1.0, [&] { seen.push_back(loop.now()); });
+  loop.after(2.0, [&] { seen.push_back(loop.now()); });
+  EXPECT_EQ(loop.run_until_idle(), 3u);
+  EXPECT_EQ(seen, (std::vector<double>{1.0, 2.0, 3.0}));
+  EXPECT_DOUBLE_EQ(loop.now(), 3.0);
+}
+
+TEST(EventLoop, EqualTimesRunInSchedulingOrder) {
+  EventLoop loop;
+  std::string order;
+  loop.at(1.0, [&] { order += 'a'; });
+  loop.at(1.0, [&] { order += 'b'; });
+  loop.at(0.5, [&] {
+    order += 'c';
+    loop.at(1.0, [&] { order += 'd'; });  // scheduled later, so after a and b
+  });
+  loop.run_until_idle();
+  EXPECT_EQ(order, "cabd");
+}
+
+// The schedule a callback builds depends only on what ran before it, so two loops fed the
+// same program produce the same trace: the basis of deterministic simulated missions.
+TEST(EventLoop, EventLoopRunsSameScheduleIdentically) {
+  auto trace_of = [] {
+    EventLoop loop;
+    std::vector<std::string> trace;
+    std::function<void(int)> tick = [&](int n) {
+      trace.push_back(std::to_string(loop.now()) + ":" + std::to_string(n));
+      if (n < 50) {
+        loop.after(0.1 * (n % 4), [&, n] { tick(n + 1); });
+        loop.after(0.1 * (n % 3), [&, n] { trace.push_back("side" + std::to_string(n)); });
+      }
+    };
+    loop.at(0.0, [&] { tick(0); });
+    loop.run_until_idle();
+    return trace;
+  };
+  std::vector<std::string> first = trace_of();
+  EXPECT_GT(first.size(), 100u);
+  EXPECT_EQ(first, trace_of());
+}
+
+TEST(EventLoop, CancelledTimerNeverRuns) {
+  EventLoop loop;
+  bool ran = false;
+  TimerId id = loop.after(1.0, [&] { ran = true; });
+  EXPECT_TRUE(loop.pending(id));
+  EXPECT_TRUE(loop.cancel(id));
+  EXPECT_FALSE(loop.cancel(id));
+  EXPECT_EQ(loop.size(), 0u);
+  EXPECT_EQ(loop.run_until_idle(), 0u);
+  EXPECT_FALSE(ran);
+}
+
+TEST(EventLoop, CallbackCanCancelALaterTimer) {
+  EventLoop loop;
+  bool ran = false;
+  TimerId later = loop.at(2.0, [&] { ran = true; });
+  loop.at(1.0, [&] { loop.cancel(later); });
+  loop.run_until_idle();
+  EXPECT_FALSE(ran);
+}
+
+TEST(EventLoop, RunUntilRunsDueEventsAndSetsNow) {
+  EventLoop loop;
+  int ran = 0;
+  loop.at(1.0, [&] { ++ran; });
+  loop.at(2.0, [&] { ++ran; });
+  loop.at(5.0, [&] { ++ran; });
+  EXPECT_EQ(loop.run_until(2.0), 2u);  // an event exactly at the bound runs
+  EXPECT_DOUBLE_EQ(loop.now(), 2.0);
+  EXPECT_EQ(loop.run_until(4.0), 0u);
+  EXPECT_DOUBLE_EQ(loop.now(), 4.0);
+  EXPECT_EQ(loop.size(), 1u);
+}
+
+TEST(EventLoop, PastTimeRunsNow) {
+  EventLoop loop;
+  loop.run_until(10.0);
+  double when = -1;
+  loop.at(3.0, [&] { when = loop.now(); });
+  loop.run_until_idle();
+  EXPECT_DOUBLE_EQ(when, 10.0);
+}
+
+TEST(EventLoop, NonFiniteTimeSchedulesNothing) {
+  EventLoop loop;
+  EXPECT_EQ(loop.at(std::numeric_limits<double>::infinity(), [] {}), kNoTimer);
+  EXPECT_EQ(loop.after(std::numeric_limits<double>::quiet_NaN(), [] {}), kNoTimer);
+  EXPECT_EQ(loop.size(), 0u);
+}
+
+TEST(EventLoop, StopReturnsAfterTheCurrentCallback) {
+  EventLoop loop;
+  int ran = 0;
+  loop.at(1.0, [&] { ++ran; loop.stop(); });
+  loop.at(2.0, [&] { ++ran; });
+  EXPECT_EQ(loop.run_until(10.0), 1u);
+  EXPECT_DOUBLE_EQ(loop.now(), 1.0);  // stopped: time stays at the last event
+  EXPECT_EQ(loop.run_until_idle(), 1u);
+  EXPECT_EQ(ran, 2);
+  EXPECT_EQ(loop.events_run(), 2u);
+}
+
+// A fake wall clock: sleeping just moves its time, so real-time mode is tested without waiting.
+class FakeWall final : public WallClock {
+ public:
+  double now_s() override { return t; }
+  void sleep_until_s(double until) override {
+    sleeps.push_back(until);
+    t = until;
+  }
+  double t = 100.0;
+  std::vector<double> sleeps;
+};
+
+TEST(EventLoop, RealTimeWaitsUntilScaledWallTime) {
+  FakeWall wall;
+  EventLoop loop({ClockMode::real_time, 2.0, &wall});
+  loop.at(1.0, [] {});
+  loop.at(3.0, [] {});
+  loop.run_until_idle();
+  // Twice as fast as the wall: mission second 1 at wall +0.5, second 3 at wall +1.5.
+  EXPECT_EQ(wall.sleeps, (std::vector<double>{100.5, 101.5}));
+}
+
+TEST(EventLoop, RealTimeDoesNotWaitForLateEvents) {
+  FakeWall wall;
+  EventLoop loop({ClockMode::real_time, 1.0, &wall});
+  loop.at(1.0, [&] { wall.t += 5.0; });  // a slow callback: the next event is already due
+  loop.at(2.0, [] {});
+  loop.run_until_idle();
+  EXPECT_EQ(wall.sleeps, (std::vector<double>{101.0}));
+}
+
+TEST(EventLoop, VirtualTimeNeverTouchesTheWallClock) {
+  FakeWall wall;
+  EventLoop loop({ClockMode::virtual_time, 1.0, &wall});
+  loop.at(3600.0, [] {});
+  loop.run_until(7200.0);
+  EXPECT_TRUE(wall.sleeps.empty());
+  EXPECT_DOUBLE_EQ(loop.now(), 7200.0);
+}
+
+}  // namespace
+}  // namespace eamos::mid
