@@ -29,9 +29,7 @@ void Engine::start() {
   drain();
 }
 
-double Engine::property(int drone, const std::string& name) const {
-  if (drone != m_.self) return hooks_.remote_property ? hooks_.remote_property(drone, name) : NAN;
-  mid::DroneState s = drone_.state();
+double property_of(const mid::DroneState& s, const std::string& name) {
   if (name == "X") return s.x;
   if (name == "Y") return s.y;
   if (name == "Z") return s.z;
@@ -40,6 +38,11 @@ double Engine::property(int drone, const std::string& name) const {
   if (name == "Landed") return s.landed ? 1 : 0;
   auto it = s.sensors.find(name);
   return it == s.sensors.end() ? 0.0 : it->second;
+}
+
+double Engine::property(int drone, const std::string& name) const {
+  if (drone != m_.self) return hooks_.remote_property ? hooks_.remote_property(drone, name) : NAN;
+  return property_of(drone_.state(), name);
 }
 
 void Engine::trace(const Node& n, const std::string& event, const std::string& outcome) {

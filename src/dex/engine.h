@@ -17,6 +17,10 @@
 
 namespace eamos::dex {
 
+/// A uniform property (X, Y, Z, Battery, Armed, Landed, SensorK) of a drone state;
+/// booleans as 0/1, an unknown sensor as 0.
+double property_of(const mid::DroneState& s, const std::string& name);
+
 /// Why a mission failed: the drone, the action and the source line.
 struct Failure {
   std::string drone;

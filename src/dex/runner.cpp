@@ -26,17 +26,6 @@ class InProcessTransport : public Transport {
   int in_flight_ = 0;
 };
 
-double property_of(const mid::DroneState& s, const std::string& name) {
-  if (name == "X") return s.x;
-  if (name == "Y") return s.y;
-  if (name == "Z") return s.z;
-  if (name == "Battery") return s.battery;
-  if (name == "Armed") return s.armed ? 1 : 0;
-  if (name == "Landed") return s.landed ? 1 : 0;
-  auto it = s.sensors.find(name);
-  return it == s.sensors.end() ? 0.0 : it->second;
-}
-
 }  // namespace
 
 RunResult run_in_process(const std::vector<Mission>& missions, const mid::AdapterRegistry& adapters,
