@@ -6,13 +6,14 @@ BUILD=${1:-build}
 cd "$(dirname "$0")/.."
 mkdir -p out/bench
 
+build_type=$(grep '^CMAKE_BUILD_TYPE:' "$BUILD/CMakeCache.txt" | cut -d= -f2)
 {
   echo "date:       $(date -u '+%Y-%m-%d %H:%M UTC')"
   echo "cpus:       $(nproc) × $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')"
   echo "memory:     $(free -h | awk '/^Mem:/ {print $2}')"
   echo "os:         $(. /etc/os-release && echo "$PRETTY_NAME"), kernel $(uname -r)"
   echo "compiler:   $(c++ --version | head -1)"
-  echo "build type: $(grep '^CMAKE_BUILD_TYPE:' "$BUILD/CMakeCache.txt" | cut -d= -f2)"
+  echo "build type: ${build_type:-RelWithDebInfo (the default of CMakeLists.txt)}"
 } | tee out/bench/machine.txt
 
 # The paper's second measurement: a 5,000-node, 20-drone mission; its largest drone MDG.

@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config
-  libfmt-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
+  libfmt-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev nettle-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   graphviz
   clang libclang-rt-14-dev

@@ -19,7 +19,8 @@ using graph::Compilation;
 using graph::MegKind;
 using graph::MegNode;
 
-/// Mission files break lines down to each member of a node or arc: one node per line.
+/// Mission files put each top-level member, each setting, and each node and arc on a line
+/// of its own (members nested deeper stay on their parent's line).
 constexpr int kMissionFileWrap = 2;
 
 void write_vec3(JsonWriter& w, const fleet::Vec3& v) {
@@ -286,7 +287,7 @@ bool write_drone_mission(std::ostream& out, const Compilation& c, int drone, con
 // The canonical form hashed is one line of JSON: every drone's settings and type, then
 // every MEG node with all of its content and every arc. The digest reads it as it is
 // written, so a large mission is hashed without being held in memory. It is kept lean
-// (no labels, arcs as arrays): at 500,000 nodes hashing is a sixth of the compile.
+// (no labels, arcs as arrays): at 500,000 nodes hashing is a fifth of the compile.
 std::string mission_hash(const Compilation& c) {
   Sha256 sha;
   {

@@ -1,10 +1,12 @@
 #pragma once
-// SHA-256 (FIPS 180-4), fed in pieces. The mission hash is the compiler's only use of a
-// digest, and linking and initialising OpenSSL's libcrypto for it cost about 4 MB of the
-// compiler's peak memory (docs/performance.md); these few lines cost nothing.
+// SHA-256 fed in pieces, over GNU Nettle's implementation. The mission hash is the
+// compiler's only digest; Nettle is a small, well-kept library, where linking and
+// initialising OpenSSL's libcrypto for it cost about 4 MB of the compiler's peak memory
+// (docs/performance.md).
 #include <cstddef>
-#include <cstdint>
 #include <string>
+
+#include <nettle/sha2.h>
 
 namespace eamos::deploy {
 
@@ -16,12 +18,7 @@ class Sha256 {
   std::string hex_digest();
 
  private:
-  void compress(const unsigned char* block);  ///< one 64-byte block into state_
-
-  std::uint32_t state_[8];
-  unsigned char block_[64];       ///< bytes not yet compressed
-  std::size_t block_used_ = 0;
-  std::uint64_t total_bytes_ = 0;
+  sha256_ctx ctx_;
 };
 
 }  // namespace eamos::deploy
