@@ -15,7 +15,10 @@ mkdir -p "$OUT/graphs"
 for drone in Drone1 Drone2 Drone3; do
   "$EAMOS" graph "$MISSION" --kind mdg --drone "$drone" --format svg -o "$OUT/graphs/mdg-$drone.svg"
 done
-"$EAMOS" stats "$MISSION" -o "$OUT/stats.json"
+"$EAMOS" stats "$MISSION" -o "$OUT/stats.json" -q
+"$EAMOS" run "$MISSION" -q --fleet examples/listing2-right.yaml \
+  --trace "$OUT/trace.jsonl" --summary "$OUT/summary.json"
 echo
-echo "demo: deployment in $OUT/deploy/, graphs in $OUT/graphs/, statistics in $OUT/stats.json"
+echo "demo: deployment in $OUT/deploy/, graphs in $OUT/graphs/, statistics in $OUT/stats.json,"
+echo "      trace in $OUT/trace.jsonl, summary in $OUT/summary.json"
 ls "$OUT/deploy" "$OUT/graphs"

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
 #include <sstream>
 
 #include "deploy/synthesize.h"
@@ -32,11 +33,11 @@ struct Flight {
   }
 };
 
-Flight fly(const std::string& text) {
+Flight fly(const std::string& text, const fleet::Fleet& fleet = {}) {
   graph::Compilation c;
   Diagnostics diags;
   Flight f;
-  if (!graph::compile(std::make_shared<SourceFile>("t.eamos", text), fleet::Fleet{}, diags, c)) {
+  if (!graph::compile(std::make_shared<SourceFile>("t.eamos", text), fleet, diags, c)) {
     ADD_FAILURE() << diags.format();
     return f;
   }
@@ -144,6 +145,40 @@ TEST(Run, SameMissionGivesByteIdenticalTrace) {
   Flight one = fly(m), two = fly(m);
   EXPECT_FALSE(one.jsonl.empty());
   EXPECT_EQ(one.jsonl, two.jsonl);
+}
+
+std::string example(const std::string& name) {
+  std::ifstream in(std::string(EAMOS_SOURCE_DIR) + "/examples/" + name);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Figure 3 of the paper: Drone1 goes right (Sensor1 >= 100) or left, Drone3 waits until
+// Drone1 is 5 m out, meets it there, and Drone2 orbits taking pictures until Drone3 is back
+// below 3 m, when its Land preempts the Orbit; then everybody disarms.
+TEST(Run, Listing2FollowsFigure3ToTheRightAndToTheLeft) {
+  for (const char* side : {"right", "left"}) {
+    fleet::Fleet fleet;
+    Diagnostics diags;
+    ASSERT_TRUE(fleet::load_fleet(std::string(EAMOS_SOURCE_DIR) + "/examples/listing2-" + side + ".yaml",
+                                  fleet, diags))
+        << diags.format();
+    Flight f = fly(example("listing2.eamos"), fleet);
+    ASSERT_TRUE(f.result.completed) << side << ": " << f.result.error;
+    double x = std::string(side) == "right" ? 5.0 : -5.0;
+    EXPECT_EQ(f.result.drones[0].state.x, x) << side;
+    EXPECT_EQ(f.result.drones[2].state.x, x) << side;  // Drone3 flew to Drone1's x
+    EXPECT_GE(f.result.drones[1].state.pictures, 1) << side;
+    EXPECT_GE(f.find("end", "Drone2.Orbit()", "preempted"), 0) << side;
+    std::string fly1 = std::string("Drone1.FlyByX(") + (x > 0 ? "5" : "-5") + ")";
+    EXPECT_GE(f.time_of("start", "Drone3.Takeoff(3)"), f.time_of("start", fly1)) << side;
+    EXPECT_GE(f.time_of("start", "Drone2.Land()"), f.time_of("end", "Drone3.FlyByX(Drone1.X())")) << side;
+    for (const auto& d : f.result.drones) {
+      EXPECT_TRUE(d.state.landed) << side << " " << d.name;
+      EXPECT_FALSE(d.state.armed) << side << " " << d.name;
+    }
+  }
 }
 
 }  // namespace
