@@ -9,11 +9,11 @@ OUT=out/listing2
 
 mkdir -p "$OUT/graphs"
 "$EAMOS" check "$MISSION"
-"$EAMOS" compile "$MISSION" -o "$OUT/deploy"
-"$EAMOS" graph "$MISSION" --kind amt --format svg -o "$OUT/graphs/amt.svg"
-"$EAMOS" graph "$MISSION" --kind meg --format svg -o "$OUT/graphs/meg.svg"
+"$EAMOS" compile -q "$MISSION" -o "$OUT/deploy"
+"$EAMOS" graph -q "$MISSION" --kind amt --format svg -o "$OUT/graphs/amt.svg"
+"$EAMOS" graph -q "$MISSION" --kind meg --format svg -o "$OUT/graphs/meg.svg"
 for drone in Drone1 Drone2 Drone3; do
-  "$EAMOS" graph "$MISSION" --kind mdg --drone "$drone" --format svg -o "$OUT/graphs/mdg-$drone.svg"
+  "$EAMOS" graph -q "$MISSION" --kind mdg --drone "$drone" --format svg -o "$OUT/graphs/mdg-$drone.svg"
 done
 "$EAMOS" stats "$MISSION" -o "$OUT/stats.json" -q
 "$EAMOS" run "$MISSION" -q --fleet examples/listing2-right.yaml \
