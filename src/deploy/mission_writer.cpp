@@ -73,15 +73,6 @@ void write_settings(JsonWriter& w, const fleet::DroneSettings& s, int index) {
   w.end_object();
 }
 
-const char* class_name(fleet::ActionClass k) {
-  switch (k) {
-    case fleet::ActionClass::motion: return "motion";
-    case fleet::ActionClass::payload: return "payload";
-    case fleet::ActionClass::system: return "system";
-  }
-  return "";
-}
-
 void write_type(JsonWriter& w, const fleet::DroneType& t) {
   w.begin_object();
   w.member("name", t.name);
@@ -96,7 +87,7 @@ void write_type(JsonWriter& w, const fleet::DroneType& t) {
     w.begin_array();
     for (int n : a.arities) w.value(n);
     w.end_array();
-    w.member("class", class_name(a.action_class));
+    w.member("class", fleet::action_class_name(a.action_class));
     w.end_object();
   }
   w.end_array();

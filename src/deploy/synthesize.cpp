@@ -39,19 +39,10 @@ json settings_json(const fleet::DroneSettings& s, int index) {
   return j;
 }
 
-const char* class_name(fleet::ActionClass k) {
-  switch (k) {
-    case fleet::ActionClass::motion: return "motion";
-    case fleet::ActionClass::payload: return "payload";
-    case fleet::ActionClass::system: return "system";
-  }
-  return "";
-}
-
 json type_json(const fleet::DroneType& t) {
   json actions = json::array();
   for (const auto& a : t.actions)
-    actions.push_back({{"name", a.name}, {"arities", a.arities}, {"class", class_name(a.action_class)}});
+    actions.push_back({{"name", a.name}, {"arities", a.arities}, {"class", fleet::action_class_name(a.action_class)}});
   json props = json::array();
   for (const auto& p : t.properties)
     props.push_back({{"name", p.name}, {"type", p.type == fleet::ValueType::boolean ? "boolean" : "number"}});

@@ -4,6 +4,15 @@
 
 namespace eamos::fleet {
 
+const char* action_class_name(ActionClass k) {
+  switch (k) {
+    case ActionClass::motion: return "motion";
+    case ActionClass::payload: return "payload";
+    case ActionClass::system: return "system";
+  }
+  return "";
+}
+
 namespace {
 bool is_sensor_name(const std::string& name) {
   return sensor_index(name, std::numeric_limits<int>::max()) > 0;

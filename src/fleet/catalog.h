@@ -14,6 +14,9 @@ enum class ValueType { number, boolean };
 /// (arm/disarm) change the vehicle's state without moving it.
 enum class ActionClass { motion, payload, system };
 
+/// "motion", "payload" or "system", as mission files write it.
+const char* action_class_name(ActionClass k);
+
 struct ActionSpec {
   std::string name;          ///< e.g. "FlyTo"
   std::vector<int> arities;  ///< accepted argument counts; every argument is a number
