@@ -26,6 +26,18 @@ class InProcessTransport : public Transport {
   int in_flight_ = 0;
 };
 
+/// Appends `s` to `track` when position or phase differ from the last sample.
+void record_sample(std::vector<Sample>& track, const mid::DroneState& s) {
+  Sample now{s.t, s.x, s.y, s.z, s.armed, s.landed};
+  if (!track.empty()) {
+    const Sample& last = track.back();
+    if (last.x == now.x && last.y == now.y && last.z == now.z && last.armed == now.armed &&
+        last.landed == now.landed)
+      return;
+  }
+  track.push_back(now);
+}
+
 }  // namespace
 
 RunResult run_in_process(const std::vector<Mission>& missions, const mid::AdapterRegistry& adapters,
@@ -50,6 +62,8 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
   // Telemetry board: the newest state each drone's broker published.
   std::vector<mid::DroneState> board(n);
   for (int d = 0; d < n; ++d) board[d] = drones[d]->state();
+  std::vector<std::vector<Sample>> tracks(n);
+  for (int d = 0; d < n; ++d) record_sample(tracks[d], board[d]);
 
   std::vector<std::unique_ptr<Engine>> engines;
   InProcessTransport transport(loop, engines);
@@ -89,6 +103,7 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
   for (int d = 0; d < n; ++d)
     drones[d]->subscribe([&, d](const mid::DroneState& s) {
       board[d] = s;
+      record_sample(tracks[d], s);
       for (auto& e : engines) e->properties_changed(d);
       loop.after(0.0, check_done);
     });
@@ -110,7 +125,7 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
   if (failed || !result.completed) loop.run_until(loop.now() + 600.0);  // let failsafes finish
   result.duration = finished_at;
   for (int d = 0; d < n; ++d) {
-    result.drones.push_back({missions[d].settings.name, drones[d]->state()});
+    result.drones.push_back({missions[d].settings.name, drones[d]->state(), std::move(tracks[d])});
     result.activations += engines[d]->activations();
   }
   return result;

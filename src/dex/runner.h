@@ -20,9 +20,18 @@ struct RunOptions {
   double time_limit_s = 3600.0;  ///< a mission still running then fails ("did not finish")
 };
 
+/// One drone's position and phase at a moment its broker published a change of them.
+struct Sample {
+  double t;        ///< mission seconds
+  double x, y, z;  ///< m east, north, up of the mission origin
+  bool armed;
+  bool landed;
+};
+
 struct DroneSummary {
   std::string name;
-  mid::DroneState state;
+  mid::DroneState state;       ///< at the end of the run
+  std::vector<Sample> track;   ///< from the state before start, one sample per change
 };
 
 struct RunResult {

@@ -1,0 +1,385 @@
+#include "dex/plot.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <sstream>
+#include <tuple>
+
+namespace eamos::dex {
+
+namespace {
+
+constexpr double kWidth = 960;         ///< whole picture, px
+constexpr double kLeft = 110;          ///< left edge of both panels' plot areas (row names go left of it)
+constexpr double kMapRight = 780;      ///< right edge of the map (its legend goes right of it)
+constexpr double kMapMaxHeight = 420;  ///< the map is at most this tall, px
+constexpr double kRight = 930;         ///< right edge of the timeline
+constexpr double kLaneHeight = 20;     ///< one lane of timeline bars
+constexpr double kBarHeight = 15;
+constexpr double kTickStrip = 10;      ///< top strip of a timeline row for condition ticks
+constexpr double kCharWidth = 6.3;     ///< estimated width of one character at font-size 11
+const char* kFont = "Helvetica, Arial, sans-serif";
+const char* kGround = "#999999";       ///< track on the ground
+const char* kLanded = "#009E73";
+
+/// Okabe–Ito, one colour per drone, cycling (as src/graph/export_dot.cpp).
+const char* drone_colour(int d) {
+  static const char* palette[] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7",
+                                  "#E69F00", "#56B4E9", "#F0E442", "#000000"};
+  return palette[d % 8];
+}
+
+const char* outcome_colour(const std::string& outcome) {
+  if (outcome == "succeeded") return "#009E73";
+  if (outcome == "preempted") return "#E69F00";
+  if (outcome == "cancelled") return "#999999";
+  if (outcome == "failed") return "#D55E00";
+  return "#56B4E9";  // still running when the run ended
+}
+
+std::string xml(const std::string& s) {
+  std::string out;
+  for (char c : s) switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += c;
+    }
+  return out;
+}
+
+/// Fixed-point number without trailing zeros ("12.5", "3", "-0.25").
+std::string num(double v, int decimals = 2) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  std::string s = buf;
+  if (s.find('.') != std::string::npos) {
+    while (s.back() == '0') s.pop_back();
+    if (s.back() == '.') s.pop_back();
+  }
+  if (s == "-0") s = "0";
+  return s;
+}
+
+/// A round tick step (1, 2 or 5 times a power of ten) giving about `ticks` ticks over `span`.
+double nice_step(double span, int ticks) {
+  double raw = span / ticks;
+  double p = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 5.0})
+    if (raw <= m * p) return m * p;
+  return 10 * p;
+}
+
+std::string text(double x, double y, const std::string& s, const std::string& attrs = "") {
+  return "<text x=\"" + num(x) + "\" y=\"" + num(y) + "\"" + (attrs.empty() ? "" : " " + attrs) + ">" +
+         xml(s) + "</text>\n";
+}
+
+/// "Drone1.Takeoff(3)" in Drone1's row reads "Takeoff(3)".
+std::string without_drone(const std::string& s, const std::string& drone) {
+  std::string prefix = drone + ".";
+  return s.rfind(prefix, 0) == 0 ? s.substr(prefix.size()) : s;
+}
+
+struct Bar {
+  double start = 0, end = 0;
+  std::string text, outcome, reason;
+  int line = 0;
+  int lane = 0;
+};
+
+/// Each drone's action bars: a start event paired with the next end event of the same
+/// action (drone, line, text); an action with no end runs to `until`.
+std::vector<std::vector<Bar>> bars_of(const RunResult& run, const std::vector<TraceEvent>& events, double until) {
+  std::map<std::string, int> row;
+  for (std::size_t d = 0; d < run.drones.size(); ++d) row[run.drones[d].name] = static_cast<int>(d);
+  std::vector<std::vector<Bar>> bars(run.drones.size());
+  std::map<std::tuple<std::string, int, std::string>, std::vector<std::size_t>> open;
+  for (const TraceEvent& e : events) {
+    auto r = row.find(e.drone);
+    if (r == row.end()) continue;
+    auto key = std::make_tuple(e.drone, e.line, e.text);
+    if (e.event == "start") {
+      open[key].push_back(bars[r->second].size());
+      bars[r->second].push_back({e.t, until, e.text, "", "", e.line, 0});
+    } else if (e.event == "end" && !open[key].empty()) {
+      Bar& b = bars[r->second][open[key].front()];
+      open[key].erase(open[key].begin());
+      b.end = e.t;
+      b.outcome = e.outcome;
+      b.reason = e.reason;
+    }
+  }
+  return bars;
+}
+
+// ---- top panel -------------------------------------------------------------------------
+
+struct MapFrame {
+  double x0, y0, scale;  ///< metres at the plot area's left/bottom edge; px per metre
+  double top, bottom;    ///< px
+  double to_x(double x) const { return kLeft + (x - x0) * scale; }
+  double to_y(double y) const { return bottom - (y - y0) * scale; }
+};
+
+MapFrame map_frame(const RunResult& run, double top) {
+  double lo_x = 0, hi_x = 0, lo_y = 0, hi_y = 0;
+  bool any = false;
+  for (const auto& d : run.drones)
+    for (const Sample& s : d.track) {
+      if (!any) lo_x = hi_x = s.x, lo_y = hi_y = s.y, any = true;
+      lo_x = std::min(lo_x, s.x), hi_x = std::max(hi_x, s.x);
+      lo_y = std::min(lo_y, s.y), hi_y = std::max(hi_y, s.y);
+    }
+  // Room around the tracks for markers and names: 10 % and at least 2 m.
+  double pad = std::max(2.0, 0.1 * std::max(hi_x - lo_x, hi_y - lo_y));
+  lo_x -= pad, hi_x += pad, lo_y -= pad, hi_y += pad;
+  double width = kMapRight - kLeft;
+  double scale = std::min(width / (hi_x - lo_x), kMapMaxHeight / (hi_y - lo_y));
+  // Equal scale: widen the x range to the panel's width, centred.
+  double cx = (lo_x + hi_x) / 2;
+  MapFrame f;
+  f.scale = scale;
+  f.x0 = cx - width / scale / 2;
+  f.y0 = lo_y;
+  f.top = top;
+  f.bottom = top + (hi_y - lo_y) * scale;
+  return f;
+}
+
+void map_axes(std::ostream& out, const MapFrame& f) {
+  double x1 = f.x0 + (kMapRight - kLeft) / f.scale;
+  double y1 = f.y0 + (f.bottom - f.top) / f.scale;
+  double step = nice_step(std::max(x1 - f.x0, y1 - f.y0), 10);
+  out << "<g class=\"map-axes\" font-size=\"11\" fill=\"#444444\">\n";
+  for (double x = std::ceil(f.x0 / step) * step; x <= x1 + 1e-9; x += step) {
+    double px = f.to_x(x);
+    out << "<line x1=\"" << num(px) << "\" y1=\"" << num(f.top) << "\" x2=\"" << num(px) << "\" y2=\""
+        << num(f.bottom + 4) << "\" stroke=\"" << (std::abs(x) < 1e-9 ? "#cccccc" : "#eeeeee") << "\"/>\n";
+    out << text(px, f.bottom + 16, num(x), "text-anchor=\"middle\"");
+  }
+  for (double y = std::ceil(f.y0 / step) * step; y <= y1 + 1e-9; y += step) {
+    double py = f.to_y(y);
+    out << "<line x1=\"" << num(kLeft - 4) << "\" y1=\"" << num(py) << "\" x2=\"" << num(kMapRight)
+        << "\" y2=\"" << num(py) << "\" stroke=\"" << (std::abs(y) < 1e-9 ? "#cccccc" : "#eeeeee") << "\"/>\n";
+    out << text(kLeft - 7, py + 4, num(y), "text-anchor=\"end\"");
+  }
+  out << "<rect x=\"" << num(kLeft) << "\" y=\"" << num(f.top) << "\" width=\"" << num(kMapRight - kLeft)
+      << "\" height=\"" << num(f.bottom - f.top) << "\" fill=\"none\" stroke=\"#888888\"/>\n";
+  out << text((kLeft + kMapRight) / 2, f.bottom + 32, "x (m, east)", "text-anchor=\"middle\"");
+  out << text(kLeft - 45, (f.top + f.bottom) / 2, "y (m, north)",
+              "text-anchor=\"middle\" transform=\"rotate(-90 " + num(kLeft - 45) + " " +
+                  num((f.top + f.bottom) / 2) + ")\"");
+  out << "</g>\n";
+}
+
+/// One drone's track: runs of segments on the ground (grey, dashed) and in the air
+/// (solid, the drone's colour), then the armed, landed and start markers.
+void map_track(std::ostream& out, const MapFrame& f, const DroneSummary& drone, int d) {
+  const std::vector<Sample>& s = drone.track;
+  if (s.empty()) return;
+  out << "<g class=\"track\" data-drone=\"" << xml(drone.name) << "\">\n";
+  std::size_t i = 0;
+  while (i + 1 < s.size()) {
+    bool air = !s[i].landed;
+    std::size_t j = i + 1;
+    while (j + 1 < s.size() && !s[j].landed == air) ++j;
+    // Points closer than half a pixel to the last kept one add nothing to the picture.
+    std::string points = num(f.to_x(s[i].x)) + "," + num(f.to_y(s[i].y));
+    double lx = f.to_x(s[i].x), ly = f.to_y(s[i].y);
+    for (std::size_t k = i + 1; k <= j; ++k) {
+      double px = f.to_x(s[k].x), py = f.to_y(s[k].y);
+      if (k < j && std::hypot(px - lx, py - ly) < 0.5) continue;
+      points += " " + num(px) + "," + num(py);
+      lx = px, ly = py;
+    }
+    out << "<polyline class=\"" << (air ? "air" : "ground") << "\" points=\"" << points
+        << "\" fill=\"none\" stroke-linejoin=\"round\" stroke-linecap=\"round\" "
+        << (air ? std::string("stroke=\"") + drone_colour(d) + "\" stroke-width=\"2.5\""
+                : std::string("stroke=\"") + kGround + "\" stroke-width=\"1.5\" stroke-dasharray=\"4 3\"")
+        << "/>\n";
+    i = j;
+  }
+  for (std::size_t k = 1; k < s.size(); ++k) {
+    double px = f.to_x(s[k].x), py = f.to_y(s[k].y);
+    if (s[k].armed && !s[k - 1].armed && s[k].landed)
+      out << "<rect class=\"armed\" x=\"" << num(px - 4) << "\" y=\"" << num(py - 4)
+          << "\" width=\"8\" height=\"8\" fill=\"#000000\"><title>" << xml(drone.name) << " armed at "
+          << num(s[k].t) << " s</title></rect>\n";
+    if (s[k].landed && !s[k - 1].landed)
+      out << "<path class=\"landed\" d=\"M" << num(px) << "," << num(py - 6) << " l6,6 l-6,6 l-6,-6 z\" fill=\""
+          << kLanded << "\" stroke=\"#ffffff\"><title>" << xml(drone.name) << " landed at " << num(s[k].t)
+          << " s</title></path>\n";
+  }
+  double sx = f.to_x(s[0].x), sy = f.to_y(s[0].y);
+  out << "<circle class=\"start\" cx=\"" << num(sx) << "\" cy=\"" << num(sy) << "\" r=\"5\" fill=\"#ffffff\" stroke=\""
+      << drone_colour(d) << "\" stroke-width=\"2\"/>\n";
+  out << text(sx - 8, sy + 4, drone.name,
+              std::string("text-anchor=\"end\" font-size=\"12\" font-weight=\"bold\" fill=\"") + drone_colour(d) + "\"");
+  out << "</g>\n";
+}
+
+void map_legend(std::ostream& out, const RunResult& run, double top) {
+  double x = kMapRight + 20, y = top + 12;
+  out << "<g class=\"legend\" font-size=\"11\" fill=\"#222222\">\n";
+  for (std::size_t d = 0; d < run.drones.size(); ++d, y += 18) {
+    out << "<line x1=\"" << num(x) << "\" y1=\"" << num(y - 4) << "\" x2=\"" << num(x + 22) << "\" y2=\""
+        << num(y - 4) << "\" stroke=\"" << drone_colour(static_cast<int>(d)) << "\" stroke-width=\"2.5\"/>\n";
+    out << text(x + 30, y, run.drones[d].name);
+  }
+  y += 8;
+  out << "<line x1=\"" << num(x) << "\" y1=\"" << num(y - 4) << "\" x2=\"" << num(x + 22) << "\" y2=\"" << num(y - 4)
+      << "\" stroke=\"" << kGround << "\" stroke-width=\"1.5\" stroke-dasharray=\"4 3\"/>\n";
+  out << text(x + 30, y, "on the ground");
+  y += 18;
+  out << "<circle cx=\"" << num(x + 11) << "\" cy=\"" << num(y - 4) << "\" r=\"5\" fill=\"#ffffff\" stroke=\"#444444\" stroke-width=\"2\"/>\n";
+  out << text(x + 30, y, "start");
+  y += 18;
+  out << "<rect x=\"" << num(x + 7) << "\" y=\"" << num(y - 8) << "\" width=\"8\" height=\"8\" fill=\"#000000\"/>\n";
+  out << text(x + 30, y, "armed");
+  y += 18;
+  out << "<path d=\"M" << num(x + 11) << "," << num(y - 10) << " l6,6 l-6,6 l-6,-6 z\" fill=\"" << kLanded << "\"/>\n";
+  out << text(x + 30, y, "landed");
+  out << "</g>\n";
+}
+
+// ---- bottom panel ----------------------------------------------------------------------
+
+double time_x(double t, double until) { return kLeft + t / until * (kRight - kLeft); }
+
+/// Lanes so that no two bars, labels included, overlap; returns the number of lanes.
+int pack_lanes(std::vector<Bar>& bars, const std::string& drone, double until) {
+  std::vector<double> lane_end;
+  for (Bar& b : bars) {
+    double x0 = time_x(b.start, until);
+    double x1 = std::max(time_x(b.end, until), x0 + without_drone(b.text, drone).size() * kCharWidth + 8);
+    std::size_t l = 0;
+    while (l < lane_end.size() && lane_end[l] > x0) ++l;
+    if (l == lane_end.size()) lane_end.push_back(0);
+    lane_end[l] = x1 + 4;
+    b.lane = static_cast<int>(l);
+  }
+  return std::max<int>(1, static_cast<int>(lane_end.size()));
+}
+
+/// Returns the y below the panel.
+double timeline(std::ostream& out, const RunResult& run, const std::vector<TraceEvent>& events, double top,
+                double until) {
+  std::vector<std::vector<Bar>> bars = bars_of(run, events, until);
+  std::vector<double> row_top;
+  double y = top;
+  std::vector<int> lanes;
+  for (std::size_t d = 0; d < run.drones.size(); ++d) {
+    lanes.push_back(pack_lanes(bars[d], run.drones[d].name, until));
+    row_top.push_back(y);
+    y += kTickStrip + lanes.back() * kLaneHeight + 6;
+  }
+  double bottom = y;
+  double step = nice_step(until, 12);
+  out << "<g class=\"time-axis\" font-size=\"11\" fill=\"#444444\">\n";
+  for (double t = 0; t <= until + 1e-9; t += step) {
+    double px = time_x(t, until);
+    out << "<line x1=\"" << num(px) << "\" y1=\"" << num(top) << "\" x2=\"" << num(px) << "\" y2=\""
+        << num(bottom + 4) << "\" stroke=\"#eeeeee\"/>\n";
+    out << text(px, bottom + 16, num(t), "text-anchor=\"middle\"");
+  }
+  out << text((kLeft + kRight) / 2, bottom + 32, "mission time (s)", "text-anchor=\"middle\"");
+  out << "</g>\n";
+  for (std::size_t d = 0; d < run.drones.size(); ++d) {
+    const std::string& name = run.drones[d].name;
+    double rt = row_top[d];
+    double rb = rt + kTickStrip + lanes[d] * kLaneHeight + 6;
+    out << "<g class=\"row\" data-drone=\"" << xml(name) << "\">\n";
+    out << "<line x1=\"" << num(kLeft - 100) << "\" y1=\"" << num(rb) << "\" x2=\"" << num(kRight) << "\" y2=\""
+        << num(rb) << "\" stroke=\"#cccccc\"/>\n";
+    out << text(kLeft - 10, (rt + rb) / 2 + 4, name,
+                std::string("text-anchor=\"end\" font-size=\"12\" font-weight=\"bold\" fill=\"") +
+                    drone_colour(static_cast<int>(d)) + "\"");
+    for (const Bar& b : bars[d]) {
+      double x0 = time_x(b.start, until), x1 = time_x(b.end, until);
+      double by = rt + kTickStrip + b.lane * kLaneHeight + (kLaneHeight - kBarHeight) / 2;
+      const char* c = outcome_colour(b.outcome);
+      std::string tip = b.text + " (line " + std::to_string(b.line) + "): " + num(b.start) + "–" + num(b.end) +
+                        " s, " + (b.outcome.empty() ? "still running" : b.outcome) +
+                        (b.reason.empty() ? "" : " (" + b.reason + ")");
+      out << "<g data-action=\"" << xml(b.text) << "\" data-outcome=\"" << xml(b.outcome) << "\"><title>"
+          << xml(tip) << "</title>\n";
+      out << "<rect x=\"" << num(x0) << "\" y=\"" << num(by) << "\" width=\"" << num(std::max(x1 - x0, 2.0))
+          << "\" height=\"" << num(kBarHeight) << "\" rx=\"2\" fill=\"" << c << "\" fill-opacity=\"0.3\" stroke=\""
+          << c << "\"/>\n";
+      out << text(x0 + 4, by + kBarHeight - 4, without_drone(b.text, name), "font-size=\"11\" fill=\"#222222\"");
+      out << "</g>\n";
+    }
+    for (const TraceEvent& e : events) {
+      if (e.event != "condition" || e.drone != name) continue;
+      double px = time_x(e.t, until);
+      bool v = e.value.value_or(false);
+      out << "<path class=\"condition\" d=\"M" << num(px - 4) << "," << num(rt + 2) << " l8,0 l-4,7 z\" fill=\""
+          << (v ? "#009E73" : "#D55E00") << "\"><title>" << xml(e.name + " " + e.text) << " → "
+          << (v ? "true" : "false") << " at " << num(e.t) << " s</title></path>\n";
+    }
+    out << "</g>\n";
+  }
+  return bottom + 40;
+}
+
+void timeline_legend(std::ostream& out, double y) {
+  double x = kLeft;
+  out << "<g class=\"legend\" font-size=\"11\" fill=\"#222222\">\n";
+  for (const char* o : {"succeeded", "preempted", "cancelled", "failed", "running at the end"}) {
+    const char* c = outcome_colour(o);
+    out << "<rect x=\"" << num(x) << "\" y=\"" << num(y - 10) << "\" width=\"22\" height=\"12\" rx=\"2\" fill=\"" << c
+        << "\" fill-opacity=\"0.3\" stroke=\"" << c << "\"/>\n";
+    out << text(x + 28, y, o);
+    x += 28 + std::string(o).size() * kCharWidth + 18;
+  }
+  for (bool v : {true, false}) {
+    out << "<path d=\"M" << num(x) << "," << num(y - 9) << " l8,0 l-4,7 z\" fill=\"" << (v ? "#009E73" : "#D55E00")
+        << "\"/>\n";
+    std::string label = v ? "condition true" : "condition false";
+    out << text(x + 14, y, label);
+    x += 14 + label.size() * kCharWidth + 18;
+  }
+  out << "</g>\n";
+}
+
+}  // namespace
+
+std::string plot_svg(const RunResult& run, const std::vector<TraceEvent>& events) {
+  std::ostringstream body;
+  double y = 20;
+  std::string status = run.completed ? "completed in " + num(run.duration) + " s"
+                                     : "failed" + (run.error.empty() ? std::string() : ": " + run.error);
+  body << text(kLeft - 100, y, "Mission run — " + status, "font-size=\"15\" font-weight=\"bold\" fill=\"#222222\"");
+  y += 26;
+  body << text(kLeft - 100, y, "Tracks seen from above", "font-size=\"13\" font-weight=\"bold\" fill=\"#444444\"");
+  y += 12;
+  MapFrame frame = map_frame(run, y);
+  map_axes(body, frame);
+  for (std::size_t d = 0; d < run.drones.size(); ++d) map_track(body, frame, run.drones[d], static_cast<int>(d));
+  map_legend(body, run, frame.top);
+  y = frame.bottom + 64;
+
+  double until = run.duration;
+  for (const TraceEvent& e : events) until = std::max(until, e.t);
+  if (until <= 0) until = 1;
+  body << text(kLeft - 100, y, "Actions over time", "font-size=\"13\" font-weight=\"bold\" fill=\"#444444\"");
+  y += 12;
+  y = timeline(body, run, events, y, until);
+  timeline_legend(body, y);
+  y += 16;
+
+  std::ostringstream out;
+  out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << num(kWidth) << "\" height=\"" << num(y)
+      << "\" viewBox=\"0 0 " << num(kWidth) << " " << num(y) << "\" font-family=\"" << kFont << "\">\n";
+  out << "<rect width=\"100%\" height=\"100%\" fill=\"#ffffff\"/>\n";
+  out << body.str();
+  out << "</svg>\n";
+  return out.str();
+}
+
+}  // namespace eamos::dex

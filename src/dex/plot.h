@@ -1,0 +1,19 @@
+#pragma once
+// A picture of one run (the paper's Figure 3): the drones' tracks seen from above, and a
+// timeline per drone with a bar per action, coloured by how it ended. Plain SVG text.
+#include <string>
+#include <vector>
+
+#include "dex/runner.h"
+#include "dex/trace.h"
+
+namespace eamos::dex {
+
+/// Top panel: each drone's track in the x/y plane (equal scale, metres), grey on the
+/// ground, solid in the air, start labelled with the drone's name, a black square where
+/// it armed, a green diamond where it landed. Bottom panel: one row per drone over mission
+/// time, a bar per action start (`data-action` attribute) from start to end, coloured by
+/// outcome, and a tick per condition decision. `events` is the run's trace.
+std::string plot_svg(const RunResult& run, const std::vector<TraceEvent>& events);
+
+}  // namespace eamos::dex
