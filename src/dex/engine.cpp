@@ -246,6 +246,7 @@ void Engine::activate_condition(int node, bool by_back_arc) {
       bool do_it = is_while ? v : !v;
       if (do_it) {
         s.watching = true;
+        s.last_value = static_cast<int>(v);  // traced just now: log again only on a change
         ++active_;
         watched_.push_back(node);
         end(node, Branch::do_);

@@ -99,6 +99,19 @@ TEST(Run, SameMissionGivesByteIdenticalTrace) {
   EXPECT_EQ(one.jsonl, two.jsonl);
 }
 
+// The examples together use all 13 control structures; each must fly to completion, with
+// every drone landed and disarmed at the end.
+TEST(Run, EveryExampleCompletesInTheSimulator) {
+  for (const char* name : {"survey.eamos", "relay.eamos", "patrol.eamos"}) {
+    Flight f = fly(example(name));
+    ASSERT_TRUE(f.result.completed) << name << ": " << f.result.error;
+    for (const auto& d : f.result.drones) {
+      EXPECT_TRUE(d.state.landed) << name << " " << d.name;
+      EXPECT_FALSE(d.state.armed) << name << " " << d.name;
+    }
+  }
+}
+
 // Figure 3 of the paper: Drone1 goes right (Sensor1 >= 100) or left, Drone3 waits until
 // Drone1 is 5 m out, meets it there, and Drone2 orbits taking pictures until Drone3 is back
 // below 3 m, when its Land preempts the Orbit; then everybody disarms.
