@@ -25,4 +25,6 @@ awk '/"per_drone"/ {in_drones = 1} in_drones && /^        "nodes":/ {
 
 "$BUILD/bench/bench_compile" --benchmark_out=out/bench/compile.json --benchmark_out_format=json \
   --benchmark_repetitions=${REPS:-5} --benchmark_report_aggregates_only=true
+"$BUILD/bench/bench_dex" --benchmark_out=out/bench/dex.json --benchmark_out_format=json \
+  --benchmark_repetitions=${REPS:-5} --benchmark_report_aggregates_only=true
 echo "bench: results in out/bench/"
