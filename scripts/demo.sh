@@ -17,8 +17,8 @@ for drone in Drone1 Drone2 Drone3; do
 done
 "$EAMOS" stats "$MISSION" -o "$OUT/stats.json" -q
 "$EAMOS" run "$MISSION" -q --fleet examples/listing2-right.yaml \
-  --trace "$OUT/trace.jsonl" --summary "$OUT/summary.json"
+  --trace "$OUT/trace.jsonl" --summary "$OUT/summary.json" --plot "$OUT/plot.svg"
 echo
 echo "demo: deployment in $OUT/deploy/, graphs in $OUT/graphs/, statistics in $OUT/stats.json,"
-echo "      trace in $OUT/trace.jsonl, summary in $OUT/summary.json"
+echo "      trace in $OUT/trace.jsonl, summary in $OUT/summary.json, picture of the run in $OUT/plot.svg"
 ls "$OUT/deploy" "$OUT/graphs"

@@ -23,6 +23,7 @@ int cmd_stats(const CommonOptions& o, const std::string& output);
 struct RunCommandOptions {
   std::string trace;      ///< JSON Lines trace file; "" = none
   std::string summary;    ///< summary JSON file; "" = none
+  std::string plot;       ///< SVG picture of the run (tracks and action timeline); "" = none
   bool realtime = false;
   double speed = 0.0;     ///< > 0: real time scaled by this factor
   double time_limit = 3600.0;

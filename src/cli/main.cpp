@@ -56,6 +56,7 @@ int main(int argc, char** argv) {
   eamos::cli::RunCommandOptions run_opts;
   run->add_option("--trace", run_opts.trace, "Write the trace as JSON Lines to this file");
   run->add_option("--summary", run_opts.summary, "Write the summary JSON to this file");
+  run->add_option("--plot", run_opts.plot, "Draw the run (tracks and action timeline) as SVG to this file");
   auto* realtime = run->add_flag("--realtime", run_opts.realtime, "Run in real time instead of virtual time");
   run->add_option("--speed", run_opts.speed, "Real time scaled by X (2 = twice as fast)")
       ->check(CLI::PositiveNumber)->excludes(realtime);

@@ -7,6 +7,7 @@
 
 #include "cli/commands.h"
 #include "deploy/synthesize.h"
+#include "dex/plot.h"
 #include "dex/runner.h"
 #include "dex/trace_writers.h"
 #include "graph/pipeline.h"
@@ -65,6 +66,8 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
     jsonl = std::make_unique<dex::JsonlTrace>(trace_file);
     tee.add(jsonl.get());
   }
+  dex::MemoryTrace memory;  // the plot is drawn from the whole trace after the run
+  if (!r.plot.empty()) tee.add(&memory);
   dex::RunOptions options;
   options.time_limit_s = r.time_limit;
   if (r.realtime || r.speed > 0) {
@@ -73,6 +76,7 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   }
   dex::RunResult result = dex::run_in_process(missions, adapters, &tee, options);
   if (!r.summary.empty() && !write_output(r.summary, summary_json(result).dump(2) + "\n")) return 1;
+  if (!r.plot.empty() && !write_output(r.plot, dex::plot_svg(result, memory.events))) return 1;
   if (result.completed) {
     std::cout << "mission completed in " << result.duration << " s (mission time)\n";
     return 0;

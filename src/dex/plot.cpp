@@ -74,6 +74,11 @@ double nice_step(double span, int ticks) {
   return 10 * p;
 }
 
+/// A diamond 12 px across centred on (x, y).
+std::string diamond(double x, double y) {
+  return "M" + num(x) + "," + num(y - 6) + " l6,6 l-6,6 l-6,-6 z";
+}
+
 std::string text(double x, double y, const std::string& s, const std::string& attrs = "") {
   return "<text x=\"" + num(x) + "\" y=\"" + num(y) + "\"" + (attrs.empty() ? "" : " " + attrs) + ">" +
          xml(s) + "</text>\n";
@@ -90,6 +95,7 @@ struct Bar {
   std::string text, outcome, reason;
   int line = 0;
   int lane = 0;
+  bool label_left = false;  ///< the label ends left of the bar (no room right of it)
 };
 
 /// Each drone's action bars: a start event paired with the next end event of the same
@@ -204,22 +210,26 @@ void map_track(std::ostream& out, const MapFrame& f, const DroneSummary& drone, 
         << "/>\n";
     i = j;
   }
+  double sx = f.to_x(s[0].x), sy = f.to_y(s[0].y);
+  out << "<circle class=\"start\" cx=\"" << num(sx) << "\" cy=\"" << num(sy) << "\" r=\"6\" fill=\"#ffffff\" stroke=\""
+      << drone_colour(d) << "\" stroke-width=\"2\"><title>" << xml(drone.name) << " starts at " << num(s[0].x) << ", "
+      << num(s[0].y) << " m</title></circle>\n";
   for (std::size_t k = 1; k < s.size(); ++k) {
     double px = f.to_x(s[k].x), py = f.to_y(s[k].y);
     if (s[k].armed && !s[k - 1].armed && s[k].landed)
-      out << "<rect class=\"armed\" x=\"" << num(px - 4) << "\" y=\"" << num(py - 4)
-          << "\" width=\"8\" height=\"8\" fill=\"#000000\"><title>" << xml(drone.name) << " armed at "
+      out << "<rect class=\"armed\" x=\"" << num(px - 3) << "\" y=\"" << num(py - 3)
+          << "\" width=\"6\" height=\"6\" fill=\"#000000\"><title>" << xml(drone.name) << " armed at "
           << num(s[k].t) << " s</title></rect>\n";
     if (s[k].landed && !s[k - 1].landed)
-      out << "<path class=\"landed\" d=\"M" << num(px) << "," << num(py - 6) << " l6,6 l-6,6 l-6,-6 z\" fill=\""
-          << kLanded << "\" stroke=\"#ffffff\"><title>" << xml(drone.name) << " landed at " << num(s[k].t)
+      out << "<path class=\"landed\" d=\"" << diamond(px, py) << "\" fill=\"" << kLanded
+          << "\" stroke=\"#222222\"><title>" << xml(drone.name) << " landed at " << num(s[k].t)
           << " s</title></path>\n";
   }
-  double sx = f.to_x(s[0].x), sy = f.to_y(s[0].y);
-  out << "<circle class=\"start\" cx=\"" << num(sx) << "\" cy=\"" << num(sy) << "\" r=\"5\" fill=\"#ffffff\" stroke=\""
-      << drone_colour(d) << "\" stroke-width=\"2\"/>\n";
-  out << text(sx - 8, sy + 4, drone.name,
-              std::string("text-anchor=\"end\" font-size=\"12\" font-weight=\"bold\" fill=\"") + drone_colour(d) + "\"");
+  // The name left of the start, on a white halo so crossing tracks do not hide it.
+  out << text(sx - 10, sy + 4, drone.name,
+              std::string("text-anchor=\"end\" font-size=\"12\" font-weight=\"bold\" stroke=\"#ffffff\" "
+                          "stroke-width=\"4\" paint-order=\"stroke\" stroke-linejoin=\"round\" fill=\"") +
+                  drone_colour(d) + "\"");
   out << "</g>\n";
 }
 
@@ -236,13 +246,13 @@ void map_legend(std::ostream& out, const RunResult& run, double top) {
       << "\" stroke=\"" << kGround << "\" stroke-width=\"1.5\" stroke-dasharray=\"4 3\"/>\n";
   out << text(x + 30, y, "on the ground");
   y += 18;
-  out << "<circle cx=\"" << num(x + 11) << "\" cy=\"" << num(y - 4) << "\" r=\"5\" fill=\"#ffffff\" stroke=\"#444444\" stroke-width=\"2\"/>\n";
+  out << "<circle cx=\"" << num(x + 11) << "\" cy=\"" << num(y - 4) << "\" r=\"6\" fill=\"#ffffff\" stroke=\"#444444\" stroke-width=\"2\"/>\n";
   out << text(x + 30, y, "start");
   y += 18;
-  out << "<rect x=\"" << num(x + 7) << "\" y=\"" << num(y - 8) << "\" width=\"8\" height=\"8\" fill=\"#000000\"/>\n";
+  out << "<rect x=\"" << num(x + 8) << "\" y=\"" << num(y - 7) << "\" width=\"6\" height=\"6\" fill=\"#000000\"/>\n";
   out << text(x + 30, y, "armed");
   y += 18;
-  out << "<path d=\"M" << num(x + 11) << "," << num(y - 10) << " l6,6 l-6,6 l-6,-6 z\" fill=\"" << kLanded << "\"/>\n";
+  out << "<path d=\"" << diamond(x + 11, y - 4) << "\" fill=\"" << kLanded << "\" stroke=\"#222222\"/>\n";
   out << text(x + 30, y, "landed");
   out << "</g>\n";
 }
@@ -251,19 +261,23 @@ void map_legend(std::ostream& out, const RunResult& run, double top) {
 
 double time_x(double t, double until) { return kLeft + t / until * (kRight - kLeft); }
 
-/// Lanes so that no two bars, labels included, overlap; returns the number of lanes.
+/// Lanes so that no two bars, labels included, overlap; returns the number of lanes. A
+/// label goes right of its bar's start, or left of it near the panel's right edge.
 int pack_lanes(std::vector<Bar>& bars, const std::string& drone, double until) {
-  std::vector<double> lane_end;
+  std::vector<std::vector<std::pair<double, double>>> lanes;  // occupied px intervals
   for (Bar& b : bars) {
-    double x0 = time_x(b.start, until);
-    double x1 = std::max(time_x(b.end, until), x0 + without_drone(b.text, drone).size() * kCharWidth + 8);
+    double x0 = time_x(b.start, until), x1 = time_x(b.end, until);
+    double label = without_drone(b.text, drone).size() * kCharWidth + 8;
+    b.label_left = x0 + label > kWidth - 4;
+    double from = b.label_left ? x0 - label : x0, to = b.label_left ? x1 : std::max(x1, x0 + label);
     std::size_t l = 0;
-    while (l < lane_end.size() && lane_end[l] > x0) ++l;
-    if (l == lane_end.size()) lane_end.push_back(0);
-    lane_end[l] = x1 + 4;
+    auto overlaps = [&](const std::pair<double, double>& i) { return i.first < to + 4 && from < i.second + 4; };
+    while (l < lanes.size() && std::any_of(lanes[l].begin(), lanes[l].end(), overlaps)) ++l;
+    if (l == lanes.size()) lanes.emplace_back();
+    lanes[l].push_back({from, to});
     b.lane = static_cast<int>(l);
   }
-  return std::max<int>(1, static_cast<int>(lane_end.size()));
+  return std::max<int>(1, static_cast<int>(lanes.size()));
 }
 
 /// Returns the y below the panel.
@@ -311,7 +325,8 @@ double timeline(std::ostream& out, const RunResult& run, const std::vector<Trace
       out << "<rect x=\"" << num(x0) << "\" y=\"" << num(by) << "\" width=\"" << num(std::max(x1 - x0, 2.0))
           << "\" height=\"" << num(kBarHeight) << "\" rx=\"2\" fill=\"" << c << "\" fill-opacity=\"0.3\" stroke=\""
           << c << "\"/>\n";
-      out << text(x0 + 4, by + kBarHeight - 4, without_drone(b.text, name), "font-size=\"11\" fill=\"#222222\"");
+      out << text(b.label_left ? x0 - 4 : x0 + 4, by + kBarHeight - 4, without_drone(b.text, name),
+                  std::string("font-size=\"11\" fill=\"#222222\"") + (b.label_left ? " text-anchor=\"end\"" : ""));
       out << "</g>\n";
     }
     for (const TraceEvent& e : events) {
@@ -324,7 +339,7 @@ double timeline(std::ostream& out, const RunResult& run, const std::vector<Trace
     }
     out << "</g>\n";
   }
-  return bottom + 40;
+  return bottom + 58;
 }
 
 void timeline_legend(std::ostream& out, double y) {
