@@ -99,6 +99,29 @@ void BM_Fly5000Nodes20Drones(benchmark::State& state) {
 }
 BENCHMARK(BM_Fly5000Nodes20Drones)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+/// The engine alone, no physics: a RepeatFor whose body is a zero-second pause, so every
+/// activation is the engine's own work (condition, pause timer, terminal, back arc).
+void BM_EngineActivations(benchmark::State& state) {
+  auto c = compile("var A Quad\nfunc INIT() { A.Arm(); RepeatFor(A.Armed(), SEQ_r, SEQ_n, 100000) }\n"
+                   "func SEQ_r() { PauseFor(0) }\nfunc SEQ_n() { A.Disarm() }\n");
+  std::vector<eamos::dex::Mission> missions(1);
+  std::string error;
+  eamos::dex::load_mission(nlohmann::json::parse(c->files[0]), missions[0], error);
+  eamos::mid::AdapterRegistry adapters;
+  eamos::sim::register_adapter(adapters);
+  double activations = 0, wall = 0;
+  for (auto _ : state) {
+    auto t0 = std::chrono::steady_clock::now();
+    eamos::dex::RunResult r = eamos::dex::run_in_process(missions, adapters, nullptr);
+    wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (!r.completed) state.SkipWithError(r.error.c_str());
+    activations += static_cast<double>(r.activations);
+  }
+  state.counters["activations_per_s"] = benchmark::Counter(activations / wall);
+  state.counters["activations"] = activations / static_cast<double>(state.iterations());
+}
+BENCHMARK(BM_EngineActivations)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 }  // namespace
 
 BENCHMARK_MAIN();
