@@ -104,6 +104,23 @@ TEST(Semantics, DoAsyncDetachesDoBranchAndFlipCancelsItOnEveryDrone) {
   EXPECT_TRUE(f.result.drones[1].state.landed);
 }
 
+TEST(Semantics, DoUntilAsyncRunsDoBranchUntilConditionTurnsTrueThenDoneBranch) {
+  Flight f = fly(kTwo + "func INIT() { PAR_up(); PAR_main() }\n"
+                        "func PAR_up() { SEQ_a(); B.Arm() }\nfunc SEQ_a() { A.Arm(); A.Takeoff(3) }\n"
+                        "func PAR_main() { SEQ_watch(); SEQ_b() }\n"
+                        "func SEQ_watch() { DoUntilAsync(B.Z() > 4, SEQ_do, SEQ_done); A.TakePicture() }\n"
+                        "func SEQ_do() { A.Orbit(3) }\nfunc SEQ_done() { A.Land(); A.Disarm() }\n"
+                        "func SEQ_b() { PauseFor(5); B.Takeoff(8); B.Land(); B.Disarm() }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_EQ(f.time_of("start", "A.TakePicture()"), f.time_of("start", "A.Orbit(3)"));  // detached
+  int cancelled = f.find("end", "A.Orbit(3)", "cancelled");
+  ASSERT_GE(cancelled, 0);
+  EXPECT_GT(f.events[cancelled].t, f.time_of("start", "B.Takeoff(8)"));
+  EXPECT_LT(f.events[cancelled].t, f.time_of("end", "B.Takeoff(8)"));
+  EXPECT_EQ(f.time_of("start", "A.Land()"), f.events[cancelled].t);
+  EXPECT_FALSE(f.result.drones[0].state.armed);
+}
+
 TEST(Semantics, ConditionEvaluatedByOneDroneDecidesForTheOthers) {
   Flight f = fly(kTwo + "func INIT() { A.Arm(); B.Arm(); If(A.Armed(), PAR_yes, PAR_no) }\n"
                         "func PAR_yes() { B.TakePicture() }\nfunc PAR_no() { B.Disarm() }\n");
