@@ -169,6 +169,7 @@ void write_node_content(JsonWriter& w, const Compilation& c, const MegNode& n, b
   if (n.kind == MegKind::terminal && n.role != graph::Role::none)
     w.member("role", graph::role_name(n.role));
   if (n.kind == MegKind::pause) w.member("seconds", n.seconds);
+  if (n.scope >= 0) w.member("scope", n.scope);
 }
 
 void write_arc(JsonWriter& w, int from, int to, graph::ArcKind kind, graph::Branch branch) {

@@ -19,6 +19,13 @@ struct Message {
   int from = 0;              ///< sending drone
   int meg = 0;               ///< MEG id of the node that ended / flipped
   graph::Branch branch = graph::Branch::any;
+  /// Which run of a Repeat/Do body the sender belongs to: `scope` is the MEG id of the
+  /// sender's innermost body condition (-1: none) and `epoch` the sender's count of that
+  /// body's runs. A receiver that already knows a later run drops the message as stale.
+  int scope = -1;
+  long long epoch = 0;
+  /// Sent by a Repeat/Do condition (and with `cancel`): the run number of its own body.
+  long long body_epoch = 0;
 };
 
 /// The transport under InBridge and OutBridge: in-process here; DDS between processes.

@@ -65,12 +65,30 @@ void Engine::deliver(int node, ArcKind kind, bool from_terminal) {
   drain();
 }
 
+long long Engine::epoch_of(int scope) const {
+  auto it = epoch_.find(scope);
+  return it == epoch_.end() ? 0 : it->second;
+}
+
+// A node whose body started a new run since its counters were last set starts afresh.
+void Engine::refresh(int node) {
+  const Node& n = m_.nodes[node];
+  if (n.scope < 0) return;
+  State& s = state_[node];
+  long long e = epoch_of(n.scope);
+  if (s.epoch == e) return;
+  s.epoch = e;
+  s.exec_pending = n.exec_in;
+  s.back_pending = n.back_in;
+}
+
 void Engine::drain() {
   if (draining_) return;
   draining_ = true;
   while (!queue_.empty() && !halted_) {
     Delivery d = queue_.front();
     queue_.pop_front();
+    refresh(d.node);
     State& s = state_[d.node];
     const Node& n = m_.nodes[d.node];
     switch (d.kind) {
@@ -102,6 +120,15 @@ void Engine::receive(const Message& msg) {
   if (halted_ || msg.mission_hash != m_.hash) return;
   int from = m_.find(msg.meg, msg.from);
   if (from < 0) return;
+  if (msg.scope >= 0) {
+    long long& known = epoch_[msg.scope];
+    if (msg.epoch < known) return;  // from a run of that body that has been superseded
+    known = msg.epoch;
+  }
+  if (msg.body_epoch > 0) {
+    long long& known = epoch_[msg.meg];
+    known = std::max(known, msg.body_epoch);
+  }
   if (msg.kind == Message::Kind::cancel) {
     cancel_local(m_.nodes[from].cancels);
     return;
@@ -232,7 +259,10 @@ void Engine::activate_condition(int node, bool by_back_arc) {
       bool again = n.control == ControlKind::RepeatUntil ? !v
                    : n.control == ControlKind::RepeatWhile ? v
                                                            : v && s.iterations < n.count;
-      if (again) ++s.iterations;
+      if (again) {
+        ++s.iterations;
+        ++epoch_[n.meg];  // a new run of the repeat branch
+      }
       end(node, again ? Branch::repeat : Branch::exit);
       return;
     }
@@ -249,6 +279,7 @@ void Engine::activate_condition(int node, bool by_back_arc) {
         s.last_value = static_cast<int>(v);  // traced just now: log again only on a change
         ++active_;
         watched_.push_back(node);
+        ++epoch_[n.meg];  // a new run of the do-branch
         end(node, Branch::do_);
       } else {
         end(node, Branch::skip);
@@ -274,8 +305,14 @@ void Engine::evaluate_watch(int node) {
 void Engine::flip_do(int node) {
   const Node& n = m_.nodes[node];
   stop_watching(node);
+  ++epoch_[n.meg];  // the cancelled run is over: anything still in flight from it is stale
   cancel_local(n.cancels);
   Message msg{Message::Kind::cancel, m_.hash, m_.self, n.meg, Branch::any};
+  msg.body_epoch = epoch_[n.meg];
+  if (n.scope >= 0) {
+    msg.scope = n.scope;
+    msg.epoch = epoch_of(n.scope);
+  }
   for (int d = 0; d < static_cast<int>(m_.fleet.size()); ++d)
     if (d != m_.self && hooks_.transport) hooks_.transport->send(d, msg);
   end(node, Branch::done);
@@ -348,6 +385,11 @@ void Engine::end(int node, Branch branch, bool released_by_partner) {
     }
   }
   Message msg{Message::Kind::ended, m_.hash, m_.self, n.meg, branch};
+  if (n.scope >= 0) {
+    msg.scope = n.scope;
+    msg.epoch = epoch_of(n.scope);
+  }
+  if (n.kind == MegKind::condition) msg.body_epoch = epoch_of(n.meg);
   for (int d : remote)
     if (hooks_.transport) hooks_.transport->send(d, msg);
 }

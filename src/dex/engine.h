@@ -5,6 +5,7 @@
 // which successors to trigger; the engine keeps its run state apart from the Mission,
 // which it never changes (Taskflow: graph and executor apart).
 #include <deque>
+#include <map>
 #include <functional>
 #include <string>
 #include <vector>
@@ -66,6 +67,7 @@ class Engine {
     bool watching = false;
     long long iterations = 0;
     int last_value = -1;  ///< watched conditions: last traced value (-1 none), to log changes only
+    long long epoch = 0;  ///< run of the node's body (Mission::Node::scope) its counters belong to
   };
   struct Delivery {
     int node;
@@ -98,6 +100,13 @@ class Engine {
   int active_ = 0;
   std::uint64_t activations_ = 0;
   std::vector<int> watched_;  ///< condition nodes currently watching
+  /// Runs of each Repeat/Do body (by the condition's MEG id) this drone knows of: a body's
+  /// nodes reset their counters when a new run reaches them, and messages from an older
+  /// run are dropped. This is what keeps a cancelled do-branch or a finished iteration from
+  /// leaking a late trigger into the next run.
+  std::map<int, long long> epoch_;
+  void refresh(int node);
+  long long epoch_of(int scope) const;
 };
 
 }  // namespace eamos::dex

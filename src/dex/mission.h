@@ -29,7 +29,7 @@ struct Node {
   lang::ControlKind control = lang::ControlKind::none;
   long long count = 0;         ///< RepeatFor limit
   double seconds = 0.0;        ///< PauseFor
-  int scope = -1;              ///< index of the innermost Repeat/Do condition whose body holds it
+  int scope = -1;              ///< MEG id of the innermost Repeat/Do condition whose body holds it
   std::vector<int> cancels;    ///< Do conditions: local nodes a flip cancels
   std::vector<int> out;        ///< indices into Mission::arcs
   int exec_in = 0;             ///< number of exec arcs into this node

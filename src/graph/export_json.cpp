@@ -55,6 +55,7 @@ json meg_node_json(const Compilation& c, const MegNode& n) {
     if (n.role != Role::none) j["role"] = role_name(n.role);
   }
   if (n.kind == MegKind::pause) j["seconds"] = n.seconds;
+  if (n.scope >= 0) j["scope"] = n.scope;
   return j;
 }
 

@@ -247,6 +247,13 @@ class MegBuilder {
     return nullptr;
   }
 
+  /// Nodes [first, last) belong to the body of condition `c` unless a body nested inside
+  /// already claimed them (inner bodies are built, and marked, first).
+  void mark_scope(int first, int last, int c) {
+    for (int i = first; i < last; ++i)
+      if (meg_.nodes[i].scope < 0) meg_.nodes[i].scope = c;
+  }
+
   /// Builds a branch starting at (condition, branch) and ends it in a new terminal.
   int build_branch(const AmtNode& n, int c, Role role, Branch branch) {
     const AmtNode* body = child_with_role(n, role);
@@ -285,7 +292,9 @@ class MegBuilder {
       case ControlKind::RepeatUntil:
       case ControlKind::RepeatWhile:
       case ControlKind::RepeatFor: {
+        int first = static_cast<int>(meg_.nodes.size());
         int tr = build_branch(n, c, Role::repeat, Branch::repeat);
+        mark_scope(first, static_cast<int>(meg_.nodes.size()), c);
         meg_.add_arc(tr, c, ArcKind::back);
         return {{build_branch(n, c, Role::after, Branch::exit)}};
       }
@@ -308,6 +317,7 @@ class MegBuilder {
     Ends body_ends = body ? build(*body, {{c, Branch::do_}}) : Ends{{c, Branch::do_}};
     int last = static_cast<int>(meg_.nodes.size());
     for (int i = first; i < last; ++i) meg_.nodes[c].cancels.push_back(i);
+    mark_scope(first, last, c);
     int t_do = add_terminal(n, c, Role::do_);
     connect(body_ends, t_do);
     // "Don't do" releases the do-terminal like a partner would: it ends without its branch.

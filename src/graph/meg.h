@@ -81,6 +81,10 @@ struct MegNode {
   Role role = Role::none;      ///< which branch it ends
   // pause:
   double seconds = 0.0;
+  /// The innermost Repeat or Do condition whose body (repeat branch with its terminal, or
+  /// do-branch) holds this node, -1 for none. The DEX numbers each run of a body (an epoch)
+  /// so that a trigger left over from an earlier, cancelled or finished run is ignored.
+  int scope = -1;
 };
 
 struct Meg {

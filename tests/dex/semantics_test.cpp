@@ -121,6 +121,33 @@ TEST(Semantics, DoUntilAsyncRunsDoBranchUntilConditionTurnsTrueThenDoneBranch) {
   EXPECT_FALSE(f.result.drones[0].state.armed);
 }
 
+// A do-branch spanning two drones, cancelled in every iteration of a loop: each run starts
+// afresh on both drones (epochs), nothing of a cancelled run leaks into the next.
+TEST(Semantics, DoInsideRepeatIsCancelledAndRestartedOnEveryDroneEachIteration) {
+  Flight f = fly(kTwo + "func INIT() { PAR_up(); RepeatFor(true, SEQ_iter, SEQ_end, 3) }\n"
+                        "func PAR_up() { SEQ_a(); SEQ_b() }\n"
+                        "func SEQ_a() { A.Arm(); A.Takeoff(3) }\nfunc SEQ_b() { B.Arm(); B.Takeoff(3) }\n"
+                        "func SEQ_iter() { DoWhileSync(A.Z() < 6, PAR_work, SEQ_reset) }\n"
+                        "func PAR_work() { A.FlyByZ(5); SEQ_bw() }\n"
+                        "func SEQ_bw() { B.TakePicture(); B.Hover(30) }\n"
+                        "func SEQ_reset() { A.FlyTo(0, 0, 3) }\n"
+                        "func SEQ_end() { PAR_land() }\nfunc PAR_land() { SEQ_la(); SEQ_lb() }\n"
+                        "func SEQ_la() { A.Land(); A.Disarm() }\nfunc SEQ_lb() { B.Land(); B.Disarm() }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  int climbs_cancelled = 0, hovers_cancelled = 0, hovers_done = 0;
+  for (const auto& e : f.events) {
+    climbs_cancelled += e.event == "end" && e.text == "A.FlyByZ(5)" && e.outcome == "cancelled";
+    hovers_cancelled += e.event == "end" && e.text == "B.Hover(30)" && e.outcome == "cancelled";
+    hovers_done += e.event == "end" && e.text == "B.Hover(30)" && e.outcome == "succeeded";
+  }
+  EXPECT_EQ(climbs_cancelled, 3);
+  EXPECT_EQ(hovers_cancelled, 3);
+  EXPECT_EQ(hovers_done, 0);
+  EXPECT_EQ(f.result.drones[1].state.pictures, 3);
+  EXPECT_FALSE(f.result.drones[0].state.armed);
+  EXPECT_FALSE(f.result.drones[1].state.armed);
+}
+
 TEST(Semantics, ConditionEvaluatedByOneDroneDecidesForTheOthers) {
   Flight f = fly(kTwo + "func INIT() { A.Arm(); B.Arm(); If(A.Armed(), PAR_yes, PAR_no) }\n"
                         "func PAR_yes() { B.TakePicture() }\nfunc PAR_no() { B.Disarm() }\n");
