@@ -6,6 +6,7 @@
 #include <string>
 
 #include "graph/meg.h"
+#include "mid/drone_api.h"
 
 namespace eamos::dex {
 
@@ -28,12 +29,22 @@ struct Message {
   long long body_epoch = 0;
 };
 
+/// A drone's newest properties, published to every other drone: the argument data and
+/// condition inputs of the mission (`Drone3.FlyByX(Drone1.X())` reads Drone1's telemetry).
+struct Telemetry {
+  std::string mission_hash;
+  int from = 0;
+  mid::DroneState state;
+};
+
 /// The transport under InBridge and OutBridge: in-process here; DDS between processes.
 class Transport {
  public:
   virtual ~Transport() = default;
   /// Delivers `m` to drone `to` later (never inside send), in send order per sender.
   virtual void send(int to, const Message& m) = 0;
+  /// Delivers `t` to every other drone later, newest value wins.
+  virtual void publish(const Telemetry& t) = 0;
 };
 
 }  // namespace eamos::dex

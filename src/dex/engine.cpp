@@ -11,7 +11,8 @@ using graph::MegKind;
 using lang::ControlKind;
 
 Engine::Engine(const Mission& mission, mid::Drone& drone, mid::EventLoop& loop, EngineHooks hooks)
-    : m_(mission), drone_(drone), loop_(loop), hooks_(std::move(hooks)), state_(mission.nodes.size()) {
+    : m_(mission), drone_(drone), loop_(loop), hooks_(std::move(hooks)), state_(mission.nodes.size()),
+      board_(mission.fleet.size()) {
   for (std::size_t i = 0; i < m_.nodes.size(); ++i) {
     state_[i].exec_pending = m_.nodes[i].exec_in;
     state_[i].back_pending = m_.nodes[i].back_in;
@@ -41,8 +42,9 @@ double property_of(const mid::DroneState& s, const std::string& name) {
 }
 
 double Engine::property(int drone, const std::string& name) const {
-  if (drone != m_.self) return hooks_.remote_property ? hooks_.remote_property(drone, name) : NAN;
-  return property_of(drone_.state(), name);
+  if (drone == m_.self) return property_of(drone_.state(), name);
+  if (drone < 0 || drone >= static_cast<int>(board_.size()) || !board_[drone]) return NAN;
+  return property_of(*board_[drone], name);
 }
 
 void Engine::trace(const Node& n, const std::string& event, const std::string& outcome) {
@@ -140,6 +142,12 @@ void Engine::receive(const Message& msg) {
     queue_.push_back({arc.to, arc.kind, false});
   }
   drain();
+}
+
+void Engine::receive(const Telemetry& t) {
+  if (t.mission_hash != m_.hash || t.from < 0 || t.from >= static_cast<int>(board_.size())) return;
+  board_[t.from] = t.state;
+  properties_changed(t.from);
 }
 
 void Engine::activate(int node, bool by_back_arc) {

@@ -6,6 +6,7 @@
 // which it never changes (Taskflow: graph and executor apart).
 #include <deque>
 #include <map>
+#include <optional>
 #include <functional>
 #include <string>
 #include <vector>
@@ -33,8 +34,6 @@ struct Failure {
 struct EngineHooks {
   Transport* transport = nullptr;  ///< OutBridge's way out
   TraceSink* trace = nullptr;
-  /// Newest known value of another drone's property (telemetry); NaN when unknown.
-  std::function<double(int drone, const std::string& property)> remote_property;
   std::function<void(const Failure&)> on_failure;
   std::function<void()> on_end;  ///< the mission's end node ran (this drone is the lead)
 };
@@ -47,6 +46,8 @@ class Engine {
   void start();
   /// InBridge: a message from another drone.
   void receive(const Message& m);
+  /// InBridge: another drone's telemetry; re-evaluates the conditions that read it.
+  void receive(const Telemetry& t);
   /// A property of `drone` changed: re-evaluate the conditions that wait on it.
   void properties_changed(int drone);
   /// The mission failed elsewhere or here: start nothing more, cancel what runs.
@@ -100,6 +101,7 @@ class Engine {
   int active_ = 0;
   std::uint64_t activations_ = 0;
   std::vector<int> watched_;  ///< condition nodes currently watching
+  std::vector<std::optional<mid::DroneState>> board_;  ///< other drones' newest telemetry
   /// Runs of each Repeat/Do body (by the condition's MEG id) this drone knows of: a body's
   /// nodes reset their counters when a new run reaches them, and messages from an older
   /// run are dropped. This is what keeps a cancelled do-branch or a finished iteration from

@@ -18,6 +18,16 @@ class InProcessTransport : public Transport {
       engines_[to]->receive(m);
     });
   }
+  void publish(const Telemetry& t) override {
+    for (int to = 0; to < static_cast<int>(engines_.size()); ++to) {
+      if (to == t.from) continue;
+      ++in_flight_;
+      loop_.after(0.0, [this, to, t] {
+        --in_flight_;
+        engines_[to]->receive(t);
+      });
+    }
+  }
   int in_flight() const { return in_flight_; }
 
  private:
@@ -59,11 +69,8 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     }
     drones.push_back(std::move(c.drone));
   }
-  // Telemetry board: the newest state each drone's broker published.
-  std::vector<mid::DroneState> board(n);
-  for (int d = 0; d < n; ++d) board[d] = drones[d]->state();
   std::vector<std::vector<Sample>> tracks(n);
-  for (int d = 0; d < n; ++d) record_sample(tracks[d], board[d]);
+  for (int d = 0; d < n; ++d) record_sample(tracks[d], drones[d]->state());
 
   std::vector<std::unique_ptr<Engine>> engines;
   InProcessTransport transport(loop, engines);
@@ -92,7 +99,6 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     EngineHooks hooks;
     hooks.transport = &transport;
     hooks.trace = trace;
-    hooks.remote_property = [&board](int drone, const std::string& p) { return property_of(board[drone], p); };
     hooks.on_failure = fail;
     hooks.on_end = [&] {
       end_reached = true;
@@ -100,13 +106,21 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     };
     engines.push_back(std::make_unique<Engine>(missions[d], *drones[d], loop, hooks));
   }
+  // Each drone's broker feeds its own engine directly and every other drone through the
+  // transport (the OutBridge side of telemetry); a first publication seeds every board.
+  // Before anything runs, every engine holds every drone's initial state, as a DEX would
+  // after the start barrier: a condition at t = 0 never reads a value that is not there yet.
   for (int d = 0; d < n; ++d)
+    for (int to = 0; to < n; ++to)
+      if (to != d) engines[to]->receive(Telemetry{missions[d].hash, d, drones[d]->state()});
+  for (int d = 0; d < n; ++d) {
     drones[d]->subscribe([&, d](const mid::DroneState& s) {
-      board[d] = s;
       record_sample(tracks[d], s);
-      for (auto& e : engines) e->properties_changed(d);
+      engines[d]->properties_changed(d);
+      transport.publish({missions[d].hash, d, s});
       loop.after(0.0, check_done);
     });
+  }
   for (auto& e : engines) e->start();
 
   // Endless motions (an Orbit nobody preempts) keep the loop busy: bound the run.

@@ -148,6 +148,14 @@ TEST(Semantics, DoInsideRepeatIsCancelledAndRestartedOnEveryDroneEachIteration) 
   EXPECT_FALSE(f.result.drones[1].state.armed);
 }
 
+TEST(Semantics, ConditionReadsOtherDronesTelemetryFromTheFirstInstant) {
+  // B evaluates (it is read twice); A's position comes from A's telemetry, known at t = 0.
+  Flight f = fly(kTwo + "func INIT() { If(A.Y() == 0 && B.Y() == 5 && B.X() == 0, SEQ_t, SEQ_f) }\n"
+                        "func SEQ_t() { A.Arm() }\nfunc SEQ_f() { A.TakePicture() }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_GE(f.find("end", "A.Arm()", "succeeded"), 0);
+}
+
 TEST(Semantics, ConditionEvaluatedByOneDroneDecidesForTheOthers) {
   Flight f = fly(kTwo + "func INIT() { A.Arm(); B.Arm(); If(A.Armed(), PAR_yes, PAR_no) }\n"
                         "func PAR_yes() { B.TakePicture() }\nfunc PAR_no() { B.Disarm() }\n");
