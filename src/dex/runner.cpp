@@ -1,6 +1,7 @@
 #include "dex/runner.h"
 
 #include <cmath>
+#include <cstdio>
 
 namespace eamos::dex {
 
@@ -131,7 +132,10 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
   }
   if (!result.completed && !failed) {
     finished_at = loop.now();
-    result.error = "mission did not complete within " + std::to_string(options.time_limit_s) + " s";
+    char limit[32];
+    std::snprintf(limit, sizeof limit, "%g", options.time_limit_s);
+    result.error = std::string("mission did not complete within ") + limit +
+                   " s of mission time; raise --time-limit if it is meant to run longer";
     for (auto& e : engines) e->halt();
     for (int d = 0; d < n; ++d)
       if (!drones[d]->state().landed) drones[d]->failsafe(missions[d].settings.failsafe);
