@@ -74,6 +74,25 @@ void BM_SetupLargestDroneOf5000(benchmark::State& state) {
 }
 BENCHMARK(BM_SetupLargestDroneOf5000)->Unit(benchmark::kMicrosecond);
 
+struct Totals {
+  double activations = 0, simulated = 0, wall = 0;
+};
+
+/// Flies `missions` once per benchmark iteration and adds up what each flight did.
+Totals fly_repeatedly(benchmark::State& state, const std::vector<eamos::dex::Mission>& missions,
+                      const eamos::mid::AdapterRegistry& adapters) {
+  Totals t;
+  for (auto _ : state) {
+    auto t0 = std::chrono::steady_clock::now();
+    eamos::dex::RunResult r = eamos::dex::run_in_process(missions, adapters, nullptr);
+    t.wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (!r.completed) state.SkipWithError(r.error.c_str());
+    t.activations += static_cast<double>(r.activations);
+    t.simulated += r.duration;
+  }
+  return t;
+}
+
 /// Flies the whole 5,000-node, 20-drone mission in the simulator on virtual time.
 void BM_Fly5000Nodes20Drones(benchmark::State& state) {
   auto c = compile(stress_text());
@@ -84,15 +103,8 @@ void BM_Fly5000Nodes20Drones(benchmark::State& state) {
   }
   eamos::mid::AdapterRegistry adapters;
   eamos::sim::register_adapter(adapters);
-  double activations = 0, simulated = 0, wall = 0;
-  for (auto _ : state) {
-    auto t0 = std::chrono::steady_clock::now();
-    eamos::dex::RunResult r = eamos::dex::run_in_process(missions, adapters, nullptr);
-    wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (!r.completed) state.SkipWithError(r.error.c_str());
-    activations += static_cast<double>(r.activations);
-    simulated += r.duration;
-  }
+  Totals t = fly_repeatedly(state, missions, adapters);
+  double activations = t.activations, simulated = t.simulated, wall = t.wall;
   state.counters["activations_per_s"] = benchmark::Counter(activations / wall);
   state.counters["sim_s_per_wall_s"] = benchmark::Counter(simulated / wall);
   state.counters["mission_s"] = simulated / static_cast<double>(state.iterations());
@@ -109,14 +121,8 @@ void BM_EngineActivations(benchmark::State& state) {
   eamos::dex::load_mission(nlohmann::json::parse(c->files[0]), missions[0], error);
   eamos::mid::AdapterRegistry adapters;
   eamos::sim::register_adapter(adapters);
-  double activations = 0, wall = 0;
-  for (auto _ : state) {
-    auto t0 = std::chrono::steady_clock::now();
-    eamos::dex::RunResult r = eamos::dex::run_in_process(missions, adapters, nullptr);
-    wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (!r.completed) state.SkipWithError(r.error.c_str());
-    activations += static_cast<double>(r.activations);
-  }
+  Totals t = fly_repeatedly(state, missions, adapters);
+  double activations = t.activations, wall = t.wall;
   state.counters["activations_per_s"] = benchmark::Counter(activations / wall);
   state.counters["activations"] = activations / static_cast<double>(state.iterations());
 }

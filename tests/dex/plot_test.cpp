@@ -4,12 +4,8 @@
 
 #include <string>
 
-#include "deploy/synthesize.h"
 #include "dex/plot.h"
-#include "dex/runner.h"
-#include "dex/trace_writers.h"
-#include "graph/pipeline.h"
-#include "sim/sim_adapter.h"
+#include "flight.h"
 
 namespace eamos {
 namespace {
@@ -28,21 +24,8 @@ TEST(Plot, DrawsTracksAndOneBarPerAction) {
       "func SEQ_a() { A.Arm(); A.Takeoff(3); A.FlyByX(4); A.Land() }\n"
       "func SEQ_b() { B.Arm(); B.Takeoff(5); B.Land() }\n"
       "func PAR_down() { A.Disarm(); B.Disarm() }\n";
-  graph::Compilation c;
-  Diagnostics diags;
-  ASSERT_TRUE(graph::compile(std::make_shared<SourceFile>("t.eamos", text), {}, diags, c)) << diags.format();
-  std::string hash = deploy::mission_hash(c);
-  std::vector<dex::Mission> missions(c.drone_count());
-  for (int d = 0; d < c.drone_count(); ++d) {
-    std::string error;
-    ASSERT_TRUE(dex::load_mission(deploy::drone_mission(c, d, hash), missions[d], error)) << error;
-  }
-  mid::AdapterRegistry adapters;
-  sim::register_adapter(adapters);
-  dex::MemoryTrace memory;
-  dex::RunOptions options;
-  options.time_limit_s = 600;
-  dex::RunResult result = dex::run_in_process(missions, adapters, &memory, options);
+  test::Flight f = test::fly(text);
+  const dex::RunResult& result = f.result;
   ASSERT_TRUE(result.completed) << result.error;
 
   // Samples: the state before start, then only changes; A flew, so it has many.
@@ -53,7 +36,7 @@ TEST(Plot, DrawsTracksAndOneBarPerAction) {
   for (std::size_t i = 1; i < result.drones[0].track.size(); ++i)
     EXPECT_LE(result.drones[0].track[i - 1].t, result.drones[0].track[i].t);
 
-  std::string svg = dex::plot_svg(result, memory.events);
+  std::string svg = dex::plot_svg(result, f.events);
   EXPECT_EQ(svg.rfind("<svg", 0), 0u);
   while (!svg.empty() && svg.back() == '\n') svg.pop_back();
   EXPECT_TRUE(svg.ends_with("</svg>"));
@@ -61,7 +44,7 @@ TEST(Plot, DrawsTracksAndOneBarPerAction) {
   EXPECT_NE(svg.find(">A</text>"), std::string::npos);
   EXPECT_NE(svg.find(">B</text>"), std::string::npos);
   int starts = 0;
-  for (const auto& e : memory.events) starts += e.event == "start";
+  for (const auto& e : f.events) starts += e.event == "start";
   EXPECT_EQ(starts, 9);
   EXPECT_EQ(count(svg, "data-action="), starts);
   EXPECT_EQ(count(svg, "data-outcome=\"succeeded\""), starts);
