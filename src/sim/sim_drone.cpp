@@ -146,6 +146,16 @@ void SimDrone::start_motion(ActionId id, const mid::ActionRequest& r) {
       }
       m.kind = MotionKind::land;
       m.target = *goal;
+      // Like an autopilot, a drone told to land while moving brakes first and lands where
+      // it comes to rest, rather than flying back to where the command found it.
+      const fleet::Vec3& v = kin_.velocity;
+      double speed = std::sqrt(v.x * v.x + v.y * v.y);
+      double accel = settings_.limits.max_accel_mps2;
+      if (speed > 0 && accel > 0) {
+        double stop = speed / (2.0 * accel);  // distance / speed: d = v² / 2a
+        m.target.x += v.x * stop;
+        m.target.y += v.y * stop;
+      }
     } else if (r.name == "ReturnHome") {
       // Back at the altitude it flies at, then straight down onto home.
       m.kind = MotionKind::go;

@@ -245,3 +245,24 @@ TEST_F(Motion, DerivedTimeoutDoesNotFailANormalFlight) {
 
 }  // namespace
 }  // namespace eamos::sim
+
+namespace eamos::sim::test {
+namespace {
+
+// An autopilot told to land while flying brakes and lands where it comes to rest; it does
+// not fly back to where the command found it.
+TEST_F(Motion, LandWhileMovingLandsWhereTheDroneComesToRest) {
+  run("Arm");
+  run("Takeoff", {5});
+  auto fly = start("FlyByX", {40});
+  loop.run_until(loop.now() + 5.0);  // well under way east at cruise speed
+  double x_at_land = d().state().x;
+  Result land = run("Land");
+  EXPECT_EQ(land.end.outcome, mid::Outcome::succeeded);
+  EXPECT_EQ(fly->end.outcome, mid::Outcome::preempted);
+  EXPECT_GT(d().state().x, x_at_land + 1.0);  // braking distance ahead, not back
+  EXPECT_TRUE(d().state().landed);
+}
+
+}  // namespace
+}  // namespace eamos::sim::test
