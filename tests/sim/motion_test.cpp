@@ -251,7 +251,7 @@ namespace {
 
 // An autopilot told to land while flying brakes and lands where it comes to rest; it does
 // not fly back to where the command found it.
-TEST_F(Motion, LandWhileMovingLandsWhereTheDroneComesToRest) {
+TEST_F(SimTest, LandWhileMovingLandsWhereTheDroneComesToRest) {
   run("Arm");
   run("Takeoff", {5});
   auto fly = start("FlyByX", {40});
