@@ -1,0 +1,252 @@
+#include "mavlink/payloads.h"
+
+#include <string>
+
+namespace eamos::mavlink {
+
+namespace {
+
+// Every id used below is in the table (the round-trip tests cover each one).
+const MessageDef& def_of(uint32_t id) { return *find_message(id); }
+
+std::string param_name(int i) { return "param" + std::to_string(i + 1); }
+
+}  // namespace
+
+Message pack(const Heartbeat& m) {
+  FieldWriter w(def_of(msg::HEARTBEAT));
+  w.set("type", m.type);
+  w.set("autopilot", m.autopilot);
+  w.set("base_mode", m.base_mode);
+  w.set("custom_mode", m.custom_mode);
+  w.set("system_status", m.system_status);
+  w.set("mavlink_version", m.mavlink_version);
+  return w.take();
+}
+
+std::optional<Heartbeat> unpack_heartbeat(const Message& m) {
+  if (m.id != msg::HEARTBEAT) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  return Heartbeat{r.get<uint8_t>("type"), r.get<uint8_t>("autopilot"),
+                   r.get<uint8_t>("base_mode"), r.get<uint32_t>("custom_mode"),
+                   r.get<uint8_t>("system_status"), r.get<uint8_t>("mavlink_version")};
+}
+
+Message pack(const SysStatus& m) {
+  FieldWriter w(def_of(msg::SYS_STATUS));
+  w.set("onboard_control_sensors_present", m.sensors_present);
+  w.set("onboard_control_sensors_enabled", m.sensors_enabled);
+  w.set("onboard_control_sensors_health", m.sensors_health);
+  w.set("load", m.load);
+  w.set("voltage_battery", m.voltage_battery);
+  w.set("current_battery", m.current_battery);
+  w.set("battery_remaining", m.battery_remaining);
+  w.set("drop_rate_comm", m.drop_rate_comm);
+  w.set("errors_comm", m.errors_comm);
+  return w.take();
+}
+
+std::optional<SysStatus> unpack_sys_status(const Message& m) {
+  if (m.id != msg::SYS_STATUS) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  return SysStatus{r.get<uint32_t>("onboard_control_sensors_present"),
+                   r.get<uint32_t>("onboard_control_sensors_enabled"),
+                   r.get<uint32_t>("onboard_control_sensors_health"),
+                   r.get<uint16_t>("load"),
+                   r.get<uint16_t>("voltage_battery"),
+                   r.get<int16_t>("current_battery"),
+                   r.get<int8_t>("battery_remaining"),
+                   r.get<uint16_t>("drop_rate_comm"),
+                   r.get<uint16_t>("errors_comm")};
+}
+
+Message pack(const LocalPositionNed& m) {
+  FieldWriter w(def_of(msg::LOCAL_POSITION_NED));
+  w.set("time_boot_ms", m.time_boot_ms);
+  w.set("x", m.x);
+  w.set("y", m.y);
+  w.set("z", m.z);
+  w.set("vx", m.vx);
+  w.set("vy", m.vy);
+  w.set("vz", m.vz);
+  return w.take();
+}
+
+std::optional<LocalPositionNed> unpack_local_position_ned(const Message& m) {
+  if (m.id != msg::LOCAL_POSITION_NED) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  return LocalPositionNed{r.get<uint32_t>("time_boot_ms"), r.get<float>("x"),
+                          r.get<float>("y"), r.get<float>("z"), r.get<float>("vx"),
+                          r.get<float>("vy"), r.get<float>("vz")};
+}
+
+Message pack(const GlobalPositionInt& m) {
+  FieldWriter w(def_of(msg::GLOBAL_POSITION_INT));
+  w.set("time_boot_ms", m.time_boot_ms);
+  w.set("lat", m.lat);
+  w.set("lon", m.lon);
+  w.set("alt", m.alt);
+  w.set("relative_alt", m.relative_alt);
+  w.set("vx", m.vx);
+  w.set("vy", m.vy);
+  w.set("vz", m.vz);
+  w.set("hdg", m.hdg);
+  return w.take();
+}
+
+std::optional<GlobalPositionInt> unpack_global_position_int(const Message& m) {
+  if (m.id != msg::GLOBAL_POSITION_INT) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  return GlobalPositionInt{r.get<uint32_t>("time_boot_ms"), r.get<int32_t>("lat"),
+                           r.get<int32_t>("lon"), r.get<int32_t>("alt"),
+                           r.get<int32_t>("relative_alt"), r.get<int16_t>("vx"),
+                           r.get<int16_t>("vy"), r.get<int16_t>("vz"),
+                           r.get<uint16_t>("hdg")};
+}
+
+Message pack(const CommandLong& m) {
+  FieldWriter w(def_of(msg::COMMAND_LONG));
+  w.set("target_system", m.target_system);
+  w.set("target_component", m.target_component);
+  w.set("command", m.command);
+  w.set("confirmation", m.confirmation);
+  for (int i = 0; i < 7; ++i) w.set(param_name(i), m.param[i]);
+  return w.take();
+}
+
+std::optional<CommandLong> unpack_command_long(const Message& m) {
+  if (m.id != msg::COMMAND_LONG) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  CommandLong c{r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component"),
+                r.get<uint16_t>("command"), r.get<uint8_t>("confirmation"), {}};
+  for (int i = 0; i < 7; ++i) c.param[i] = r.get<float>(param_name(i));
+  return c;
+}
+
+Message pack(const CommandInt& m) {
+  FieldWriter w(def_of(msg::COMMAND_INT));
+  w.set("target_system", m.target_system);
+  w.set("target_component", m.target_component);
+  w.set("frame", m.frame);
+  w.set("command", m.command);
+  w.set("current", m.current);
+  w.set("autocontinue", m.autocontinue);
+  for (int i = 0; i < 4; ++i) w.set(param_name(i), m.param[i]);
+  w.set("x", m.x);
+  w.set("y", m.y);
+  w.set("z", m.z);
+  return w.take();
+}
+
+std::optional<CommandInt> unpack_command_int(const Message& m) {
+  if (m.id != msg::COMMAND_INT) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  CommandInt c{r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component"),
+               r.get<uint8_t>("frame"), r.get<uint16_t>("command"),
+               r.get<uint8_t>("current"), r.get<uint8_t>("autocontinue"), {},
+               r.get<int32_t>("x"), r.get<int32_t>("y"), r.get<float>("z")};
+  for (int i = 0; i < 4; ++i) c.param[i] = r.get<float>(param_name(i));
+  return c;
+}
+
+Message pack(const CommandAck& m) {
+  FieldWriter w(def_of(msg::COMMAND_ACK));
+  w.set("command", m.command);
+  w.set("result", m.result);
+  w.set("progress", m.progress);
+  w.set("result_param2", m.result_param2);
+  w.set("target_system", m.target_system);
+  w.set("target_component", m.target_component);
+  return w.take();
+}
+
+std::optional<CommandAck> unpack_command_ack(const Message& m) {
+  if (m.id != msg::COMMAND_ACK) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  return CommandAck{r.get<uint16_t>("command"), r.get<uint8_t>("result"),
+                    r.get<uint8_t>("progress"), r.get<int32_t>("result_param2"),
+                    r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component")};
+}
+
+Message pack(const SetPositionTargetLocalNed& m) {
+  FieldWriter w(def_of(msg::SET_POSITION_TARGET_LOCAL_NED));
+  w.set("time_boot_ms", m.time_boot_ms);
+  w.set("target_system", m.target_system);
+  w.set("target_component", m.target_component);
+  w.set("coordinate_frame", m.coordinate_frame);
+  w.set("type_mask", m.type_mask);
+  w.set("x", m.x);
+  w.set("y", m.y);
+  w.set("z", m.z);
+  w.set("vx", m.vx);
+  w.set("vy", m.vy);
+  w.set("vz", m.vz);
+  w.set("afx", m.afx);
+  w.set("afy", m.afy);
+  w.set("afz", m.afz);
+  w.set("yaw", m.yaw);
+  w.set("yaw_rate", m.yaw_rate);
+  return w.take();
+}
+
+std::optional<SetPositionTargetLocalNed> unpack_set_position_target_local_ned(
+    const Message& m) {
+  if (m.id != msg::SET_POSITION_TARGET_LOCAL_NED) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  return SetPositionTargetLocalNed{
+      r.get<uint32_t>("time_boot_ms"), r.get<uint8_t>("target_system"),
+      r.get<uint8_t>("target_component"), r.get<uint8_t>("coordinate_frame"),
+      r.get<uint16_t>("type_mask"), r.get<float>("x"), r.get<float>("y"), r.get<float>("z"),
+      r.get<float>("vx"), r.get<float>("vy"), r.get<float>("vz"), r.get<float>("afx"),
+      r.get<float>("afy"), r.get<float>("afz"), r.get<float>("yaw"),
+      r.get<float>("yaw_rate")};
+}
+
+Message pack(const ExtendedSysState& m) {
+  FieldWriter w(def_of(msg::EXTENDED_SYS_STATE));
+  w.set("vtol_state", m.vtol_state);
+  w.set("landed_state", m.landed_state);
+  return w.take();
+}
+
+std::optional<ExtendedSysState> unpack_extended_sys_state(const Message& m) {
+  if (m.id != msg::EXTENDED_SYS_STATE) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  return ExtendedSysState{r.get<uint8_t>("vtol_state"), r.get<uint8_t>("landed_state")};
+}
+
+Message pack(const BatteryStatus& m) {
+  FieldWriter w(def_of(msg::BATTERY_STATUS));
+  w.set("id", m.id);
+  w.set("battery_function", m.battery_function);
+  w.set("type", m.type);
+  w.set("temperature", m.temperature);
+  for (int i = 0; i < 10; ++i) w.set("voltages", m.voltages[i], i);
+  w.set("current_battery", m.current_battery);
+  w.set("current_consumed", m.current_consumed);
+  w.set("energy_consumed", m.energy_consumed);
+  w.set("battery_remaining", m.battery_remaining);
+  w.set("time_remaining", m.time_remaining);
+  w.set("charge_state", m.charge_state);
+  return w.take();
+}
+
+std::optional<BatteryStatus> unpack_battery_status(const Message& m) {
+  if (m.id != msg::BATTERY_STATUS) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  BatteryStatus b;
+  b.id = r.get<uint8_t>("id");
+  b.battery_function = r.get<uint8_t>("battery_function");
+  b.type = r.get<uint8_t>("type");
+  b.temperature = r.get<int16_t>("temperature");
+  for (int i = 0; i < 10; ++i) b.voltages[i] = r.get<uint16_t>("voltages", i);
+  b.current_battery = r.get<int16_t>("current_battery");
+  b.current_consumed = r.get<int32_t>("current_consumed");
+  b.energy_consumed = r.get<int32_t>("energy_consumed");
+  b.battery_remaining = r.get<int8_t>("battery_remaining");
+  b.time_remaining = r.get<int32_t>("time_remaining");
+  b.charge_state = r.get<uint8_t>("charge_state");
+  return b;
+}
+
+}  // namespace eamos::mavlink

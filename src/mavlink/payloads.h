@@ -1,0 +1,131 @@
+#pragma once
+// Plain structs for the messages the MAVLink adapter uses, with pack (struct -> Message) and
+// unpack (Message -> struct, nullopt for another message id). Field names and units are
+// common.xml's; the structs do not convert units, the adapter does.
+#include <array>
+#include <cstdint>
+#include <optional>
+
+#include "mavlink/fields.h"
+
+namespace eamos::mavlink {
+
+struct Heartbeat {
+  uint8_t type = 0;             ///< MAV_TYPE
+  uint8_t autopilot = 0;        ///< MAV_AUTOPILOT
+  uint8_t base_mode = 0;        ///< MAV_MODE_FLAG bits (armed = 128)
+  uint32_t custom_mode = 0;     ///< autopilot-specific flight mode
+  uint8_t system_status = 0;    ///< MAV_STATE
+  uint8_t mavlink_version = 3;  ///< always 3 for MAVLink 2
+};
+
+struct SysStatus {
+  uint32_t sensors_present = 0;
+  uint32_t sensors_enabled = 0;
+  uint32_t sensors_health = 0;
+  uint16_t load = 0;              ///< d%
+  uint16_t voltage_battery = 0;   ///< mV, UINT16_MAX unknown
+  int16_t current_battery = -1;   ///< cA, -1 unknown
+  int8_t battery_remaining = -1;  ///< %, -1 unknown
+  uint16_t drop_rate_comm = 0;    ///< c%
+  uint16_t errors_comm = 0;
+};
+
+struct LocalPositionNed {
+  uint32_t time_boot_ms = 0;
+  float x = 0, y = 0, z = 0;     ///< m, north east down
+  float vx = 0, vy = 0, vz = 0;  ///< m/s
+};
+
+struct GlobalPositionInt {
+  uint32_t time_boot_ms = 0;
+  int32_t lat = 0, lon = 0;     ///< degE7
+  int32_t alt = 0;              ///< mm above mean sea level
+  int32_t relative_alt = 0;     ///< mm above home
+  int16_t vx = 0, vy = 0, vz = 0;  ///< cm/s, north east down
+  uint16_t hdg = UINT16_MAX;    ///< cdeg, UINT16_MAX unknown
+};
+
+struct CommandLong {
+  uint8_t target_system = 0;
+  uint8_t target_component = 0;
+  uint16_t command = 0;      ///< MAV_CMD
+  uint8_t confirmation = 0;  ///< 0 first try, +1 per retry
+  std::array<float, 7> param{};
+};
+
+struct CommandInt {
+  uint8_t target_system = 0;
+  uint8_t target_component = 0;
+  uint8_t frame = 0;  ///< MAV_FRAME
+  uint16_t command = 0;
+  uint8_t current = 0;
+  uint8_t autocontinue = 0;
+  std::array<float, 4> param{};
+  int32_t x = 0, y = 0;  ///< degE7 or local m*1e4, by frame
+  float z = 0;
+};
+
+struct CommandAck {
+  uint16_t command = 0;
+  uint8_t result = 0;        ///< MAV_RESULT
+  uint8_t progress = 0;      ///< % while IN_PROGRESS
+  int32_t result_param2 = 0;
+  uint8_t target_system = 0;
+  uint8_t target_component = 0;
+};
+
+struct SetPositionTargetLocalNed {
+  uint32_t time_boot_ms = 0;
+  uint8_t target_system = 0;
+  uint8_t target_component = 0;
+  uint8_t coordinate_frame = 1;  ///< MAV_FRAME_LOCAL_NED
+  uint16_t type_mask = 0;        ///< POSITION_TARGET_TYPEMASK: set bits are ignored
+  float x = 0, y = 0, z = 0;
+  float vx = 0, vy = 0, vz = 0;
+  float afx = 0, afy = 0, afz = 0;
+  float yaw = 0, yaw_rate = 0;
+};
+
+struct ExtendedSysState {
+  uint8_t vtol_state = 0;    ///< MAV_VTOL_STATE
+  uint8_t landed_state = 0;  ///< MAV_LANDED_STATE: 1 on ground, 2 in air, 3 taking off, 4 landing
+};
+
+struct BatteryStatus {
+  uint8_t id = 0;
+  uint8_t battery_function = 0;
+  uint8_t type = 0;
+  int16_t temperature = INT16_MAX;  ///< cdegC
+  std::array<uint16_t, 10> voltages{};  ///< mV per cell, UINT16_MAX unused
+  int16_t current_battery = -1;     ///< cA
+  int32_t current_consumed = -1;    ///< mAh
+  int32_t energy_consumed = -1;     ///< hJ
+  int8_t battery_remaining = -1;    ///< %
+  int32_t time_remaining = 0;       ///< s
+  uint8_t charge_state = 0;         ///< MAV_BATTERY_CHARGE_STATE
+};
+
+Message pack(const Heartbeat& m);
+Message pack(const SysStatus& m);
+Message pack(const LocalPositionNed& m);
+Message pack(const GlobalPositionInt& m);
+Message pack(const CommandLong& m);
+Message pack(const CommandInt& m);
+Message pack(const CommandAck& m);
+Message pack(const SetPositionTargetLocalNed& m);
+Message pack(const ExtendedSysState& m);
+Message pack(const BatteryStatus& m);
+
+std::optional<Heartbeat> unpack_heartbeat(const Message& m);
+std::optional<SysStatus> unpack_sys_status(const Message& m);
+std::optional<LocalPositionNed> unpack_local_position_ned(const Message& m);
+std::optional<GlobalPositionInt> unpack_global_position_int(const Message& m);
+std::optional<CommandLong> unpack_command_long(const Message& m);
+std::optional<CommandInt> unpack_command_int(const Message& m);
+std::optional<CommandAck> unpack_command_ack(const Message& m);
+std::optional<SetPositionTargetLocalNed> unpack_set_position_target_local_ned(const Message& m);
+std::optional<ExtendedSysState> unpack_extended_sys_state(const Message& m);
+std::optional<BatteryStatus> unpack_battery_status(const Message& m);
+
+}  // namespace eamos::mavlink

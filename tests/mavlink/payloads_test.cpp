@@ -1,0 +1,204 @@
+// Every message struct survives pack -> frame -> parse -> unpack unchanged, and the field
+// helpers write little-endian.
+#include <gtest/gtest.h>
+
+#include "mavlink/frame.h"
+#include "mavlink/payloads.h"
+
+namespace eamos::mavlink {
+namespace {
+
+// Encodes and parses one message, as a link would.
+Message through_the_wire(const Message& m) {
+  Encoder enc;
+  Parser parser;
+  auto frames = parser.feed(enc.encode(m));
+  EXPECT_EQ(frames.size(), 1u);
+  return frames.empty() ? Message{} : frames[0].message;
+}
+
+TEST(Fields, PutAndGetAreLittleEndian) {
+  std::vector<uint8_t> buf(8, 0);
+  put_le<uint32_t>(buf, 1, 0x11223344);
+  EXPECT_EQ(buf, (std::vector<uint8_t>{0, 0x44, 0x33, 0x22, 0x11, 0, 0, 0}));
+  EXPECT_EQ(get_le<uint32_t>(buf, 1), 0x11223344u);
+  put_le<float>(buf, 0, 1.0f);  // 0x3F800000
+  EXPECT_EQ(buf[3], 0x3F);
+  put_le<double>(buf, 0, -2.5);
+  EXPECT_EQ(get_le<double>(buf, 0), -2.5);
+  put_le<int16_t>(buf, 0, -2);
+  EXPECT_EQ(buf[0], 0xFE);
+  EXPECT_EQ(get_le<int16_t>(buf, 0), -2);
+}
+
+TEST(Fields, CharArraysArePaddedAndCut) {
+  MessageDef def{9, "T", wire_order({{FieldType::char_, "s", 4}}), 4, 4, 0};
+  FieldWriter w(def);
+  w.set_chars("s", "ab");
+  Message m = w.take();
+  EXPECT_EQ(m.payload, (std::vector<uint8_t>{'a', 'b', 0, 0}));
+  EXPECT_EQ(FieldReader(def, m).get_chars("s"), "ab");
+  FieldWriter full(def);
+  full.set_chars("s", "abcdef");
+  Message cut = full.take();
+  EXPECT_EQ(FieldReader(def, cut).get_chars("s"), "abcd");
+}
+
+TEST(RoundTrip, Heartbeat) {
+  Heartbeat in{6, 8, 0x81, 0x0A0B0C0D, 4, 3};
+  auto out = unpack_heartbeat(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->type, 6);
+  EXPECT_EQ(out->autopilot, 8);
+  EXPECT_EQ(out->base_mode, 0x81);
+  EXPECT_EQ(out->custom_mode, 0x0A0B0C0Du);
+  EXPECT_EQ(out->system_status, 4);
+  EXPECT_EQ(out->mavlink_version, 3);
+}
+
+TEST(RoundTrip, SysStatus) {
+  SysStatus in{1, 2, 3, 500, 12600, -150, 87, 10, 2};
+  auto out = unpack_sys_status(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->sensors_present, 1u);
+  EXPECT_EQ(out->sensors_enabled, 2u);
+  EXPECT_EQ(out->sensors_health, 3u);
+  EXPECT_EQ(out->load, 500);
+  EXPECT_EQ(out->voltage_battery, 12600);
+  EXPECT_EQ(out->current_battery, -150);
+  EXPECT_EQ(out->battery_remaining, 87);
+  EXPECT_EQ(out->drop_rate_comm, 10);
+  EXPECT_EQ(out->errors_comm, 2);
+}
+
+TEST(RoundTrip, LocalPositionNed) {
+  LocalPositionNed in{1234, 1.5f, -2.25f, -10.0f, 0.5f, 0.25f, -0.125f};
+  auto out = unpack_local_position_ned(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->time_boot_ms, 1234u);
+  EXPECT_EQ(out->x, 1.5f);
+  EXPECT_EQ(out->y, -2.25f);
+  EXPECT_EQ(out->z, -10.0f);
+  EXPECT_EQ(out->vx, 0.5f);
+  EXPECT_EQ(out->vy, 0.25f);
+  EXPECT_EQ(out->vz, -0.125f);
+}
+
+TEST(RoundTrip, GlobalPositionInt) {
+  GlobalPositionInt in{99, 473977418, 85455939, 488000, 10000, -5, 6, -7, 35999};
+  auto out = unpack_global_position_int(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->time_boot_ms, 99u);
+  EXPECT_EQ(out->lat, 473977418);
+  EXPECT_EQ(out->lon, 85455939);
+  EXPECT_EQ(out->alt, 488000);
+  EXPECT_EQ(out->relative_alt, 10000);
+  EXPECT_EQ(out->vx, -5);
+  EXPECT_EQ(out->vy, 6);
+  EXPECT_EQ(out->vz, -7);
+  EXPECT_EQ(out->hdg, 35999);
+}
+
+TEST(RoundTrip, CommandLong) {
+  CommandLong in{1, 1, 400, 2, {1, 21196, 0, 0, 0, 0, 7.5f}};
+  auto out = unpack_command_long(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->target_system, 1);
+  EXPECT_EQ(out->target_component, 1);
+  EXPECT_EQ(out->command, 400);
+  EXPECT_EQ(out->confirmation, 2);
+  EXPECT_EQ(out->param, in.param);
+}
+
+TEST(RoundTrip, CommandInt) {
+  CommandInt in{1, 1, 6, 192, 0, 1, {-1, 1, 0, 3}, 473977418, 85455939, 25.5f};
+  auto out = unpack_command_int(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->target_system, 1);
+  EXPECT_EQ(out->target_component, 1);
+  EXPECT_EQ(out->frame, 6);
+  EXPECT_EQ(out->command, 192);
+  EXPECT_EQ(out->current, 0);
+  EXPECT_EQ(out->autocontinue, 1);
+  EXPECT_EQ(out->param, in.param);
+  EXPECT_EQ(out->x, 473977418);
+  EXPECT_EQ(out->y, 85455939);
+  EXPECT_EQ(out->z, 25.5f);
+}
+
+TEST(RoundTrip, CommandAck) {
+  CommandAck in{176, 5, 50, -3, 255, 190};
+  auto out = unpack_command_ack(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->command, 176);
+  EXPECT_EQ(out->result, 5);
+  EXPECT_EQ(out->progress, 50);
+  EXPECT_EQ(out->result_param2, -3);
+  EXPECT_EQ(out->target_system, 255);
+  EXPECT_EQ(out->target_component, 190);
+}
+
+TEST(RoundTrip, SetPositionTargetLocalNed) {
+  SetPositionTargetLocalNed in{10, 2, 1, 1, 0x0DF8, 1, 2, -3, 4, 5, 6, 7, 8, 9, 1.25f, 0.5f};
+  auto out = unpack_set_position_target_local_ned(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->time_boot_ms, 10u);
+  EXPECT_EQ(out->target_system, 2);
+  EXPECT_EQ(out->target_component, 1);
+  EXPECT_EQ(out->coordinate_frame, 1);
+  EXPECT_EQ(out->type_mask, 0x0DF8);
+  EXPECT_EQ(out->x, 1);
+  EXPECT_EQ(out->y, 2);
+  EXPECT_EQ(out->z, -3);
+  EXPECT_EQ(out->vx, 4);
+  EXPECT_EQ(out->vy, 5);
+  EXPECT_EQ(out->vz, 6);
+  EXPECT_EQ(out->afx, 7);
+  EXPECT_EQ(out->afy, 8);
+  EXPECT_EQ(out->afz, 9);
+  EXPECT_EQ(out->yaw, 1.25f);
+  EXPECT_EQ(out->yaw_rate, 0.5f);
+}
+
+TEST(RoundTrip, ExtendedSysState) {
+  auto out = unpack_extended_sys_state(through_the_wire(pack(ExtendedSysState{3, 2})));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->vtol_state, 3);
+  EXPECT_EQ(out->landed_state, 2);
+}
+
+TEST(RoundTrip, BatteryStatus) {
+  BatteryStatus in;
+  in.id = 1;
+  in.battery_function = 1;
+  in.type = 1;
+  in.temperature = 2500;
+  for (int i = 0; i < 10; ++i) in.voltages[i] = static_cast<uint16_t>(i < 4 ? 4100 + i : 65535);
+  in.current_battery = 1234;
+  in.current_consumed = 560;
+  in.energy_consumed = 7890;
+  in.battery_remaining = 66;
+  in.time_remaining = 600;
+  in.charge_state = 1;
+  auto out = unpack_battery_status(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->id, 1);
+  EXPECT_EQ(out->battery_function, 1);
+  EXPECT_EQ(out->type, 1);
+  EXPECT_EQ(out->temperature, 2500);
+  EXPECT_EQ(out->voltages, in.voltages);
+  EXPECT_EQ(out->current_battery, 1234);
+  EXPECT_EQ(out->current_consumed, 560);
+  EXPECT_EQ(out->energy_consumed, 7890);
+  EXPECT_EQ(out->battery_remaining, 66);
+  EXPECT_EQ(out->time_remaining, 600);
+  EXPECT_EQ(out->charge_state, 1);
+}
+
+TEST(Unpack, OtherMessageIdGivesNothing) {
+  EXPECT_FALSE(unpack_command_ack(pack(Heartbeat{})));
+  EXPECT_FALSE(unpack_heartbeat(pack(CommandAck{})));
+}
+
+}  // namespace
+}  // namespace eamos::mavlink
