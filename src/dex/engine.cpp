@@ -5,6 +5,18 @@
 
 namespace eamos::dex {
 
+namespace {
+bool is_do(lang::ControlKind k) {
+  return k == lang::ControlKind::DoUntilSync || k == lang::ControlKind::DoWhileSync ||
+         k == lang::ControlKind::DoUntilAsync || k == lang::ControlKind::DoWhileAsync;
+}
+/// Do*: whether the condition's value `v` says "do" (While: true, Until: false).
+bool says_do(lang::ControlKind k, bool v) {
+  bool is_while = k == lang::ControlKind::DoWhileSync || k == lang::ControlKind::DoWhileAsync;
+  return is_while ? v : !v;
+}
+}  // namespace
+
 using graph::ArcKind;
 using graph::Branch;
 using graph::MegKind;
@@ -279,10 +291,8 @@ void Engine::activate_condition(int node, bool by_back_arc) {
     case ControlKind::DoUntilAsync:
     case ControlKind::DoWhileAsync: {
       bool v = condition_value(node);
-      bool is_while = n.control == ControlKind::DoWhileSync || n.control == ControlKind::DoWhileAsync;
       bool async = n.control == ControlKind::DoUntilAsync || n.control == ControlKind::DoWhileAsync;
-      bool do_it = is_while ? v : !v;
-      if (do_it) {
+      if (says_do(n.control, v)) {
         s.watching = true;
         s.last_value = static_cast<int>(v);  // traced just now: log again only on a change
         ++active_;
@@ -331,19 +341,14 @@ void Engine::properties_changed(int drone) {
   std::vector<int> now = watched_;  // ending a watch edits watched_
   for (int node : now) {
     if (!state_[node].watching) continue;
-    std::vector<int> reads;
-    collect_drones(m_.nodes[node].condition, reads);
-    if (std::find(reads.begin(), reads.end(), drone) == reads.end()) continue;
     const Node& n = m_.nodes[node];
-    bool is_do = n.control == ControlKind::DoUntilSync || n.control == ControlKind::DoWhileSync ||
-                 n.control == ControlKind::DoUntilAsync || n.control == ControlKind::DoWhileAsync;
-    if (!is_do) {
+    const std::vector<int>& reads = n.condition_reads;
+    if (std::find(reads.begin(), reads.end(), drone) == reads.end()) continue;
+    if (!is_do(n.control)) {
       evaluate_watch(node);
       continue;
     }
-    bool v = condition_value(node);
-    bool is_while = n.control == ControlKind::DoWhileSync || n.control == ControlKind::DoWhileAsync;
-    if ((is_while ? v : !v) == false) flip_do(node);
+    if (!says_do(n.control, condition_value(node))) flip_do(node);
   }
   drain();
 }

@@ -109,6 +109,7 @@ bool load_node(const json& j, Mission& m, Node& n, std::string& error) {
     }
   if (n.kind == graph::MegKind::condition) {
     if (!parse_expr(j.at("condition"), m.fleet, n.condition, error)) return false;
+    collect_drones(n.condition, n.condition_reads);
     n.control = lang::control_from_name(j.at("control").get<std::string>());
     if (n.control == lang::ControlKind::none) return error = "unknown control structure", false;
     n.count = j.value("count", 0LL);

@@ -26,6 +26,7 @@ struct Node {
   int col = 0;
   std::vector<Expr> args;      ///< action arguments
   Expr condition;              ///< condition nodes
+  std::vector<int> condition_reads;  ///< drones the condition reads, computed once at load
   lang::ControlKind control = lang::ControlKind::none;
   long long count = 0;         ///< RepeatFor limit
   double seconds = 0.0;        ///< PauseFor

@@ -86,15 +86,20 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     finished_at = loop.now();
     loop.stop();
   };
+  // The mission is over without completing: start nothing more, land (or whatever the
+  // fleet file says) every drone still in the air.
+  auto abandon = [&] {
+    for (auto& e : engines) e->halt();
+    for (int d = 0; d < n; ++d)
+      if (!drones[d]->state().landed) drones[d]->failsafe(missions[d].settings.failsafe);
+  };
   auto fail = [&](const Failure& f) {
     if (failed) return;
     failed = true;
     finished_at = loop.now();
     result.failure = f;
     result.error = f.drone + "." + f.action + " (line " + std::to_string(f.line) + ") failed: " + f.reason;
-    for (auto& e : engines) e->halt();
-    for (int d = 0; d < n; ++d)
-      if (!drones[d]->state().landed) drones[d]->failsafe(missions[d].settings.failsafe);
+    abandon();
   };
   for (int d = 0; d < n; ++d) {
     EngineHooks hooks;
@@ -136,9 +141,7 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     std::snprintf(limit, sizeof limit, "%g", options.time_limit_s);
     result.error = std::string("mission did not complete within ") + limit +
                    " s of mission time; raise --time-limit if it is meant to run longer";
-    for (auto& e : engines) e->halt();
-    for (int d = 0; d < n; ++d)
-      if (!drones[d]->state().landed) drones[d]->failsafe(missions[d].settings.failsafe);
+    abandon();
   }
   if (failed || !result.completed) loop.run_until(loop.now() + 600.0);  // let failsafes finish
   result.duration = finished_at;
