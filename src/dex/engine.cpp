@@ -56,7 +56,7 @@ double property_of(const mid::DroneState& s, const std::string& name) {
 double Engine::property(int drone, const std::string& name) const {
   if (drone == m_.self) return property_of(drone_.state(), name);
   if (drone < 0 || drone >= static_cast<int>(board_.size()) || !board_[drone]) return NAN;
-  return property_of(*board_[drone], name);
+  return property_of(board_[drone]->state, name);
 }
 
 void Engine::trace(const Node& n, const std::string& event, const std::string& outcome) {
@@ -156,10 +156,11 @@ void Engine::receive(const Message& msg) {
   drain();
 }
 
-void Engine::receive(const Telemetry& t) {
-  if (t.mission_hash != m_.hash || t.from < 0 || t.from >= static_cast<int>(board_.size())) return;
-  board_[t.from] = t.state;
-  properties_changed(t.from);
+void Engine::receive(std::shared_ptr<const Telemetry> t) {
+  if (!t || t->mission_hash != m_.hash || t->from < 0 || t->from >= static_cast<int>(board_.size())) return;
+  int from = t->from;
+  board_[from] = std::move(t);
+  properties_changed(from);
 }
 
 void Engine::activate(int node, bool by_back_arc) {

@@ -47,7 +47,7 @@ class Engine {
   /// InBridge: a message from another drone.
   void receive(const Message& m);
   /// InBridge: another drone's telemetry; re-evaluates the conditions that read it.
-  void receive(const Telemetry& t);
+  void receive(std::shared_ptr<const Telemetry> t);
   /// A property of `drone` changed: re-evaluate the conditions that wait on it.
   void properties_changed(int drone);
   /// The mission failed elsewhere or here: start nothing more, cancel what runs.
@@ -101,7 +101,7 @@ class Engine {
   int active_ = 0;
   std::uint64_t activations_ = 0;
   std::vector<int> watched_;  ///< condition nodes currently watching
-  std::vector<std::optional<mid::DroneState>> board_;  ///< other drones' newest telemetry
+  std::vector<std::shared_ptr<const Telemetry>> board_;  ///< other drones' newest telemetry
   /// Runs of each Repeat/Do body (by the condition's MEG id) this drone knows of: a body's
   /// nodes reset their counters when a new run reaches them, and messages from an older
   /// run are dropped. This is what keeps a cancelled do-branch or a finished iteration from

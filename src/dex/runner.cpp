@@ -7,11 +7,18 @@ namespace eamos::dex {
 
 namespace {
 
-/// Delivers messages through the event loop, in send order, with no latency.
+/// Delivers messages through the event loop, in send order, with no latency. Telemetry
+/// goes only to the drones whose mission reads the sender (Mission::reads), the way a DDS
+/// reader subscribes to what it needs.
 class InProcessTransport : public Transport {
  public:
-  InProcessTransport(mid::EventLoop& loop, std::vector<std::unique_ptr<Engine>>& engines)
-      : loop_(loop), engines_(engines) {}
+  InProcessTransport(mid::EventLoop& loop, std::vector<std::unique_ptr<Engine>>& engines,
+                     const std::vector<Mission>& missions)
+      : loop_(loop), engines_(engines), readers_(missions.size()) {
+    for (std::size_t to = 0; to < missions.size(); ++to)
+      for (int d : missions[to].reads)
+        if (d >= 0 && d < static_cast<int>(readers_.size())) readers_[d].push_back(static_cast<int>(to));
+  }
   void send(int to, const Message& m) override {
     ++in_flight_;
     loop_.after(0.0, [this, to, m] {
@@ -19,9 +26,9 @@ class InProcessTransport : public Transport {
       engines_[to]->receive(m);
     });
   }
-  void publish(const Telemetry& t) override {
-    for (int to = 0; to < static_cast<int>(engines_.size()); ++to) {
-      if (to == t.from) continue;
+  void publish(std::shared_ptr<const Telemetry> t) override {
+    for (int to : readers_[t->from]) {
+      if (to == t->from) continue;
       ++in_flight_;
       loop_.after(0.0, [this, to, t] {
         --in_flight_;
@@ -34,6 +41,7 @@ class InProcessTransport : public Transport {
  private:
   mid::EventLoop& loop_;
   std::vector<std::unique_ptr<Engine>>& engines_;
+  std::vector<std::vector<int>> readers_;  ///< per drone: the drones that read its telemetry
   int in_flight_ = 0;
 };
 
@@ -74,7 +82,7 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
   for (int d = 0; d < n; ++d) record_sample(tracks[d], drones[d]->state());
 
   std::vector<std::unique_ptr<Engine>> engines;
-  InProcessTransport transport(loop, engines);
+  InProcessTransport transport(loop, engines, missions);
   bool end_reached = false;
   bool failed = false;
   double finished_at = 0.0;
@@ -118,12 +126,13 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
   // after the start barrier: a condition at t = 0 never reads a value that is not there yet.
   for (int d = 0; d < n; ++d)
     for (int to = 0; to < n; ++to)
-      if (to != d) engines[to]->receive(Telemetry{missions[d].hash, d, drones[d]->state()});
+      if (to != d)
+        engines[to]->receive(std::make_shared<const Telemetry>(Telemetry{missions[d].hash, d, drones[d]->state()}));
   for (int d = 0; d < n; ++d) {
     drones[d]->subscribe([&, d](const mid::DroneState& s) {
       record_sample(tracks[d], s);
       engines[d]->properties_changed(d);
-      transport.publish({missions[d].hash, d, s});
+      transport.publish(std::make_shared<const Telemetry>(Telemetry{missions[d].hash, d, s}));
       loop.after(0.0, check_done);
     });
   }
