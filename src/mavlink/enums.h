@@ -1,0 +1,76 @@
+#pragma once
+// The common.xml enum values the adapter and the simulated vehicle use, named as there, and
+// MAV_RESULT in words (a refusal reaches the mission as text).
+#include <cstdint>
+#include <string>
+
+namespace eamos::mavlink {
+
+namespace cmd {  // MAV_CMD
+inline constexpr uint16_t NAV_RETURN_TO_LAUNCH = 20;
+inline constexpr uint16_t NAV_LAND = 21;
+inline constexpr uint16_t NAV_TAKEOFF = 22;
+inline constexpr uint16_t DO_SET_MODE = 176;
+inline constexpr uint16_t COMPONENT_ARM_DISARM = 400;
+inline constexpr uint16_t SET_MESSAGE_INTERVAL = 511;
+inline constexpr uint16_t IMAGE_START_CAPTURE = 2000;
+}  // namespace cmd
+
+namespace result {  // MAV_RESULT
+inline constexpr uint8_t ACCEPTED = 0;
+inline constexpr uint8_t TEMPORARILY_REJECTED = 1;
+inline constexpr uint8_t DENIED = 2;
+inline constexpr uint8_t UNSUPPORTED = 3;
+inline constexpr uint8_t FAILED = 4;
+inline constexpr uint8_t IN_PROGRESS = 5;
+inline constexpr uint8_t CANCELLED = 6;
+}  // namespace result
+
+namespace mav_type {  // MAV_TYPE
+inline constexpr uint8_t GENERIC = 0;
+inline constexpr uint8_t QUADROTOR = 2;
+inline constexpr uint8_t GCS = 6;
+inline constexpr uint8_t ONBOARD_CONTROLLER = 18;
+}  // namespace mav_type
+
+namespace autopilot {  // MAV_AUTOPILOT
+inline constexpr uint8_t GENERIC = 0;
+inline constexpr uint8_t ARDUPILOTMEGA = 3;
+inline constexpr uint8_t INVALID = 8;  ///< not an autopilot (GCS, companion computer)
+inline constexpr uint8_t PX4 = 12;
+}  // namespace autopilot
+
+namespace mode_flag {  // MAV_MODE_FLAG
+inline constexpr uint8_t CUSTOM_MODE_ENABLED = 1;
+inline constexpr uint8_t SAFETY_ARMED = 128;
+}  // namespace mode_flag
+
+namespace landed {  // MAV_LANDED_STATE
+inline constexpr uint8_t UNDEFINED = 0;
+inline constexpr uint8_t ON_GROUND = 1;
+inline constexpr uint8_t IN_AIR = 2;
+inline constexpr uint8_t TAKEOFF = 3;
+inline constexpr uint8_t LANDING = 4;
+}  // namespace landed
+
+namespace state {  // MAV_STATE
+inline constexpr uint8_t STANDBY = 3;
+inline constexpr uint8_t ACTIVE = 4;
+}  // namespace state
+
+namespace comp {  // MAV_COMPONENT
+inline constexpr uint8_t AUTOPILOT1 = 1;
+inline constexpr uint8_t ONBOARD_COMPUTER = 191;
+}  // namespace comp
+
+/// POSITION_TARGET_TYPEMASK for "position only": velocity, acceleration, yaw and yaw rate
+/// ignored (bits 3-8, 10, 11).
+inline constexpr uint16_t kPositionOnlyMask = 0x0DF8;
+inline constexpr uint8_t kFrameLocalNed = 1;  ///< MAV_FRAME_LOCAL_NED
+
+/// "MAV_RESULT_DENIED (denied)" and so on; an unknown value as its number.
+std::string result_text(uint8_t mav_result);
+/// "MAV_CMD_NAV_TAKEOFF" for the commands above, else "MAV_CMD 1234".
+std::string command_name(uint16_t command);
+
+}  // namespace eamos::mavlink

@@ -1,0 +1,190 @@
+#include "mavlink/link.h"
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netdb.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+namespace eamos::mavlink {
+
+namespace {
+
+std::string sys_error(const std::string& what) { return what + ": " + std::strerror(errno); }
+
+/// Resolves an IPv4 address; "" means every local address.
+bool resolve(const std::string& host, uint16_t port, sockaddr_in& out, std::string& error) {
+  out = {};
+  out.sin_family = AF_INET;
+  out.sin_port = htons(port);
+  if (host.empty()) {
+    out.sin_addr.s_addr = htonl(INADDR_ANY);
+    return true;
+  }
+  if (inet_pton(AF_INET, host.c_str(), &out.sin_addr) == 1) return true;
+  addrinfo hints{};
+  hints.ai_family = AF_INET;
+  addrinfo* found = nullptr;
+  if (int rc = getaddrinfo(host.c_str(), nullptr, &hints, &found); rc != 0 || !found) {
+    error = "cannot resolve host '" + host + "': " + gai_strerror(rc);
+    return false;
+  }
+  out.sin_addr = reinterpret_cast<sockaddr_in*>(found->ai_addr)->sin_addr;
+  freeaddrinfo(found);
+  return true;
+}
+
+/// Connects with a bound wait, so an unreachable autopilot is an error, not a hang.
+bool connect_within(int fd, const sockaddr_in& to, int timeout_ms, std::string& error) {
+  int flags = fcntl(fd, F_GETFL, 0);
+  fcntl(fd, F_SETFL, flags | O_NONBLOCK);
+  int rc = connect(fd, reinterpret_cast<const sockaddr*>(&to), sizeof to);
+  if (rc != 0 && errno != EINPROGRESS) {
+    error = sys_error("connect");
+    return false;
+  }
+  if (rc != 0) {
+    pollfd p{fd, POLLOUT, 0};
+    if (poll(&p, 1, timeout_ms) != 1) {
+      error = "connect: no answer within " + std::to_string(timeout_ms / 1000) + " s";
+      return false;
+    }
+    int so_error = 0;
+    socklen_t len = sizeof so_error;
+    getsockopt(fd, SOL_SOCKET, SO_ERROR, &so_error, &len);
+    if (so_error != 0) {
+      error = std::string("connect: ") + std::strerror(so_error);
+      return false;
+    }
+  }
+  fcntl(fd, F_SETFL, flags);
+  return true;
+}
+
+}  // namespace
+
+OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame) {
+  auto fail = [&](const std::string& why) {
+    return OpenResult{nullptr, "connection '" + endpoint.url + "': " + why};
+  };
+  sockaddr_in addr{};
+  std::string error;
+  if (!resolve(endpoint.host, endpoint.port, addr, error)) return fail(error);
+
+  bool tcp = endpoint.kind == LinkKind::tcp_client;
+  int fd = socket(AF_INET, tcp ? SOCK_STREAM : SOCK_DGRAM, 0);
+  if (fd < 0) return fail(sys_error("socket"));
+  if (endpoint.kind == LinkKind::udp_listen) {
+    // No SO_REUSEADDR: on Linux it would let a second program share the port and steal
+    // half of the vehicle's datagrams; a clear "in use" error is better.
+    if (bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+      error = sys_error("bind to port " + std::to_string(endpoint.port));
+      close(fd);
+      return fail(error + " (is another program listening there?)");
+    }
+  } else if (endpoint.kind == LinkKind::udp_out) {
+    sockaddr_in any{};
+    any.sin_family = AF_INET;  // port 0: an ephemeral port, where the replies come back
+    if (bind(fd, reinterpret_cast<sockaddr*>(&any), sizeof any) != 0) {
+      error = sys_error("bind");
+      close(fd);
+      return fail(error);
+    }
+  } else if (!connect_within(fd, addr, 5000, error)) {
+    close(fd);
+    return fail(error + " (is the autopilot or SITL serving TCP there?)");
+  }
+  int pipe_fds[2];
+  if (pipe(pipe_fds) != 0) {
+    close(fd);
+    return fail(sys_error("pipe"));
+  }
+  std::unique_ptr<Link> link(new Link(endpoint, fd, pipe_fds[0], pipe_fds[1], std::move(on_frame)));
+  if (endpoint.kind != LinkKind::udp_listen) {
+    link->peer_ = addr;
+    link->has_peer_ = true;
+  }
+  link->thread_ = std::thread([l = link.get()] { l->receive_loop(); });
+  return {std::move(link), ""};
+}
+
+Link::Link(Endpoint endpoint, int fd, int wake_read, int wake_write, FrameHandler on_frame)
+    : endpoint_(std::move(endpoint)),
+      fd_(fd),
+      wake_read_(wake_read),
+      wake_write_(wake_write),
+      on_frame_(std::move(on_frame)) {
+  sockaddr_in local{};
+  socklen_t len = sizeof local;
+  if (getsockname(fd_, reinterpret_cast<sockaddr*>(&local), &len) == 0)
+    local_port_ = ntohs(local.sin_port);
+}
+
+Link::~Link() {
+  if (thread_.joinable()) {
+    char byte = 1;
+    [[maybe_unused]] ssize_t n = write(wake_write_, &byte, 1);
+    thread_.join();
+  }
+  for (int fd : {fd_, wake_read_, wake_write_})
+    if (fd >= 0) close(fd);
+}
+
+bool Link::send(std::span<const uint8_t> bytes) {
+  std::lock_guard lock(mutex_);
+  if (!has_peer_ || closed_) return false;
+  ssize_t n = endpoint_.kind == LinkKind::tcp_client
+                  ? ::send(fd_, bytes.data(), bytes.size(), MSG_NOSIGNAL)
+                  : sendto(fd_, bytes.data(), bytes.size(), 0,
+                           reinterpret_cast<const sockaddr*>(&peer_), sizeof peer_);
+  return n == static_cast<ssize_t>(bytes.size());
+}
+
+ParserStats Link::stats() const {
+  std::lock_guard lock(mutex_);
+  return stats_;
+}
+
+void Link::receive_loop() {
+  std::vector<uint8_t> buffer(65536);
+  for (;;) {
+    pollfd fds[2] = {{fd_, POLLIN, 0}, {wake_read_, POLLIN, 0}};
+    if (poll(fds, 2, -1) < 0) {
+      if (errno == EINTR) continue;
+      return;
+    }
+    if (fds[1].revents != 0) return;  // the destructor wants us gone
+    if (fds[0].revents == 0) continue;
+    sockaddr_in from{};
+    socklen_t from_len = sizeof from;
+    ssize_t n = recvfrom(fd_, buffer.data(), buffer.size(), 0,
+                         reinterpret_cast<sockaddr*>(&from), &from_len);
+    if (n <= 0) {
+      if (endpoint_.kind != LinkKind::tcp_client) continue;  // UDP: e.g. ICMP port unreachable
+      std::lock_guard lock(mutex_);
+      closed_ = true;  // the TCP peer hung up; heartbeats stop and the adapter notices
+      return;
+    }
+    if (endpoint_.kind == LinkKind::udp_listen) {
+      std::lock_guard lock(mutex_);
+      peer_ = from;  // reply to whoever spoke last, as PX4's offboard link expects
+      has_peer_ = true;
+    }
+    handle_bytes(std::span(buffer.data(), static_cast<size_t>(n)));
+  }
+}
+
+void Link::handle_bytes(std::span<const uint8_t> bytes) {
+  std::vector<Frame> frames = parser_.feed(bytes);
+  {
+    std::lock_guard lock(mutex_);
+    stats_ = parser_.stats();
+  }
+  for (Frame& f : frames) on_frame_(std::move(f));
+}
+
+}  // namespace eamos::mavlink

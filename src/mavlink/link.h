@@ -1,0 +1,69 @@
+#pragma once
+// A MAVLink connection over UDP or TCP (url.h) with its own receive thread. The thread reads
+// bytes, runs them through the Parser and hands each good frame to the FrameHandler — on the
+// link's thread, so the handler must only pass the frame on (the adapter posts it to its event
+// loop) and never touch state the loop's thread owns. send() may be called from any thread.
+#include <netinet/in.h>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <span>
+#include <string>
+#include <thread>
+
+#include "mavlink/frame.h"
+#include "mavlink/url.h"
+
+namespace eamos::mavlink {
+
+using FrameHandler = std::function<void(Frame)>;
+
+struct OpenResult;
+
+class Link {
+ public:
+  /// Opens the socket (binds, or connects for TCP) and starts the receive thread.
+  static OpenResult open(const Endpoint& endpoint, FrameHandler on_frame);
+  /// Stops and joins the receive thread, then closes the socket: after it returns the
+  /// handler is never called again.
+  ~Link();
+  Link(const Link&) = delete;
+  Link& operator=(const Link&) = delete;
+
+  /// Sends one encoded frame. False when there is nobody to send to yet (udp:// before the
+  /// first datagram arrived), or the socket failed (a closed TCP connection).
+  bool send(std::span<const uint8_t> bytes);
+  /// The local UDP/TCP port (useful when udpout:// picked an ephemeral one).
+  uint16_t local_port() const { return local_port_; }
+  const Endpoint& endpoint() const { return endpoint_; }
+  /// Parser counters so far (garbage, bad CRCs), copied under the lock.
+  ParserStats stats() const;
+
+ private:
+  Link(Endpoint endpoint, int fd, int wake_read, int wake_write, FrameHandler on_frame);
+  void receive_loop();
+  void handle_bytes(std::span<const uint8_t> bytes);
+
+  Endpoint endpoint_;
+  int fd_ = -1;
+  int wake_read_ = -1;   ///< self-pipe: the destructor writes to wake the receive thread
+  int wake_write_ = -1;
+  uint16_t local_port_ = 0;
+  FrameHandler on_frame_;
+  Parser parser_;               ///< only the receive thread feeds it
+  mutable std::mutex mutex_;    ///< guards peer_ and stats_
+  sockaddr_in peer_{};          ///< the last sender (udp://) or the target (udpout://)
+  bool has_peer_ = false;
+  bool closed_ = false;         ///< TCP: the peer closed the connection
+  ParserStats stats_;
+  std::thread thread_;
+};
+
+struct OpenResult {
+  std::unique_ptr<Link> link;  ///< set on success
+  std::string error;           ///< why it could not be opened, with the URL
+};
+
+}  // namespace eamos::mavlink

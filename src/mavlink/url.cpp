@@ -1,0 +1,47 @@
+#include "mavlink/url.h"
+
+#include <charconv>
+
+namespace eamos::mavlink {
+
+namespace {
+
+const char* kExamples = "udp://:14540, udpout://127.0.0.1:14550 or tcp://127.0.0.1:5760";
+
+EndpointResult bad(std::string_view url, const std::string& why) {
+  return {std::nullopt, "connection '" + std::string(url) + "': " + why + " (examples: " +
+                            kExamples + ")"};
+}
+
+}  // namespace
+
+EndpointResult parse_url(std::string_view url) {
+  size_t sep = url.find("://");
+  if (sep == std::string_view::npos) return bad(url, "no scheme; start with udp://, udpout:// or tcp://");
+  std::string_view scheme = url.substr(0, sep);
+  std::string_view rest = url.substr(sep + 3);
+  Endpoint e;
+  e.url = std::string(url);
+  if (scheme == "udp") e.kind = LinkKind::udp_listen;
+  else if (scheme == "udpout") e.kind = LinkKind::udp_out;
+  else if (scheme == "tcp") e.kind = LinkKind::tcp_client;
+  else return bad(url, "unknown scheme '" + std::string(scheme) + "'; use udp, udpout or tcp");
+
+  size_t colon = rest.rfind(':');
+  if (colon == std::string_view::npos) return bad(url, "no port; write HOST:PORT or :PORT");
+  e.host = std::string(rest.substr(0, colon));
+  std::string_view port = rest.substr(colon + 1);
+  unsigned value = 0;
+  auto [end, ec] = std::from_chars(port.data(), port.data() + port.size(), value);
+  if (port.empty() || ec != std::errc() || end != port.data() + port.size() || value < 1 ||
+      value > 65535)
+    return bad(url, "port '" + std::string(port) + "' is not a number from 1 to 65535");
+  e.port = static_cast<uint16_t>(value);
+  if (e.host.empty() && e.kind != LinkKind::udp_listen)
+    return bad(url, std::string(scheme) + " needs the peer's host, e.g. 127.0.0.1:" + std::string(port));
+  if (e.host.find('/') != std::string::npos || e.host.find('?') != std::string::npos)
+    return bad(url, "unexpected path or query after the host");
+  return {e, ""};
+}
+
+}  // namespace eamos::mavlink

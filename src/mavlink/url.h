@@ -1,0 +1,32 @@
+#pragma once
+// Where a MAVLink peer is, written the way MAVSDK and mavproxy write it:
+//   udp://[HOST]:PORT        listen on PORT (HOST: the local address, default every one) and
+//                            reply to whoever sent last — how PX4 SITL reaches an offboard
+//                            program on 14540 + instance
+//   udpout://HOST:PORT       send to HOST:PORT from an ephemeral port, read the replies there
+//   tcp://HOST:PORT          connect to a TCP server (ArduPilot SITL serves 5760 + 10·instance)
+// Parsing is separate from opening so a fleet file's URL is checked before any socket exists.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace eamos::mavlink {
+
+enum class LinkKind { udp_listen, udp_out, tcp_client };
+
+struct Endpoint {
+  LinkKind kind = LinkKind::udp_listen;
+  std::string host;    ///< numeric IPv4 address or host name; "" = every local address (listen)
+  uint16_t port = 0;   ///< 1…65535
+  std::string url;     ///< as written, for messages
+};
+
+struct EndpointResult {
+  std::optional<Endpoint> endpoint;  ///< set when the URL is valid
+  std::string error;                 ///< what is wrong and what a valid URL looks like
+};
+
+EndpointResult parse_url(std::string_view url);
+
+}  // namespace eamos::mavlink

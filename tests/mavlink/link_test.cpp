@@ -1,0 +1,80 @@
+// Links carry frames both ways over loopback sockets; handlers run on the link's thread, so
+// the tests hand frames over through a small mailbox and wait for them with a deadline.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <vector>
+
+#include "mavlink/link.h"
+#include "mavlink/payloads.h"
+
+namespace eamos::mavlink {
+namespace {
+
+struct Mailbox {
+  std::mutex m;
+  std::condition_variable cv;
+  std::vector<Frame> frames;
+
+  FrameHandler handler() {
+    return [this](Frame f) {
+      std::lock_guard lock(m);
+      frames.push_back(std::move(f));
+      cv.notify_all();
+    };
+  }
+  /// Waits until `n` frames arrived; the deadline only guards against a broken link.
+  bool wait_for(size_t n) {
+    std::unique_lock lock(m);
+    return cv.wait_for(lock, std::chrono::seconds(5), [&] { return frames.size() >= n; });
+  }
+};
+
+Endpoint endpoint(const std::string& url) { return *parse_url(url).endpoint; }
+
+TEST(UdpLink, ListenerRepliesToTheLastSender) {
+  Mailbox vehicle_side, adapter_side;
+  OpenResult listen = Link::open(endpoint("udp://127.0.0.1:25301"), adapter_side.handler());
+  ASSERT_TRUE(listen.link) << listen.error;
+  OpenResult out = Link::open(endpoint("udpout://127.0.0.1:25301"), vehicle_side.handler());
+  ASSERT_TRUE(out.link) << out.error;
+
+  Heartbeat hb;
+  hb.custom_mode = 42;
+  EXPECT_FALSE(listen.link->send(Encoder{}.encode(pack(hb))));  // nobody has spoken yet
+  Encoder vehicle{7, 1};
+  ASSERT_TRUE(out.link->send(vehicle.encode(pack(hb))));
+  ASSERT_TRUE(adapter_side.wait_for(1));
+  EXPECT_EQ(adapter_side.frames[0].sysid, 7);
+  EXPECT_EQ(unpack_heartbeat(adapter_side.frames[0].message)->custom_mode, 42u);
+
+  Encoder adapter{7, 191};
+  ASSERT_TRUE(listen.link->send(adapter.encode(pack(CommandAck{400, 0}))));
+  ASSERT_TRUE(vehicle_side.wait_for(1));
+  EXPECT_EQ(vehicle_side.frames[0].compid, 191);
+  EXPECT_EQ(unpack_command_ack(vehicle_side.frames[0].message)->command, 400);
+}
+
+TEST(UdpLink, PortInUseIsAClearError) {
+  Mailbox a;
+  OpenResult first = Link::open(endpoint("udp://127.0.0.1:25302"), a.handler());
+  ASSERT_TRUE(first.link);
+  // Two adapters on one port would each see half of the vehicle's datagrams.
+  OpenResult second = Link::open(endpoint("udp://127.0.0.1:25302"), a.handler());
+  EXPECT_FALSE(second.link);
+  EXPECT_NE(second.error.find("udp://127.0.0.1:25302"), std::string::npos) << second.error;
+  EXPECT_NE(second.error.find("bind"), std::string::npos) << second.error;
+}
+
+TEST(TcpLink, RefusedConnectionNamesTheUrl) {
+  Mailbox a;
+  OpenResult r = Link::open(endpoint("tcp://127.0.0.1:25303"), a.handler());
+  EXPECT_FALSE(r.link);
+  EXPECT_NE(r.error.find("tcp://127.0.0.1:25303"), std::string::npos) << r.error;
+  EXPECT_NE(r.error.find("refused"), std::string::npos) << r.error;
+}
+
+}  // namespace
+}  // namespace eamos::mavlink

@@ -1,0 +1,42 @@
+// Connection URLs are checked before any socket is opened, with errors that show valid ones.
+#include <gtest/gtest.h>
+
+#include "mavlink/url.h"
+
+namespace eamos::mavlink {
+namespace {
+
+TEST(ConnectionUrl, UdpWithoutHostListensOnEveryAddress) {
+  EndpointResult r = parse_url("udp://:14540");
+  ASSERT_TRUE(r.endpoint) << r.error;
+  EXPECT_EQ(r.endpoint->kind, LinkKind::udp_listen);
+  EXPECT_EQ(r.endpoint->host, "");
+  EXPECT_EQ(r.endpoint->port, 14540);
+}
+
+TEST(ConnectionUrl, UdpoutAndTcpNameThePeer) {
+  EndpointResult out = parse_url("udpout://127.0.0.1:14550");
+  ASSERT_TRUE(out.endpoint);
+  EXPECT_EQ(out.endpoint->kind, LinkKind::udp_out);
+  EXPECT_EQ(out.endpoint->host, "127.0.0.1");
+  EndpointResult tcp = parse_url("tcp://localhost:5760");
+  ASSERT_TRUE(tcp.endpoint);
+  EXPECT_EQ(tcp.endpoint->kind, LinkKind::tcp_client);
+  EXPECT_EQ(tcp.endpoint->port, 5760);
+}
+
+TEST(ConnectionUrl, ErrorsSayWhatIsWrongAndShowExamples) {
+  EXPECT_NE(parse_url("14540").error.find("no scheme"), std::string::npos);
+  EXPECT_NE(parse_url("serial:///dev/ttyUSB0").error.find("unknown scheme 'serial'"), std::string::npos);
+  EXPECT_NE(parse_url("udp://:0").error.find("from 1 to 65535"), std::string::npos);
+  EXPECT_NE(parse_url("udp://:70000").error.find("from 1 to 65535"), std::string::npos);
+  EXPECT_NE(parse_url("udp://:14x").error.find("'14x'"), std::string::npos);
+  EXPECT_NE(parse_url("tcp://:5760").error.find("needs the peer's host"), std::string::npos);
+  EXPECT_NE(parse_url("udp://localhost").error.find("no port"), std::string::npos);
+  EXPECT_NE(parse_url("udp://:1").error, "x");  // valid: no error text at all
+  EXPECT_EQ(parse_url("udp://:1").error, "");
+  EXPECT_NE(parse_url("tcp://").error.find("udpout://127.0.0.1:14550"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace eamos::mavlink
