@@ -1,5 +1,6 @@
 #include "mid/event_loop.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <thread>
@@ -65,23 +66,53 @@ std::size_t EventLoop::run_until(double t) {
 std::size_t EventLoop::run(double limit, bool bounded) {
   stop_requested_ = false;
   start_wall_anchor();
+  bool real = options_.mode == ClockMode::real_time;
   std::size_t ran = 0;
-  while (!queue_.empty() && !stop_requested_) {
+  while (!stop_requested_) {
+    take_posted();
+    while (!queue_.empty() && callbacks_.count(queue_.top().seq) == 0) queue_.pop();  // cancelled
+    // A real-time run bounded by `limit` waits for posted input until then, even when no
+    // timer is due: that is how a DEX idles between messages.
+    if (queue_.empty() || (bounded && queue_.top().time > limit)) {
+      if (bounded && real && !wait_for(limit)) continue;
+      break;
+    }
     Entry next = queue_.top();
-    if (bounded && next.time > limit) break;
+    if (!wait_for(next.time)) continue;
     queue_.pop();
     auto it = callbacks_.find(next.seq);
-    if (it == callbacks_.end()) continue;  // cancelled
+    if (it == callbacks_.end()) continue;
     // Take the callback out first: it may schedule or cancel timers, rehashing the map.
     std::function<void()> fn = std::move(it->second);
     callbacks_.erase(it);
-    wait_for(next.time);
     now_ = next.time;
     fn();
     ++ran;
     ++events_run_;
   }
   return ran;
+}
+
+void EventLoop::post(std::function<void()> fn) {
+  {
+    std::lock_guard<std::mutex> lock(post_mutex_);
+    posted_.push_back(std::move(fn));
+  }
+  post_cv_.notify_one();
+}
+
+bool EventLoop::take_posted() {
+  std::vector<std::function<void()>> taken;
+  {
+    std::lock_guard<std::mutex> lock(post_mutex_);
+    taken.swap(posted_);
+  }
+  if (taken.empty()) return false;
+  double t = now_;
+  if (options_.mode == ClockMode::real_time)
+    t = std::max(now_, mission_anchor_ + (options_.wall->now_s() - wall_anchor_) * options_.speed);
+  for (auto& fn : taken) at(t, std::move(fn));
+  return true;
 }
 
 void EventLoop::start_wall_anchor() {
@@ -92,10 +123,18 @@ void EventLoop::start_wall_anchor() {
   mission_anchor_ = now_;
 }
 
-void EventLoop::wait_for(double t) {
-  if (options_.mode != ClockMode::real_time) return;
+bool EventLoop::wait_for(double t) {
+  if (options_.mode != ClockMode::real_time) return true;
   double wall = wall_anchor_ + (t - mission_anchor_) / options_.speed;
-  if (wall > options_.wall->now_s()) options_.wall->sleep_until_s(wall);
+  if (!(wall > options_.wall->now_s())) return true;
+  if (options_.wall != &system_wall_clock()) {
+    options_.wall->sleep_until_s(wall);  // a test's fake clock: nothing posts meanwhile
+    return true;
+  }
+  using namespace std::chrono;
+  auto deadline = steady_clock::time_point(duration_cast<steady_clock::duration>(duration<double>(wall)));
+  std::unique_lock<std::mutex> lock(post_mutex_);
+  return !post_cv_.wait_until(lock, deadline, [this] { return !posted_.empty(); });
 }
 
 }  // namespace eamos::mid

@@ -5,7 +5,9 @@
 // event, so a 60 s mission takes as long as its callbacks; real time (the CLI's
 // --realtime/--speed) sleeps until each event's wall time.
 #include <cstdint>
+#include <condition_variable>
 #include <functional>
+#include <mutex>
 #include <queue>
 #include <unordered_map>
 #include <vector>
@@ -70,6 +72,12 @@ class EventLoop {
   /// Makes the running run_until_idle/run_until return after the current callback.
   void stop() { stop_requested_ = true; }
 
+  /// The one thread-safe call: runs `fn` on the loop's thread as soon as the loop gets to
+  /// it, at the mission time of that moment. I/O threads (a DDS listener, a MAVLink socket
+  /// reader) hand their input over this way, so adapter and engine state is only ever
+  /// touched by the loop's thread. A real-time loop waiting for its next timer wakes up.
+  void post(std::function<void()> fn);
+
   /// Callbacks run since construction (a cost measure: idle drones must not add to it).
   std::uint64_t events_run() const { return events_run_; }
 
@@ -84,7 +92,11 @@ class EventLoop {
 
   std::size_t run(double limit, bool bounded);
   void start_wall_anchor();
-  void wait_for(double t);
+  /// Real time: waits until the wall time of mission time `t`; false when a post() came
+  /// first (the caller runs the posted callbacks and looks again).
+  bool wait_for(double t);
+  /// Moves posted callbacks into the queue at the current mission time; true if any.
+  bool take_posted();
 
   ClockOptions options_;
   double now_ = 0.0;
@@ -94,6 +106,9 @@ class EventLoop {
   /// Cancelled timers stay in the heap and are skipped when popped: cancel is O(1).
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue_;
   std::unordered_map<TimerId, std::function<void()>> callbacks_;
+  std::mutex post_mutex_;
+  std::condition_variable post_cv_;
+  std::vector<std::function<void()>> posted_;  ///< guarded by post_mutex_
   double wall_anchor_ = 0.0;     ///< real time: wall time at which mission time ...
   double mission_anchor_ = 0.0;  ///< ... was this
 };

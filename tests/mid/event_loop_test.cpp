@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace eamos::mid {
@@ -156,6 +157,25 @@ TEST(EventLoop, VirtualTimeNeverTouchesTheWallClock) {
   loop.run_until(7200.0);
   EXPECT_TRUE(wall.sleeps.empty());
   EXPECT_DOUBLE_EQ(loop.now(), 7200.0);
+}
+
+TEST(EventLoop, PostedCallbackRunsOnTheLoopAtTheCurrentTime) {
+  EventLoop loop;
+  std::vector<double> at;
+  loop.at(2.0, [&] { loop.post([&] { at.push_back(loop.now()); }); });
+  loop.at(5.0, [&] { at.push_back(loop.now()); });
+  loop.run_until_idle();
+  EXPECT_EQ(at, (std::vector<double>{2.0, 5.0}));
+}
+
+TEST(EventLoop, PostFromAnotherThreadWakesAWaitingRealTimeLoop) {
+  EventLoop loop({ClockMode::real_time, 1.0, nullptr});
+  bool ran = false;
+  std::thread io([&] { loop.post([&] { ran = true; loop.stop(); }); });
+  loop.run_until(3600.0);  // would wait an hour of wall time without the wake-up
+  io.join();
+  EXPECT_TRUE(ran);
+  EXPECT_LT(loop.now(), 3600.0);
 }
 
 }  // namespace
