@@ -1,0 +1,31 @@
+#include "mavlink_adapter/adapter.h"
+
+#include <memory>
+
+#include "mavlink/url.h"
+
+namespace eamos::mavlink_adapter {
+
+void register_adapter(mid::AdapterRegistry& registry, MavlinkOptions options) {
+  registry.register_adapter(
+      kAdapterName,
+      [options](const fleet::DroneSettings& settings, const fleet::DroneType& type,
+                mid::EventLoop& loop) -> mid::CreateResult {
+        auto failed = [&](const std::string& why) {
+          return mid::CreateResult{mid::CreateStatus::adapter_failed, nullptr,
+                                   "drone '" + settings.name + "': " + why};
+        };
+        if (!options.real_time)
+          return failed("the mavlink adapter flies real vehicles, which cannot follow virtual "
+                        "time: run with --realtime (or --speed 1)");
+        if (settings.connection.empty())
+          return failed("no `connection:` in the fleet file, e.g. connection: udp://:14540");
+        mavlink::EndpointResult url = mavlink::parse_url(settings.connection);
+        if (!url.endpoint) return failed(url.error);
+        auto drone = std::make_unique<MavlinkDrone>(settings, type, loop, options);
+        if (std::string error = drone->connect(*url.endpoint); !error.empty()) return failed(error);
+        return {mid::CreateStatus::success, std::move(drone), ""};
+      });
+}
+
+}  // namespace eamos::mavlink_adapter

@@ -1,0 +1,51 @@
+#pragma once
+// What differs between PX4 and ArduPilot, in one row per autopilot, so the adapter's logic
+// never asks "which autopilot is this?". The row is chosen from the vehicle's first
+// HEARTBEAT (its `autopilot` field).
+#include <array>
+#include <cstdint>
+#include <string>
+
+namespace eamos::mavlink_adapter {
+
+struct Autopilot {
+  const char* name;              ///< "PX4", "ArduPilot": for messages
+  uint8_t mav_autopilot;         ///< HEARTBEAT.autopilot value that selects this row
+  uint32_t setpoint_mode;        ///< custom_mode in which position setpoints are flown
+  const char* setpoint_mode_name;  ///< "OFFBOARD" (PX4), "GUIDED" (ArduPilot)
+  /// PX4 refuses OFFBOARD unless setpoints already stream (and leaves it when they stop).
+  bool stream_before_switch;
+  /// ArduPilot Copter takes off only in GUIDED; PX4 switches to AUTO.TAKEOFF by itself.
+  bool takeoff_in_setpoint_mode;
+  /// MAV_CMD_NAV_TAKEOFF param7: PX4 reads metres above mean sea level, ArduPilot metres
+  /// above home.
+  bool takeoff_altitude_amsl;
+  /// PX4 packs custom_mode as main mode << 16 | sub mode << 24 and DO_SET_MODE takes them
+  /// as param2/param3; ArduPilot's custom_mode is the mode number, DO_SET_MODE param2.
+  bool main_sub_modes;
+};
+
+/// The row for a HEARTBEAT.autopilot value; nullptr for autopilots we do not fly.
+const Autopilot* autopilot_for(uint8_t mav_autopilot);
+
+/// DO_SET_MODE param1…param3 that select `custom_mode`.
+std::array<float, 3> set_mode_params(const Autopilot& a, uint32_t custom_mode);
+
+/// A flight mode in words, e.g. "OFFBOARD", "AUTO.LOITER", "GUIDED", or its number.
+std::string mode_name(const Autopilot& a, uint32_t custom_mode);
+
+/// PX4's custom_mode values, also used by the simulated vehicle.
+namespace px4 {
+inline constexpr uint32_t mode(uint8_t main, uint8_t sub = 0) {
+  return uint32_t(main) << 16 | uint32_t(sub) << 24;
+}
+inline constexpr uint8_t MAIN_POSCTL = 3, MAIN_AUTO = 4, MAIN_OFFBOARD = 6;
+inline constexpr uint8_t AUTO_TAKEOFF = 2, AUTO_LOITER = 3, AUTO_RTL = 5, AUTO_LAND = 6;
+inline constexpr uint32_t OFFBOARD = mode(MAIN_OFFBOARD);
+inline constexpr uint32_t LOITER = mode(MAIN_AUTO, AUTO_LOITER);
+inline constexpr uint32_t TAKEOFF = mode(MAIN_AUTO, AUTO_TAKEOFF);
+inline constexpr uint32_t LAND = mode(MAIN_AUTO, AUTO_LAND);
+inline constexpr uint32_t RTL = mode(MAIN_AUTO, AUTO_RTL);
+}  // namespace px4
+
+}  // namespace eamos::mavlink_adapter

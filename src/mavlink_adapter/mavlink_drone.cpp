@@ -1,0 +1,327 @@
+// The uniform actions in MAVLink terms: what is refused here, what is a command, what is
+// flown with setpoints. Telemetry, the link and the setpoint stream are in
+// mavlink_drone_link.cpp.
+#include "mavlink_adapter/mavlink_drone.h"
+
+#include <cstdio>
+
+#include "mavlink/enums.h"
+#include "mid/requests.h"
+#include "mid/timeouts.h"
+#include "mid/vec.h"
+
+namespace eamos::mavlink_adapter {
+
+namespace ml = eamos::mavlink;
+using fleet::Vec3;
+using mid::ActionId;
+using mid::Outcome;
+
+namespace {
+std::string metres(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f m", v);
+  return buf;
+}
+}  // namespace
+
+MavlinkDrone::MavlinkDrone(fleet::DroneSettings settings, fleet::DroneType type,
+                           mid::EventLoop& loop, MavlinkOptions options)
+    : settings_(std::move(settings)),
+      type_(std::move(type)),
+      loop_(loop),
+      options_(options),
+      commands_(loop, [this](const ml::Message& m) { send(m); }, options.commands),
+      tracker_(loop, [this](ActionId id) { stop_action(id); }) {}
+
+MavlinkDrone::~MavlinkDrone() {
+  link_.reset();  // joins the receive thread: nothing new gets posted
+  for (auto& [id, timer] : action_timers_) loop_.cancel(timer);
+  for (mid::TimerId t : {stream_timer_, heartbeat_timer_, watchdog_timer_}) loop_.cancel(t);
+}
+
+// --- starting actions ----------------------------------------------------------------------
+
+ActionId MavlinkDrone::start(const mid::ActionRequest& request, mid::EndCallback on_end) {
+  if (!failsafe_reason_.empty())
+    return tracker_.refuse(request, std::move(on_end), "failsafe active (" + failsafe_reason_ + ")");
+  if (link_lost_)
+    return tracker_.refuse(request, std::move(on_end),
+                           "link lost: no HEARTBEAT from system " + std::to_string(sysid_));
+  mid::RequestCheck check = mid::check_request(request, type_);
+  if (!check.spec) return tracker_.refuse(request, std::move(on_end), check.error);
+  if (std::string why = refusal(request, *check.spec); !why.empty())
+    return tracker_.refuse(request, std::move(on_end), why);
+
+  double timeout = mid::action_timeout(request, position(), settings_);
+  fleet::ActionClass cls = check.spec->action_class;
+  if (cls == fleet::ActionClass::motion) clear_action_timer(tracker_.motion());  // preempted
+  ActionId id = tracker_.begin(request, cls, std::move(on_end), timeout);
+  switch (cls) {
+    case fleet::ActionClass::system: start_system(id, request); break;
+    case fleet::ActionClass::payload: start_payload(id, request); break;
+    case fleet::ActionClass::motion: start_motion(id, request); break;
+  }
+  return id;
+}
+
+std::string MavlinkDrone::refusal(const mid::ActionRequest& r, const fleet::ActionSpec& spec) const {
+  // Only what the uniform rules demand and an autopilot would not check the same way;
+  // everything else (Arm preconditions, Takeoff while disarmed) the autopilot judges, and its
+  // MAV_RESULT becomes the reason.
+  const auto& a = r.args;
+  bool landed = vehicle_.landed();
+  if (r.name == "Disarm") {
+    if (!landed) return "in the air at z = " + metres(position().z) + ": land before disarming";
+    if (tracker_.motion() != mid::kNoAction)
+      return tracker_.request(tracker_.motion())->name + " is running: cannot disarm";
+  }
+  if (spec.action_class != fleet::ActionClass::motion) return "";
+  if (r.name == "Takeoff") {
+    if (a[0] <= 0.0) return "takeoff altitude must be positive, got " + metres(a[0]);
+    if (a[0] > settings_.limits.max_altitude_m)
+      return "takeoff altitude " + metres(a[0]) + " is above max_altitude " +
+             metres(settings_.limits.max_altitude_m);
+    return "";
+  }
+  if (!vehicle_.armed) return "disarmed: arm before " + r.name;
+  if (r.name == "Land") return "";
+  if (landed) return "on the ground: take off before " + r.name;
+  if (r.name == "Orbit" && a.size() == 1 && a[0] <= 0.0)
+    return "orbit radius must be positive, got " + metres(a[0]);
+  if (r.name == "Hover" && a.size() == 1 && a[0] < 0.0) return "hover duration must not be negative";
+  if (r.name == "ReturnHome") return "";
+  if (auto goal = mid::goal_position(r, position(), settings_.home)) {
+    if (goal->z <= ground_z())
+      return "target z = " + metres(goal->z) + " is not above the ground (z = " +
+             metres(ground_z()) + "); use Land to land";
+    if (goal->z > ground_z() + settings_.limits.max_altitude_m)
+      return "target z = " + metres(goal->z) + " is above max_altitude " +
+             metres(settings_.limits.max_altitude_m) + " over the ground";
+  }
+  return "";
+}
+
+void MavlinkDrone::start_system(ActionId id, const mid::ActionRequest& r) {
+  bool arm = r.name == "Arm";
+  commands_.send(command(ml::cmd::COMPONENT_ARM_DISARM, {arm ? 1.0f : 0.0f}),
+                 [this, id, arm](const CommandResult& result) {
+                   if (!tracker_.running(id)) return;
+                   if (!result.accepted) {
+                     tracker_.end(id, Outcome::failed, "refused by the autopilot: " + result.error);
+                     return;
+                   }
+                   vehicle_.armed = arm;  // the next HEARTBEAT confirms it
+                   publish();
+                   tracker_.end(id, Outcome::succeeded);
+                 });
+}
+
+void MavlinkDrone::start_payload(ActionId id, const mid::ActionRequest& r) {
+  if (r.name == "TakePicture") {
+    // param3 = 1: one image; the autopilot forwards it to its camera.
+    commands_.send(command(ml::cmd::IMAGE_START_CAPTURE, {0, 0, 1}),
+                   [this, id](const CommandResult& result) {
+                     if (!tracker_.running(id)) return;
+                     if (!result.accepted) {
+                       tracker_.end(id, Outcome::failed, "no picture: " + result.error);
+                       return;
+                     }
+                     ++pictures_;
+                     publish();
+                     tracker_.end(id, Outcome::succeeded);
+                   });
+    return;
+  }
+  int k = fleet::sensor_index(r.name, type_.sensors);
+  action_timers_[id] = loop_.after(0.1, [this, id, k] {
+    action_timers_.erase(id);
+    tracker_.end(id, Outcome::succeeded, "", sensor_value(k));
+  });
+}
+
+void MavlinkDrone::start_motion(ActionId id, const mid::ActionRequest& r) {
+  motion_owner_ = id;
+  orbit_ = {};
+  goal_.reset();
+  until_ = Until::forever;
+  const Vec3 here = position();
+  if (r.name == "Takeoff") return start_takeoff(id, r.args[0]);
+  if (r.name == "Land" || r.name == "ReturnHome") {
+    if (r.name == "Land" && vehicle_.landed()) {
+      motion_owner_ = mid::kNoAction;
+      tracker_.end(id, Outcome::succeeded);
+      return;
+    }
+    until_ = Until::landed;
+    return command_motion(id, r.name == "Land" ? ml::cmd::NAV_LAND : ml::cmd::NAV_RETURN_TO_LAUNCH);
+  }
+  if (auto goal = mid::goal_position(r, here, settings_.home)) {
+    goal_.emplace(*goal, options_.tolerance);
+    until_ = Until::reached;
+    setpoint_ = *goal;
+    stream_setpoints();
+    return;
+  }
+  setpoint_ = here;
+  if (r.name == "Orbit") {
+    orbit_ = {true, here, r.args.empty() ? 5.0 : r.args[0], 0.0, false};
+    stream_setpoints();
+    return;
+  }
+  stream_setpoints();  // Hover: hold where it is; Hover(s) ends after s seconds
+  if (r.args.size() == 1) {
+    action_timers_[id] = loop_.after(r.args[0], [this, id] {
+      action_timers_.erase(id);
+      if (motion_owner_ == id) motion_owner_ = mid::kNoAction;
+      tracker_.end(id, Outcome::succeeded);
+    });
+  }
+}
+
+void MavlinkDrone::start_takeoff(ActionId id, double altitude) {
+  const Vec3 here = position();
+  goal_.emplace(Vec3{here.x, here.y, ground_z() + altitude}, options_.tolerance);
+  until_ = Until::reached;
+  std::array<float, 7> p{};
+  p[4] = p[5] = NAN;  // latitude, longitude: where it stands
+  p[6] = static_cast<float>(altitude);
+  if (autopilot_->takeoff_altitude_amsl) {
+    if (!vehicle_.have_altitude) {
+      motion_owner_ = mid::kNoAction;
+      tracker_.end(id, Outcome::failed,
+                   std::string("no GLOBAL_POSITION_INT from the vehicle yet: ") + autopilot_->name +
+                       " takes off to an altitude above mean sea level");
+      return;
+    }
+    p[6] = static_cast<float>(vehicle_.amsl_m - vehicle_.relative_alt_m + altitude);
+  }
+  if (!autopilot_->takeoff_in_setpoint_mode || vehicle_.custom_mode == autopilot_->setpoint_mode)
+    return command_motion(id, ml::cmd::NAV_TAKEOFF, p);
+  auto params = set_mode_params(*autopilot_, autopilot_->setpoint_mode);
+  commands_.send(command(ml::cmd::DO_SET_MODE, {params[0], params[1], params[2]}),
+                 [this, id, p](const CommandResult& result) {
+                   if (!tracker_.running(id)) return;
+                   if (!result.accepted) return end_refused(id, result);
+                   command_motion(id, ml::cmd::NAV_TAKEOFF, p);
+                 });
+}
+
+void MavlinkDrone::command_motion(ActionId id, uint16_t cmd, std::array<float, 7> params) {
+  commands_.send(command(cmd, params), [this, id](const CommandResult& result) {
+    if (!tracker_.running(id)) return;
+    if (!result.accepted) return end_refused(id, result);
+    // The autopilot flies this one in its own mode: stop the setpoints only now, so a
+    // refused command leaves the vehicle doing what it did.
+    streaming_ = false;
+    in_control_ = false;
+    check_goal();
+  });
+}
+
+void MavlinkDrone::end_refused(ActionId id, const CommandResult& result) {
+  if (motion_owner_ == id) {
+    motion_owner_ = mid::kNoAction;
+    goal_.reset();
+  }
+  tracker_.end(id, Outcome::failed, std::string("refused by ") + autopilot_->name + ": " + result.error);
+}
+
+// --- stopping ------------------------------------------------------------------------------
+
+bool MavlinkDrone::cancel(ActionId id) {
+  if (!tracker_.running(id)) return false;
+  stop_action(id);
+  tracker_.end(id, Outcome::cancelled, "cancelled");
+  return true;
+}
+
+void MavlinkDrone::stop_action(ActionId id) {
+  clear_action_timer(id);
+  if (id != motion_owner_) return;
+  motion_owner_ = mid::kNoAction;
+  goal_.reset();
+  orbit_ = {};
+  hold_here();
+}
+
+void MavlinkDrone::clear_action_timer(ActionId id) {
+  auto it = action_timers_.find(id);
+  if (it == action_timers_.end()) return;
+  loop_.cancel(it->second);
+  action_timers_.erase(it);
+}
+
+void MavlinkDrone::hold_here() {
+  if (vehicle_.landed() || !vehicle_.armed) {
+    streaming_ = false;
+    return;
+  }
+  setpoint_ = position();
+  stream_setpoints();
+}
+
+void MavlinkDrone::fail_all(const std::string& reason) {
+  for (ActionId id : tracker_.running_ids()) {
+    clear_action_timer(id);
+    tracker_.end(id, Outcome::failed, reason);
+  }
+  motion_owner_ = mid::kNoAction;
+  goal_.reset();
+  orbit_ = {};
+}
+
+void MavlinkDrone::failsafe(fleet::Failsafe what) {
+  failsafe_reason_ = std::string("failsafe: ") + fleet::failsafe_name(what);
+  for (ActionId id : tracker_.running_ids()) {
+    stop_action(id);
+    tracker_.end(id, Outcome::cancelled, failsafe_reason_);
+  }
+  if (vehicle_.landed()) {
+    streaming_ = false;
+    if (vehicle_.armed) commands_.send(command(ml::cmd::COMPONENT_ARM_DISARM, {0.0f}), nullptr);
+    return;
+  }
+  if (what == fleet::Failsafe::hover) return hold_here();
+  uint16_t cmd = what == fleet::Failsafe::land ? ml::cmd::NAV_LAND : ml::cmd::NAV_RETURN_TO_LAUNCH;
+  commands_.send(command(cmd), [this](const CommandResult& result) {
+    if (result.accepted) streaming_ = false;  // refused: keep holding where it is
+  });
+}
+
+// --- properties ----------------------------------------------------------------------------
+
+Vec3 MavlinkDrone::position() const {
+  return vehicle_.have_position ? ned_to_mission(vehicle_.ned, settings_.home) : settings_.home;
+}
+
+double MavlinkDrone::sensor_value(int k) const {
+  auto it = settings_.sensors.find("Sensor" + std::to_string(k));
+  if (it == settings_.sensors.end()) return 0.0;
+  return it->second.base + dot(it->second.gradient, position());
+}
+
+mid::DroneState MavlinkDrone::state() const {
+  mid::DroneState s;
+  s.t = loop_.now();
+  Vec3 p = position();
+  s.x = p.x;
+  s.y = p.y;
+  s.z = p.z;
+  s.battery = vehicle_.battery >= 0 ? vehicle_.battery : settings_.battery_percent;
+  s.armed = vehicle_.armed;
+  s.landed = vehicle_.landed();
+  for (int k = 1; k <= type_.sensors; ++k) s.sensors["Sensor" + std::to_string(k)] = sensor_value(k);
+  s.pictures = pictures_;
+  return s;
+}
+
+mid::SubscriptionId MavlinkDrone::subscribe(mid::StateCallback fn) {
+  return broker_.subscribe(std::move(fn));
+}
+
+void MavlinkDrone::publish() {
+  if (!broker_.empty()) broker_.publish(state());
+}
+
+}  // namespace eamos::mavlink_adapter

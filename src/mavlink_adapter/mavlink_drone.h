@@ -1,0 +1,150 @@
+#pragma once
+// A vehicle flown over MAVLink behind the uniform drone API. The adapter is an onboard
+// controller on the vehicle's system (component 191): it sends its own HEARTBEAT at 1 Hz,
+// asks for the telemetry it needs with SET_MESSAGE_INTERVAL, and flies
+//   Arm/Disarm      MAV_CMD_COMPONENT_ARM_DISARM
+//   Takeoff         MAV_CMD_NAV_TAKEOFF (ArduPilot: after switching to GUIDED)
+//   Land            MAV_CMD_NAV_LAND, done when EXTENDED_SYS_STATE says on ground
+//   ReturnHome      MAV_CMD_NAV_RETURN_TO_LAUNCH, done when on ground
+//   FlyTo, FlyBy*   position setpoints (SET_POSITION_TARGET_LOCAL_NED) in OFFBOARD/GUIDED
+//   Hover           a position setpoint where the drone is
+//   Orbit           setpoints moving around the circle, computed here (ArduPilot Copter has
+//                   no DO_ORBIT, and PX4's needs a global position, so one way for both)
+//   TakePicture     MAV_CMD_IMAGE_START_CAPTURE to the autopilot
+//   SensorK         the fleet file's sensor model at the drone's position (MAVLink has no
+//                   standard "mission sensor"; a real payload needs its own adapter code)
+// Every frame arrives on the link's thread and is posted to the event loop, so all state
+// here is touched by the loop's thread only. No HEARTBEAT for `link_timeout_s` = link lost:
+// the running actions end `failed` and new ones are refused until heartbeats return.
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "mavlink/link.h"
+#include "mavlink_adapter/autopilot.h"
+#include "mavlink_adapter/command_sender.h"
+#include "mavlink_adapter/telemetry.h"
+#include "mid/action_tracker.h"
+#include "mid/drone_api.h"
+#include "mid/location_validator.h"
+#include "mid/state_broker.h"
+
+namespace eamos::mavlink_adapter {
+
+struct MavlinkOptions {
+  bool real_time = false;          ///< the loop runs in real time: required (a real vehicle
+                                   ///< cannot follow virtual time)
+  double connect_timeout_s = 10.0; ///< wall seconds to wait for the vehicle's first HEARTBEAT
+  double link_timeout_s = 3.0;     ///< mission seconds without a HEARTBEAT = link lost
+  CommandOptions commands;
+  double setpoint_hz = 10.0;       ///< setpoint stream rate (PX4 needs > 2 Hz in OFFBOARD)
+  int setpoints_before_switch = 5; ///< PX4: setpoints sent before asking for OFFBOARD
+  double position_hz = 10.0;       ///< LOCAL_POSITION_NED rate asked for
+  mid::Tolerance tolerance;        ///< when a goal counts as reached
+};
+
+class MavlinkDrone final : public mid::Drone {
+ public:
+  MavlinkDrone(fleet::DroneSettings settings, fleet::DroneType type, mid::EventLoop& loop,
+               MavlinkOptions options);
+  ~MavlinkDrone() override;
+
+  /// Opens the link and waits (blocking, up to connect_timeout_s) for the vehicle's first
+  /// HEARTBEAT; "" on success, else what went wrong and what to check.
+  std::string connect(const mavlink::Endpoint& endpoint);
+
+  const std::string& name() const override { return settings_.name; }
+  mid::ActionId start(const mid::ActionRequest& request, mid::EndCallback on_end) override;
+  bool cancel(mid::ActionId id) override;
+  mid::DroneState state() const override;
+  mid::SubscriptionId subscribe(mid::StateCallback fn) override;
+  void unsubscribe(mid::SubscriptionId id) override { broker_.unsubscribe(id); }
+  void failsafe(fleet::Failsafe what) override;
+
+  /// The autopilot row chosen from the first HEARTBEAT; nullptr before connect().
+  const Autopilot* autopilot() const { return autopilot_; }
+  bool link_lost() const { return link_lost_; }
+
+ private:
+  enum class Until { reached, landed, forever };
+  struct Orbit {
+    bool active = false;
+    fleet::Vec3 centre;
+    double radius = 0.0;
+    double angle = 0.0;     ///< rad from east, counter-clockwise
+    bool on_circle = false;
+  };
+
+  // actions (mavlink_drone.cpp)
+  std::string refusal(const mid::ActionRequest& r, const fleet::ActionSpec& spec) const;
+  void start_system(mid::ActionId id, const mid::ActionRequest& r);
+  void start_payload(mid::ActionId id, const mid::ActionRequest& r);
+  void start_motion(mid::ActionId id, const mid::ActionRequest& r);
+  void start_takeoff(mid::ActionId id, double altitude);
+  void command_motion(mid::ActionId id, uint16_t cmd, std::array<float, 7> params = {});
+  void end_refused(mid::ActionId id, const CommandResult& result);
+  void stop_action(mid::ActionId id);
+  void clear_action_timer(mid::ActionId id);
+  void hold_here();
+  void fail_all(const std::string& reason);
+
+  // link, telemetry, setpoints (mavlink_drone_link.cpp)
+  void on_frame(const mavlink::Frame& frame);
+  void on_heartbeat();
+  void link_watchdog();
+  void lose_link();
+  void request_telemetry();
+  void check_goal();
+  void send(const mavlink::Message& m);
+  void send_heartbeat();
+  mavlink::CommandLong command(uint16_t id, std::array<float, 7> params = {}) const;
+  void stream_setpoints();
+  void stream_tick();
+  void advance_orbit(double dt);
+  void switch_to_setpoint_mode();
+  void publish();
+  fleet::Vec3 position() const;
+  double ground_z() const { return settings_.home.z; }
+  double sensor_value(int k) const;
+
+  fleet::DroneSettings settings_;
+  fleet::DroneType type_;
+  mid::EventLoop& loop_;
+  MavlinkOptions options_;
+  const Autopilot* autopilot_ = nullptr;
+  uint8_t sysid_ = 0;  ///< the vehicle's system id (0 until known)
+
+  /// Posted frames hold a weak pointer to this: a frame that reaches the loop after the
+  /// drone is gone is dropped instead of touching freed memory.
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+  std::unique_ptr<mavlink::Link> link_;
+  mavlink::Encoder encoder_;
+  CommandSender commands_;
+  mid::ActionTracker tracker_;
+  mid::StateBroker broker_;
+  VehicleState vehicle_;
+  bool link_lost_ = false;
+  bool telemetry_requested_ = false;
+  std::string failsafe_reason_;  ///< "" = none; else why new actions are refused
+  int pictures_ = 0;
+
+  // the motion the adapter flies for an action
+  mid::ActionId motion_owner_ = mid::kNoAction;
+  Until until_ = Until::forever;
+  std::optional<mid::LocationValidator> goal_;
+  bool streaming_ = false;        ///< setpoints are the vehicle's control (else: its own modes)
+  bool in_control_ = false;       ///< the vehicle entered the setpoint mode for our stream; if
+                                  ///< it leaves it (a pilot, a failsafe), we do not fight it
+  fleet::Vec3 setpoint_;          ///< mission frame
+  Orbit orbit_;
+  int setpoints_sent_ = 0;
+  bool mode_switch_pending_ = false;
+
+  std::map<mid::ActionId, mid::TimerId> action_timers_;  ///< Hover(s), SensorK
+  mid::TimerId stream_timer_ = mid::kNoTimer;
+  mid::TimerId heartbeat_timer_ = mid::kNoTimer;
+  mid::TimerId watchdog_timer_ = mid::kNoTimer;
+};
+
+}  // namespace eamos::mavlink_adapter

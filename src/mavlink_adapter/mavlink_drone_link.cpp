@@ -1,0 +1,263 @@
+// The MavlinkDrone's side of the wire: connecting, frames from the link, heartbeats both
+// ways, link loss, telemetry requests, goal checks and the setpoint stream.
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <mutex>
+
+#include "mavlink/enums.h"
+#include "mavlink_adapter/mavlink_drone.h"
+#include "mid/vec.h"
+
+namespace eamos::mavlink_adapter {
+
+namespace ml = eamos::mavlink;
+using fleet::Vec3;
+using mid::ActionId;
+using mid::Outcome;
+
+namespace {
+
+/// The first autopilot HEARTBEAT, handed from the link's thread to connect().
+struct FirstHeartbeat {
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool heard = false;
+  uint8_t sysid = 0;
+  uint8_t autopilot = 0;
+};
+
+}  // namespace
+
+std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
+  auto first = std::make_shared<FirstHeartbeat>();
+  const uint8_t wanted = static_cast<uint8_t>(settings_.sysid);
+  std::weak_ptr<bool> alive = alive_;
+  mid::EventLoop* loop = &loop_;
+  // Runs on the link's thread: it may only note the first heartbeat and post the frame.
+  auto handler = [this, first, wanted, alive, loop](ml::Frame frame) {
+    if (auto hb = ml::unpack_heartbeat(frame.message);
+        hb && hb->autopilot != ml::autopilot::INVALID && (wanted == 0 || frame.sysid == wanted)) {
+      std::lock_guard lock(first->mutex);
+      if (!first->heard) {
+        first->heard = true;
+        first->sysid = frame.sysid;
+        first->autopilot = hb->autopilot;
+      }
+      first->cv.notify_all();
+    }
+    loop->post([this, alive, frame = std::move(frame)] {
+      if (alive.lock()) this->on_frame(frame);
+    });
+  };
+  ml::OpenResult opened = ml::Link::open(endpoint, handler);
+  if (!opened.link) return opened.error;
+  link_ = std::move(opened.link);
+
+  std::unique_lock lock(first->mutex);
+  auto wait = std::chrono::duration<double>(options_.connect_timeout_s);
+  if (!first->cv.wait_for(lock, wait, [&] { return first->heard; })) {
+    lock.unlock();
+    link_.reset();
+    char text[64];
+    std::snprintf(text, sizeof text, "%.0f s", options_.connect_timeout_s);
+    std::string who = wanted ? "system " + std::to_string(wanted) : std::string("any autopilot");
+    return "no HEARTBEAT from " + who + " on " + endpoint.url + " within " + text +
+           "; is the vehicle (or its SITL) running and sending to this address, with this system id?";
+  }
+  sysid_ = first->sysid;
+  autopilot_ = autopilot_for(first->autopilot);
+  if (!autopilot_) {
+    link_.reset();
+    return "system " + std::to_string(sysid_) + " on " + endpoint.url + " reports MAV_AUTOPILOT " +
+           std::to_string(first->autopilot) + "; the mavlink adapter flies PX4 (12) and ArduPilot (3)";
+  }
+  lock.unlock();
+  encoder_ = {sysid_, ml::comp::ONBOARD_COMPUTER, 0};
+  send_heartbeat();
+  link_watchdog();
+  return "";
+}
+
+// --- frames --------------------------------------------------------------------------------
+
+void MavlinkDrone::on_frame(const ml::Frame& frame) {
+  if (frame.sysid != sysid_) return;  // another vehicle (or a GCS) on the same port
+  if (auto ack = ml::unpack_command_ack(frame.message)) return commands_.on_ack(*ack);
+  if (auto hb = ml::unpack_heartbeat(frame.message); hb && hb->autopilot == ml::autopilot::INVALID)
+    return;  // a camera, gimbal or companion of the same system: not the autopilot
+  Changes c = apply_telemetry(vehicle_, frame);
+  if (c.heartbeat) on_heartbeat();
+  if (c.landed && vehicle_.landed()) {
+    streaming_ = false;  // on the ground: nothing to hold
+    in_control_ = false;
+  }
+  if (c.position || c.landed) check_goal();
+  if (c.position || c.armed || c.landed) publish();
+}
+
+void MavlinkDrone::on_heartbeat() {
+  link_lost_ = false;
+  link_watchdog();
+  if (!telemetry_requested_) request_telemetry();
+  if (streaming_ && in_control_ && !mode_switch_pending_ &&
+      vehicle_.custom_mode != autopilot_->setpoint_mode) {
+    // Someone else (a pilot's switch, the autopilot's own failsafe) took the vehicle out of
+    // the setpoint mode: give way instead of switching back.
+    streaming_ = false;
+    in_control_ = false;
+    if (motion_owner_ != mid::kNoAction) {
+      ActionId id = motion_owner_;
+      motion_owner_ = mid::kNoAction;
+      goal_.reset();
+      orbit_ = {};
+      tracker_.end(id, Outcome::failed,
+                   std::string("the vehicle left ") + autopilot_->setpoint_mode_name + " for " +
+                       mode_name(*autopilot_, vehicle_.custom_mode));
+    }
+  }
+}
+
+void MavlinkDrone::link_watchdog() {
+  loop_.cancel(watchdog_timer_);
+  watchdog_timer_ = loop_.after(options_.link_timeout_s, [this] {
+    watchdog_timer_ = mid::kNoTimer;
+    lose_link();
+  });
+}
+
+void MavlinkDrone::lose_link() {
+  link_lost_ = true;
+  streaming_ = false;
+  in_control_ = false;
+  char text[128];
+  std::snprintf(text, sizeof text, "link lost: no HEARTBEAT from system %d for %.1f s", sysid_,
+                options_.link_timeout_s);
+  fail_all(text);
+  commands_.fail_all("link lost");
+}
+
+void MavlinkDrone::request_telemetry() {
+  telemetry_requested_ = true;
+  struct Rate { uint32_t id; double hz; };
+  for (Rate r : {Rate{ml::msg::LOCAL_POSITION_NED, options_.position_hz},
+                 Rate{ml::msg::EXTENDED_SYS_STATE, 2.0}, Rate{ml::msg::GLOBAL_POSITION_INT, 2.0},
+                 Rate{ml::msg::SYS_STATUS, 1.0}, Rate{ml::msg::BATTERY_STATUS, 1.0}}) {
+    // An autopilot that refuses a rate still streams its defaults: nothing to do about it.
+    commands_.send(command(ml::cmd::SET_MESSAGE_INTERVAL,
+                           {static_cast<float>(r.id), static_cast<float>(1e6 / r.hz)}),
+                   nullptr);
+  }
+}
+
+void MavlinkDrone::check_goal() {
+  if (motion_owner_ == mid::kNoAction || !tracker_.running(motion_owner_)) return;
+  bool done = false;
+  if (until_ == Until::reached) done = goal_ && vehicle_.have_position && goal_->reached(position());
+  if (until_ == Until::landed) done = vehicle_.landed();
+  if (!done) return;
+  ActionId id = motion_owner_;
+  motion_owner_ = mid::kNoAction;
+  goal_.reset();
+  tracker_.end(id, Outcome::succeeded);  // setpoints, if any, keep holding the goal
+}
+
+// --- sending -------------------------------------------------------------------------------
+
+void MavlinkDrone::send(const ml::Message& m) {
+  if (link_) link_->send(encoder_.encode(m));
+}
+
+void MavlinkDrone::send_heartbeat() {
+  ml::Heartbeat hb;
+  hb.type = ml::mav_type::ONBOARD_CONTROLLER;
+  hb.autopilot = ml::autopilot::INVALID;
+  hb.system_status = ml::state::ACTIVE;
+  send(ml::pack(hb));
+  heartbeat_timer_ = loop_.after(1.0, [this] { send_heartbeat(); });
+}
+
+ml::CommandLong MavlinkDrone::command(uint16_t id, std::array<float, 7> params) const {
+  ml::CommandLong c;
+  c.target_system = sysid_;
+  c.target_component = ml::comp::AUTOPILOT1;
+  c.command = id;
+  c.param = params;
+  return c;
+}
+
+// --- setpoints -----------------------------------------------------------------------------
+
+void MavlinkDrone::stream_setpoints() {
+  streaming_ = true;
+  if (stream_timer_ != mid::kNoTimer) return;
+  setpoints_sent_ = 0;
+  stream_tick();
+}
+
+void MavlinkDrone::stream_tick() {
+  stream_timer_ = mid::kNoTimer;
+  if (!streaming_ || link_lost_) return;
+  const double dt = 1.0 / options_.setpoint_hz;
+  if (orbit_.active) advance_orbit(dt);
+  ml::SetPositionTargetLocalNed sp;
+  sp.time_boot_ms = static_cast<uint32_t>(loop_.now() * 1000.0);
+  sp.target_system = sysid_;
+  sp.target_component = ml::comp::AUTOPILOT1;
+  sp.coordinate_frame = ml::kFrameLocalNed;
+  sp.type_mask = ml::kPositionOnlyMask;
+  Vec3 ned = mission_to_ned(setpoint_, settings_.home);
+  sp.x = static_cast<float>(ned.x);
+  sp.y = static_cast<float>(ned.y);
+  sp.z = static_cast<float>(ned.z);
+  send(ml::pack(sp));
+  ++setpoints_sent_;
+  if (!in_control_ && !mode_switch_pending_ &&
+      (!autopilot_->stream_before_switch || setpoints_sent_ >= options_.setpoints_before_switch))
+    switch_to_setpoint_mode();
+  stream_timer_ = loop_.after(dt, [this] { stream_tick(); });
+}
+
+void MavlinkDrone::switch_to_setpoint_mode() {
+  if (vehicle_.custom_mode == autopilot_->setpoint_mode) {
+    in_control_ = true;
+    return;
+  }
+  mode_switch_pending_ = true;
+  auto p = set_mode_params(*autopilot_, autopilot_->setpoint_mode);
+  commands_.send(command(ml::cmd::DO_SET_MODE, {p[0], p[1], p[2]}), [this](const CommandResult& r) {
+    mode_switch_pending_ = false;
+    if (r.accepted) {
+      in_control_ = true;
+      vehicle_.custom_mode = autopilot_->setpoint_mode;  // until the next HEARTBEAT says otherwise
+      return;
+    }
+    streaming_ = false;
+    if (motion_owner_ == mid::kNoAction) return;
+    ActionId id = motion_owner_;
+    motion_owner_ = mid::kNoAction;
+    goal_.reset();
+    orbit_ = {};
+    tracker_.end(id, Outcome::failed,
+                 std::string("switch to ") + autopilot_->setpoint_mode_name + " refused by " +
+                     autopilot_->name + ": " + r.error);
+  });
+}
+
+void MavlinkDrone::advance_orbit(double dt) {
+  const double r = orbit_.radius;
+  if (!orbit_.on_circle) {
+    // Out to the circle's east point first, like the simulator, then around it.
+    setpoint_ = {orbit_.centre.x + r, orbit_.centre.y, orbit_.centre.z};
+    if (horizontal_norm(position() - setpoint_) <= options_.tolerance.horizontal_m) orbit_.on_circle = true;
+    return;
+  }
+  const fleet::Limits& l = settings_.limits;
+  double speed = std::min(l.max_speed_mps, std::sqrt(0.8 * l.max_accel_mps2 * r));
+  orbit_.angle = std::fmod(orbit_.angle + speed * dt / r, 2.0 * M_PI);
+  setpoint_ = {orbit_.centre.x + r * std::cos(orbit_.angle),
+               orbit_.centre.y + r * std::sin(orbit_.angle), orbit_.centre.z};
+}
+
+}  // namespace eamos::mavlink_adapter

@@ -1,0 +1,54 @@
+#include "mavlink_adapter/telemetry.h"
+
+#include "mavlink/enums.h"
+#include "mavlink/payloads.h"
+
+namespace eamos::mavlink_adapter {
+
+namespace ml = eamos::mavlink;
+
+bool VehicleState::landed() const {
+  if (landed_state == ml::landed::UNDEFINED) return !armed;
+  return landed_state == ml::landed::ON_GROUND;
+}
+
+Changes apply_telemetry(VehicleState& v, const ml::Frame& frame) {
+  Changes c;
+  const ml::Message& m = frame.message;
+  bool was_landed = v.landed();
+  if (auto hb = ml::unpack_heartbeat(m)) {
+    c.heartbeat = true;
+    v.heard = true;
+    v.autopilot = hb->autopilot;
+    v.custom_mode = hb->custom_mode;
+    bool armed = (hb->base_mode & ml::mode_flag::SAFETY_ARMED) != 0;
+    c.armed = armed != v.armed;
+    v.armed = armed;
+  } else if (auto p = ml::unpack_local_position_ned(m)) {
+    c.position = true;
+    v.have_position = true;
+    v.ned = {p->x, p->y, p->z};
+  } else if (auto e = ml::unpack_extended_sys_state(m)) {
+    v.landed_state = e->landed_state;
+  } else if (auto s = ml::unpack_sys_status(m)) {
+    if (s->battery_remaining >= 0) v.battery = s->battery_remaining;
+  } else if (auto b = ml::unpack_battery_status(m)) {
+    if (b->battery_remaining >= 0) v.battery = b->battery_remaining;
+  } else if (auto g = ml::unpack_global_position_int(m)) {
+    v.have_altitude = true;
+    v.amsl_m = g->alt / 1000.0;
+    v.relative_alt_m = g->relative_alt / 1000.0;
+  }
+  c.landed = v.landed() != was_landed;
+  return c;
+}
+
+fleet::Vec3 ned_to_mission(fleet::Vec3 ned, fleet::Vec3 home) {
+  return {home.x + ned.y, home.y + ned.x, home.z - ned.z};
+}
+
+fleet::Vec3 mission_to_ned(fleet::Vec3 p, fleet::Vec3 home) {
+  return {p.y - home.y, p.x - home.x, home.z - p.z};
+}
+
+}  // namespace eamos::mavlink_adapter
