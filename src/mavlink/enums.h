@@ -68,6 +68,20 @@ inline constexpr uint8_t ONBOARD_COMPUTER = 191;
 inline constexpr uint16_t kPositionOnlyMask = 0x0DF8;
 inline constexpr uint8_t kFrameLocalNed = 1;  ///< MAV_FRAME_LOCAL_NED
 
+/// PX4's custom_mode: main mode << 16 | sub mode << 24 (PX4's px4_custom_mode.h).
+namespace px4 {
+inline constexpr uint32_t mode(uint8_t main, uint8_t sub = 0) {
+  return uint32_t(main) << 16 | uint32_t(sub) << 24;
+}
+inline constexpr uint8_t MAIN_POSCTL = 3, MAIN_AUTO = 4, MAIN_OFFBOARD = 6;
+inline constexpr uint8_t AUTO_TAKEOFF = 2, AUTO_LOITER = 3, AUTO_RTL = 5, AUTO_LAND = 6;
+inline constexpr uint32_t OFFBOARD = mode(MAIN_OFFBOARD);
+inline constexpr uint32_t LOITER = mode(MAIN_AUTO, AUTO_LOITER);
+inline constexpr uint32_t TAKEOFF = mode(MAIN_AUTO, AUTO_TAKEOFF);
+inline constexpr uint32_t LAND = mode(MAIN_AUTO, AUTO_LAND);
+inline constexpr uint32_t RTL = mode(MAIN_AUTO, AUTO_RTL);
+}  // namespace px4
+
 /// "MAV_RESULT_DENIED (denied)" and so on; an unknown value as its number.
 std::string result_text(uint8_t mav_result);
 /// "MAV_CMD_NAV_TAKEOFF" for the commands above, else "MAV_CMD 1234".

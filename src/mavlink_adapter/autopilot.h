@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <string>
 
+#include "mavlink/enums.h"
+
 namespace eamos::mavlink_adapter {
 
 struct Autopilot {
@@ -34,18 +36,6 @@ std::array<float, 3> set_mode_params(const Autopilot& a, uint32_t custom_mode);
 /// A flight mode in words, e.g. "OFFBOARD", "AUTO.LOITER", "GUIDED", or its number.
 std::string mode_name(const Autopilot& a, uint32_t custom_mode);
 
-/// PX4's custom_mode values, also used by the simulated vehicle.
-namespace px4 {
-inline constexpr uint32_t mode(uint8_t main, uint8_t sub = 0) {
-  return uint32_t(main) << 16 | uint32_t(sub) << 24;
-}
-inline constexpr uint8_t MAIN_POSCTL = 3, MAIN_AUTO = 4, MAIN_OFFBOARD = 6;
-inline constexpr uint8_t AUTO_TAKEOFF = 2, AUTO_LOITER = 3, AUTO_RTL = 5, AUTO_LAND = 6;
-inline constexpr uint32_t OFFBOARD = mode(MAIN_OFFBOARD);
-inline constexpr uint32_t LOITER = mode(MAIN_AUTO, AUTO_LOITER);
-inline constexpr uint32_t TAKEOFF = mode(MAIN_AUTO, AUTO_TAKEOFF);
-inline constexpr uint32_t LAND = mode(MAIN_AUTO, AUTO_LAND);
-inline constexpr uint32_t RTL = mode(MAIN_AUTO, AUTO_RTL);
-}  // namespace px4
+namespace px4 = mavlink::px4;
 
 }  // namespace eamos::mavlink_adapter

@@ -188,10 +188,13 @@ void MavlinkDrone::start_takeoff(ActionId id, double altitude) {
   p[6] = static_cast<float>(altitude);
   if (autopilot_->takeoff_altitude_amsl) {
     if (!vehicle_.have_altitude) {
-      motion_owner_ = mid::kNoAction;
-      tracker_.end(id, Outcome::failed,
-                   std::string("no GLOBAL_POSITION_INT from the vehicle yet: ") + autopilot_->name +
-                       " takes off to an altitude above mean sea level");
+      // PX4 takes off to an altitude above mean sea level, which GLOBAL_POSITION_INT tells;
+      // right after connecting it may not have come yet. Ask again shortly; the action's
+      // timeout bounds the wait.
+      action_timers_[id] = loop_.after(0.1, [this, id, altitude] {
+        action_timers_.erase(id);
+        if (motion_owner_ == id && tracker_.running(id)) start_takeoff(id, altitude);
+      });
       return;
     }
     p[6] = static_cast<float>(vehicle_.amsl_m - vehicle_.relative_alt_m + altitude);

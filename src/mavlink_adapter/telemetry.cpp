@@ -8,7 +8,8 @@ namespace eamos::mavlink_adapter {
 namespace ml = eamos::mavlink;
 
 bool VehicleState::landed() const {
-  if (landed_state == ml::landed::UNDEFINED) return !armed;
+  // Without EXTENDED_SYS_STATE: disarmed, or less than 0.3 m above the local origin.
+  if (landed_state == ml::landed::UNDEFINED) return !armed || !have_position || -ned.z < 0.3;
   return landed_state == ml::landed::ON_GROUND;
 }
 

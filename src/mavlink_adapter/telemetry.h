@@ -24,7 +24,8 @@ struct VehicleState {
   double amsl_m = 0.0;            ///< altitude above mean sea level
   double relative_alt_m = 0.0;    ///< altitude above home
 
-  /// On the ground: EXTENDED_SYS_STATE says so, or (without it) the vehicle is disarmed.
+  /// On the ground: EXTENDED_SYS_STATE says so; without it, disarmed or within 0.3 m of
+  /// the local origin's height.
   bool landed() const;
 };
 

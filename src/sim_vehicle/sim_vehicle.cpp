@@ -1,0 +1,279 @@
+#include "sim_vehicle/sim_vehicle.h"
+
+#include <cmath>
+#include <limits>
+
+#include "mavlink/enums.h"
+#include "mid/vec.h"
+
+namespace eamos::sim_vehicle {
+
+namespace ml = eamos::mavlink;
+namespace px4 = eamos::mavlink::px4;
+using fleet::Vec3;
+
+namespace {
+
+fleet::DroneSettings vehicle_settings(uint8_t sysid) {
+  fleet::DroneSettings s;
+  s.name = "sim-vehicle-" + std::to_string(sysid);
+  s.type = "Quad";
+  return s;  // home at the origin: the local NED origin is home, as on a real vehicle
+}
+
+// PX4 SITL's default home, so GLOBAL_POSITION_INT looks like a real one.
+constexpr double kHomeLat = 47.397742, kHomeLon = 8.545594;
+constexpr double kMetresPerDegree = 111'111.0;
+
+const uint32_t kStreamed[] = {ml::msg::LOCAL_POSITION_NED, ml::msg::EXTENDED_SYS_STATE,
+                              ml::msg::SYS_STATUS, ml::msg::BATTERY_STATUS,
+                              ml::msg::GLOBAL_POSITION_INT};
+
+}  // namespace
+
+SimVehicle::SimVehicle(mid::EventLoop& loop, VehicleOptions options)
+    : loop_(loop),
+      options_(options),
+      drone_(vehicle_settings(options.sysid), fleet::generic_multirotor("Quad"), loop),
+      encoder_{options.sysid, ml::comp::AUTOPILOT1, 0},
+      mode_(px4::LOITER) {}
+
+SimVehicle::~SimVehicle() {
+  link_.reset();
+  for (auto& [id, timer] : streams_) loop_.cancel(timer);
+  loop_.cancel(offboard_timer_);
+  loop_.cancel(disarm_timer_);
+}
+
+std::string SimVehicle::open(const ml::Endpoint& endpoint) {
+  std::weak_ptr<bool> alive = alive_;
+  mid::EventLoop* loop = &loop_;
+  ml::OpenResult opened = ml::Link::open(endpoint, [this, alive, loop](ml::Frame f) {
+    loop->post([this, alive, f = std::move(f)] {
+      if (alive.lock()) on_frame(f);
+    });
+  });
+  if (!opened.link) return opened.error;
+  link_ = std::move(opened.link);
+  send_stream(ml::msg::HEARTBEAT);
+  rates_hz_[ml::msg::HEARTBEAT] = 1.0;
+  for (uint32_t id : kStreamed) set_rate(id, options_.default_rate_hz);
+  return "";
+}
+
+// --- input ---------------------------------------------------------------------------------
+
+void SimVehicle::on_frame(const ml::Frame& frame) {
+  if (auto c = ml::unpack_command_long(frame.message)) return on_command(*c);
+  if (auto sp = ml::unpack_set_position_target_local_ned(frame.message)) return on_setpoint(*sp);
+}
+
+void SimVehicle::on_command(const ml::CommandLong& c) {
+  if (c.target_system != options_.sysid && c.target_system != 0) return;
+  // A resend means our ACK was lost: answer again, but do not arm or take off twice.
+  if (c.confirmation > 0 && has_last_ && last_command_ == c.command) return ack(c.command, last_result_);
+  uint8_t result = execute(c);
+  last_command_ = c.command;
+  last_result_ = result;
+  has_last_ = true;
+  ack(c.command, result);
+}
+
+uint8_t SimVehicle::execute(const ml::CommandLong& c) {
+  mid::DroneState s = drone_.state();
+  switch (c.command) {
+    case ml::cmd::COMPONENT_ARM_DISARM: {
+      bool arm = c.param[0] > 0.5f;
+      if (!arm && !s.landed) return ml::result::DENIED;
+      if (arm && s.battery <= 0.0) return ml::result::DENIED;
+      loop_.cancel(disarm_timer_);
+      start(arm ? "Arm" : "Disarm", {});
+      return ml::result::ACCEPTED;
+    }
+    case ml::cmd::NAV_TAKEOFF: {
+      if (!s.armed || !s.landed) return ml::result::DENIED;
+      double alt = std::isnan(c.param[6]) ? 2.5 : c.param[6] - options_.home_amsl_m;
+      if (!(alt > 0.0) || alt > 120.0) return ml::result::DENIED;
+      mode_ = px4::TAKEOFF;
+      start("Takeoff", {alt}, px4::LOITER);
+      return ml::result::ACCEPTED;
+    }
+    case ml::cmd::NAV_LAND: return set_mode(px4::LAND);
+    case ml::cmd::NAV_RETURN_TO_LAUNCH: return set_mode(px4::RTL);
+    case ml::cmd::DO_SET_MODE:
+      return set_mode(px4::mode(static_cast<uint8_t>(c.param[1]), static_cast<uint8_t>(c.param[2])));
+    case ml::cmd::SET_MESSAGE_INTERVAL: {
+      auto id = static_cast<uint32_t>(c.param[0]);
+      bool known = false;
+      for (uint32_t m : kStreamed) known = known || m == id;
+      if (!known) return ml::result::DENIED;
+      double us = c.param[1];
+      set_rate(id, us < 0 ? 0.0 : us == 0 ? options_.default_rate_hz : 1e6 / us);
+      return ml::result::ACCEPTED;
+    }
+    case ml::cmd::IMAGE_START_CAPTURE:
+      start("TakePicture", {});
+      return ml::result::ACCEPTED;
+  }
+  return ml::result::UNSUPPORTED;
+}
+
+uint8_t SimVehicle::set_mode(uint32_t mode) {
+  mid::DroneState s = drone_.state();
+  switch (mode) {
+    case px4::OFFBOARD:
+      // PX4's rule: no switch to OFFBOARD unless setpoints are already streaming.
+      if (!have_setpoint_ || loop_.now() - setpoint_at_ > options_.offboard_loss_s)
+        return ml::result::DENIED;
+      mode_ = px4::OFFBOARD;
+      flying_ = false;
+      fly_to_setpoint();
+      check_offboard();
+      return ml::result::ACCEPTED;
+    case px4::LOITER:
+      mode_ = px4::LOITER;
+      if (!s.landed) start("Hover", {});
+      return ml::result::ACCEPTED;
+    case px4::LAND:
+      mode_ = px4::LAND;
+      if (!s.landed) start("Land", {});
+      return ml::result::ACCEPTED;
+    case px4::RTL:
+      if (s.landed || !s.armed) return ml::result::DENIED;
+      mode_ = px4::RTL;
+      start("ReturnHome", {});
+      return ml::result::ACCEPTED;
+  }
+  return ml::result::DENIED;
+}
+
+void SimVehicle::on_setpoint(const ml::SetPositionTargetLocalNed& sp) {
+  if (sp.target_system != options_.sysid || sp.coordinate_frame != ml::kFrameLocalNed) return;
+  setpoint_ = {sp.y, sp.x, -sp.z};  // NED -> the simulator's east, north, up
+  have_setpoint_ = true;
+  setpoint_at_ = loop_.now();
+  fly_to_setpoint();
+}
+
+void SimVehicle::fly_to_setpoint() {
+  if (mode_ != px4::OFFBOARD || !have_setpoint_) return;
+  if (flying_ && flying_to_ == setpoint_) return;
+  flying_to_ = setpoint_;
+  flying_ = true;
+  start("FlyTo", {setpoint_.x, setpoint_.y, setpoint_.z});
+}
+
+void SimVehicle::check_offboard() {
+  loop_.cancel(offboard_timer_);
+  offboard_timer_ = mid::kNoTimer;
+  if (mode_ != px4::OFFBOARD) return;
+  if (loop_.now() - setpoint_at_ > options_.offboard_loss_s) {
+    set_mode(px4::LOITER);  // the companion went quiet: hold where we are
+    return;
+  }
+  offboard_timer_ = loop_.after(0.2, [this] { check_offboard(); });
+}
+
+void SimVehicle::start(const std::string& action, std::vector<double> args, uint32_t mode_after) {
+  std::weak_ptr<bool> alive = alive_;
+  drone_.start({action, std::move(args)}, [this, alive, action, mode_after](const mid::ActionEnd& end) {
+    if (!alive.lock()) return;
+    if (action == "FlyTo" && end.outcome != mid::Outcome::preempted) flying_ = false;
+    if (end.outcome != mid::Outcome::succeeded) return;
+    if (mode_after != 0) mode_ = mode_after;
+    if (action == "Land" || action == "ReturnHome") after_touchdown();
+  });
+}
+
+void SimVehicle::after_touchdown() {
+  loop_.cancel(disarm_timer_);
+  disarm_timer_ = loop_.after(options_.disarm_after_land_s, [this] {
+    disarm_timer_ = mid::kNoTimer;
+    if (drone_.state().landed) start("Disarm", {});
+  });
+}
+
+void SimVehicle::ack(uint16_t command, uint8_t result) {
+  ml::CommandAck a;
+  a.command = command;
+  a.result = result;
+  send(ml::pack(a));
+}
+
+// --- output --------------------------------------------------------------------------------
+
+void SimVehicle::set_rate(uint32_t id, double hz) {
+  rates_hz_[id] = hz;
+  if (auto it = streams_.find(id); it != streams_.end()) {
+    loop_.cancel(it->second);
+    streams_.erase(it);
+  }
+  if (hz > 0) streams_[id] = loop_.after(1.0 / hz, [this, id] { send_stream(id); });
+}
+
+void SimVehicle::send_stream(uint32_t id) {
+  send(telemetry(id));
+  double hz = rates_hz_.count(id) ? rates_hz_[id] : 1.0;
+  streams_[id] = loop_.after(1.0 / hz, [this, id] { send_stream(id); });
+}
+
+ml::Message SimVehicle::telemetry(uint32_t id) const {
+  mid::DroneState s = drone_.state();
+  Vec3 v = drone_.velocity();
+  switch (id) {
+    case ml::msg::LOCAL_POSITION_NED: {
+      ml::LocalPositionNed p;
+      p.time_boot_ms = static_cast<uint32_t>(s.t * 1000.0);
+      p.x = static_cast<float>(s.y);
+      p.y = static_cast<float>(s.x);
+      p.z = static_cast<float>(-s.z);
+      p.vx = static_cast<float>(v.y);
+      p.vy = static_cast<float>(v.x);
+      p.vz = static_cast<float>(-v.z);
+      return ml::pack(p);
+    }
+    case ml::msg::EXTENDED_SYS_STATE: {
+      ml::ExtendedSysState e;
+      e.landed_state = s.landed                ? ml::landed::ON_GROUND
+                       : mode_ == px4::TAKEOFF ? ml::landed::TAKEOFF
+                       : mode_ == px4::LAND    ? ml::landed::LANDING
+                                               : ml::landed::IN_AIR;
+      return ml::pack(e);
+    }
+    case ml::msg::SYS_STATUS: {
+      ml::SysStatus st;
+      st.battery_remaining = static_cast<int8_t>(std::lround(s.battery));
+      return ml::pack(st);
+    }
+    case ml::msg::BATTERY_STATUS: {
+      ml::BatteryStatus b;
+      b.battery_remaining = static_cast<int8_t>(std::lround(s.battery));
+      b.voltages.fill(UINT16_MAX);
+      return ml::pack(b);
+    }
+    case ml::msg::GLOBAL_POSITION_INT: {
+      ml::GlobalPositionInt g;
+      g.time_boot_ms = static_cast<uint32_t>(s.t * 1000.0);
+      double lat = kHomeLat + s.y / kMetresPerDegree;
+      double lon = kHomeLon + s.x / (kMetresPerDegree * std::cos(kHomeLat * M_PI / 180.0));
+      g.lat = static_cast<int32_t>(std::lround(lat * 1e7));
+      g.lon = static_cast<int32_t>(std::lround(lon * 1e7));
+      g.alt = static_cast<int32_t>(std::lround((options_.home_amsl_m + s.z) * 1000.0));
+      g.relative_alt = static_cast<int32_t>(std::lround(s.z * 1000.0));
+      return ml::pack(g);
+    }
+  }
+  ml::Heartbeat hb;
+  hb.type = ml::mav_type::QUADROTOR;
+  hb.autopilot = ml::autopilot::PX4;
+  hb.base_mode = ml::mode_flag::CUSTOM_MODE_ENABLED | (s.armed ? ml::mode_flag::SAFETY_ARMED : 0);
+  hb.custom_mode = mode_;
+  hb.system_status = s.armed ? ml::state::ACTIVE : ml::state::STANDBY;
+  return ml::pack(hb);
+}
+
+void SimVehicle::send(const ml::Message& m) {
+  if (link_) link_->send(encoder_.encode(m));
+}
+
+}  // namespace eamos::sim_vehicle

@@ -1,0 +1,88 @@
+#pragma once
+// A PX4-like MAVLink vehicle on top of the built-in simulator, so the mavlink adapter is
+// tested end to end without PX4: `eamos sim-vehicle` and the adapter tests run it. It
+// behaves like PX4 where the adapter depends on it, and is simpler everywhere else:
+//  - HEARTBEAT at 1 Hz (MAV_AUTOPILOT_PX4, PX4 custom modes, armed flag);
+//  - COMMAND_LONG answered with COMMAND_ACK: ARM_DISARM, NAV_TAKEOFF (param7 above mean
+//    sea level; refused while disarmed), NAV_LAND, NAV_RETURN_TO_LAUNCH, DO_SET_MODE
+//    (OFFBOARD only while setpoints stream, AUTO.LOITER/LAND/RTL), SET_MESSAGE_INTERVAL,
+//    IMAGE_START_CAPTURE; anything else MAV_RESULT_UNSUPPORTED. A resend (confirmation > 0)
+//    of the last command is acknowledged again, not executed twice;
+//  - SET_POSITION_TARGET_LOCAL_NED flown in OFFBOARD; setpoints older than 1 s there fall
+//    back to AUTO.LOITER (PX4's offboard loss failsafe, COM_OF_LOSS_T);
+//  - telemetry (LOCAL_POSITION_NED, EXTENDED_SYS_STATE, SYS_STATUS, BATTERY_STATUS,
+//    GLOBAL_POSITION_INT) at 1 Hz each, or the rate SET_MESSAGE_INTERVAL asks for;
+//  - disarms 2 s after touching down (PX4's COM_DISARM_LAND).
+// Its local NED origin is its home; it runs on its own event loop in real time.
+#include <map>
+#include <memory>
+#include <string>
+
+#include "mavlink/link.h"
+#include "mavlink/payloads.h"
+#include "mid/event_loop.h"
+#include "sim/sim_drone.h"
+
+namespace eamos::sim_vehicle {
+
+struct VehicleOptions {
+  uint8_t sysid = 1;
+  double home_amsl_m = 488.0;      ///< ground altitude above mean sea level (PX4 SITL's Zurich)
+  double offboard_loss_s = 1.0;    ///< OFFBOARD without a fresh setpoint this long: hold
+  double disarm_after_land_s = 2.0;
+  double default_rate_hz = 1.0;    ///< telemetry rate until SET_MESSAGE_INTERVAL says otherwise
+};
+
+class SimVehicle {
+ public:
+  SimVehicle(mid::EventLoop& loop, VehicleOptions options);
+  ~SimVehicle();
+  SimVehicle(const SimVehicle&) = delete;
+  SimVehicle& operator=(const SimVehicle&) = delete;
+
+  /// Opens the link and starts heartbeats and telemetry; "" on success, else why not.
+  std::string open(const mavlink::Endpoint& endpoint);
+
+  uint32_t mode() const { return mode_; }
+  const sim::SimDrone& drone() const { return drone_; }
+
+ private:
+  void on_frame(const mavlink::Frame& frame);
+  void on_command(const mavlink::CommandLong& c);
+  uint8_t execute(const mavlink::CommandLong& c);  ///< the MAV_RESULT to acknowledge with
+  uint8_t set_mode(uint32_t mode);
+  void on_setpoint(const mavlink::SetPositionTargetLocalNed& sp);
+  void fly_to_setpoint();
+  void start(const std::string& action, std::vector<double> args, uint32_t mode_after = 0);
+  void ack(uint16_t command, uint8_t result);
+  void after_touchdown();
+  void check_offboard();
+
+  void set_rate(uint32_t message_id, double hz);
+  void send_stream(uint32_t message_id);
+  mavlink::Message telemetry(uint32_t message_id) const;
+  void send(const mavlink::Message& m);
+
+  mid::EventLoop& loop_;
+  VehicleOptions options_;
+  sim::SimDrone drone_;
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);  ///< see MavlinkDrone::alive_
+  std::unique_ptr<mavlink::Link> link_;
+  mavlink::Encoder encoder_;
+
+  uint32_t mode_;                       ///< PX4 custom_mode
+  fleet::Vec3 setpoint_;                ///< mission frame of the simulator (x east, y north, z up)
+  bool have_setpoint_ = false;
+  double setpoint_at_ = -1e9;           ///< loop time of the newest setpoint
+  fleet::Vec3 flying_to_;               ///< target of the running FlyTo
+  bool flying_ = false;
+  uint16_t last_command_ = 0;           ///< for resends: acknowledge again, do not redo
+  uint8_t last_result_ = 0;
+  bool has_last_ = false;
+  std::map<uint32_t, mid::TimerId> streams_;  ///< message id -> its next send
+  std::map<uint32_t, double> rates_hz_;
+  mid::TimerId offboard_timer_ = mid::kNoTimer;
+  mid::TimerId disarm_timer_ = mid::kNoTimer;
+};
+
+}  // namespace eamos::sim_vehicle

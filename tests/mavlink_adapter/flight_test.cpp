@@ -1,0 +1,161 @@
+// The mavlink adapter against the simulated PX4-like vehicle over loopback UDP, both on real
+// time sped up 4×: every test flies a few mission seconds. Each test has its own port.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "mavlink_adapter/adapter.h"
+#include "vehicle_thread.h"
+
+namespace eamos::mavlink_adapter {
+namespace {
+
+constexpr double kSpeed = 4.0;
+
+struct Flight {
+  mid::EventLoop loop{{mid::ClockMode::real_time, kSpeed}};
+  mid::AdapterRegistry registry;
+  std::unique_ptr<mid::Drone> drone;
+  mid::CreateResult created;
+
+  explicit Flight(int port, MavlinkOptions options = {}) {
+    options.real_time = true;
+    register_adapter(registry, options);
+    fleet::DroneSettings s;
+    s.name = "Drone1";
+    s.adapter = "mavlink";
+    s.connection = "udp://127.0.0.1:" + std::to_string(port);
+    s.sysid = 1;
+    created = registry.create("mavlink", s, fleet::generic_multirotor("Quad"), loop);
+    drone = std::move(created.drone);
+  }
+
+  /// Starts an action and runs the loop until it ends (at most `max_s` mission seconds).
+  mid::ActionEnd fly(const std::string& name, std::vector<double> args = {}, double max_s = 60) {
+    std::optional<mid::ActionEnd> end;
+    drone->start({name, std::move(args)}, [&](const mid::ActionEnd& e) {
+      end = e;
+      loop.stop();
+    });
+    loop.run_until(loop.now() + max_s);
+    return end.value_or(mid::ActionEnd{mid::Outcome::failed, "test: no end within the limit"});
+  }
+};
+
+TEST(MavlinkFlight, ConnectsAndRecognisesPx4) {
+  test::VehicleThread vehicle(25311, 1, kSpeed);
+  Flight f(25311);
+  ASSERT_EQ(f.created.status, mid::CreateStatus::success) << f.created.message;
+  auto* d = dynamic_cast<MavlinkDrone*>(f.drone.get());
+  ASSERT_NE(d->autopilot(), nullptr);
+  EXPECT_STREQ(d->autopilot()->name, "PX4");
+}
+
+TEST(MavlinkFlight, ArmTakeoffFlyAndLand) {
+  test::VehicleThread vehicle(25312, 1, kSpeed);
+  Flight f(25312);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  mid::ActionEnd e = f.fly("Arm");
+  ASSERT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
+  EXPECT_TRUE(f.drone->state().armed);
+
+  e = f.fly("Takeoff", {3});
+  ASSERT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
+  EXPECT_NEAR(f.drone->state().z, 3.0, 0.3);
+  EXPECT_FALSE(f.drone->state().landed);
+
+  e = f.fly("FlyByX", {5});
+  ASSERT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
+  EXPECT_NEAR(f.drone->state().x, 5.0, 0.5);
+  EXPECT_NEAR(f.drone->state().z, 3.0, 0.3);
+
+  e = f.fly("Land");
+  ASSERT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
+  EXPECT_TRUE(f.drone->state().landed);
+  EXPECT_NEAR(f.drone->state().z, 0.0, 0.1);
+}
+
+TEST(MavlinkFlight, TakeoffWhileDisarmedFailsWithTheAutopilotsResult) {
+  test::VehicleThread vehicle(25313, 1, kSpeed);
+  Flight f(25313);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  mid::ActionEnd e = f.fly("Takeoff", {3});
+  EXPECT_EQ(e.outcome, mid::Outcome::failed);
+  EXPECT_EQ(e.reason, "refused by PX4: MAV_CMD_NAV_TAKEOFF: MAV_RESULT_DENIED (denied by the autopilot)");
+}
+
+TEST(MavlinkFlight, LinkLossFailsTheRunningAction) {
+  test::VehicleThread vehicle(25314, 1, kSpeed);
+  MavlinkOptions options;
+  options.link_timeout_s = 2.0;
+  Flight f(25314, options);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
+  ASSERT_EQ(f.fly("Takeoff", {2}).outcome, mid::Outcome::succeeded);
+  std::optional<mid::ActionEnd> end;
+  f.drone->start({"Hover", {}}, [&](const mid::ActionEnd& e) {
+    end = e;
+    f.loop.stop();
+  });
+  f.loop.run_until(f.loop.now() + 1.0);
+  EXPECT_FALSE(end);  // Hover() runs until something stops it
+  vehicle.halt();
+  f.loop.run_until(f.loop.now() + 10.0);
+  ASSERT_TRUE(end);
+  EXPECT_EQ(end->outcome, mid::Outcome::failed);
+  EXPECT_EQ(end->reason, "link lost: no HEARTBEAT from system 1 for 2.0 s");
+  mid::ActionEnd refused = f.fly("Land");
+  EXPECT_EQ(refused.outcome, mid::Outcome::failed);
+  EXPECT_EQ(refused.reason, "link lost: no HEARTBEAT from system 1");
+}
+
+TEST(MavlinkFlight, OrbitRunsUntilCancelledThenHolds) {
+  test::VehicleThread vehicle(25315, 1, kSpeed);
+  Flight f(25315);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
+  ASSERT_EQ(f.fly("Takeoff", {3}).outcome, mid::Outcome::succeeded);
+  std::optional<mid::ActionEnd> end;
+  mid::ActionId id = f.drone->start({"Orbit", {3}}, [&](const mid::ActionEnd& e) { end = e; });
+  f.loop.run_until(f.loop.now() + 6.0);
+  EXPECT_FALSE(end);
+  mid::DroneState s = f.drone->state();
+  EXPECT_NEAR(std::hypot(s.x, s.y), 3.0, 1.0);  // on (or near) the circle around the start
+  EXPECT_TRUE(f.drone->cancel(id));
+  f.loop.run_until(f.loop.now() + 0.5);
+  ASSERT_TRUE(end);
+  EXPECT_EQ(end->outcome, mid::Outcome::cancelled);
+}
+
+TEST(MavlinkAdapter, NoVehicleIsACreateErrorThatSaysWhatToCheck) {
+  MavlinkOptions options;
+  options.connect_timeout_s = 0.3;
+  Flight f(25316, options);
+  EXPECT_EQ(f.created.status, mid::CreateStatus::adapter_failed);
+  EXPECT_NE(f.created.message.find("no HEARTBEAT from system 1 on udp://127.0.0.1:25316"),
+            std::string::npos)
+      << f.created.message;
+}
+
+TEST(MavlinkAdapter, VirtualTimeAndMissingConnectionAreRefused) {
+  mid::EventLoop loop;
+  mid::AdapterRegistry registry;
+  register_adapter(registry);  // real_time = false
+  fleet::DroneSettings s;
+  s.name = "Drone1";
+  s.connection = "udp://:25317";
+  auto r = registry.create("mavlink", s, fleet::generic_multirotor("Quad"), loop);
+  EXPECT_NE(r.message.find("--realtime"), std::string::npos) << r.message;
+
+  mid::AdapterRegistry live;
+  register_adapter(live, {.real_time = true});
+  s.connection = "";
+  r = live.create("mavlink", s, fleet::generic_multirotor("Quad"), loop);
+  EXPECT_NE(r.message.find("no `connection:`"), std::string::npos) << r.message;
+  s.connection = "udp:14540";
+  r = live.create("mavlink", s, fleet::generic_multirotor("Quad"), loop);
+  EXPECT_NE(r.message.find("no scheme"), std::string::npos) << r.message;
+}
+
+}  // namespace
+}  // namespace eamos::mavlink_adapter

@@ -1,0 +1,42 @@
+#pragma once
+// A simulated MAVLink vehicle on its own thread and real-time loop, as a separate process
+// would be, for the adapter's loopback tests. It sends to udpout://127.0.0.1:PORT.
+#include <atomic>
+#include <stdexcept>
+#include <thread>
+
+#include "mavlink/url.h"
+#include "mid/event_loop.h"
+#include "sim_vehicle/sim_vehicle.h"
+
+namespace eamos::test {
+
+class VehicleThread {
+ public:
+  VehicleThread(int port, uint8_t sysid, double speed)
+      : loop_({mid::ClockMode::real_time, speed}), vehicle_(loop_, {sysid}) {
+    std::string url = "udpout://127.0.0.1:" + std::to_string(port);
+    if (std::string e = vehicle_.open(*mavlink::parse_url(url).endpoint); !e.empty())
+      throw std::runtime_error(e);
+    thread_ = std::thread([this] {
+      while (!stop_) loop_.run_until(loop_.now() + 1.0);
+    });
+  }
+  ~VehicleThread() { halt(); }
+
+  /// Stops the vehicle's loop, as if the vehicle vanished: no heartbeats any more.
+  void halt() {
+    if (!thread_.joinable()) return;
+    stop_ = true;
+    loop_.post([this] { loop_.stop(); });
+    thread_.join();
+  }
+
+ private:
+  mid::EventLoop loop_;
+  sim_vehicle::SimVehicle vehicle_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+}  // namespace eamos::test
