@@ -3,7 +3,10 @@
 // input had errors (all of them printed) or a file could not be read or written.
 #include <string>
 
+#include "dex/runner.h"
 #include "graph/pipeline.h"
+#include "launch/dex_process.h"
+#include "launch/ground.h"
 
 namespace eamos::cli {
 
@@ -30,6 +33,13 @@ struct RunCommandOptions {
   bool log = true;        ///< print the live log
 };
 int cmd_run(const CommonOptions& o, const RunCommandOptions& r);
+/// Writes the summary and plot of a finished run as `eamos run` does; false when a file
+/// could not be written.
+bool report_run(const RunCommandOptions& r, const dex::RunResult& result, const std::vector<dex::TraceEvent>& events);
+int cmd_dex(const launch::DexProcessOptions& options);
+int cmd_launch(const launch::LaunchOptions& options, const RunCommandOptions& r);
+/// `eamos run --distributed`: compiles into options.dir (a temporary folder when ""), then launches.
+int cmd_run_distributed(const CommonOptions& o, const RunCommandOptions& r, launch::LaunchOptions options);
 int cmd_gen_stress(long long nodes, int drones, unsigned seed, const std::string& output);
 
 /// Compiles and prints every diagnostic; true when the graphs are usable.

@@ -18,6 +18,24 @@ void add_common(CLI::App* cmd, eamos::cli::CommonOptions& o) {
   cmd->add_flag("-q,--quiet", o.quiet, "Do not print warnings");
 }
 
+void add_dds(CLI::App* cmd, eamos::transport::DdsOptions& d) {
+  cmd->add_option("--domain", d.domain, "DDS domain id (0-230); missions on one domain ignore each other")
+      ->default_val(0)->check(CLI::Range(0, 230));
+  cmd->add_option("--interface", d.interface,
+                  "Network interface name or address for DDS (default: loopback only, config/cyclonedds-loopback.xml)");
+  cmd->add_option("--dds-config", d.config_file, "A Cyclone DDS XML configuration to use instead")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--liveliness-timeout", d.lease_s,
+                  "Seconds without liveliness after which a drone is lost and the mission fails")
+      ->default_val(2.0)->check(CLI::PositiveNumber);
+}
+
+void add_report(CLI::App* cmd, eamos::cli::RunCommandOptions& r) {
+  cmd->add_option("--trace", r.trace, "Write the trace as JSON Lines to this file");
+  cmd->add_option("--summary", r.summary, "Write the summary JSON to this file");
+  cmd->add_option("--plot", r.plot, "Draw the run (tracks and action timeline) as SVG to this file");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -54,14 +72,49 @@ int main(int argc, char** argv) {
   auto* run = app.add_subcommand("run", "Compile and fly a mission in the built-in simulator; exit 0 only when it completed");
   add_common(run, o);
   eamos::cli::RunCommandOptions run_opts;
-  run->add_option("--trace", run_opts.trace, "Write the trace as JSON Lines to this file");
-  run->add_option("--summary", run_opts.summary, "Write the summary JSON to this file");
-  run->add_option("--plot", run_opts.plot, "Draw the run (tracks and action timeline) as SVG to this file");
+  add_report(run, run_opts);
   auto* realtime = run->add_flag("--realtime", run_opts.realtime, "Run in real time instead of virtual time");
   run->add_option("--speed", run_opts.speed, "Real time scaled by X (2 = twice as fast)")
       ->check(CLI::PositiveNumber)->excludes(realtime);
   run->add_option("--time-limit", run_opts.time_limit, "Fail a mission still running after this many mission seconds")
       ->check(CLI::PositiveNumber);
+
+  bool distributed = false;
+  eamos::launch::LaunchOptions launch_opts;
+  run->add_flag("--distributed", distributed,
+                "One DEX process per drone over Cyclone DDS, as `eamos launch` (real time)");
+  run->add_option("--deploy-dir", launch_opts.dir, "With --distributed: where to write the deployment (default: a temporary folder)");
+  run->add_option("--barrier-timeout", launch_opts.barrier_timeout_s, "With --distributed: seconds to wait for every DEX to be ready")
+      ->check(CLI::PositiveNumber);
+  add_dds(run, launch_opts.dds);
+
+  auto* launch = app.add_subcommand("launch", "Run a deployment folder as one DEX process per drone over Cyclone DDS, with a ground process that starts them together and collects their traces");
+  launch->add_option("deployment", launch_opts.dir, "Deployment folder written by `eamos compile -o`")
+      ->required()->check(CLI::ExistingDirectory);
+  eamos::cli::RunCommandOptions launch_report;
+  add_report(launch, launch_report);
+  launch->add_option("--speed", launch_opts.speed, "Mission time runs X times as fast as the wall clock (simulated drones only)")
+      ->check(CLI::PositiveNumber);
+  launch->add_option("--time-limit", launch_opts.time_limit_s, "Fail a mission still running after this many mission seconds")
+      ->check(CLI::PositiveNumber);
+  launch->add_option("--barrier-timeout", launch_opts.barrier_timeout_s, "Seconds to wait for every DEX to be ready")
+      ->check(CLI::PositiveNumber);
+  launch->add_option("--drones", launch_opts.local, "Start only these drones here; the others run their DEX elsewhere")
+      ->delimiter(',');
+  add_dds(launch, launch_opts.dds);
+
+  auto* dexcmd = app.add_subcommand("dex", "Run one drone's DEX from its deployment folder (the deployment package's entry point)");
+  eamos::launch::DexProcessOptions dex_opts;
+  dexcmd->add_option("folder", dex_opts.folder, "The drone's deployment folder (DIR/<drone>)")
+      ->required()->check(CLI::ExistingDirectory);
+  dexcmd->add_option("--speed", dex_opts.speed, "Mission time runs X times as fast as the wall clock; must match the ground's")
+      ->check(CLI::PositiveNumber);
+  dexcmd->add_option("--time-limit", dex_opts.time_limit_s, "Fail a mission still running after this many mission seconds")
+      ->check(CLI::PositiveNumber);
+  dexcmd->add_option("--start-timeout", dex_opts.start_timeout_s, "Give up when no start came within this many seconds (default: wait)")
+      ->check(CLI::NonNegativeNumber);
+  dexcmd->add_option("--trace", dex_opts.trace_file, "Also write this drone's trace as JSON Lines to this file");
+  add_dds(dexcmd, dex_opts.dds);
 
   auto* gen = app.add_subcommand("gen-stress", "Generate a large valid mission for scaling tests");
   long long nodes = 5000;
@@ -85,7 +138,14 @@ int main(int argc, char** argv) {
     if (*compile) return eamos::cli::cmd_compile(o, out_dir);
     if (*graph) return eamos::cli::cmd_graph(o, kind, drone, format, graph_out);
     if (*stats) return eamos::cli::cmd_stats(o, stats_out);
+    if (*run && distributed) {
+      launch_opts.speed = run_opts.speed > 0 ? run_opts.speed : 1.0;
+      launch_opts.time_limit_s = run_opts.time_limit;
+      return eamos::cli::cmd_run_distributed(o, run_opts, launch_opts);
+    }
     if (*run) return eamos::cli::cmd_run(o, run_opts);
+    if (*launch) return eamos::cli::cmd_launch(launch_opts, launch_report);
+    if (*dexcmd) return eamos::cli::cmd_dex(dex_opts);
     if (*gen) return eamos::cli::cmd_gen_stress(nodes, drones, seed, gen_out);
   } catch (const std::exception& e) {
     std::cerr << "eamos: error: " << e.what() << "\n";

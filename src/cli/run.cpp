@@ -75,14 +75,18 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
     options.clock.speed = r.speed > 0 ? r.speed : 1.0;
   }
   dex::RunResult result = dex::run_in_process(missions, adapters, &tee, options);
-  if (!r.summary.empty() && !write_output(r.summary, summary_json(result).dump(2) + "\n")) return 1;
-  if (!r.plot.empty() && !write_output(r.plot, dex::plot_svg(result, memory.events))) return 1;
-  if (result.completed) {
+  if (!report_run(r, result, memory.events)) return 1;
+  return result.completed ? 0 : 1;
+}
+
+bool report_run(const RunCommandOptions& r, const dex::RunResult& result, const std::vector<dex::TraceEvent>& events) {
+  if (!r.summary.empty() && !write_output(r.summary, summary_json(result).dump(2) + "\n")) return false;
+  if (!r.plot.empty() && !write_output(r.plot, dex::plot_svg(result, events))) return false;
+  if (result.completed)
     std::cout << "mission completed in " << result.duration << " s (mission time)\n";
-    return 0;
-  }
-  std::cerr << "eamos: mission failed: " << result.error << "\n";
-  return 1;
+  else
+    std::cerr << "eamos: mission failed: " << result.error << "\n";
+  return true;
 }
 
 }  // namespace eamos::cli

@@ -45,7 +45,18 @@ class InProcessTransport : public Transport {
   int in_flight_ = 0;
 };
 
-/// Appends `s` to `track` when position or phase differ from the last sample.
+}  // namespace
+
+TraceEvent failsafe_event(double t, const std::string& drone, fleet::Failsafe what, const std::string& reason) {
+  TraceEvent e;
+  e.t = t;
+  e.drone = drone;
+  e.event = "failsafe";
+  e.name = fleet::failsafe_name(what);
+  e.reason = reason;
+  return e;
+}
+
 void record_sample(std::vector<Sample>& track, const mid::DroneState& s) {
   Sample now{s.t, s.x, s.y, s.z, s.armed, s.landed};
   if (!track.empty()) {
@@ -56,8 +67,6 @@ void record_sample(std::vector<Sample>& track, const mid::DroneState& s) {
   }
   track.push_back(now);
 }
-
-}  // namespace
 
 RunResult run_in_process(const std::vector<Mission>& missions, const mid::AdapterRegistry& adapters,
                          TraceSink* trace, const RunOptions& options) {
@@ -98,8 +107,11 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
   // fleet file says) every drone still in the air.
   auto abandon = [&] {
     for (auto& e : engines) e->halt();
-    for (int d = 0; d < n; ++d)
-      if (!drones[d]->state().landed) drones[d]->failsafe(missions[d].settings.failsafe);
+    for (int d = 0; d < n; ++d) {
+      if (drones[d]->state().landed) continue;
+      if (trace) trace->record(failsafe_event(loop.now(), missions[d].settings.name, missions[d].settings.failsafe, result.error));
+      drones[d]->failsafe(missions[d].settings.failsafe);
+    }
   };
   auto fail = [&](const Failure& f) {
     if (failed) return;

@@ -28,6 +28,12 @@ struct Sample {
   bool landed;
 };
 
+/// The trace event of a drone entering its failsafe because the mission was abandoned.
+TraceEvent failsafe_event(double t, const std::string& drone, fleet::Failsafe what, const std::string& reason);
+
+/// Appends `s` to `track` when position or phase differ from the last sample.
+void record_sample(std::vector<Sample>& track, const mid::DroneState& s);
+
 struct DroneSummary {
   std::string name;
   mid::DroneState state;       ///< at the end of the run

@@ -1,0 +1,35 @@
+#pragma once
+// `eamos dex DIR/<drone>`: one drone's DEX as its own process, the deployment package's
+// entry point (paper, section V). It loads the drone's mission file, makes the drone from
+// the Adapter Space, joins the DDS domain and says READY; when the ground's start barrier
+// passes it runs the mission in real time, exchanging triggers and telemetry with the
+// other DEXes directly. No node is central during the mission: a failure anywhere is
+// broadcast as ABORT and every drone runs its failsafe; the lead drone (holder of the end
+// node) declares the mission finished once every drone is idle and nothing is in flight.
+#include <iosfwd>
+#include <string>
+
+#include "mid/adapter_registry.h"
+#include "transport/dds_node.h"
+
+namespace eamos::launch {
+
+struct DexProcessOptions {
+  std::string folder;             ///< the drone's deployment folder (holds mission.json)
+  transport::DdsOptions dds;
+  double speed = 1.0;             ///< mission seconds per wall second; must match the ground's
+  double start_timeout_s = 0.0;   ///< give up when no start came by then; 0 = wait for ever
+  double time_limit_s = 3600.0;   ///< a mission still running then fails
+  /// Wall seconds the lead watches every drone idle with nothing in flight before it calls
+  /// the mission finished: covers status samples still on their way.
+  double settle_s = 0.15;
+  std::string trace_file;         ///< the drone's own JSONL trace; "" = none
+  bool log = true;                ///< live log on `out`
+};
+
+/// Runs the process; returns its exit status: 0 when the mission completed, 1 otherwise
+/// (bad folder, no start, failed or abandoned mission).
+int run_dex_process(const DexProcessOptions& options, const mid::AdapterRegistry& adapters,
+                    std::ostream& out, std::ostream& err);
+
+}  // namespace eamos::launch

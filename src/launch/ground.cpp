@@ -1,0 +1,339 @@
+#include "launch/ground.h"
+
+#include <signal.h>
+
+#include <algorithm>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <random>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "launch/inbox.h"
+#include "launch/spawn.h"
+#include "launch/wall_time.h"
+
+namespace eamos::launch {
+
+namespace {
+
+using transport::LifecycleKind;
+using transport::LifecycleSample;
+using transport::Phase;
+using transport::StatusSample;
+using transport::TelemetrySample;
+using transport::TraceSample;
+
+struct DroneEntry {
+  std::string name;
+  std::string folder;  ///< absolute or relative to the working directory
+  bool local = false;
+  Child child;
+  std::optional<std::uint64_t> ready_nonce;
+  std::optional<StatusSample> final_status;
+  std::vector<dex::Sample> track;
+  std::string log;
+};
+
+bool read_manifest(const std::string& dir, std::string& hash, std::vector<DroneEntry>& drones, std::string& error) {
+  std::ifstream in(dir + "/manifest.json");
+  if (!in) {
+    error = "cannot read " + dir + "/manifest.json; is '" + dir + "' a folder written by `eamos compile -o`?";
+    return false;
+  }
+  try {
+    nlohmann::json m = nlohmann::json::parse(in);
+    if (m.value("format", "") != "eamos-deployment") {
+      error = dir + "/manifest.json is not an eamos deployment manifest";
+      return false;
+    }
+    hash = m.at("mission_hash").get<std::string>();
+    for (const auto& d : m.at("drones"))
+      drones.push_back({d.at("name").get<std::string>(), dir + "/" + d.at("folder").get<std::string>()});
+  } catch (const std::exception& e) {
+    error = dir + "/manifest.json: " + e.what();
+    return false;
+  }
+  if (drones.empty()) {
+    error = dir + "/manifest.json lists no drones";
+    return false;
+  }
+  return true;
+}
+
+std::string tail_of(const std::string& path, std::size_t lines) {
+  std::ifstream in(path);
+  std::vector<std::string> all;
+  for (std::string line; std::getline(in, line);) all.push_back(line);
+  std::string out;
+  for (std::size_t i = all.size() > lines ? all.size() - lines : 0; i < all.size(); ++i) out += "    " + all[i] + "\n";
+  return out;
+}
+
+class Ground {
+ public:
+  Ground(const LaunchOptions& o, dex::TraceSink* live, LaunchResult& r, std::ostream& out, std::ostream& err)
+      : o_(o), live_(live), r_(r), out_(out), err_(err), loop_(mid::ClockOptions{mid::ClockMode::real_time, 1.0}) {}
+  int run();
+
+ private:
+  bool start_processes();
+  void tick();
+  void send_start();
+  void fail_barrier(const std::string& why);
+  void on_lifecycle(const LifecycleSample& s);
+  void on_status(const StatusSample& s);
+  void on_trace(TraceSample s);
+  void on_telemetry(const TelemetrySample& s);
+  bool ours(const std::string& hash);
+  bool all_done();
+  void stop_all(int signal);
+
+  const LaunchOptions& o_;
+  dex::TraceSink* live_;
+  LaunchResult& r_;
+  std::ostream& out_;
+  std::ostream& err_;
+  mid::EventLoop loop_;
+  std::unique_ptr<transport::DdsNode> node_;
+  std::string hash_;
+  std::vector<DroneEntry> drones_;
+  enum class Stage { barrier, running, done } stage_ = Stage::barrier;
+  double barrier_deadline_ = 0.0;
+  double wall_guard_ = 0.0;
+  std::optional<double> finish_at_;
+  std::optional<LifecycleSample> abort_;
+  std::optional<LifecycleSample> finished_;
+  std::string error_;
+  std::set<std::string> foreign_;
+};
+
+int Ground::run() {
+  std::string error;
+  if (!read_manifest(o_.dir, hash_, drones_, error)) {
+    err_ << "eamos launch: error: " << error << "\n";
+    return 1;
+  }
+  std::set<std::string> names;
+  for (auto& d : drones_) names.insert(d.name);
+  for (const std::string& n : o_.local)
+    if (!names.count(n)) {
+      err_ << "eamos launch: error: --drones names '" << n << "', which is not a drone of this mission\n";
+      return 1;
+    }
+  for (auto& d : drones_)
+    d.local = o_.local.empty() || std::find(o_.local.begin(), o_.local.end(), d.name) != o_.local.end();
+
+  Inbox* inbox = new Inbox();  // outlives node_: listeners may still deliver while it closes
+  std::unique_ptr<Inbox> inbox_owner(inbox);
+  transport::DdsHandlers h;
+  h.lifecycle = [inbox, this](LifecycleSample s) { inbox->deliver([this, s] { on_lifecycle(s); }); };
+  h.status = [inbox, this](StatusSample s) { inbox->deliver([this, s] { on_status(s); }); };
+  h.trace = [inbox, this](TraceSample s) { inbox->deliver([this, s] { on_trace(s); }); };
+  h.telemetry = [inbox, this](TelemetrySample s) { inbox->deliver([this, s] { on_telemetry(s); }); };
+  h.lost = [inbox, this](const std::string& hash, int drone) {
+    inbox->deliver([this, hash, drone] {
+      if (hash == hash_ && drone >= 0 && drone < static_cast<int>(drones_.size()) && stage_ == Stage::running &&
+          !drones_[drone].final_status)
+        err_ << "ground: " << drones_[drone].name << " lost its liveliness\n";
+    });
+  };
+  node_ = transport::DdsNode::open(o_.dds, std::move(h), error);
+  if (!node_) {
+    err_ << "eamos launch: error: " << error << "\n";
+    return 1;
+  }
+  inbox->attach(loop_, [](const TelemetrySample&) {});
+  if (!start_processes()) {
+    stop_all(SIGTERM);
+    return 1;
+  }
+  barrier_deadline_ = wall_s() + o_.barrier_timeout_s;
+  tick();
+  loop_.run_until(1e9);
+  node_.reset();
+  for (auto& d : drones_)
+    if (d.local) reap(d.child, 5.0);
+
+  // The report, in the shape `eamos run` gives.
+  std::stable_sort(r_.events.begin(), r_.events.end(),
+                   [](const dex::TraceEvent& a, const dex::TraceEvent& b) { return a.t < b.t; });
+  dex::RunResult& run = r_.run;
+  run.completed = finished_.has_value() && !abort_ && error_.empty();
+  if (abort_) {
+    run.failure = abort_->failure;
+    run.error = abort_->reason;
+    run.duration = abort_->t;
+  } else if (finished_) {
+    run.duration = finished_->t;
+  }
+  if (!error_.empty()) run.error = error_;
+  for (auto& d : drones_) {
+    mid::DroneState state = d.final_status ? d.final_status->state : mid::DroneState{};
+    run.drones.push_back({d.name, state, d.track});
+    if (d.final_status) run.activations += d.final_status->activations;
+  }
+  int status = run.completed ? 0 : 1;
+  for (auto& d : drones_)
+    if (d.local && d.child.exit_status && *d.child.exit_status != 0 && run.completed) {
+      err_ << "ground: the DEX of " << d.name << " exited with status " << *d.child.exit_status << "; its log:\n"
+           << tail_of(d.log, 10);
+      status = 1;
+    }
+  return status;
+}
+
+bool Ground::start_processes() {
+  std::string exe = o_.exe.empty() ? self_exe() : o_.exe;
+  char number[64];
+  for (auto& d : drones_) {
+    if (!d.local) continue;
+    std::vector<std::string> argv = {exe, "dex", d.folder, "--domain", std::to_string(o_.dds.domain)};
+    if (!o_.dds.interface.empty()) argv.insert(argv.end(), {"--interface", o_.dds.interface});
+    if (!o_.dds.config_file.empty()) argv.insert(argv.end(), {"--dds-config", o_.dds.config_file});
+    std::snprintf(number, sizeof number, "%.17g", o_.speed);
+    argv.insert(argv.end(), {"--speed", number});
+    std::snprintf(number, sizeof number, "%.17g", o_.dds.lease_s);
+    argv.insert(argv.end(), {"--liveliness-timeout", number});
+    std::snprintf(number, sizeof number, "%.17g", o_.time_limit_s);
+    argv.insert(argv.end(), {"--time-limit", number});
+    std::snprintf(number, sizeof number, "%.17g", o_.barrier_timeout_s + 5.0);
+    argv.insert(argv.end(), {"--start-timeout", number});
+    d.log = d.folder + "/dex.log";
+    std::remove(d.log.c_str());
+    std::string error;
+    d.child = spawn(argv, d.log, error);
+    if (d.child.pid < 0) {
+      err_ << "eamos launch: error: " << error << "\n";
+      return false;
+    }
+    out_ << "ground: started the DEX of " << d.name << " (pid " << d.child.pid << ", log " << d.log << ")\n";
+  }
+  out_ << std::flush;
+  return true;
+}
+
+void Ground::tick() {
+  for (auto& d : drones_)
+    if (d.local) poll(d.child);
+  if (stage_ == Stage::barrier) {
+    for (auto& d : drones_)
+      if (d.local && d.child.exit_status && !d.ready_nonce)
+        return fail_barrier("the DEX of " + d.name + " exited with status " + std::to_string(*d.child.exit_status) +
+                            " before it was ready; its log (" + d.log + "):\n" + tail_of(d.log, 10));
+    bool all = std::all_of(drones_.begin(), drones_.end(), [](const DroneEntry& d) { return d.ready_nonce.has_value(); });
+    if (all) {
+      send_start();
+    } else if (wall_s() > barrier_deadline_) {
+      std::string missing;
+      for (auto& d : drones_)
+        if (!d.ready_nonce) missing += (missing.empty() ? "" : ", ") + d.name;
+      char secs[32];
+      std::snprintf(secs, sizeof secs, "%g", o_.barrier_timeout_s);
+      return fail_barrier(std::string("start barrier timed out after ") + secs + " s; not ready: " + missing);
+    }
+  } else if (stage_ == Stage::running) {
+    if (wall_s() > wall_guard_) {
+      error_ = "the DEX processes did not report an end in time";
+      stop_all(SIGKILL);
+      stage_ = Stage::done;
+    } else if (all_done()) {
+      if (!finish_at_) finish_at_ = wall_s() + 0.3;  // the last trace samples may still be on the way
+      if (wall_s() > *finish_at_) stage_ = Stage::done;
+    }
+  }
+  if (stage_ == Stage::done) return loop_.stop();
+  loop_.after(0.05, [this] { tick(); });
+}
+
+bool Ground::all_done() {
+  for (auto& d : drones_) {
+    if (d.local && !d.child.exit_status) return false;
+    if (!d.local && !d.final_status) return false;
+  }
+  return true;
+}
+
+void Ground::send_start() {
+  std::random_device rd;
+  LifecycleSample start;
+  start.mission_hash = hash_;
+  start.drone = transport::kGround;
+  start.kind = LifecycleKind::start;
+  start.run_id = ((static_cast<std::uint64_t>(rd()) << 32) | rd()) | 1;
+  start.start_at_ns = unix_ns() + static_cast<std::int64_t>(o_.start_delay_s * 1e9);
+  start.speed = o_.speed;
+  for (auto& d : drones_) start.nonces.push_back(*d.ready_nonce);
+  node_->write(start);
+  r_.run_id = start.run_id;
+  stage_ = Stage::running;
+  wall_guard_ = wall_s() + o_.start_delay_s + o_.time_limit_s / o_.speed + 700.0 / o_.speed + 30.0;
+  out_ << "ground: every drone is ready; starting run " << start.run_id << "\n" << std::flush;
+}
+
+void Ground::fail_barrier(const std::string& why) {
+  error_ = why;
+  err_ << "eamos launch: error: " << why << "\n";
+  stop_all(SIGTERM);
+  stage_ = Stage::done;
+  loop_.stop();
+}
+
+void Ground::stop_all(int signal) {
+  for (auto& d : drones_)
+    if (d.local && d.child.pid > 0 && !d.child.exit_status) kill(d.child.pid, signal);
+}
+
+bool Ground::ours(const std::string& hash) {
+  if (hash == hash_) return true;
+  if (foreign_.insert(hash).second)
+    err_ << "ground: ignoring messages of another mission (hash " << hash.substr(0, 12) << "…) on DDS domain "
+         << o_.dds.domain << "\n";
+  return false;
+}
+
+void Ground::on_lifecycle(const LifecycleSample& s) {
+  if (!ours(s.mission_hash)) return;
+  if (s.kind == LifecycleKind::ready) {
+    if (stage_ != Stage::barrier || s.drone < 0 || s.drone >= static_cast<int>(drones_.size())) return;
+    if (!drones_[s.drone].ready_nonce) out_ << "ground: " << drones_[s.drone].name << " ready\n" << std::flush;
+    drones_[s.drone].ready_nonce = s.nonce;
+    return;
+  }
+  if (s.run_id != r_.run_id || stage_ != Stage::running) return;
+  if (s.kind == LifecycleKind::abort && !abort_) abort_ = s;
+  if (s.kind == LifecycleKind::finished) finished_ = s;
+}
+
+void Ground::on_status(const StatusSample& s) {
+  if (!ours(s.mission_hash) || s.run_id != r_.run_id || s.drone < 0 || s.drone >= static_cast<int>(drones_.size()))
+    return;
+  if (s.phase == Phase::completed || s.phase == Phase::failed) drones_[s.drone].final_status = s;
+}
+
+void Ground::on_trace(TraceSample s) {
+  if (!ours(s.mission_hash) || s.run_id != r_.run_id || s.drone < 0 || s.drone >= static_cast<int>(drones_.size()))
+    return;
+  s.event.drone = drones_[s.drone].name;
+  if (live_) live_->record(s.event);
+  r_.events.push_back(std::move(s.event));
+}
+
+void Ground::on_telemetry(const TelemetrySample& s) {
+  const dex::Telemetry& t = s.telemetry;
+  if (!ours(t.mission_hash) || t.from < 0 || t.from >= static_cast<int>(drones_.size())) return;
+  if (s.run_id != 0 && s.run_id != r_.run_id) return;
+  dex::record_sample(drones_[t.from].track, t.state);
+}
+
+}  // namespace
+
+int launch(const LaunchOptions& options, dex::TraceSink* live, LaunchResult& result, std::ostream& out,
+           std::ostream& err) {
+  Ground g(options, live, result, out, err);
+  return g.run();
+}
+
+}  // namespace eamos::launch

@@ -1,0 +1,39 @@
+#pragma once
+// `eamos launch DIR`: the ground process. It starts one DEX process per drone on this
+// machine (or waits for DEXes started elsewhere), holds the start barrier until every
+// drone is READY with the same mission hash, starts them together, and collects their
+// trace, telemetry and final status into one report like `eamos run`'s. It takes no part
+// in the mission itself: the DEXes trigger, cancel and abort among themselves.
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "dex/runner.h"
+#include "dex/trace.h"
+#include "transport/dds_node.h"
+
+namespace eamos::launch {
+
+struct LaunchOptions {
+  std::string dir;                  ///< deployment folder (manifest.json, one folder per drone)
+  transport::DdsOptions dds;
+  double speed = 1.0;               ///< mission seconds per wall second, for every DEX
+  double barrier_timeout_s = 30.0;  ///< wall seconds to wait for every READY
+  double time_limit_s = 3600.0;     ///< mission seconds, passed to every DEX
+  double start_delay_s = 0.5;       ///< wall seconds between START and mission time 0
+  std::vector<std::string> local;   ///< drones to start here; empty = all of them
+  std::string exe;                  ///< the eamos program for DEX processes ("" = this one)
+};
+
+struct LaunchResult {
+  dex::RunResult run;                   ///< as `eamos run` reports it
+  std::vector<dex::TraceEvent> events;  ///< every drone's events, by time
+  std::uint64_t run_id = 0;
+};
+
+/// Runs the mission in DIR; `live` (may be null) sees events as they arrive. Returns the
+/// exit status: 0 when the mission completed and every DEX exited cleanly.
+int launch(const LaunchOptions& options, dex::TraceSink* live, LaunchResult& result, std::ostream& out,
+           std::ostream& err);
+
+}  // namespace eamos::launch

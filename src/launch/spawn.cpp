@@ -1,0 +1,67 @@
+#include "launch/spawn.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <thread>
+
+extern char** environ;
+
+namespace eamos::launch {
+
+Child spawn(const std::vector<std::string>& argv, const std::string& log, std::string& error) {
+  Child c;
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  std::vector<char*> args;
+  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  int rc = posix_spawn(&c.pid, args[0], &actions, nullptr, args.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) {
+    error = "cannot start " + argv[0] + ": " + std::strerror(rc);
+    c.pid = -1;
+  }
+  return c;
+}
+
+void poll(Child& c) {
+  if (c.pid <= 0 || c.exit_status) return;
+  int status = 0;
+  if (waitpid(c.pid, &status, WNOHANG) != c.pid) return;
+  c.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+void reap(Child& c, double timeout_s) {
+  auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (!c.exit_status && c.pid > 0) {
+    poll(c);
+    if (c.exit_status) return;
+    if (std::chrono::steady_clock::now() > until) {
+      kill(c.pid, SIGKILL);
+      int status = 0;
+      waitpid(c.pid, &status, 0);
+      c.exit_status = 128 + SIGKILL;
+      return;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
+std::string self_exe() {
+  char buf[4096];
+  ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
+  if (n <= 0) return "eamos";
+  buf[n] = '\0';
+  return buf;
+}
+
+}  // namespace eamos::launch

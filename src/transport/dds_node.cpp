@@ -1,0 +1,259 @@
+#include "transport/dds_node.h"
+
+#include <dds/dds.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "loopback_config.h"
+#include "transport/wire_convert.h"
+
+namespace eamos::transport {
+
+namespace {
+
+bool is_loopback(const std::string& interface) {
+  return interface.empty() || interface == "127.0.0.1" || interface == "lo" || interface == "localhost";
+}
+
+bool looks_like_address(const std::string& s) {
+  return !s.empty() && s.find_first_not_of("0123456789.:") == std::string::npos;
+}
+
+std::string retcode(dds_return_t rc) { return dds_strretcode(rc); }
+
+/// Reliable, transient-local: what a reader needs even when it matched late.
+dds_qos_t* durable_qos(bool keep_all) {
+  dds_qos_t* q = dds_create_qos();
+  dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(10));
+  dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
+  if (keep_all)
+    dds_qset_history(q, DDS_HISTORY_KEEP_ALL, 0);
+  else
+    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
+  return q;
+}
+
+template <typename Wire, typename Fn>
+void take_all(dds_entity_t reader, Fn&& fn, std::function<void(std::uint64_t)> on_info = {}) {
+  constexpr int kBatch = 64;
+  void* samples[kBatch];
+  dds_sample_info_t infos[kBatch];
+  for (;;) {
+    samples[0] = nullptr;
+    int n = dds_take(reader, samples, infos, kBatch, kBatch);
+    if (n <= 0) return;
+    for (int i = 0; i < n; ++i) {
+      if (!infos[i].valid_data) continue;  // dispose/unregister notices carry no sample
+      if (on_info) on_info(infos[i].publication_handle);
+      fn(from_wire(*static_cast<const Wire*>(samples[i])));
+    }
+    dds_return_loan(reader, samples, n);
+    if (n < kBatch) return;
+  }
+}
+
+void on_trigger(dds_entity_t, void* arg) { static_cast<DdsNode*>(arg)->take_triggers(); }
+void on_telemetry(dds_entity_t, void* arg) { static_cast<DdsNode*>(arg)->take_telemetry(); }
+void on_lifecycle(dds_entity_t, void* arg) { static_cast<DdsNode*>(arg)->take_lifecycle(); }
+void on_status(dds_entity_t, void* arg) { static_cast<DdsNode*>(arg)->take_status(); }
+void on_trace(dds_entity_t, void* arg) { static_cast<DdsNode*>(arg)->take_trace(); }
+void on_liveliness(dds_entity_t, const dds_liveliness_changed_status_t s, void* arg) {
+  if (s.alive_count_change < 0 || s.not_alive_count_change > 0)
+    static_cast<DdsNode*>(arg)->liveliness_changed(s.last_publication_handle);
+}
+
+}  // namespace
+
+bool dds_config(const DdsOptions& options, std::string& xml, std::string& error) {
+  if (!options.config_file.empty()) {
+    std::ifstream in(options.config_file);
+    if (!in) {
+      error = "cannot read DDS configuration '" + options.config_file + "'";
+      return false;
+    }
+    std::stringstream ss;
+    ss << in.rdbuf();
+    xml = ss.str();
+    return true;
+  }
+  if (is_loopback(options.interface)) {
+    xml = kLoopbackConfig;
+    return true;
+  }
+  std::string attr = looks_like_address(options.interface) ? "address" : "name";
+  xml = "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface " + attr + "=\"" +
+        options.interface + "\"/></Interfaces></General><Discovery><ParticipantIndex>auto</ParticipantIndex>"
+        "<MaxAutoParticipantIndex>100</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>";
+  return true;
+}
+
+std::unique_ptr<DdsNode> DdsNode::open(const DdsOptions& options, DdsHandlers handlers, std::string& error) {
+  std::unique_ptr<DdsNode> node(new DdsNode());
+  node->handlers_ = std::move(handlers);
+  if (!node->create(options, error)) return nullptr;
+  return node;
+}
+
+bool DdsNode::create(const DdsOptions& options, std::string& error) {
+  if (options.domain < 0 || options.domain > 230) {
+    error = "DDS domain id " + std::to_string(options.domain) + " is out of range; use 0 to 230";
+    return false;
+  }
+  if (!(options.lease_s > 0.0)) {
+    error = "liveliness timeout must be positive";
+    return false;
+  }
+  if (!dds_config(options, config_, error)) return false;
+  // A second node in one process (tests, benches) joins the domain the first one created.
+  dds_entity_t domain = dds_create_domain(options.domain, config_.c_str());
+  if (domain < 0 && domain != DDS_RETCODE_PRECONDITION_NOT_MET) {
+    error = "cannot create DDS domain " + std::to_string(options.domain) + ": " + retcode(domain) +
+            " (check --interface and --dds-config)";
+    return false;
+  }
+  domain_ = domain > 0 ? domain : 0;
+  participant_ = dds_create_participant(options.domain, nullptr, nullptr);
+  if (participant_ < 0) {
+    error = "cannot join DDS domain " + std::to_string(options.domain) + ": " + retcode(participant_);
+    return false;
+  }
+
+  struct TopicSpec {
+    const char* name;
+    const dds_topic_descriptor_t* type;
+    bool keep_all;
+    int* writer;
+    int* reader;
+    dds_on_data_available_fn on_data;
+  };
+  TopicSpec specs[] = {
+      {"eamos_trigger", &eamos_wire_Trigger_desc, true, &w_trigger_, &r_trigger_, on_trigger},
+      {"eamos_telemetry", &eamos_wire_Telemetry_desc, false, &w_telemetry_, &r_telemetry_, on_telemetry},
+      {"eamos_lifecycle", &eamos_wire_Lifecycle_desc, false, &w_lifecycle_, &r_lifecycle_, on_lifecycle},
+      {"eamos_status", &eamos_wire_Status_desc, false, &w_status_, &r_status_, on_status},
+      {"eamos_trace", &eamos_wire_TraceRecord_desc, true, &w_trace_, &r_trace_, on_trace},
+  };
+  for (TopicSpec& spec : specs) {
+    dds_qos_t* qos = durable_qos(spec.keep_all);
+    dds_entity_t topic = dds_create_topic(participant_, spec.type, spec.name, qos, nullptr);
+    if (topic < 0) {
+      dds_delete_qos(qos);
+      error = std::string("cannot create DDS topic ") + spec.name + ": " + retcode(topic);
+      return false;
+    }
+    dds_qos_t* wqos = dds_create_qos();
+    dds_copy_qos(wqos, qos);
+    if (spec.writer == &w_status_)
+      dds_qset_liveliness(wqos, DDS_LIVELINESS_MANUAL_BY_TOPIC, DDS_SECS(1) * options.lease_s);
+    *spec.writer = dds_create_writer(participant_, topic, wqos, nullptr);
+    dds_delete_qos(wqos);
+    dds_listener_t* listener = dds_create_listener(this);
+    dds_lset_data_available(listener, spec.on_data);
+    if (spec.reader == &r_status_) dds_lset_liveliness_changed(listener, on_liveliness);
+    dds_qset_ignorelocal(qos, DDS_IGNORELOCAL_PARTICIPANT);
+    // Only the ground reads traces: a DEX does not take every other drone's events.
+    bool wanted = spec.reader != &r_trace_ || handlers_.trace != nullptr;
+    *spec.reader = wanted ? dds_create_reader(participant_, topic, qos, listener) : 0;
+    dds_delete_listener(listener);
+    dds_delete_qos(qos);
+    if (*spec.writer < 0 || *spec.reader < 0) {
+      error = std::string("cannot create DDS endpoints of ") + spec.name;
+      return false;
+    }
+  }
+  return true;
+}
+
+DdsNode::~DdsNode() {
+  // Deleting the participant stops its listeners before anything they use goes away.
+  if (participant_ > 0) dds_delete(participant_);
+  if (domain_ > 0) dds_delete(domain_);
+}
+
+bool DdsNode::write(const TriggerSample& s) {
+  eamos_wire_Trigger w = to_wire(s);
+  return dds_write(w_trigger_, &w) == DDS_RETCODE_OK;
+}
+
+bool DdsNode::write(const TelemetrySample& s) {
+  TelemetryOut out;
+  to_wire(s, out);
+  return dds_write(w_telemetry_, &out.c) == DDS_RETCODE_OK;
+}
+
+bool DdsNode::write(const LifecycleSample& s) {
+  eamos_wire_Lifecycle w = to_wire(s);
+  return dds_write(w_lifecycle_, &w) == DDS_RETCODE_OK;
+}
+
+bool DdsNode::write(const StatusSample& s) {
+  eamos_wire_Status w = to_wire(s);
+  return dds_write(w_status_, &w) == DDS_RETCODE_OK;
+}
+
+bool DdsNode::write(const TraceSample& s) {
+  eamos_wire_TraceRecord w = to_wire(s);
+  return dds_write(w_trace_, &w) == DDS_RETCODE_OK;
+}
+
+void DdsNode::assert_alive() { dds_assert_liveliness(w_status_); }
+
+bool DdsNode::flush(double timeout_s) {
+  bool ok = true;
+  for (int w : {w_trigger_, w_lifecycle_, w_status_, w_trace_})
+    ok = dds_wait_for_acks(w, static_cast<dds_duration_t>(timeout_s * 1e9)) == DDS_RETCODE_OK && ok;
+  return ok;
+}
+
+void DdsNode::take_triggers() {
+  take_all<eamos_wire_Trigger>(r_trigger_, [this](TriggerSample s) {
+    if (handlers_.trigger) handlers_.trigger(std::move(s));
+  });
+}
+
+void DdsNode::take_telemetry() {
+  take_all<eamos_wire_Telemetry>(r_telemetry_, [this](TelemetrySample s) {
+    if (handlers_.telemetry) handlers_.telemetry(std::move(s));
+  });
+}
+
+void DdsNode::take_lifecycle() {
+  take_all<eamos_wire_Lifecycle>(r_lifecycle_, [this](LifecycleSample s) {
+    if (handlers_.lifecycle) handlers_.lifecycle(std::move(s));
+  });
+}
+
+void DdsNode::take_status() {
+  std::uint64_t handle = 0;
+  take_all<eamos_wire_Status>(
+      r_status_,
+      [this, &handle](StatusSample s) {
+        {
+          std::lock_guard<std::mutex> lock(writers_mutex_);
+          status_writers_[handle] = {s.mission_hash, s.drone};
+        }
+        if (handlers_.status) handlers_.status(std::move(s));
+      },
+      [&handle](std::uint64_t h) { handle = h; });
+}
+
+void DdsNode::take_trace() {
+  take_all<eamos_wire_TraceRecord>(r_trace_, [this](TraceSample s) {
+    if (handlers_.trace) handlers_.trace(std::move(s));
+  });
+}
+
+void DdsNode::liveliness_changed(std::uint64_t publication_handle) {
+  std::pair<std::string, int> who;
+  {
+    std::lock_guard<std::mutex> lock(writers_mutex_);
+    auto it = status_writers_.find(publication_handle);
+    if (it == status_writers_.end()) return;  // a writer that never said which drone it is
+    who = it->second;
+  }
+  if (handlers_.lost) handlers_.lost(who.first, who.second);
+}
+
+}  // namespace eamos::transport

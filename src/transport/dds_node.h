@@ -1,0 +1,91 @@
+#pragma once
+// One process's place on the DDS domain: a participant with the five eamos topics, a
+// writer and a reader for each, and the QoS the guarantees rest on:
+//  - triggers: reliable, transient-local, keep-all: a reader matched late (or re-matched
+//    after a network hiccup) still gets every trigger of the run;
+//  - telemetry: reliable, transient-local, keep-last 1 per drone: newest value wins;
+//  - lifecycle and status: reliable, transient-local, keep-last 1 per (mission, drone[,
+//    kind]); the status writer offers MANUAL_BY_TOPIC liveliness with the lease, asserted
+//    by its owner's event loop, so a hung DEX is as lost as a killed one;
+//  - trace: reliable, transient-local, keep-all, for the ground's merged trace.
+// Received samples are converted and handed to the handlers on a DDS thread: handlers
+// must only post() to their event loop.
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "transport/samples.h"
+
+namespace eamos::transport {
+
+struct DdsOptions {
+  int domain = 0;
+  /// "" or "127.0.0.1": the shipped loopback configuration (config/cyclonedds-loopback.xml);
+  /// otherwise a network interface name or address, with multicast discovery.
+  std::string interface;
+  std::string config_file;  ///< a Cyclone DDS XML file of the user's, used as is
+  double lease_s = 2.0;     ///< status writer liveliness lease: how soon a lost drone is noticed
+};
+
+struct DdsHandlers {
+  std::function<void(TriggerSample)> trigger;
+  std::function<void(TelemetrySample)> telemetry;
+  std::function<void(LifecycleSample)> lifecycle;
+  std::function<void(StatusSample)> status;
+  std::function<void(TraceSample)> trace;
+  /// A status writer lost its liveliness (lease expired, or its process went away):
+  /// which mission and drone it belonged to.
+  std::function<void(const std::string& mission_hash, int drone)> lost;
+};
+
+class DdsNode {
+ public:
+  /// Joins the domain; nullptr with `error` set when Cyclone DDS refuses (bad config file,
+  /// unknown interface, domain id out of range).
+  static std::unique_ptr<DdsNode> open(const DdsOptions& options, DdsHandlers handlers, std::string& error);
+  ~DdsNode();
+  DdsNode(const DdsNode&) = delete;
+  DdsNode& operator=(const DdsNode&) = delete;
+
+  // Writers; false when DDS refused the write (logged by the caller).
+  bool write(const TriggerSample& s);
+  bool write(const TelemetrySample& s);
+  bool write(const LifecycleSample& s);
+  bool write(const StatusSample& s);
+  bool write(const TraceSample& s);
+  /// Tells the others this process is alive (MANUAL_BY_TOPIC liveliness of the status writer).
+  void assert_alive();
+  /// Waits until every reader has acknowledged what was written (before a clean exit).
+  bool flush(double timeout_s);
+  /// The configuration XML in use (for logs and tests).
+  const std::string& config() const { return config_; }
+
+  // Called from DDS listener threads.
+  void take_triggers();
+  void take_telemetry();
+  void take_lifecycle();
+  void take_status();
+  void take_trace();
+  void liveliness_changed(std::uint64_t publication_handle);
+
+ private:
+  DdsNode() = default;
+  bool create(const DdsOptions& options, std::string& error);
+
+  DdsHandlers handlers_;
+  std::string config_;
+  int domain_ = 0;
+  int participant_ = 0;
+  int w_trigger_ = 0, w_telemetry_ = 0, w_lifecycle_ = 0, w_status_ = 0, w_trace_ = 0;
+  int r_trigger_ = 0, r_telemetry_ = 0, r_lifecycle_ = 0, r_status_ = 0, r_trace_ = 0;
+  std::mutex writers_mutex_;  ///< status writer's (mission, drone), for liveliness reports
+  std::map<std::uint64_t, std::pair<std::string, int>> status_writers_;
+};
+
+/// The Cyclone DDS XML for `options` (loopback, an interface, or the user's file).
+bool dds_config(const DdsOptions& options, std::string& xml, std::string& error);
+
+}  // namespace eamos::transport

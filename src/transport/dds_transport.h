@@ -1,0 +1,32 @@
+#pragma once
+// The DEX's Transport (dex/bridge.h) over DDS: OutBridge writes triggers and telemetry as
+// samples tagged with the mission hash and run id; it counts what it sent, which the
+// status uses to tell when nothing is in flight.
+#include <cstdint>
+
+#include "dex/bridge.h"
+#include "transport/dds_node.h"
+
+namespace eamos::transport {
+
+class DdsTransport : public dex::Transport {
+ public:
+  DdsTransport(DdsNode& node, std::uint64_t run_id) : node_(node), run_id_(run_id) {}
+  void send(int to, const dex::Message& m) override {
+    TriggerSample s{run_id_, to, ++sent_, m};
+    if (!node_.write(s)) ++write_errors_;
+  }
+  void publish(std::shared_ptr<const dex::Telemetry> t) override {
+    if (!node_.write(TelemetrySample{run_id_, *t})) ++write_errors_;
+  }
+  std::uint64_t sent() const { return sent_; }
+  std::uint64_t write_errors() const { return write_errors_; }
+
+ private:
+  DdsNode& node_;
+  std::uint64_t run_id_;
+  std::uint64_t sent_ = 0;
+  std::uint64_t write_errors_ = 0;
+};
+
+}  // namespace eamos::transport

@@ -1,0 +1,72 @@
+#pragma once
+// The DDS samples as C++ values (the IDL's C structs stay inside the transport): what a
+// DEX process and the ground process exchange besides dex::Message and dex::Telemetry.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dex/bridge.h"
+#include "dex/engine.h"
+#include "dex/trace.h"
+#include "mid/drone_api.h"
+
+namespace eamos::transport {
+
+inline constexpr int kGround = -1;  ///< the `drone` of what the ground process writes
+
+struct TriggerSample {
+  std::uint64_t run_id = 0;
+  int to = 0;
+  std::uint64_t seq = 0;  ///< per sender, from 1
+  dex::Message message;   ///< carries the mission hash and the sender
+};
+
+struct TelemetrySample {
+  std::uint64_t run_id = 0;
+  dex::Telemetry telemetry;
+};
+
+enum class LifecycleKind { ready, start, abort, finished };
+const char* lifecycle_name(LifecycleKind k);
+
+struct LifecycleSample {
+  std::string mission_hash;
+  int drone = kGround;  ///< sender
+  LifecycleKind kind = LifecycleKind::ready;
+  std::uint64_t run_id = 0;
+  std::uint64_t nonce = 0;              ///< ready: the sending process, one per process start
+  std::int64_t start_at_ns = 0;         ///< start: Unix time of mission time 0
+  double speed = 1.0;                   ///< start: mission seconds per wall second
+  double t = 0.0;                       ///< abort, finished: mission time
+  std::vector<std::uint64_t> nonces;    ///< start: per drone, the process that was ready
+  std::string reason;                   ///< abort
+  std::optional<dex::Failure> failure;  ///< abort caused by a failed action
+};
+
+enum class Phase { waiting, running, completed, failed };
+const char* phase_name(Phase p);
+
+struct StatusSample {
+  std::string mission_hash;
+  int drone = 0;
+  std::uint64_t run_id = 0;
+  Phase phase = Phase::waiting;
+  bool busy = false;
+  bool end_reached = false;
+  std::uint64_t sent = 0;      ///< triggers sent
+  std::uint64_t received = 0;  ///< triggers of this run received
+  std::uint64_t activations = 0;
+  double since = 0.0;          ///< mission time the drone entered its current busy/idle state
+  mid::DroneState state;       ///< sensors not included
+};
+
+struct TraceSample {
+  std::string mission_hash;
+  std::uint64_t run_id = 0;
+  int drone = 0;
+  std::uint64_t seq = 0;  ///< per drone, from 1: the drone's own order of events
+  dex::TraceEvent event;
+};
+
+}  // namespace eamos::transport
