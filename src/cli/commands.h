@@ -40,6 +40,14 @@ int cmd_dex(const launch::DexProcessOptions& options);
 int cmd_launch(const launch::LaunchOptions& options, const RunCommandOptions& r);
 /// `eamos run --distributed`: compiles into options.dir (a temporary folder when ""), then launches.
 int cmd_run_distributed(const CommonOptions& o, const RunCommandOptions& r, launch::LaunchOptions options);
+struct SimVehicleCommandOptions {
+  int udp_port = 14540;     ///< sends to udpout://127.0.0.1:PORT, like PX4 SITL instance 0
+  std::string connection;   ///< any link URL instead of --udp; "" = use udp_port
+  int sysid = 1;
+  double speed = 1.0;       ///< mission time runs this many times as fast as the wall clock
+  double duration = 0.0;    ///< stop after this many mission seconds; 0 = until SIGINT/SIGTERM
+};
+int cmd_sim_vehicle(const SimVehicleCommandOptions& o);
 int cmd_gen_stress(long long nodes, int drones, unsigned seed, const std::string& output);
 
 /// Compiles and prints every diagnostic; true when the graphs are usable.

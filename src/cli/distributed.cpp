@@ -10,6 +10,7 @@
 #include "dex/trace_writers.h"
 #include "launch/dex_process.h"
 #include "launch/ground.h"
+#include "mavlink_adapter/adapter.h"
 #include "sim/sim_adapter.h"
 
 namespace eamos::cli {
@@ -17,6 +18,7 @@ namespace eamos::cli {
 int cmd_dex(const launch::DexProcessOptions& options) {
   mid::AdapterRegistry adapters;
   sim::register_adapter(adapters);
+  mavlink_adapter::register_adapter(adapters, {.real_time = true});  // a DEX process runs on wall time
   return launch::run_dex_process(options, adapters, std::cout, std::cerr);
 }
 

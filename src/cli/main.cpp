@@ -126,6 +126,18 @@ int main(int argc, char** argv) {
   gen->add_option("--seed", seed, "Seed of the generator (same seed, same mission)");
   gen->add_option("-o,--output", gen_out, "Output file (default: standard output)");
 
+  auto* simv = app.add_subcommand("sim-vehicle", "Run a PX4-like MAVLink vehicle on the built-in simulator (for the mavlink adapter)");
+  eamos::cli::SimVehicleCommandOptions simv_opts;
+  auto* udp = simv->add_option("--udp", simv_opts.udp_port, "Send to 127.0.0.1:PORT, like PX4 SITL (whose instance i sends to 14540 + i)")
+      ->check(CLI::Range(1, 65535));
+  simv->add_option("--connection", simv_opts.connection, "Any link URL instead: udp://:PORT, udpout://HOST:PORT or tcp://HOST:PORT")
+      ->excludes(udp);
+  simv->add_option("--sysid", simv_opts.sysid, "MAVLink system id")->check(CLI::Range(1, 255));
+  simv->add_option("--speed", simv_opts.speed, "Mission time runs X times as fast as the wall clock; the adapter's run must use the same")
+      ->check(CLI::PositiveNumber);
+  simv->add_option("--duration", simv_opts.duration, "Stop after this many mission seconds (default: until interrupted)")
+      ->check(CLI::NonNegativeNumber);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -146,6 +158,7 @@ int main(int argc, char** argv) {
     if (*run) return eamos::cli::cmd_run(o, run_opts);
     if (*launch) return eamos::cli::cmd_launch(launch_opts, launch_report);
     if (*dexcmd) return eamos::cli::cmd_dex(dex_opts);
+    if (*simv) return eamos::cli::cmd_sim_vehicle(simv_opts);
     if (*gen) return eamos::cli::cmd_gen_stress(nodes, drones, seed, gen_out);
   } catch (const std::exception& e) {
     std::cerr << "eamos: error: " << e.what() << "\n";

@@ -11,6 +11,7 @@
 #include "dex/runner.h"
 #include "dex/trace_writers.h"
 #include "graph/pipeline.h"
+#include "mavlink_adapter/adapter.h"
 #include "sim/sim_adapter.h"
 
 namespace eamos::cli {
@@ -51,6 +52,7 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   }
   mid::AdapterRegistry adapters;
   sim::register_adapter(adapters);
+  mavlink_adapter::register_adapter(adapters, {.real_time = r.realtime || r.speed > 0});
 
   dex::TeeTrace tee;
   dex::LiveLog live(std::cout);
