@@ -53,7 +53,7 @@ ActionId MavlinkDrone::start(const mid::ActionRequest& request, mid::EndCallback
   if (std::string why = refusal(request, *check.spec); !why.empty())
     return tracker_.refuse(request, std::move(on_end), why);
 
-  double timeout = mid::action_timeout(request, position(), settings_);
+  double timeout = mid::action_timeout(request, reference(), settings_);
   fleet::ActionClass cls = check.spec->action_class;
   if (cls == fleet::ActionClass::motion) clear_action_timer(tracker_.motion());  // preempted
   ActionId id = tracker_.begin(request, cls, std::move(on_end), timeout);
@@ -91,7 +91,7 @@ std::string MavlinkDrone::refusal(const mid::ActionRequest& r, const fleet::Acti
     return "orbit radius must be positive, got " + metres(a[0]);
   if (r.name == "Hover" && a.size() == 1 && a[0] < 0.0) return "hover duration must not be negative";
   if (r.name == "ReturnHome") return "";
-  if (auto goal = mid::goal_position(r, position(), settings_.home)) {
+  if (auto goal = mid::goal_position(r, reference(), settings_.home)) {
     if (goal->z <= ground_z())
       return "target z = " + metres(goal->z) + " is not above the ground (z = " +
              metres(ground_z()) + "); use Land to land";
@@ -141,11 +141,12 @@ void MavlinkDrone::start_payload(ActionId id, const mid::ActionRequest& r) {
 }
 
 void MavlinkDrone::start_motion(ActionId id, const mid::ActionRequest& r) {
+  const Vec3 here = reference();
   motion_owner_ = id;
   orbit_ = {};
   goal_.reset();
+  holding_.reset();
   until_ = Until::forever;
-  const Vec3 here = position();
   if (r.name == "Takeoff") return start_takeoff(id, r.args[0]);
   if (r.name == "Land" || r.name == "ReturnHome") {
     if (r.name == "Land" && vehicle_.landed()) {
@@ -244,6 +245,7 @@ void MavlinkDrone::stop_action(ActionId id) {
   if (id != motion_owner_) return;
   motion_owner_ = mid::kNoAction;
   goal_.reset();
+  holding_.reset();
   orbit_ = {};
   hold_here();
 }
@@ -293,6 +295,12 @@ void MavlinkDrone::failsafe(fleet::Failsafe what) {
 }
 
 // --- properties ----------------------------------------------------------------------------
+
+Vec3 MavlinkDrone::reference() const {
+  if (holding_ && mid::LocationValidator(*holding_, options_.tolerance).reached(position()))
+    return *holding_;
+  return position();
+}
 
 Vec3 MavlinkDrone::position() const {
   return vehicle_.have_position ? ned_to_mission(vehicle_.ned, settings_.home) : settings_.home;

@@ -41,7 +41,8 @@ struct MavlinkOptions {
   double setpoint_hz = 10.0;       ///< setpoint stream rate (PX4 needs > 2 Hz in OFFBOARD)
   int setpoints_before_switch = 5; ///< PX4: setpoints sent before asking for OFFBOARD
   double position_hz = 10.0;       ///< LOCAL_POSITION_NED rate asked for
-  mid::Tolerance tolerance;        ///< when a goal counts as reached
+  mid::Tolerance tolerance;        ///< when a goal counts as reached: this close ...
+  double settled_mps = 0.3;        ///< ... and no faster than this (stopped, not passing by)
 };
 
 class MavlinkDrone final : public mid::Drone {
@@ -105,6 +106,7 @@ class MavlinkDrone final : public mid::Drone {
   void switch_to_setpoint_mode();
   void publish();
   fleet::Vec3 position() const;
+  fleet::Vec3 reference() const;  ///< where relative motions start: holding_ or position()
   double ground_z() const { return settings_.home.z; }
   double sensor_value(int k) const;
 
@@ -133,6 +135,9 @@ class MavlinkDrone final : public mid::Drone {
   mid::ActionId motion_owner_ = mid::kNoAction;
   Until until_ = Until::forever;
   std::optional<mid::LocationValidator> goal_;
+  /// The goal the vehicle holds after reaching it; the next FlyBy counts from it, not from
+  /// the measured position, so the estimator's centimetres do not add up over a mission.
+  std::optional<fleet::Vec3> holding_;
   bool streaming_ = false;        ///< setpoints are the vehicle's control (else: its own modes)
   bool in_control_ = false;       ///< the vehicle entered the setpoint mode for our stream; if
                                   ///< it leaves it (a pilot, a failsafe), we do not fight it

@@ -154,13 +154,22 @@ void MavlinkDrone::request_telemetry() {
 void MavlinkDrone::check_goal() {
   if (motion_owner_ == mid::kNoAction || !tracker_.running(motion_owner_)) return;
   bool done = false;
-  if (until_ == Until::reached) done = goal_ && vehicle_.have_position && goal_->reached(position());
+  if (until_ == Until::reached)
+    done = goal_ && vehicle_.have_position && goal_->reached(position()) &&
+           norm(vehicle_.ned_velocity) <= options_.settled_mps;
   if (until_ == Until::landed) done = vehicle_.landed();
   if (!done) return;
   ActionId id = motion_owner_;
   motion_owner_ = mid::kNoAction;
+  Vec3 goal_target = goal_ ? goal_->target() : position();
   goal_.reset();
-  tracker_.end(id, Outcome::succeeded);  // setpoints, if any, keep holding the goal
+  tracker_.end(id, Outcome::succeeded);
+  if (until_ != Until::reached) return;
+  // Hold the goal with setpoints, also after a Takeoff the autopilot flew in its own mode:
+  // PX4 needs the stream before OFFBOARD, and an already running stream lets the next
+  // FlyTo start at once instead of half a second later.
+  holding_ = setpoint_ = goal_target;
+  stream_setpoints();
 }
 
 // --- sending -------------------------------------------------------------------------------

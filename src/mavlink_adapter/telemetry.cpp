@@ -29,6 +29,7 @@ Changes apply_telemetry(VehicleState& v, const ml::Frame& frame) {
     c.position = true;
     v.have_position = true;
     v.ned = {p->x, p->y, p->z};
+    v.ned_velocity = {p->vx, p->vy, p->vz};
   } else if (auto e = ml::unpack_extended_sys_state(m)) {
     v.landed_state = e->landed_state;
   } else if (auto s = ml::unpack_sys_status(m)) {

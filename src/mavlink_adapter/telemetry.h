@@ -19,6 +19,7 @@ struct VehicleState {
   uint8_t landed_state = 0;       ///< MAV_LANDED_STATE; 0 until EXTENDED_SYS_STATE arrives
   bool have_position = false;     ///< a LOCAL_POSITION_NED arrived
   fleet::Vec3 ned;                ///< m, north east down, the vehicle's local frame
+  fleet::Vec3 ned_velocity;       ///< m/s, north east down
   double battery = -1.0;          ///< %, -1 unknown
   bool have_altitude = false;     ///< a GLOBAL_POSITION_INT arrived
   double amsl_m = 0.0;            ///< altitude above mean sea level

@@ -72,6 +72,7 @@ void SimVehicle::on_command(const ml::CommandLong& c) {
   if (c.target_system != options_.sysid && c.target_system != 0) return;
   // A resend means our ACK was lost: answer again, but do not arm or take off twice.
   if (c.confirmation > 0 && has_last_ && last_command_ == c.command) return ack(c.command, last_result_);
+  if (c.command == ml::cmd::IMAGE_START_CAPTURE) return take_picture();
   uint8_t result = execute(c);
   last_command_ = c.command;
   last_result_ = result;
@@ -111,9 +112,6 @@ uint8_t SimVehicle::execute(const ml::CommandLong& c) {
       set_rate(id, us < 0 ? 0.0 : us == 0 ? options_.default_rate_hz : 1e6 / us);
       return ml::result::ACCEPTED;
     }
-    case ml::cmd::IMAGE_START_CAPTURE:
-      start("TakePicture", {});
-      return ml::result::ACCEPTED;
   }
   return ml::result::UNSUPPORTED;
 }
@@ -153,6 +151,20 @@ void SimVehicle::on_setpoint(const ml::SetPositionTargetLocalNed& sp) {
   have_setpoint_ = true;
   setpoint_at_ = loop_.now();
   fly_to_setpoint();
+}
+
+void SimVehicle::take_picture() {
+  // Acknowledged when the picture is taken (0.5 s, as in the simulator), like a camera that
+  // answers once the image is stored.
+  std::weak_ptr<bool> alive = alive_;
+  drone_.start({"TakePicture", {}}, [this, alive](const mid::ActionEnd& end) {
+    if (!alive.lock()) return;
+    uint8_t result = end.outcome == mid::Outcome::succeeded ? ml::result::ACCEPTED : ml::result::FAILED;
+    last_command_ = ml::cmd::IMAGE_START_CAPTURE;
+    last_result_ = result;
+    has_last_ = true;
+    ack(ml::cmd::IMAGE_START_CAPTURE, result);
+  });
 }
 
 void SimVehicle::fly_to_setpoint() {

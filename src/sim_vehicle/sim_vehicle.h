@@ -6,8 +6,9 @@
 //  - COMMAND_LONG answered with COMMAND_ACK: ARM_DISARM, NAV_TAKEOFF (param7 above mean
 //    sea level; refused while disarmed), NAV_LAND, NAV_RETURN_TO_LAUNCH, DO_SET_MODE
 //    (OFFBOARD only while setpoints stream, AUTO.LOITER/LAND/RTL), SET_MESSAGE_INTERVAL,
-//    IMAGE_START_CAPTURE; anything else MAV_RESULT_UNSUPPORTED. A resend (confirmation > 0)
-//    of the last command is acknowledged again, not executed twice;
+//    IMAGE_START_CAPTURE (acknowledged once the 0.5 s picture is taken); anything else
+//    MAV_RESULT_UNSUPPORTED. A resend (confirmation > 0) of the last command is
+//    acknowledged again, not executed twice;
 //  - SET_POSITION_TARGET_LOCAL_NED flown in OFFBOARD; setpoints older than 1 s there fall
 //    back to AUTO.LOITER (PX4's offboard loss failsafe, COM_OF_LOSS_T);
 //  - telemetry (LOCAL_POSITION_NED, EXTENDED_SYS_STATE, SYS_STATUS, BATTERY_STATUS,
@@ -51,6 +52,7 @@ class SimVehicle {
   void on_command(const mavlink::CommandLong& c);
   uint8_t execute(const mavlink::CommandLong& c);  ///< the MAV_RESULT to acknowledge with
   uint8_t set_mode(uint32_t mode);
+  void take_picture();
   void on_setpoint(const mavlink::SetPositionTargetLocalNed& sp);
   void fly_to_setpoint();
   void start(const std::string& action, std::vector<double> args, uint32_t mode_after = 0);
