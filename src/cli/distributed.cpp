@@ -18,7 +18,8 @@ namespace eamos::cli {
 int cmd_dex(const launch::DexProcessOptions& options) {
   mid::AdapterRegistry adapters;
   sim::register_adapter(adapters);
-  mavlink_adapter::register_adapter(adapters, {.real_time = true});  // a DEX process runs on wall time
+  // A DEX process always runs on wall time (scaled by its --speed).
+  mavlink_adapter::register_adapter(adapters, {.real_time = true, .speed = options.speed});
   return launch::run_dex_process(options, adapters, std::cout, std::cerr);
 }
 

@@ -52,7 +52,8 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   }
   mid::AdapterRegistry adapters;
   sim::register_adapter(adapters);
-  mavlink_adapter::register_adapter(adapters, {.real_time = r.realtime || r.speed > 0});
+  mavlink_adapter::register_adapter(adapters, {.real_time = r.realtime || r.speed > 0,
+                                               .speed = r.speed > 0 ? r.speed : 1.0});
 
   dex::TeeTrace tee;
   dex::LiveLog live(std::cout);

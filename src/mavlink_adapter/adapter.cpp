@@ -22,7 +22,11 @@ void register_adapter(mid::AdapterRegistry& registry, MavlinkOptions options) {
           return failed("no `connection:` in the fleet file, e.g. connection: udp://:14540");
         mavlink::EndpointResult url = mavlink::parse_url(settings.connection);
         if (!url.endpoint) return failed(url.error);
-        auto drone = std::make_unique<MavlinkDrone>(settings, type, loop, options);
+        MavlinkOptions scaled = options;  // wall-clock budgets into mission seconds
+        scaled.link_timeout_s *= options.speed;
+        scaled.commands.ack_timeout_s *= options.speed;
+        scaled.commands.in_progress_s *= options.speed;
+        auto drone = std::make_unique<MavlinkDrone>(settings, type, loop, scaled);
         if (std::string error = drone->connect(*url.endpoint); !error.empty()) return failed(error);
         return {mid::CreateStatus::success, std::move(drone), ""};
       });

@@ -35,9 +35,13 @@ namespace eamos::mavlink_adapter {
 struct MavlinkOptions {
   bool real_time = false;          ///< the loop runs in real time: required (a real vehicle
                                    ///< cannot follow virtual time)
+  /// Mission seconds per wall second of the loop (--speed). The link's budgets below are
+  /// wall-clock (network, scheduling), so register_adapter scales them by it; a vehicle sped
+  /// up as much then gets the same slack in wall time as a real one.
+  double speed = 1.0;
   double connect_timeout_s = 10.0; ///< wall seconds to wait for the vehicle's first HEARTBEAT
-  double link_timeout_s = 3.0;     ///< mission seconds without a HEARTBEAT = link lost
-  CommandOptions commands;
+  double link_timeout_s = 3.0;     ///< wall seconds without a HEARTBEAT = link lost
+  CommandOptions commands;         ///< ACK timeouts in wall seconds
   double setpoint_hz = 10.0;       ///< setpoint stream rate (PX4 needs > 2 Hz in OFFBOARD)
   int setpoints_before_switch = 5; ///< PX4: setpoints sent before asking for OFFBOARD
   double position_hz = 10.0;       ///< LOCAL_POSITION_NED rate asked for

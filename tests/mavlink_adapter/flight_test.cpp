@@ -20,6 +20,7 @@ struct Flight {
 
   explicit Flight(int port, MavlinkOptions options = {}) {
     options.real_time = true;
+    options.speed = kSpeed;
     register_adapter(registry, options);
     fleet::DroneSettings s;
     s.name = "Drone1";
@@ -87,7 +88,7 @@ TEST(MavlinkFlight, TakeoffWhileDisarmedFailsWithTheAutopilotsResult) {
 TEST(MavlinkFlight, LinkLossFailsTheRunningAction) {
   test::VehicleThread vehicle(25314, 1, kSpeed);
   MavlinkOptions options;
-  options.link_timeout_s = 2.0;
+  options.link_timeout_s = 0.5;  // wall seconds: 2 mission seconds at 4×
   Flight f(25314, options);
   ASSERT_TRUE(f.drone) << f.created.message;
   ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
