@@ -2,6 +2,11 @@
 // the tests hand frames over through a small mailbox and wait for them with a deadline.
 #include <gtest/gtest.h>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
@@ -66,6 +71,50 @@ TEST(UdpLink, PortInUseIsAClearError) {
   EXPECT_FALSE(second.link);
   EXPECT_NE(second.error.find("udp://127.0.0.1:25302"), std::string::npos) << second.error;
   EXPECT_NE(second.error.find("bind"), std::string::npos) << second.error;
+}
+
+/// A one-connection TCP server on loopback, standing in for ArduPilot SITL's port 5760.
+struct TcpServer {
+  int listener = -1;
+  explicit TcpServer(uint16_t port) {
+    listener = socket(AF_INET, SOCK_STREAM, 0);
+    int yes = 1;
+    setsockopt(listener, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(port);
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    bind(listener, reinterpret_cast<sockaddr*>(&a), sizeof a);
+    listen(listener, 1);
+  }
+  ~TcpServer() { close(listener); }
+};
+
+TEST(TcpLink, CarriesFramesBothWaysInAnyChunking) {
+  TcpServer server(25304);
+  Mailbox adapter_side;
+  OpenResult r = Link::open(endpoint("tcp://127.0.0.1:25304"), adapter_side.handler());
+  ASSERT_TRUE(r.link) << r.error;
+  int conn = accept(server.listener, nullptr, nullptr);
+  ASSERT_GE(conn, 0);
+
+  // Two frames written as three pieces: TCP is a byte stream, not a message stream.
+  Encoder vehicle{3, 1};
+  std::vector<uint8_t> bytes = vehicle.encode(pack(Heartbeat{}));
+  std::vector<uint8_t> second = vehicle.encode(pack(ExtendedSysState{0, 2}));
+  bytes.insert(bytes.end(), second.begin(), second.end());
+  ASSERT_EQ(write(conn, bytes.data(), 5), 5);
+  ASSERT_EQ(write(conn, bytes.data() + 5, 12), 12);
+  ASSERT_EQ(write(conn, bytes.data() + 17, bytes.size() - 17), ssize_t(bytes.size() - 17));
+  ASSERT_TRUE(adapter_side.wait_for(2));
+  EXPECT_EQ(unpack_extended_sys_state(adapter_side.frames[1].message)->landed_state, 2);
+
+  std::vector<uint8_t> ack = Encoder{3, 191}.encode(pack(CommandAck{22, 0}));
+  ASSERT_TRUE(r.link->send(ack));
+  std::vector<uint8_t> got(ack.size());
+  ASSERT_EQ(read(conn, got.data(), got.size()), ssize_t(ack.size()));
+  EXPECT_EQ(got, ack);
+  close(conn);
 }
 
 TEST(TcpLink, RefusedConnectionNamesTheUrl) {
