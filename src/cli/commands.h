@@ -44,6 +44,7 @@ struct SimVehicleCommandOptions {
   int udp_port = 14540;     ///< sends to udpout://127.0.0.1:PORT, like PX4 SITL instance 0
   std::string connection;   ///< any link URL instead of --udp; "" = use udp_port
   int sysid = 1;
+  std::string autopilot = "px4";  ///< "px4" or "ardupilot": whose modes and rules it plays
   double speed = 1.0;       ///< mission time runs this many times as fast as the wall clock
   double duration = 0.0;    ///< stop after this many mission seconds; 0 = until SIGINT/SIGTERM
 };

@@ -133,6 +133,8 @@ int main(int argc, char** argv) {
   simv->add_option("--connection", simv_opts.connection, "Any link URL instead: udp://:PORT, udpout://HOST:PORT or tcp://HOST:PORT")
       ->excludes(udp);
   simv->add_option("--sysid", simv_opts.sysid, "MAVLink system id")->check(CLI::Range(1, 255));
+  simv->add_option("--autopilot", simv_opts.autopilot, "Whose modes and rules to play: px4 (OFFBOARD) or ardupilot (Copter, GUIDED)")
+      ->check(CLI::IsMember({"px4", "ardupilot"}));
   simv->add_option("--speed", simv_opts.speed, "Mission time runs X times as fast as the wall clock; the adapter's run must use the same")
       ->check(CLI::PositiveNumber);
   simv->add_option("--duration", simv_opts.duration, "Stop after this many mission seconds (default: until interrupted)")

@@ -1,4 +1,4 @@
-// `eamos sim-vehicle`: one PX4-like MAVLink vehicle on the built-in simulator, in real time,
+// `eamos sim-vehicle`: one PX4-like (or ArduPilot-like) MAVLink vehicle on the built-in simulator, in real time,
 // until interrupted or its --duration ends. Stands in for PX4 SITL in tests and demos.
 #include <csignal>
 #include <iostream>
@@ -26,12 +26,14 @@ int cmd_sim_vehicle(const SimVehicleCommandOptions& o) {
   mid::EventLoop loop({mid::ClockMode::real_time, o.speed});
   sim_vehicle::VehicleOptions options;
   options.sysid = static_cast<uint8_t>(o.sysid);
+  options.dialect = o.autopilot == "ardupilot" ? &sim_vehicle::ardupilot_dialect() : &sim_vehicle::px4_dialect();
   sim_vehicle::SimVehicle vehicle(loop, options);
   if (std::string error = vehicle.open(*endpoint.endpoint); !error.empty()) {
     std::cerr << "eamos: error: " << error << "\n";
     return 1;
   }
-  std::cout << "sim-vehicle: system " << o.sysid << " (PX4-like) on " << url << std::endl;
+  std::cout << "sim-vehicle: system " << o.sysid << " (" << options.dialect->name << "-like) on " << url
+            << std::endl;
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   // Short slices, so a signal is noticed within a quarter of a (mission) second.

@@ -31,12 +31,28 @@ const uint32_t kStreamed[] = {ml::msg::LOCAL_POSITION_NED, ml::msg::EXTENDED_SYS
 
 }  // namespace
 
+const Dialect& px4_dialect() {
+  static const Dialect d{"PX4", ml::autopilot::PX4,
+                         {px4::mode(px4::MAIN_POSCTL), px4::LOITER, px4::OFFBOARD, px4::TAKEOFF,
+                          px4::LAND, px4::RTL},
+                         Mode::hold, true, true, false, true, true, Mode::hold};
+  return d;
+}
+
+const Dialect& ardupilot_dialect() {
+  // ArduCopter: STABILIZE 0, GUIDED 4, LOITER 5, RTL 6, LAND 9; a GUIDED takeoff stays GUIDED.
+  static const Dialect d{"ArduPilot", ml::autopilot::ARDUPILOTMEGA, {0, 5, 4, 4, 9, 6},
+                         Mode::manual, false, false, true, false, false, Mode::setpoint};
+  return d;
+}
+
 SimVehicle::SimVehicle(mid::EventLoop& loop, VehicleOptions options)
     : loop_(loop),
       options_(options),
       drone_(vehicle_settings(options.sysid), fleet::generic_multirotor("Quad"), loop),
       encoder_{options.sysid, ml::comp::AUTOPILOT1, 0},
-      mode_(px4::LOITER) {}
+      dialect_(*options.dialect),
+      mode_(dialect_.boot) {}
 
 SimVehicle::~SimVehicle() {
   link_.reset();
@@ -93,16 +109,20 @@ uint8_t SimVehicle::execute(const ml::CommandLong& c) {
     }
     case ml::cmd::NAV_TAKEOFF: {
       if (!s.armed || !s.landed) return ml::result::DENIED;
-      double alt = std::isnan(c.param[6]) ? 2.5 : c.param[6] - options_.home_amsl_m;
+      if (dialect_.takeoff_in_setpoint_mode && mode_ != Mode::setpoint) return ml::result::DENIED;
+      double alt = std::isnan(c.param[6]) ? 2.5 : c.param[6];
+      if (dialect_.takeoff_altitude_amsl && !std::isnan(c.param[6])) alt -= options_.home_amsl_m;
       if (!(alt > 0.0) || alt > 120.0) return ml::result::DENIED;
-      mode_ = px4::TAKEOFF;
-      start("Takeoff", {alt}, px4::LOITER);
+      mode_ = Mode::takeoff;
+      start("Takeoff", {alt}, dialect_.after_takeoff);
       return ml::result::ACCEPTED;
     }
-    case ml::cmd::NAV_LAND: return set_mode(px4::LAND);
-    case ml::cmd::NAV_RETURN_TO_LAUNCH: return set_mode(px4::RTL);
-    case ml::cmd::DO_SET_MODE:
-      return set_mode(px4::mode(static_cast<uint8_t>(c.param[1]), static_cast<uint8_t>(c.param[2])));
+    case ml::cmd::NAV_LAND: return set_mode(Mode::land);
+    case ml::cmd::NAV_RETURN_TO_LAUNCH: return set_mode(Mode::rtl);
+    case ml::cmd::DO_SET_MODE: {
+      Mode m;
+      return requested_mode(c, m) ? set_mode(m) : ml::result::DENIED;
+    }
     case ml::cmd::SET_MESSAGE_INTERVAL: {
       auto id = static_cast<uint32_t>(c.param[0]);
       bool known = false;
@@ -116,31 +136,47 @@ uint8_t SimVehicle::execute(const ml::CommandLong& c) {
   return ml::result::UNSUPPORTED;
 }
 
-uint8_t SimVehicle::set_mode(uint32_t mode) {
+bool SimVehicle::requested_mode(const ml::CommandLong& c, Mode& out) const {
+  auto p2 = static_cast<uint32_t>(c.param[1]), p3 = static_cast<uint32_t>(c.param[2]);
+  uint32_t custom = dialect_.main_sub_modes ? (p2 << 16 | p3 << 24) : p2;
+  for (int m = 0; m < kModes; ++m)
+    if (dialect_.custom_mode[m] == custom && Mode(m) != Mode::takeoff) {
+      out = Mode(m);
+      return true;
+    }
+  return false;
+}
+
+uint8_t SimVehicle::set_mode(Mode mode) {
   mid::DroneState s = drone_.state();
   switch (mode) {
-    case px4::OFFBOARD:
+    case Mode::setpoint:
       // PX4's rule: no switch to OFFBOARD unless setpoints are already streaming.
-      if (!have_setpoint_ || loop_.now() - setpoint_at_ > options_.offboard_loss_s)
+      if (dialect_.setpoints_before_switch &&
+          (!have_setpoint_ || loop_.now() - setpoint_at_ > options_.offboard_loss_s))
         return ml::result::DENIED;
-      mode_ = px4::OFFBOARD;
+      mode_ = Mode::setpoint;
       flying_ = false;
+      if (!s.landed) start("Hover", {});  // hold until a setpoint says otherwise
       fly_to_setpoint();
       check_offboard();
       return ml::result::ACCEPTED;
-    case px4::LOITER:
-      mode_ = px4::LOITER;
+    case Mode::hold:
+    case Mode::manual:
+      mode_ = mode;
       if (!s.landed) start("Hover", {});
       return ml::result::ACCEPTED;
-    case px4::LAND:
-      mode_ = px4::LAND;
+    case Mode::land:
+      mode_ = Mode::land;
       if (!s.landed) start("Land", {});
       return ml::result::ACCEPTED;
-    case px4::RTL:
+    case Mode::rtl:
       if (s.landed || !s.armed) return ml::result::DENIED;
-      mode_ = px4::RTL;
+      mode_ = Mode::rtl;
       start("ReturnHome", {});
       return ml::result::ACCEPTED;
+    case Mode::takeoff:
+      break;
   }
   return ml::result::DENIED;
 }
@@ -168,7 +204,7 @@ void SimVehicle::take_picture() {
 }
 
 void SimVehicle::fly_to_setpoint() {
-  if (mode_ != px4::OFFBOARD || !have_setpoint_) return;
+  if (mode_ != Mode::setpoint || !have_setpoint_) return;
   if (flying_ && flying_to_ == setpoint_) return;
   flying_to_ = setpoint_;
   flying_ = true;
@@ -178,21 +214,22 @@ void SimVehicle::fly_to_setpoint() {
 void SimVehicle::check_offboard() {
   loop_.cancel(offboard_timer_);
   offboard_timer_ = mid::kNoTimer;
-  if (mode_ != px4::OFFBOARD) return;
+  if (mode_ != Mode::setpoint || !dialect_.setpoint_loss_holds) return;
   if (loop_.now() - setpoint_at_ > options_.offboard_loss_s) {
-    set_mode(px4::LOITER);  // the companion went quiet: hold where we are
+    set_mode(Mode::hold);  // the companion went quiet: hold where we are
     return;
   }
   offboard_timer_ = loop_.after(0.2, [this] { check_offboard(); });
 }
 
-void SimVehicle::start(const std::string& action, std::vector<double> args, uint32_t mode_after) {
+void SimVehicle::start(const std::string& action, std::vector<double> args,
+                       std::optional<Mode> mode_after) {
   std::weak_ptr<bool> alive = alive_;
   drone_.start({action, std::move(args)}, [this, alive, action, mode_after](const mid::ActionEnd& end) {
     if (!alive.lock()) return;
     if (action == "FlyTo" && end.outcome != mid::Outcome::preempted) flying_ = false;
     if (end.outcome != mid::Outcome::succeeded) return;
-    if (mode_after != 0) mode_ = mode_after;
+    if (mode_after) mode_ = *mode_after;
     if (action == "Land" || action == "ReturnHome") after_touchdown();
   });
 }
@@ -247,8 +284,8 @@ ml::Message SimVehicle::telemetry(uint32_t id) const {
     case ml::msg::EXTENDED_SYS_STATE: {
       ml::ExtendedSysState e;
       e.landed_state = s.landed                ? ml::landed::ON_GROUND
-                       : mode_ == px4::TAKEOFF ? ml::landed::TAKEOFF
-                       : mode_ == px4::LAND    ? ml::landed::LANDING
+                       : mode_ == Mode::takeoff ? ml::landed::TAKEOFF
+                       : mode_ == Mode::land    ? ml::landed::LANDING
                                                : ml::landed::IN_AIR;
       return ml::pack(e);
     }
@@ -277,9 +314,9 @@ ml::Message SimVehicle::telemetry(uint32_t id) const {
   }
   ml::Heartbeat hb;
   hb.type = ml::mav_type::QUADROTOR;
-  hb.autopilot = ml::autopilot::PX4;
+  hb.autopilot = dialect_.mav_autopilot;
   hb.base_mode = ml::mode_flag::CUSTOM_MODE_ENABLED | (s.armed ? ml::mode_flag::SAFETY_ARMED : 0);
-  hb.custom_mode = mode_;
+  hb.custom_mode = dialect_.custom_mode[static_cast<int>(mode_)];
   hb.system_status = s.armed ? ml::state::ACTIVE : ml::state::STANDBY;
   return ml::pack(hb);
 }

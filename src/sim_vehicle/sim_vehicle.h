@@ -1,7 +1,8 @@
 #pragma once
 // A PX4-like MAVLink vehicle on top of the built-in simulator, so the mavlink adapter is
 // tested end to end without PX4: `eamos sim-vehicle` and the adapter tests run it. It
-// behaves like PX4 where the adapter depends on it, and is simpler everywhere else:
+// behaves like PX4 where the adapter depends on it, and is simpler everywhere else (with the
+// ArduPilot dialect, like ArduPilot Copter's GUIDED rules instead):
 //  - HEARTBEAT at 1 Hz (MAV_AUTOPILOT_PX4, PX4 custom modes, armed flag);
 //  - COMMAND_LONG answered with COMMAND_ACK: ARM_DISARM, NAV_TAKEOFF (param7 above mean
 //    sea level; refused while disarmed), NAV_LAND, NAV_RETURN_TO_LAUNCH, DO_SET_MODE
@@ -17,6 +18,7 @@
 // Its local NED origin is its home; it runs on its own event loop in real time.
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "mavlink/link.h"
@@ -26,7 +28,30 @@
 
 namespace eamos::sim_vehicle {
 
+/// What the vehicle is doing, whatever the autopilot calls it.
+enum class Mode : uint8_t { manual, hold, setpoint, takeoff, land, rtl };
+inline constexpr int kModes = 6;
+
+/// How one autopilot names and rules its modes: the vehicle plays PX4 or ArduPilot Copter.
+/// This is the vehicle's own description, written from the autopilots' documentation and
+/// deliberately not shared with the adapter's table, so the tests compare two readings.
+struct Dialect {
+  const char* name;
+  uint8_t mav_autopilot;
+  uint32_t custom_mode[kModes];  ///< HEARTBEAT custom_mode per Mode
+  Mode boot;                     ///< mode at start
+  bool main_sub_modes;           ///< PX4: DO_SET_MODE param2 main, param3 sub; else param2 = mode
+  bool takeoff_altitude_amsl;    ///< NAV_TAKEOFF param7 above sea level (PX4) or home (ArduPilot)
+  bool takeoff_in_setpoint_mode; ///< ArduPilot Copter: NAV_TAKEOFF only in GUIDED
+  bool setpoints_before_switch;  ///< PX4: no OFFBOARD without a setpoint stream
+  bool setpoint_loss_holds;      ///< PX4: OFFBOARD falls back to hold when setpoints stop
+  Mode after_takeoff;            ///< PX4: AUTO.LOITER; ArduPilot: stays in GUIDED
+};
+const Dialect& px4_dialect();
+const Dialect& ardupilot_dialect();
+
 struct VehicleOptions {
+  const Dialect* dialect = &px4_dialect();
   uint8_t sysid = 1;
   double home_amsl_m = 488.0;      ///< ground altitude above mean sea level (PX4 SITL's Zurich)
   double offboard_loss_s = 1.0;    ///< OFFBOARD without a fresh setpoint this long: hold
@@ -44,18 +69,21 @@ class SimVehicle {
   /// Opens the link and starts heartbeats and telemetry; "" on success, else why not.
   std::string open(const mavlink::Endpoint& endpoint);
 
-  uint32_t mode() const { return mode_; }
+  Mode mode() const { return mode_; }
   const sim::SimDrone& drone() const { return drone_; }
 
  private:
   void on_frame(const mavlink::Frame& frame);
   void on_command(const mavlink::CommandLong& c);
   uint8_t execute(const mavlink::CommandLong& c);  ///< the MAV_RESULT to acknowledge with
-  uint8_t set_mode(uint32_t mode);
+  uint8_t set_mode(Mode mode);
+  /// The Mode a DO_SET_MODE asks for; false when the dialect has no such mode.
+  bool requested_mode(const mavlink::CommandLong& c, Mode& out) const;
   void take_picture();
   void on_setpoint(const mavlink::SetPositionTargetLocalNed& sp);
   void fly_to_setpoint();
-  void start(const std::string& action, std::vector<double> args, uint32_t mode_after = 0);
+  void start(const std::string& action, std::vector<double> args,
+             std::optional<Mode> mode_after = std::nullopt);
   void ack(uint16_t command, uint8_t result);
   void after_touchdown();
   void check_offboard();
@@ -72,7 +100,8 @@ class SimVehicle {
   std::unique_ptr<mavlink::Link> link_;
   mavlink::Encoder encoder_;
 
-  uint32_t mode_;                       ///< PX4 custom_mode
+  const Dialect& dialect_;
+  Mode mode_;
   fleet::Vec3 setpoint_;                ///< mission frame of the simulator (x east, y north, z up)
   bool have_setpoint_ = false;
   double setpoint_at_ = -1e9;           ///< loop time of the newest setpoint

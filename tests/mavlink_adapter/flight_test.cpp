@@ -76,6 +76,25 @@ TEST(MavlinkFlight, ArmTakeoffFlyAndLand) {
   EXPECT_NEAR(f.drone->state().z, 0.0, 0.1);
 }
 
+TEST(MavlinkFlight, ArduPilotTakesOffInGuidedToAnAltitudeAboveHome) {
+  test::VehicleThread vehicle(25318, 1, kSpeed, sim_vehicle::ardupilot_dialect());
+  Flight f(25318);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  EXPECT_STREQ(dynamic_cast<MavlinkDrone*>(f.drone.get())->autopilot()->name, "ArduPilot");
+  ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
+  mid::ActionEnd e = f.fly("Takeoff", {4});
+  ASSERT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
+  EXPECT_NEAR(f.drone->state().z, 4.0, 0.3);
+  e = f.fly("FlyTo", {-3, 2, 5});
+  ASSERT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
+  EXPECT_NEAR(f.drone->state().x, -3.0, 0.5);
+  EXPECT_NEAR(f.drone->state().y, 2.0, 0.5);
+  e = f.fly("ReturnHome");
+  ASSERT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
+  EXPECT_TRUE(f.drone->state().landed);
+  EXPECT_NEAR(f.drone->state().x, 0.0, 0.5);
+}
+
 TEST(MavlinkFlight, TakeoffWhileDisarmedFailsWithTheAutopilotsResult) {
   test::VehicleThread vehicle(25313, 1, kSpeed);
   Flight f(25313);
