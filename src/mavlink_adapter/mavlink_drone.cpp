@@ -203,8 +203,8 @@ void MavlinkDrone::start_takeoff(ActionId id, double altitude) {
   if (!autopilot_->takeoff_in_setpoint_mode || vehicle_.custom_mode == autopilot_->setpoint_mode)
     return command_motion(id, ml::cmd::NAV_TAKEOFF, p);
   auto params = set_mode_params(*autopilot_, autopilot_->setpoint_mode);
-  commands_.send(command(ml::cmd::DO_SET_MODE, {params[0], params[1], params[2]}),
-                 [this, id, p](const CommandResult& result) {
+  send_mode_command(command(ml::cmd::DO_SET_MODE, {params[0], params[1], params[2]}),
+                    [this, id, p](const CommandResult& result) {
                    if (!tracker_.running(id)) return;
                    if (!result.accepted) return end_refused(id, result);
                    command_motion(id, ml::cmd::NAV_TAKEOFF, p);
@@ -212,7 +212,7 @@ void MavlinkDrone::start_takeoff(ActionId id, double altitude) {
 }
 
 void MavlinkDrone::command_motion(ActionId id, uint16_t cmd, std::array<float, 7> params) {
-  commands_.send(command(cmd, params), [this, id](const CommandResult& result) {
+  send_mode_command(command(cmd, params), [this, id](const CommandResult& result) {
     if (!tracker_.running(id)) return;
     if (!result.accepted) return end_refused(id, result);
     // The autopilot flies this one in its own mode: stop the setpoints only now, so a
@@ -289,8 +289,10 @@ void MavlinkDrone::failsafe(fleet::Failsafe what) {
   }
   if (what == fleet::Failsafe::hover) return hold_here();
   uint16_t cmd = what == fleet::Failsafe::land ? ml::cmd::NAV_LAND : ml::cmd::NAV_RETURN_TO_LAUNCH;
-  commands_.send(command(cmd), [this](const CommandResult& result) {
-    if (result.accepted) streaming_ = false;  // refused: keep holding where it is
+  send_mode_command(command(cmd), [this](const CommandResult& result) {
+    if (!result.accepted) return;  // refused: keep holding where it is
+    streaming_ = false;
+    in_control_ = false;
   });
 }
 

@@ -108,6 +108,7 @@ class MavlinkDrone final : public mid::Drone {
   void stream_tick();
   void advance_orbit(double dt);
   void switch_to_setpoint_mode();
+  void send_mode_command(mavlink::CommandLong c, CommandDone done);
   void publish();
   fleet::Vec3 position() const;
   fleet::Vec3 reference() const;  ///< where relative motions start: holding_ or position()
@@ -148,7 +149,10 @@ class MavlinkDrone final : public mid::Drone {
   fleet::Vec3 setpoint_;          ///< mission frame
   Orbit orbit_;
   int setpoints_sent_ = 0;
-  bool mode_switch_pending_ = false;
+  /// Commands in flight that change the flight mode (DO_SET_MODE, NAV_TAKEOFF, NAV_LAND,
+  /// NAV_RETURN_TO_LAUNCH): meanwhile a HEARTBEAT in another mode is expected, not a takeover,
+  /// and the stream does not ask for the setpoint mode again.
+  int mode_commands_pending_ = 0;
 
   std::map<mid::ActionId, mid::TimerId> action_timers_;  ///< Hover(s), SensorK
   mid::TimerId stream_timer_ = mid::kNoTimer;

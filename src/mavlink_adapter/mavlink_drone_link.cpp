@@ -101,7 +101,7 @@ void MavlinkDrone::on_heartbeat() {
   link_lost_ = false;
   link_watchdog();
   if (!telemetry_requested_) request_telemetry();
-  if (streaming_ && in_control_ && !mode_switch_pending_ &&
+  if (streaming_ && in_control_ && mode_commands_pending_ == 0 &&
       vehicle_.custom_mode != autopilot_->setpoint_mode) {
     // Someone else (a pilot's switch, the autopilot's own failsafe) took the vehicle out of
     // the setpoint mode: give way instead of switching back.
@@ -222,7 +222,7 @@ void MavlinkDrone::stream_tick() {
   sp.z = static_cast<float>(ned.z);
   send(ml::pack(sp));
   ++setpoints_sent_;
-  if (!in_control_ && !mode_switch_pending_ &&
+  if (!in_control_ && mode_commands_pending_ == 0 &&
       (!autopilot_->stream_before_switch || setpoints_sent_ >= options_.setpoints_before_switch))
     switch_to_setpoint_mode();
   stream_timer_ = loop_.after(dt, [this] { stream_tick(); });
@@ -233,10 +233,8 @@ void MavlinkDrone::switch_to_setpoint_mode() {
     in_control_ = true;
     return;
   }
-  mode_switch_pending_ = true;
   auto p = set_mode_params(*autopilot_, autopilot_->setpoint_mode);
-  commands_.send(command(ml::cmd::DO_SET_MODE, {p[0], p[1], p[2]}), [this](const CommandResult& r) {
-    mode_switch_pending_ = false;
+  send_mode_command(command(ml::cmd::DO_SET_MODE, {p[0], p[1], p[2]}), [this](const CommandResult& r) {
     if (r.accepted) {
       in_control_ = true;
       vehicle_.custom_mode = autopilot_->setpoint_mode;  // until the next HEARTBEAT says otherwise
@@ -251,6 +249,14 @@ void MavlinkDrone::switch_to_setpoint_mode() {
     tracker_.end(id, Outcome::failed,
                  std::string("switch to ") + autopilot_->setpoint_mode_name + " refused by " +
                      autopilot_->name + ": " + r.error);
+  });
+}
+
+void MavlinkDrone::send_mode_command(ml::CommandLong c, CommandDone done) {
+  ++mode_commands_pending_;
+  commands_.send(c, [this, done = std::move(done)](const CommandResult& r) {
+    --mode_commands_pending_;
+    if (done) done(r);
   });
 }
 

@@ -147,6 +147,28 @@ TEST(MavlinkFlight, OrbitRunsUntilCancelledThenHolds) {
   EXPECT_EQ(end->outcome, mid::Outcome::cancelled);
 }
 
+TEST(MavlinkFlight, FailsafeLandCancelsTheFlightLandsAndRefusesMore) {
+  test::VehicleThread vehicle(25319, 1, kSpeed);
+  Flight f(25319);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
+  ASSERT_EQ(f.fly("Takeoff", {3}).outcome, mid::Outcome::succeeded);
+  std::optional<mid::ActionEnd> end;
+  f.drone->start({"FlyTo", {30, 0, 3}}, [&](const mid::ActionEnd& e) { end = e; });
+  f.loop.run_until(f.loop.now() + 1.0);
+  f.drone->failsafe(fleet::Failsafe::land);
+  f.loop.run_until(f.loop.now() + 0.1);
+  ASSERT_TRUE(end);
+  EXPECT_EQ(end->outcome, mid::Outcome::cancelled);
+  EXPECT_EQ(end->reason, "failsafe: land");
+  for (int i = 0; i < 100 && !f.drone->state().landed; ++i) f.loop.run_until(f.loop.now() + 0.5);
+  EXPECT_TRUE(f.drone->state().landed);
+  EXPECT_LT(f.drone->state().x, 29.0);  // landed where it was, not at the target
+  mid::ActionEnd refused = f.fly("Takeoff", {3});
+  EXPECT_EQ(refused.outcome, mid::Outcome::failed);
+  EXPECT_EQ(refused.reason, "failsafe active (failsafe: land)");
+}
+
 TEST(MavlinkAdapter, NoVehicleIsACreateErrorThatSaysWhatToCheck) {
   MavlinkOptions options;
   options.connect_timeout_s = 0.3;
