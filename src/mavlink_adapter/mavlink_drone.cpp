@@ -3,6 +3,7 @@
 // mavlink_drone_link.cpp.
 #include "mavlink_adapter/mavlink_drone.h"
 
+#include <cmath>
 #include <cstdio>
 
 #include "mavlink/enums.h"
