@@ -11,7 +11,7 @@ if [ ! -f "$BUILD/build.ninja" ]; then
   CC=clang CXX=clang++ cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DEAMOS_FUZZ=ON -DEAMOS_TESTS=OFF -DEAMOS_BENCH=OFF >/dev/null
 fi
-cmake --build "$BUILD" -j "$(nproc)" --target fuzz_frontend fuzz_fleet
+cmake --build "$BUILD" -j "$(nproc)" --target fuzz_frontend fuzz_fleet fuzz_mavlink
 
 run() {
   local target=$1 seeds=$2
@@ -31,4 +31,5 @@ run() {
 
 run fuzz_frontend "examples/*.eamos tests/lang/diagnostics/*.eamos"
 run fuzz_fleet "tests/fleet/data/*.yaml examples/*.yaml"
-echo "fuzz: both targets ran without a crash, hang or leak"
+run fuzz_mavlink "tests/fuzz/mavlink-seeds/*"
+echo "fuzz: every target ran without a crash, hang or leak"
