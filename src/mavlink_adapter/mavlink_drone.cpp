@@ -3,6 +3,7 @@
 // mavlink_drone_link.cpp.
 #include "mavlink_adapter/mavlink_drone.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -143,6 +144,7 @@ void MavlinkDrone::start_payload(ActionId id, const mid::ActionRequest& r) {
 
 void MavlinkDrone::start_motion(ActionId id, const mid::ActionRequest& r) {
   const Vec3 here = reference();
+  motion_start_ = position();
   motion_owner_ = id;
   orbit_ = {};
   goal_.reset();
@@ -298,6 +300,29 @@ void MavlinkDrone::failsafe(fleet::Failsafe what) {
 }
 
 // --- properties ----------------------------------------------------------------------------
+
+double MavlinkDrone::remaining(Vec3 from) const {
+  if (goal_) return norm(goal_->target() - from);
+  // Land and ReturnHome: what is left is the way home (ReturnHome only) and the way down.
+  double across = 0.0;
+  const mid::ActionRequest* r = tracker_.request(motion_owner_);
+  if (r && r->name == "ReturnHome") across = horizontal_norm(from - settings_.home);
+  return across + std::max(0.0, from.z - ground_z());
+}
+
+std::optional<double> MavlinkDrone::progress(ActionId id) const {
+  const mid::ActionRequest* r = tracker_.request(id);
+  if (!r || mid::is_endless(*r)) return std::nullopt;
+  double fraction = 0.0;
+  if (id == motion_owner_ && until_ != Until::forever) {
+    double total = remaining(motion_start_);
+    fraction = total > 0.0 ? 1.0 - remaining(position()) / total : 1.0;
+  } else if (r->name == "Hover") {
+    double elapsed = loop_.now() - tracker_.started_at(id);
+    fraction = r->args[0] > 0.0 ? elapsed / r->args[0] : 1.0;
+  }
+  return std::clamp(fraction, 0.0, 1.0);
+}
 
 Vec3 MavlinkDrone::reference() const {
   if (holding_ && mid::LocationValidator(*holding_, options_.tolerance).reached(position()))

@@ -62,6 +62,7 @@ class MavlinkDrone final : public mid::Drone {
   const std::string& name() const override { return settings_.name; }
   mid::ActionId start(const mid::ActionRequest& request, mid::EndCallback on_end) override;
   bool cancel(mid::ActionId id) override;
+  std::optional<double> progress(mid::ActionId id) const override;
   mid::DroneState state() const override;
   mid::SubscriptionId subscribe(mid::StateCallback fn) override;
   void unsubscribe(mid::SubscriptionId id) override { broker_.unsubscribe(id); }
@@ -114,6 +115,7 @@ class MavlinkDrone final : public mid::Drone {
   fleet::Vec3 reference() const;  ///< where relative motions start: holding_ or position()
   double ground_z() const { return settings_.home.z; }
   double sensor_value(int k) const;
+  double remaining(fleet::Vec3 from) const;  ///< path still to fly for the running motion
 
   fleet::DroneSettings settings_;
   fleet::DroneType type_;
@@ -139,6 +141,7 @@ class MavlinkDrone final : public mid::Drone {
   // the motion the adapter flies for an action
   mid::ActionId motion_owner_ = mid::kNoAction;
   Until until_ = Until::forever;
+  fleet::Vec3 motion_start_;      ///< where the running motion started, for progress()
   std::optional<mid::LocationValidator> goal_;
   /// The goal the vehicle holds after reaching it; the next FlyBy counts from it, not from
   /// the measured position, so the estimator's centimetres do not add up over a mission.

@@ -139,6 +139,7 @@ TEST(MavlinkFlight, OrbitRunsUntilCancelledThenHolds) {
   mid::ActionId id = f.drone->start({"Orbit", {3}}, [&](const mid::ActionEnd& e) { end = e; });
   f.loop.run_until(f.loop.now() + 6.0);
   EXPECT_FALSE(end);
+  EXPECT_FALSE(f.drone->progress(id));  // an orbit has no end to measure against
   mid::DroneState s = f.drone->state();
   EXPECT_NEAR(std::hypot(s.x, s.y), 3.0, 1.0);  // on (or near) the circle around the start
   EXPECT_TRUE(f.drone->cancel(id));
@@ -154,8 +155,11 @@ TEST(MavlinkFlight, FailsafeLandCancelsTheFlightLandsAndRefusesMore) {
   ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
   ASSERT_EQ(f.fly("Takeoff", {3}).outcome, mid::Outcome::succeeded);
   std::optional<mid::ActionEnd> end;
-  f.drone->start({"FlyTo", {30, 0, 3}}, [&](const mid::ActionEnd& e) { end = e; });
-  f.loop.run_until(f.loop.now() + 1.0);
+  mid::ActionId id = f.drone->start({"FlyTo", {30, 0, 3}}, [&](const mid::ActionEnd& e) { end = e; });
+  f.loop.run_until(f.loop.now() + 1.5);
+  ASSERT_TRUE(f.drone->progress(id));
+  EXPECT_GT(*f.drone->progress(id), 0.0);  // under way ...
+  EXPECT_LT(*f.drone->progress(id), 0.8);  // ... far from there
   f.drone->failsafe(fleet::Failsafe::land);
   f.loop.run_until(f.loop.now() + 0.1);
   ASSERT_TRUE(end);
