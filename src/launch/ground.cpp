@@ -317,7 +317,10 @@ void Ground::on_trace(TraceSample s) {
   if (!ours(s.mission_hash) || s.run_id != r_.run_id || s.drone < 0 || s.drone >= static_cast<int>(drones_.size()))
     return;
   s.event.drone = drones_[s.drone].name;
-  if (live_) live_->record(s.event);
+  if (live_) {
+    live_->record(s.event);
+    out_ << std::flush;  // a live log: whoever watches it (a person, a test) sees each event now
+  }
   r_.events.push_back(std::move(s.event));
 }
 
