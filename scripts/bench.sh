@@ -27,4 +27,25 @@ awk '/"per_drone"/ {in_drones = 1} in_drones && /^        "nodes":/ {
   --benchmark_repetitions=${REPS:-5} --benchmark_report_aggregates_only=true
 "$BUILD/bench/bench_dex" --benchmark_out=out/bench/dex.json --benchmark_out_format=json \
   --benchmark_repetitions=${REPS:-5} --benchmark_report_aggregates_only=true
+
+# Distributed execution (issue 4). Cross-drone trigger latency through eamos's DDS
+# transport and event loops, then ddsperf ping/pong on the same loopback configuration in
+# the same run (ddsperf prints RTT/2).
+"$BUILD/bench/bench_dds_latency" --benchmark_out=out/bench/dds_latency.json --benchmark_out_format=json
+export CYCLONEDDS_URI="file://$PWD/config/cyclonedds-loopback.xml"
+timeout 12 ddsperf -i 63 pong > /dev/null 2>&1 &
+timeout 10 ddsperf -i 63 -D 5 ping 2>&1 | grep -E ' size 12 ' | tail -3 | tee out/bench/ddsperf.txt
+wait || true
+unset CYCLONEDDS_URI
+
+# DEX process start to READY (the ground prints it), and Listing 2 in real time: in one
+# process, and as four processes (three DEXes and the ground).
+"$BUILD/src/cli/eamos" compile -q examples/listing2.eamos -o out/bench/listing2-deploy
+"$BUILD/src/cli/eamos" launch out/bench/listing2-deploy --domain 64 --speed 10 | grep 'ready (' | tee out/bench/ready.txt
+{
+  /usr/bin/time -f 'in-process  real time: %e s wall, %M KB peak' \
+    "$BUILD/src/cli/eamos" run -q examples/listing2.eamos --realtime | tail -1
+  /usr/bin/time -f 'distributed real time: %e s wall (ground process), %M KB peak (ground)' \
+    "$BUILD/src/cli/eamos" run -q examples/listing2.eamos --distributed --domain 65 | tail -1
+} 2>&1 | tee out/bench/listing2-realtime.txt
 echo "bench: results in out/bench/"

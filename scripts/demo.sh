@@ -18,7 +18,13 @@ done
 "$EAMOS" stats "$MISSION" -o "$OUT/stats.json" -q
 "$EAMOS" run "$MISSION" -q --fleet examples/listing2-right.yaml \
   --trace "$OUT/trace.jsonl" --summary "$OUT/summary.json" --plot "$OUT/plot.svg"
+# The same deployment as separate processes: one DEX per drone over Cyclone DDS (loopback),
+# started together by the ground process, five times faster than real time.
+echo
+"$EAMOS" launch "$OUT/deploy" --speed 5 --domain 3 \
+  --trace "$OUT/distributed-trace.jsonl" --summary "$OUT/distributed-summary.json"
 echo
 echo "demo: deployment in $OUT/deploy/, graphs in $OUT/graphs/, statistics in $OUT/stats.json,"
-echo "      trace in $OUT/trace.jsonl, summary in $OUT/summary.json, picture of the run in $OUT/plot.svg"
+echo "      trace in $OUT/trace.jsonl, summary in $OUT/summary.json, picture of the run in $OUT/plot.svg,"
+echo "      the distributed run's trace in $OUT/distributed-trace.jsonl (DEX logs: $OUT/deploy/<drone>/dex.log)"
 ls "$OUT/deploy" "$OUT/graphs"

@@ -108,7 +108,8 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
   auto abandon = [&] {
     for (auto& e : engines) e->halt();
     for (int d = 0; d < n; ++d) {
-      if (drones[d]->state().landed) continue;
+      mid::DroneState s = drones[d]->state();
+      if (s.landed && !s.armed) continue;  // already safe; an armed drone on the ground is disarmed
       if (trace) trace->record(failsafe_event(loop.now(), missions[d].settings.name, missions[d].settings.failsafe, result.error));
       drones[d]->failsafe(missions[d].settings.failsafe);
     }

@@ -156,7 +156,7 @@ int DexProcess::run(const mid::AdapterRegistry& adapters) {
   if (!wait_for_start()) return 1;
   begin();
   loop_->run_until(o_.time_limit_s + 1000.0);
-  node_->flush(2.0);
+  node_->flush(1.0);
   if (phase_ == Phase::completed) {
     out_ << name() << ": mission completed\n";
     return 0;
@@ -439,7 +439,8 @@ void DexProcess::abandon(const std::string& reason, const std::optional<dex::Fai
     node_->write(abort);
   }
   engine_->halt();
-  if (!drone_->state().landed) {
+  mid::DroneState now = drone_->state();
+  if (!now.landed || now.armed) {  // airborne, or armed on the ground: make it safe
     tee_.record(dex::failsafe_event(loop_->now(), name(), mission_.settings.failsafe, reason));
     drone_->failsafe(mission_.settings.failsafe);
   }

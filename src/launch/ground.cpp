@@ -35,6 +35,7 @@ struct DroneEntry {
   std::optional<StatusSample> final_status;
   std::vector<dex::Sample> track;
   std::string log;
+  double started_at = 0.0;  ///< wall time its DEX process was started
 };
 
 bool read_manifest(const std::string& dir, std::string& hash, std::vector<DroneEntry>& drones, std::string& error) {
@@ -204,6 +205,7 @@ bool Ground::start_processes() {
     d.log = d.folder + "/dex.log";
     std::remove(d.log.c_str());
     std::string error;
+    d.started_at = wall_s();
     d.child = spawn(argv, d.log, error);
     if (d.child.pid < 0) {
       err_ << "eamos launch: error: " << error << "\n";
@@ -298,7 +300,12 @@ void Ground::on_lifecycle(const LifecycleSample& s) {
   if (!ours(s.mission_hash)) return;
   if (s.kind == LifecycleKind::ready) {
     if (stage_ != Stage::barrier || s.drone < 0 || s.drone >= static_cast<int>(drones_.size())) return;
-    if (!drones_[s.drone].ready_nonce) out_ << "ground: " << drones_[s.drone].name << " ready\n" << std::flush;
+    DroneEntry& d = drones_[s.drone];
+    if (!d.ready_nonce) {
+      out_ << "ground: " << d.name << " ready";
+      if (d.local) out_ << " (" << static_cast<long>((wall_s() - d.started_at) * 1000) << " ms after its process started)";
+      out_ << "\n" << std::flush;
+    }
     drones_[s.drone].ready_nonce = s.nonce;
     return;
   }
@@ -317,7 +324,10 @@ void Ground::on_trace(TraceSample s) {
   if (!ours(s.mission_hash) || s.run_id != r_.run_id || s.drone < 0 || s.drone >= static_cast<int>(drones_.size()))
     return;
   s.event.drone = drones_[s.drone].name;
-  if (live_) live_->record(s.event);
+  if (live_) {
+    live_->record(s.event);
+    out_ << std::flush;  // a live log: whoever watches it (a person, a test) sees each event now
+  }
   r_.events.push_back(std::move(s.event));
 }
 

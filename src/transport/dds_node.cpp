@@ -2,6 +2,7 @@
 
 #include <dds/dds.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -28,10 +29,17 @@ dds_qos_t* durable_qos(bool keep_all) {
   dds_qos_t* q = dds_create_qos();
   dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(10));
   dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
-  if (keep_all)
+  // What a late reader gets is the durability service's history, not the writer's:
+  // its default (keep-last 1) would hand a late DEX only the newest trigger.
+  if (keep_all) {
     dds_qset_history(q, DDS_HISTORY_KEEP_ALL, 0);
-  else
+    dds_qset_durability_service(q, 0, DDS_HISTORY_KEEP_ALL, 0, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED,
+                                DDS_LENGTH_UNLIMITED);
+  } else {
     dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
+    dds_qset_durability_service(q, 0, DDS_HISTORY_KEEP_LAST, 1, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED,
+                                DDS_LENGTH_UNLIMITED);
+  }
   return q;
 }
 
@@ -54,11 +62,11 @@ void take_all(dds_entity_t reader, Fn&& fn, std::function<void(std::uint64_t)> o
   }
 }
 
-void on_trigger(dds_entity_t, void* arg) { static_cast<DdsNode*>(arg)->take_triggers(); }
-void on_telemetry(dds_entity_t, void* arg) { static_cast<DdsNode*>(arg)->take_telemetry(); }
-void on_lifecycle(dds_entity_t, void* arg) { static_cast<DdsNode*>(arg)->take_lifecycle(); }
-void on_status(dds_entity_t, void* arg) { static_cast<DdsNode*>(arg)->take_status(); }
-void on_trace(dds_entity_t, void* arg) { static_cast<DdsNode*>(arg)->take_trace(); }
+void on_trigger(dds_entity_t reader, void* arg) { static_cast<DdsNode*>(arg)->take_triggers(reader); }
+void on_telemetry(dds_entity_t reader, void* arg) { static_cast<DdsNode*>(arg)->take_telemetry(reader); }
+void on_lifecycle(dds_entity_t reader, void* arg) { static_cast<DdsNode*>(arg)->take_lifecycle(reader); }
+void on_status(dds_entity_t reader, void* arg) { static_cast<DdsNode*>(arg)->take_status(reader); }
+void on_trace(dds_entity_t reader, void* arg) { static_cast<DdsNode*>(arg)->take_trace(reader); }
 void on_liveliness(dds_entity_t, const dds_liveliness_changed_status_t s, void* arg) {
   if (s.alive_count_change < 0 || s.not_alive_count_change > 0)
     static_cast<DdsNode*>(arg)->liveliness_changed(s.last_publication_handle);
@@ -201,34 +209,39 @@ bool DdsNode::write(const TraceSample& s) {
 void DdsNode::assert_alive() { dds_assert_liveliness(w_status_); }
 
 bool DdsNode::flush(double timeout_s) {
+  // One deadline for all writers: a reader of a killed process stays matched until its
+  // participant's lease ends (10 s) and never acknowledges, so each wait could run out.
+  dds_time_t deadline = dds_time() + static_cast<dds_duration_t>(timeout_s * 1e9);
   bool ok = true;
-  for (int w : {w_trigger_, w_lifecycle_, w_status_, w_trace_})
-    ok = dds_wait_for_acks(w, static_cast<dds_duration_t>(timeout_s * 1e9)) == DDS_RETCODE_OK && ok;
+  for (int w : {w_trace_, w_status_, w_lifecycle_, w_trigger_}) {
+    dds_duration_t left = std::max<dds_duration_t>(0, deadline - dds_time());
+    ok = dds_wait_for_acks(w, left) == DDS_RETCODE_OK && ok;
+  }
   return ok;
 }
 
-void DdsNode::take_triggers() {
-  take_all<eamos_wire_Trigger>(r_trigger_, [this](TriggerSample s) {
+void DdsNode::take_triggers(int reader) {
+  take_all<eamos_wire_Trigger>(reader, [this](TriggerSample s) {
     if (handlers_.trigger) handlers_.trigger(std::move(s));
   });
 }
 
-void DdsNode::take_telemetry() {
-  take_all<eamos_wire_Telemetry>(r_telemetry_, [this](TelemetrySample s) {
+void DdsNode::take_telemetry(int reader) {
+  take_all<eamos_wire_Telemetry>(reader, [this](TelemetrySample s) {
     if (handlers_.telemetry) handlers_.telemetry(std::move(s));
   });
 }
 
-void DdsNode::take_lifecycle() {
-  take_all<eamos_wire_Lifecycle>(r_lifecycle_, [this](LifecycleSample s) {
+void DdsNode::take_lifecycle(int reader) {
+  take_all<eamos_wire_Lifecycle>(reader, [this](LifecycleSample s) {
     if (handlers_.lifecycle) handlers_.lifecycle(std::move(s));
   });
 }
 
-void DdsNode::take_status() {
+void DdsNode::take_status(int reader) {
   std::uint64_t handle = 0;
   take_all<eamos_wire_Status>(
-      r_status_,
+      reader,
       [this, &handle](StatusSample s) {
         {
           std::lock_guard<std::mutex> lock(writers_mutex_);
@@ -239,8 +252,8 @@ void DdsNode::take_status() {
       [&handle](std::uint64_t h) { handle = h; });
 }
 
-void DdsNode::take_trace() {
-  take_all<eamos_wire_TraceRecord>(r_trace_, [this](TraceSample s) {
+void DdsNode::take_trace(int reader) {
+  take_all<eamos_wire_TraceRecord>(reader, [this](TraceSample s) {
     if (handlers_.trace) handlers_.trace(std::move(s));
   });
 }

@@ -63,12 +63,14 @@ class DdsNode {
   /// The configuration XML in use (for logs and tests).
   const std::string& config() const { return config_; }
 
-  // Called from DDS listener threads.
-  void take_triggers();
-  void take_telemetry();
-  void take_lifecycle();
-  void take_status();
-  void take_trace();
+  // Called from DDS listener threads with the reader that has data: possibly while
+  // dds_create_reader is still running (historical data of a transient-local writer in
+  // this process), before the reader's handle is stored.
+  void take_triggers(int reader);
+  void take_telemetry(int reader);
+  void take_lifecycle(int reader);
+  void take_status(int reader);
+  void take_trace(int reader);
   void liveliness_changed(std::uint64_t publication_handle);
 
  private:

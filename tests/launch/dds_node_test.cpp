@@ -1,0 +1,118 @@
+// DdsNode's QoS where it matters: a reader that joins late still gets every trigger
+// (transient-local, keep-all) and only the newest telemetry (keep-last 1 per drone).
+// Two nodes in one process on loopback, each test on its own domain. Waits block on a
+// condition variable with a generous bound; nothing sleeps.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+
+#include "transport/dds_node.h"
+
+namespace eamos::transport {
+namespace {
+
+struct Received {
+  std::mutex mutex;
+  std::condition_variable cv;
+  std::vector<TriggerSample> triggers;
+  std::vector<TelemetrySample> telemetry;
+  std::vector<std::pair<std::string, int>> lost;
+
+  bool wait(const std::function<bool()>& done) {
+    std::unique_lock<std::mutex> lock(mutex);
+    return cv.wait_for(lock, std::chrono::seconds(20), done);
+  }
+};
+
+DdsHandlers record_into(Received& r) {
+  DdsHandlers h;
+  h.trigger = [&r](TriggerSample s) {
+    std::lock_guard<std::mutex> lock(r.mutex);
+    r.triggers.push_back(std::move(s));
+    r.cv.notify_all();
+  };
+  h.telemetry = [&r](TelemetrySample s) {
+    std::lock_guard<std::mutex> lock(r.mutex);
+    r.telemetry.push_back(std::move(s));
+    r.cv.notify_all();
+  };
+  h.lost = [&r](const std::string& hash, int drone) {
+    std::lock_guard<std::mutex> lock(r.mutex);
+    r.lost.emplace_back(hash, drone);
+    r.cv.notify_all();
+  };
+  return h;
+}
+
+TEST(DdsNode, LateReaderGetsEveryTriggerWrittenBeforeItJoined) {
+  std::string error;
+  DdsOptions options;
+  options.domain = 41;
+  Received ignored;
+  auto writer = DdsNode::open(options, record_into(ignored), error);
+  ASSERT_TRUE(writer) << error;
+  for (int i = 1; i <= 500; ++i) {
+    TriggerSample s;
+    s.run_id = 1;
+    s.to = 1;
+    s.seq = static_cast<std::uint64_t>(i);
+    s.message.mission_hash = "h";
+    s.message.meg = i;
+    ASSERT_TRUE(writer->write(s));
+  }
+  Received got;
+  auto reader = DdsNode::open(options, record_into(got), error);
+  ASSERT_TRUE(reader) << error;
+  ASSERT_TRUE(got.wait([&] { return got.triggers.size() >= 500; })) << got.triggers.size();
+  std::lock_guard<std::mutex> lock(got.mutex);
+  for (int i = 0; i < 500; ++i) EXPECT_EQ(got.triggers[i].seq, static_cast<std::uint64_t>(i + 1));
+  reader.reset();
+  writer.reset();
+}
+
+TEST(DdsNode, LateReaderGetsOnlyTheNewestTelemetryPerDrone) {
+  std::string error;
+  DdsOptions options;
+  options.domain = 42;
+  Received ignored;
+  auto writer = DdsNode::open(options, record_into(ignored), error);
+  ASSERT_TRUE(writer) << error;
+  for (int drone = 0; drone < 2; ++drone)
+    for (int i = 1; i <= 10; ++i) {
+      TelemetrySample s;
+      s.telemetry.mission_hash = "h";
+      s.telemetry.from = drone;
+      s.telemetry.state.x = i;
+      ASSERT_TRUE(writer->write(s));
+    }
+  Received got;
+  auto reader = DdsNode::open(options, record_into(got), error);
+  ASSERT_TRUE(reader) << error;
+  ASSERT_TRUE(got.wait([&] { return got.telemetry.size() >= 2; }));
+  std::lock_guard<std::mutex> lock(got.mutex);
+  ASSERT_EQ(got.telemetry.size(), 2u);
+  for (const TelemetrySample& s : got.telemetry) EXPECT_EQ(s.telemetry.state.x, 10);
+  reader.reset();
+  writer.reset();
+}
+
+TEST(DdsNode, RejectsADomainIdOutOfRange) {
+  std::string error;
+  DdsOptions options;
+  options.domain = 500;
+  EXPECT_FALSE(DdsNode::open(options, {}, error));
+  EXPECT_NE(error.find("out of range"), std::string::npos) << error;
+}
+
+TEST(DdsNode, RejectsAMissingConfigFile) {
+  std::string error;
+  DdsOptions options;
+  options.config_file = "/nonexistent/cyclonedds.xml";
+  EXPECT_FALSE(DdsNode::open(options, {}, error));
+  EXPECT_NE(error.find("/nonexistent/cyclonedds.xml"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace eamos::transport

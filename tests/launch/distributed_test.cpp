@@ -1,0 +1,276 @@
+// The mission as separate processes: `eamos launch` / `eamos run --distributed` start one
+// DEX per drone and a ground process, all over Cyclone DDS on loopback (the shipped
+// configuration). Each test has its own DDS domain. Missions run in real time at a speed-up,
+// so these tests take seconds, not minutes; nothing here sleeps: the tests block on the
+// processes' output.
+#include <gtest/gtest.h>
+
+#include <signal.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Output {
+  int status = -1;
+  std::string out;  ///< stdout and stderr together
+};
+
+/// Runs `eamos args`; `on_line` sees each output line as it comes (and may act on it).
+Output eamos(const std::string& args, const std::function<void(const std::string&)>& on_line = {}) {
+  std::string cmd = std::string(EAMOS_BINARY) + " " + args + " 2>&1";
+  Output r;
+  FILE* p = popen(cmd.c_str(), "r");
+  char buf[4096];
+  while (fgets(buf, sizeof buf, p)) {
+    r.out += buf;
+    if (on_line) on_line(buf);
+  }
+  int raw = pclose(p);
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  return r;
+}
+
+std::string source(const std::string& name) { return std::string(EAMOS_SOURCE_DIR) + "/examples/" + name; }
+
+struct Event {
+  double t;
+  std::string what;  ///< event, text, outcome, value
+};
+using Events = std::map<std::string, std::vector<Event>>;
+
+/// Per drone, its events in order.
+Events per_drone(const fs::path& trace) {
+  Events events;
+  std::ifstream in(trace);
+  for (std::string line; std::getline(in, line);) {
+    nlohmann::json e = nlohmann::json::parse(line);
+    std::string what = e["event"].get<std::string>() + " " + e.value("text", e["name"].get<std::string>()) + " " +
+                       e.value("outcome", "");
+    if (e.contains("value")) what += " " + e["value"].dump();
+    events[e["drone"]].push_back({e["t"].get<double>(), what});
+  }
+  return events;
+}
+
+/// "" when every drone has the same events in the same order in both traces; otherwise
+/// where they part. Events that `dist` records at one and the same instant on one drone
+/// have no order among themselves (a Do's cancel and another drone's trigger can land in
+/// the same step), so such a group only has to hold the same events.
+std::string order_difference(const Events& local, const Events& dist) {
+  if (local.size() != dist.size()) return "different drones";
+  for (const auto& [drone, a] : local) {
+    auto it = dist.find(drone);
+    if (it == dist.end()) return drone + " missing";
+    const std::vector<Event>& b = it->second;
+    if (a.size() != b.size())
+      return drone + ": " + std::to_string(a.size()) + " events in-process, " + std::to_string(b.size()) + " distributed";
+    for (std::size_t i = 0; i < b.size();) {
+      std::size_t j = i + 1;
+      while (j < b.size() && b[j].t == b[i].t) ++j;
+      std::vector<std::string> x, y;
+      for (std::size_t k = i; k < j; ++k) x.push_back(a[k].what), y.push_back(b[k].what);
+      std::sort(x.begin(), x.end());
+      std::sort(y.begin(), y.end());
+      if (x != y) return drone + ": event " + std::to_string(i) + " is '" + a[i].what + "' in-process, '" + b[i].what + "' distributed";
+      i = j;
+    }
+  }
+  return "";
+}
+
+nlohmann::json read_json(const fs::path& p) {
+  std::ifstream in(p);
+  return nlohmann::json::parse(in);
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class Distributed : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("eamos-dist-" + std::to_string(::getpid()) + "-" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+  /// Flies `mission` in-process and as processes; expects the same events per drone.
+  void expect_same_as_in_process(const std::string& mission, const std::string& fleet, int domain) {
+    std::string fleet_arg = fleet.empty() ? "" : " --fleet " + source(fleet);
+    Output local = eamos("run -q " + source(mission) + fleet_arg + " --trace " + (dir_ / "local.jsonl").string());
+    ASSERT_EQ(local.status, 0) << local.out;
+    Output dist = eamos("run -q " + source(mission) + fleet_arg + " --distributed --speed 10 --domain " +
+                        std::to_string(domain) + " --deploy-dir " + (dir_ / "deploy").string() + " --trace " +
+                        (dir_ / "dist.jsonl").string() + " --summary " + (dir_ / "summary.json").string());
+    ASSERT_EQ(dist.status, 0) << dist.out;
+    EXPECT_NE(dist.out.find("every drone is ready; starting run"), std::string::npos) << dist.out;
+    Events a = per_drone(dir_ / "local.jsonl"), b = per_drone(dir_ / "dist.jsonl");
+    EXPECT_FALSE(a.empty());
+    EXPECT_EQ(order_difference(a, b), "") << dist.out;
+    EXPECT_EQ(read_json(dir_ / "summary.json")["status"], "completed");
+  }
+  fs::path dir_;
+};
+
+TEST_F(Distributed, Listing2RightGivesTheSameEventsPerDroneAsInProcess) {
+  expect_same_as_in_process("listing2.eamos", "listing2-right.yaml", 21);
+}
+
+TEST_F(Distributed, Listing2LeftGivesTheSameEventsPerDroneAsInProcess) {
+  expect_same_as_in_process("listing2.eamos", "listing2-left.yaml", 22);
+}
+
+TEST_F(Distributed, SurveyGivesTheSameEventsPerDroneAsInProcess) { expect_same_as_in_process("survey.eamos", "", 23); }
+
+TEST_F(Distributed, RelayGivesTheSameEventsPerDroneAsInProcess) { expect_same_as_in_process("relay.eamos", "", 24); }
+
+TEST_F(Distributed, PatrolGivesTheSameEventsPerDroneAsInProcess) { expect_same_as_in_process("patrol.eamos", "", 25); }
+
+/// Compiles Listing 2 into dir/deploy.
+fs::path deploy_listing2(const fs::path& dir) {
+  Output c = eamos("compile -q " + source("listing2.eamos") + " -o " + (dir / "deploy").string());
+  EXPECT_EQ(c.status, 0) << c.out;
+  return dir / "deploy";
+}
+
+/// The pid the ground printed for `drone`'s DEX, or -1.
+pid_t dex_pid(const std::string& out, const std::string& drone) {
+  std::string key = "started the DEX of " + drone + " (pid ";
+  auto at = out.find(key);
+  return at == std::string::npos ? -1 : std::stoi(out.substr(at + key.size()));
+}
+
+TEST_F(Distributed, KilledDexPutsEveryOtherDroneInFailsafeWithinTheLivelinessTimeout) {
+  fs::path deploy = deploy_listing2(dir_);
+  // Speed 5: one wall second is five mission seconds. Drone2 is killed right after its
+  // takeoff, while Drone1 and Drone3 are still flying.
+  const double speed = 5.0, lease = 1.0;
+  double killed_at = -1;
+  Output r = eamos("launch " + deploy.string() + " --speed 5 --liveliness-timeout 1 --domain 26 --trace " +
+                       (dir_ / "trace.jsonl").string() + " --summary " + (dir_ / "summary.json").string(),
+                   [&](const std::string& line) {
+                     static std::string seen;
+                     seen += line;
+                     if (killed_at < 0 && line.find("Drone2.Takeoff(10)  succeeded") != std::string::npos) {
+                       pid_t pid = dex_pid(seen, "Drone2");
+                       ASSERT_GT(pid, 0) << seen;
+                       kill(pid, SIGKILL);
+                       killed_at = std::stod(line);  // the event's mission time, printed first
+                     }
+                   });
+  ASSERT_GT(killed_at, 0) << r.out;
+  EXPECT_EQ(r.status, 1) << r.out;
+  nlohmann::json summary = read_json(dir_ / "summary.json");
+  EXPECT_EQ(summary["status"], "failed");
+  EXPECT_NE(summary["error"].get<std::string>().find("Drone2 lost"), std::string::npos) << summary.dump(2);
+  // Every drone still alive entered its failsafe, within the lease plus one wall second for
+  // the kill to land and the lease check to run (seen here: 1.02 s after the kill in all).
+  std::map<std::string, double> failsafe_at;
+  std::ifstream in(dir_ / "trace.jsonl");
+  for (std::string line; std::getline(in, line);) {
+    nlohmann::json e = nlohmann::json::parse(line);
+    if (e["event"] == "failsafe") failsafe_at[e["drone"]] = e["t"];
+  }
+  for (std::string drone : {"Drone1", "Drone3"}) {
+    ASSERT_TRUE(failsafe_at.count(drone)) << drone << "\n" << r.out;
+    EXPECT_LE(failsafe_at[drone] - killed_at, (lease + 1.0) * speed) << drone;
+  }
+  EXPECT_FALSE(failsafe_at.count("Drone2"));  // dead: it cannot report
+  for (std::string drone : {"Drone1", "Drone3"}) {
+    EXPECT_TRUE(summary["drones"][drone]["landed"]) << drone;
+    EXPECT_FALSE(summary["drones"][drone]["armed"]) << drone;
+  }
+}
+
+TEST_F(Distributed, RestartedDexDoesNotResumeTheAbandonedMission) {
+  fs::path deploy = deploy_listing2(dir_);
+  Output restarted;
+  Output r = eamos("launch " + deploy.string() + " --speed 5 --liveliness-timeout 1 --domain 27",
+                   [&](const std::string& line) {
+                     static std::string seen;
+                     seen += line;
+                     if (restarted.status < 0 && line.find("Drone2.Takeoff(10)  succeeded") != std::string::npos) {
+                       kill(dex_pid(seen, "Drone2"), SIGKILL);
+                       // Started again at once, while the others still run (or abandon) the mission.
+                       restarted = eamos("dex " + (deploy / "Drone2").string() +
+                                         " --speed 5 --liveliness-timeout 1 --domain 27 --start-timeout 3");
+                     }
+                   });
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_EQ(restarted.status, 1) << restarted.out;
+  EXPECT_NE(restarted.out.find("not joining run"), std::string::npos) << restarted.out;
+  EXPECT_EQ(restarted.out.find("Drone2   start"), std::string::npos) << restarted.out;  // ran nothing
+  EXPECT_NE(restarted.out.find("no start within 3 s"), std::string::npos) << restarted.out;
+}
+
+TEST_F(Distributed, StartBarrierTimeoutAbortsWithTheMissingDrones) {
+  fs::path deploy = deploy_listing2(dir_);
+  Output r = eamos("launch " + deploy.string() + " --drones Drone1 --barrier-timeout 1 --domain 28");
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("start barrier timed out after 1 s; not ready: Drone2, Drone3"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("Drone1   start"), std::string::npos) << r.out;  // nothing flew
+}
+
+TEST_F(Distributed, SecondMissionOnTheSameDomainChangesNothing) {
+  // Listing 2 and patrol at the same time on one domain: both have a Drone1..Drone3.
+  Output other;
+  fs::path patrol_dir = dir_ / "patrol";
+  fs::create_directories(patrol_dir);
+  Output local = eamos("run -q " + source("listing2.eamos") + " --trace " + (dir_ / "local.jsonl").string());
+  ASSERT_EQ(local.status, 0);
+  Output patrol_local = eamos("run -q " + source("patrol.eamos") + " --trace " + (patrol_dir / "local.jsonl").string());
+  ASSERT_EQ(patrol_local.status, 0);
+  std::string patrol_cmd = std::string(EAMOS_BINARY) + " run -q " + source("patrol.eamos") +
+                           " --distributed --speed 10 --domain 29 --deploy-dir " + (patrol_dir / "deploy").string() +
+                           " --trace " + (patrol_dir / "dist.jsonl").string() + " > " +
+                           (patrol_dir / "out.txt").string() + " 2>&1";
+  FILE* patrol = popen(patrol_cmd.c_str(), "r");
+  Output r = eamos("run -q " + source("listing2.eamos") + " --distributed --speed 10 --domain 29 --deploy-dir " +
+                   (dir_ / "deploy").string() + " --trace " + (dir_ / "dist.jsonl").string());
+  int patrol_status = pclose(patrol);
+  ASSERT_EQ(r.status, 0) << r.out;
+  ASSERT_TRUE(WIFEXITED(patrol_status) && WEXITSTATUS(patrol_status) == 0) << read_text(patrol_dir / "out.txt");
+  EXPECT_EQ(order_difference(per_drone(dir_ / "local.jsonl"), per_drone(dir_ / "dist.jsonl")), "");
+  EXPECT_EQ(order_difference(per_drone(patrol_dir / "local.jsonl"), per_drone(patrol_dir / "dist.jsonl")), "");
+  // They did meet: each saw the other's samples and said it ignored them.
+  std::string logs = r.out + read_text(patrol_dir / "out.txt");
+  for (const char* d : {"Drone1", "Drone2", "Drone3"}) logs += read_text(dir_ / "deploy" / d / "dex.log");
+  EXPECT_NE(logs.find("ignoring messages of another mission"), std::string::npos) << logs;
+}
+
+TEST_F(Distributed, DexRefusesAFolderWithoutAMission) {
+  fs::create_directories(dir_ / "empty");
+  Output r = eamos("dex " + (dir_ / "empty").string() + " --domain 30 --start-timeout 1");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("error:"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("mission.json"), std::string::npos) << r.out;
+}
+
+TEST_F(Distributed, LaunchRefusesAFolderWithoutAManifest) {
+  Output r = eamos("launch " + dir_.string() + " --domain 30");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("manifest.json"), std::string::npos) << r.out;
+}
+
+}  // namespace
