@@ -1,5 +1,6 @@
 #include "dex/runner.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -121,6 +122,7 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     result.failure = f;
     result.error = f.drone + "." + f.action + " (line " + std::to_string(f.line) + ") failed: " + f.reason;
     abandon();
+    loop.stop();  // a real-time loop would otherwise wait out the time limit; failsafes run below
   };
   for (int d = 0; d < n; ++d) {
     EngineHooks hooks;
@@ -165,7 +167,19 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
                    " s of mission time; raise --time-limit if it is meant to run longer";
     abandon();
   }
-  if (failed || !result.completed) loop.run_until(loop.now() + 600.0);  // let failsafes finish
+  if (failed || !result.completed) {
+    // Let failsafes finish: until every drone is down, at most 600 s. In slices, because a
+    // real-time loop waits for input until its limit even when nothing is scheduled, and a
+    // MAVLink drone's heartbeats never leave it idle.
+    const double until = loop.now() + 600.0;
+    auto airborne = [&] {
+      for (const auto& d : drones)
+        if (!d->state().landed) return true;
+      return false;
+    };
+    do loop.run_until(std::min(until, loop.now() + 1.0));
+    while (loop.now() < until && airborne());
+  }
   result.duration = finished_at;
   for (int d = 0; d < n; ++d) {
     result.drones.push_back({missions[d].settings.name, drones[d]->state(), std::move(tracks[d])});

@@ -13,6 +13,7 @@
 #include <spawn.h>
 #include <sys/wait.h>
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -37,10 +38,10 @@ int run(const std::string& args, std::string& output) {
   return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
 }
 
-pid_t spawn_vehicle(int port, int sysid) {
+pid_t spawn_vehicle(int port, int sysid, const char* duration = "400") {
   std::vector<std::string> args = {EAMOS_BINARY, "sim-vehicle", "--udp", std::to_string(port),
                                    "--sysid", std::to_string(sysid), "--speed", "4",
-                                   "--duration", "400"};
+                                   "--duration", duration};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -95,6 +96,24 @@ TEST(MavlinkListing2, ThreeSimVehiclesFlyTheSameActionsAsTheSimulator) {
   ASSERT_EQ(sim.size(), 3u);
   for (const auto& [drone, seq] : sim) EXPECT_EQ(mav[drone], seq) << drone;
   fs::remove_all(dir);
+}
+
+TEST(MavlinkRun, RefusedTakeoffFailsTheMissionWithTheAutopilotsReasonAndEnds) {
+  pid_t vehicle = spawn_vehicle(25332, 1, "120");
+  std::string out;
+  const std::string data = EAMOS_TEST_DATA;
+  auto started = std::chrono::steady_clock::now();
+  int status = run("run " + data + "/data/takeoff-unarmed.eamos --fleet " + data +
+                   "/data/takeoff-unarmed.yaml --speed 4", out);
+  double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  kill(vehicle, SIGTERM);
+  waitpid(vehicle, nullptr, 0);
+  EXPECT_EQ(status, 1) << out;
+  EXPECT_NE(out.find("mission failed: Drone1.Takeoff (line 3) failed: refused by PX4: "
+                     "MAV_CMD_NAV_TAKEOFF: MAV_RESULT_DENIED"),
+            std::string::npos)
+      << out;
+  EXPECT_LT(wall, 15.0);  // not the time limit: a failed run ends once the drones are down
 }
 
 }  // namespace
