@@ -109,10 +109,7 @@ void MavlinkDrone::start_system(ActionId id, const mid::ActionRequest& r) {
   commands_.send(command(ml::cmd::COMPONENT_ARM_DISARM, {arm ? 1.0f : 0.0f}),
                  [this, id, arm](const CommandResult& result) {
                    if (!tracker_.running(id)) return;
-                   if (!result.accepted) {
-                     tracker_.end(id, Outcome::failed, "refused by the autopilot: " + result.error);
-                     return;
-                   }
+                   if (!result.accepted) return end_refused(id, result);
                    vehicle_.armed = arm;  // the next HEARTBEAT confirms it
                    publish();
                    tracker_.end(id, Outcome::succeeded);
@@ -187,6 +184,13 @@ void MavlinkDrone::start_takeoff(ActionId id, double altitude) {
   const Vec3 here = position();
   goal_.emplace(Vec3{here.x, here.y, ground_z() + altitude}, options_.tolerance);
   until_ = Until::reached;
+  if (!vehicle_.landed()) {
+    // Already up: autopilots refuse NAV_TAKEOFF in the air, the simulator climbs or descends
+    // to the altitude; do what the simulator does, with a setpoint.
+    setpoint_ = goal_->target();
+    stream_setpoints();
+    return;
+  }
   std::array<float, 7> p{};
   p[4] = p[5] = NAN;  // latitude, longitude: where it stands
   p[6] = static_cast<float>(altitude);

@@ -29,6 +29,9 @@ const uint32_t kStreamed[] = {ml::msg::LOCAL_POSITION_NED, ml::msg::EXTENDED_SYS
                               ml::msg::SYS_STATUS, ml::msg::BATTERY_STATUS,
                               ml::msg::GLOBAL_POSITION_INT};
 
+/// execute()'s answer for a command acknowledged when its action ends.
+constexpr uint8_t kAckLater = 255;
+
 }  // namespace
 
 const Dialect& px4_dialect() {
@@ -88,8 +91,9 @@ void SimVehicle::on_command(const ml::CommandLong& c) {
   if (c.target_system != options_.sysid && c.target_system != 0) return;
   // A resend means our ACK was lost: answer again, but do not arm or take off twice.
   if (c.confirmation > 0 && has_last_ && last_command_ == c.command) return ack(c.command, last_result_);
-  if (c.command == ml::cmd::IMAGE_START_CAPTURE) return take_picture();
+  if (c.command == ml::cmd::IMAGE_START_CAPTURE) return start_then_ack(c.command, "TakePicture");
   uint8_t result = execute(c);
+  if (result == kAckLater) return;
   last_command_ = c.command;
   last_result_ = result;
   has_last_ = true;
@@ -104,8 +108,8 @@ uint8_t SimVehicle::execute(const ml::CommandLong& c) {
       if (!arm && !s.landed) return ml::result::DENIED;
       if (arm && s.battery <= 0.0) return ml::result::DENIED;
       loop_.cancel(disarm_timer_);
-      start(arm ? "Arm" : "Disarm", {});
-      return ml::result::ACCEPTED;
+      start_then_ack(c.command, arm ? "Arm" : "Disarm");
+      return kAckLater;
     }
     case ml::cmd::NAV_TAKEOFF: {
       if (!s.armed || !s.landed) return ml::result::DENIED;
@@ -189,17 +193,17 @@ void SimVehicle::on_setpoint(const ml::SetPositionTargetLocalNed& sp) {
   fly_to_setpoint();
 }
 
-void SimVehicle::take_picture() {
-  // Acknowledged when the picture is taken (0.5 s, as in the simulator), like a camera that
-  // answers once the image is stored.
+void SimVehicle::start_then_ack(uint16_t command, const std::string& action) {
+  // Acknowledged once done (a picture takes 0.5 s, arming a moment), so no HEARTBEAT sent
+  // after the ACK can still show the state from before.
   std::weak_ptr<bool> alive = alive_;
-  drone_.start({"TakePicture", {}}, [this, alive](const mid::ActionEnd& end) {
+  drone_.start({action, {}}, [this, alive, command](const mid::ActionEnd& end) {
     if (!alive.lock()) return;
     uint8_t result = end.outcome == mid::Outcome::succeeded ? ml::result::ACCEPTED : ml::result::FAILED;
-    last_command_ = ml::cmd::IMAGE_START_CAPTURE;
+    last_command_ = command;
     last_result_ = result;
     has_last_ = true;
-    ack(ml::cmd::IMAGE_START_CAPTURE, result);
+    ack(command, result);
   });
 }
 

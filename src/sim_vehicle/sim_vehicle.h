@@ -75,11 +75,12 @@ class SimVehicle {
  private:
   void on_frame(const mavlink::Frame& frame);
   void on_command(const mavlink::CommandLong& c);
-  uint8_t execute(const mavlink::CommandLong& c);  ///< the MAV_RESULT to acknowledge with
+  uint8_t execute(const mavlink::CommandLong& c);  ///< the MAV_RESULT to acknowledge with,
+                                                  ///< or kAckLater
   uint8_t set_mode(Mode mode);
   /// The Mode a DO_SET_MODE asks for; false when the dialect has no such mode.
   bool requested_mode(const mavlink::CommandLong& c, Mode& out) const;
-  void take_picture();
+  void start_then_ack(uint16_t command, const std::string& action);
   void on_setpoint(const mavlink::SetPositionTargetLocalNed& sp);
   void fly_to_setpoint();
   void start(const std::string& action, std::vector<double> args,

@@ -70,6 +70,10 @@ TEST(MavlinkFlight, ArmTakeoffFlyAndLand) {
   EXPECT_NEAR(f.drone->state().x, 5.0, 0.5);
   EXPECT_NEAR(f.drone->state().z, 3.0, 0.3);
 
+  e = f.fly("Takeoff", {5});  // in the air: climbs to the altitude, as in the simulator
+  ASSERT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
+  EXPECT_NEAR(f.drone->state().z, 5.0, 0.3);
+
   e = f.fly("Land");
   ASSERT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
   EXPECT_TRUE(f.drone->state().landed);
