@@ -84,7 +84,13 @@ std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
 
 void MavlinkDrone::on_frame(const ml::Frame& frame) {
   if (frame.sysid != sysid_) return;  // another vehicle (or a GCS) on the same port
-  if (auto ack = ml::unpack_command_ack(frame.message)) return commands_.on_ack(*ack);
+  if (auto ack = ml::unpack_command_ack(frame.message)) {
+    // An ACK addressed to another component (a GCS commanding the same vehicle) is not ours;
+    // 0 means the autopilot did not say (older firmware).
+    if (ack->target_component == 0 || ack->target_component == ml::comp::ONBOARD_COMPUTER)
+      commands_.on_ack(*ack);
+    return;
+  }
   if (auto hb = ml::unpack_heartbeat(frame.message); hb && hb->autopilot == ml::autopilot::INVALID)
     return;  // a camera, gimbal or companion of the same system: not the autopilot
   Changes c = apply_telemetry(vehicle_, frame);
@@ -129,6 +135,7 @@ void MavlinkDrone::link_watchdog() {
 
 void MavlinkDrone::lose_link() {
   link_lost_ = true;
+  telemetry_requested_ = false;  // ask again when it is back: the vehicle may have rebooted
   streaming_ = false;
   in_control_ = false;
   char text[128];

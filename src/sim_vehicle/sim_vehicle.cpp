@@ -83,7 +83,11 @@ std::string SimVehicle::open(const ml::Endpoint& endpoint) {
 // --- input ---------------------------------------------------------------------------------
 
 void SimVehicle::on_frame(const ml::Frame& frame) {
-  if (auto c = ml::unpack_command_long(frame.message)) return on_command(*c);
+  if (auto c = ml::unpack_command_long(frame.message)) {
+    ack_to_system_ = frame.sysid;
+    ack_to_component_ = frame.compid;
+    return on_command(*c);
+  }
   if (auto sp = ml::unpack_set_position_target_local_ned(frame.message)) return on_setpoint(*sp);
 }
 
@@ -250,6 +254,8 @@ void SimVehicle::ack(uint16_t command, uint8_t result) {
   ml::CommandAck a;
   a.command = command;
   a.result = result;
+  a.target_system = ack_to_system_;  // as PX4 does: the sender of the command
+  a.target_component = ack_to_component_;
   send(ml::pack(a));
 }
 

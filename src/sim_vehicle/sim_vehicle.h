@@ -111,6 +111,8 @@ class SimVehicle {
   uint16_t last_command_ = 0;           ///< for resends: acknowledge again, do not redo
   uint8_t last_result_ = 0;
   bool has_last_ = false;
+  uint8_t ack_to_system_ = 0;           ///< who sent the newest command: its ACK goes there
+  uint8_t ack_to_component_ = 0;
   std::map<uint32_t, mid::TimerId> streams_;  ///< message id -> its next send
   std::map<uint32_t, double> rates_hz_;
   mid::TimerId offboard_timer_ = mid::kNoTimer;
