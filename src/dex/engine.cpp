@@ -197,31 +197,17 @@ void Engine::activate_action(int node) {
   for (const Expr& a : n.args) req.args.push_back(evaluate(a, read).number);
   trace(n, "start");
   ++active_;
-  state_[node].action = drone_.start(req, [this, node](const mid::ActionEnd& e) { on_action_end(node, e); });
+  std::uint64_t seq = ++state_[node].action_seq;
+  state_[node].action =
+      drone_.start(req, [this, node, seq](const mid::ActionEnd& e) { on_action_end(node, seq, e); });
 }
 
-void Engine::on_action_end(int node, const mid::ActionEnd& e) {
+void Engine::on_action_end(int node, std::uint64_t seq, const mid::ActionEnd& e) {
+  if (state_[node].action_seq != seq) return;  // closed when it was cancelled
   const Node& n = m_.nodes[node];
   state_[node].action = mid::kNoAction;
   --active_;
-  if (hooks_.trace) {
-    TraceEvent t;
-    t.t = loop_.now();
-    t.drone = m_.fleet[m_.self];
-    t.event = "end";
-    t.name = n.name;
-    t.line = n.line;
-    t.text = n.text;
-    t.outcome = mid::outcome_name(e.outcome);
-    t.reason = e.reason;
-    hooks_.trace->record(t);
-    if (e.value && e.outcome == mid::Outcome::succeeded) {
-      t.event = "sensor";
-      t.outcome.clear();
-      t.reading = e.value;
-      hooks_.trace->record(t);
-    }
-  }
+  trace_end(n, e);
   switch (e.outcome) {
     case mid::Outcome::succeeded:
     case mid::Outcome::preempted:
@@ -232,6 +218,26 @@ void Engine::on_action_end(int node, const mid::ActionEnd& e) {
     case mid::Outcome::failed:
       if (hooks_.on_failure) hooks_.on_failure({m_.fleet[m_.self], n.name, n.line, e.reason});
       return;
+  }
+}
+
+void Engine::trace_end(const Node& n, const mid::ActionEnd& e) {
+  if (!hooks_.trace) return;
+  TraceEvent t;
+  t.t = loop_.now();
+  t.drone = m_.fleet[m_.self];
+  t.event = "end";
+  t.name = n.name;
+  t.line = n.line;
+  t.text = n.text;
+  t.outcome = mid::outcome_name(e.outcome);
+  t.reason = e.reason;
+  hooks_.trace->record(t);
+  if (e.value && e.outcome == mid::Outcome::succeeded) {
+    t.event = "sensor";
+    t.outcome.clear();
+    t.reading = e.value;
+    hooks_.trace->record(t);
   }
 }
 
@@ -367,7 +373,15 @@ void Engine::cancel_local(const std::vector<int>& nodes) {
   for (int node : nodes) {
     State& s = state_[node];
     const Node& n = m_.nodes[node];
-    if (s.action != mid::kNoAction) drone_.cancel(s.action);  // ends `cancelled` later
+    // A cancelled action is over for the mission now, not when the drone's end callback
+    // comes: its end is traced here, in the order the cancel arrived (the same order on
+    // every transport), and the callback, when it comes, is ignored.
+    if (s.action != mid::kNoAction && drone_.cancel(s.action)) {
+      s.action = mid::kNoAction;
+      ++s.action_seq;
+      --active_;
+      trace_end(n, {mid::Outcome::cancelled, "cancelled", std::nullopt});
+    }
     if (s.timer != mid::kNoTimer) {
       loop_.cancel(s.timer);
       s.timer = mid::kNoTimer;

@@ -64,6 +64,9 @@ class Engine {
     int exec_pending = 0;
     int back_pending = 0;
     mid::ActionId action = mid::kNoAction;
+    /// Counts the node's actions: an end callback of an action the engine already closed
+    /// (cancelled by a Do flip) carries an older number and is ignored.
+    std::uint64_t action_seq = 0;
     mid::TimerId timer = mid::kNoTimer;
     bool watching = false;
     long long iterations = 0;
@@ -86,7 +89,8 @@ class Engine {
   void flip_do(int node);
   void cancel_local(const std::vector<int>& nodes);
   void stop_watching(int node);
-  void on_action_end(int node, const mid::ActionEnd& e);
+  void on_action_end(int node, std::uint64_t seq, const mid::ActionEnd& e);
+  void trace_end(const Node& n, const mid::ActionEnd& e);
   bool condition_value(int node);
   void trace(const Node& n, const std::string& event, const std::string& outcome = "");
 
