@@ -67,7 +67,7 @@ bool connect_within(int fd, const sockaddr_in& to, int timeout_ms, std::string& 
 
 }  // namespace
 
-OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame) {
+OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame, double reconnect_s) {
   auto fail = [&](const std::string& why) {
     return OpenResult{nullptr, "connection '" + endpoint.url + "': " + why};
   };
@@ -104,6 +104,7 @@ OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame) {
     return fail(sys_error("pipe"));
   }
   std::unique_ptr<Link> link(new Link(endpoint, fd, pipe_fds[0], pipe_fds[1], std::move(on_frame)));
+  link->reconnect_ms_ = static_cast<int>(reconnect_s * 1000.0);
   if (endpoint.kind != LinkKind::udp_listen) {
     link->peer_ = addr;
     link->has_peer_ = true;
@@ -165,9 +166,8 @@ void Link::receive_loop() {
                          reinterpret_cast<sockaddr*>(&from), &from_len);
     if (n <= 0) {
       if (endpoint_.kind != LinkKind::tcp_client) continue;  // UDP: e.g. ICMP port unreachable
-      std::lock_guard lock(mutex_);
-      closed_ = true;  // the TCP peer hung up; heartbeats stop and the adapter notices
-      return;
+      if (!reconnect()) return;  // the destructor came first
+      continue;
     }
     if (endpoint_.kind == LinkKind::udp_listen) {
       std::lock_guard lock(mutex_);
@@ -175,6 +175,31 @@ void Link::receive_loop() {
       has_peer_ = true;
     }
     handle_bytes(std::span(buffer.data(), static_cast<size_t>(n)));
+  }
+}
+
+bool Link::reconnect() {
+  // The TCP peer hung up (a SITL restarted, a radio dropped out). Heartbeats stop meanwhile,
+  // so the adapter sees a lost link; try again until it is back.
+  {
+    std::lock_guard lock(mutex_);
+    closed_ = true;
+    close(fd_);
+    fd_ = -1;
+  }
+  parser_ = Parser{};  // half a frame from the old connection must not join the new one
+  for (;;) {
+    pollfd wake{wake_read_, POLLIN, 0};
+    if (poll(&wake, 1, reconnect_ms_) != 0) return false;
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    std::string error;
+    if (fd >= 0 && connect_within(fd, peer_, 1000, error)) {
+      std::lock_guard lock(mutex_);
+      fd_ = fd;
+      closed_ = false;
+      return true;
+    }
+    if (fd >= 0) close(fd);
   }
 }
 

@@ -3,6 +3,7 @@
 // bytes, runs them through the Parser and hands each good frame to the FrameHandler — on the
 // link's thread, so the handler must only pass the frame on (the adapter posts it to its event
 // loop) and never touch state the loop's thread owns. send() may be called from any thread.
+// A TCP connection the peer closes is reopened (every second by default) until it is back.
 #include <netinet/in.h>
 
 #include <cstdint>
@@ -25,7 +26,8 @@ struct OpenResult;
 class Link {
  public:
   /// Opens the socket (binds, or connects for TCP) and starts the receive thread.
-  static OpenResult open(const Endpoint& endpoint, FrameHandler on_frame);
+  /// `reconnect_s`: TCP only, the pause between attempts to reopen a closed connection.
+  static OpenResult open(const Endpoint& endpoint, FrameHandler on_frame, double reconnect_s = 1.0);
   /// Stops and joins the receive thread, then closes the socket: after it returns the
   /// handler is never called again.
   ~Link();
@@ -44,19 +46,22 @@ class Link {
  private:
   Link(Endpoint endpoint, int fd, int wake_read, int wake_write, FrameHandler on_frame);
   void receive_loop();
+  /// TCP: reconnects after the peer closed; false when the link is being destroyed.
+  bool reconnect();
   void handle_bytes(std::span<const uint8_t> bytes);
 
   Endpoint endpoint_;
   int fd_ = -1;
   int wake_read_ = -1;   ///< self-pipe: the destructor writes to wake the receive thread
   int wake_write_ = -1;
+  int reconnect_ms_ = 1000;
   uint16_t local_port_ = 0;
   FrameHandler on_frame_;
   Parser parser_;               ///< only the receive thread feeds it
   mutable std::mutex mutex_;    ///< guards peer_ and stats_
   sockaddr_in peer_{};          ///< the last sender (udp://) or the target (udpout://)
   bool has_peer_ = false;
-  bool closed_ = false;         ///< TCP: the peer closed the connection
+  bool closed_ = false;         ///< TCP: the peer closed the connection; not yet reconnected
   ParserStats stats_;
   std::thread thread_;
 };

@@ -117,6 +117,24 @@ TEST(TcpLink, CarriesFramesBothWaysInAnyChunking) {
   close(conn);
 }
 
+TEST(TcpLink, ReconnectsAfterThePeerClosed) {
+  TcpServer server(25305);
+  Mailbox adapter_side;
+  OpenResult r = Link::open(endpoint("tcp://127.0.0.1:25305"), adapter_side.handler(), 0.01);
+  ASSERT_TRUE(r.link) << r.error;
+  int first = accept(server.listener, nullptr, nullptr);
+  ASSERT_GE(first, 0);
+  close(first);  // the SITL restarted
+  // accept() blocks until the link dials again.
+  int second = accept(server.listener, nullptr, nullptr);
+  ASSERT_GE(second, 0);
+  std::vector<uint8_t> hb = Encoder{3, 1}.encode(pack(Heartbeat{}));
+  ASSERT_EQ(write(second, hb.data(), hb.size()), ssize_t(hb.size()));
+  ASSERT_TRUE(adapter_side.wait_for(1));
+  EXPECT_EQ(adapter_side.frames[0].sysid, 3);
+  close(second);
+}
+
 TEST(TcpLink, RefusedConnectionNamesTheUrl) {
   Mailbox a;
   OpenResult r = Link::open(endpoint("tcp://127.0.0.1:25303"), a.handler());
