@@ -70,6 +70,8 @@ class SimVehicle {
   std::string open(const mavlink::Endpoint& endpoint);
 
   Mode mode() const { return mode_; }
+  /// The local port it receives on (anyone may send there, as a second GCS could).
+  uint16_t local_port() const { return link_ ? link_->local_port() : 0; }
   const sim::SimDrone& drone() const { return drone_; }
 
  private:

@@ -4,6 +4,9 @@
 
 #include <cmath>
 
+#include "mavlink/enums.h"
+#include "mavlink/link.h"
+#include "mavlink/payloads.h"
 #include "mavlink_adapter/adapter.h"
 #include "vehicle_thread.h"
 
@@ -131,6 +134,40 @@ TEST(MavlinkFlight, LinkLossFailsTheRunningAction) {
   mid::ActionEnd refused = f.fly("Land");
   EXPECT_EQ(refused.outcome, mid::Outcome::failed);
   EXPECT_EQ(refused.reason, "link lost: no HEARTBEAT from system 1");
+}
+
+TEST(MavlinkFlight, APilotsModeSwitchFailsTheMotionAndTheAdapterGivesWay) {
+  test::VehicleThread vehicle(25320, 1, kSpeed);
+  Flight f(25320);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
+  ASSERT_EQ(f.fly("Takeoff", {3}).outcome, mid::Outcome::succeeded);
+  std::optional<mid::ActionEnd> end;
+  f.drone->start({"FlyTo", {40, 0, 3}}, [&](const mid::ActionEnd& e) {
+    end = e;
+    f.loop.stop();
+  });
+  f.loop.run_until(f.loop.now() + 1.5);  // under way in OFFBOARD
+  ASSERT_FALSE(end);
+
+  // A ground station on the same vehicle switches to POSCTL, as a pilot's switch would.
+  auto gcs = mavlink::Link::open(*mavlink::parse_url("udpout://127.0.0.1:" + std::to_string(vehicle.port())).endpoint,
+                                 [](mavlink::Frame) {});
+  ASSERT_TRUE(gcs.link) << gcs.error;
+  mavlink::CommandLong c;
+  c.target_system = 1;
+  c.target_component = 1;
+  c.command = mavlink::cmd::DO_SET_MODE;
+  c.param = {1, mavlink::px4::MAIN_POSCTL, 0};
+  gcs.link->send(mavlink::Encoder{1, 190, 0}.encode(mavlink::pack(c)));
+
+  f.loop.run_until(f.loop.now() + 10.0);
+  ASSERT_TRUE(end);
+  EXPECT_EQ(end->outcome, mid::Outcome::failed);
+  EXPECT_EQ(end->reason, "the vehicle left OFFBOARD for POSCTL");
+  f.loop.run_until(f.loop.now() + 2.0);  // and it does not switch back
+  vehicle.halt();
+  EXPECT_EQ(vehicle.mode(), sim_vehicle::Mode::manual);
 }
 
 TEST(MavlinkFlight, OrbitRunsUntilCancelledThenHolds) {

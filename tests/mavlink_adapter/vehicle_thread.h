@@ -25,6 +25,11 @@ class VehicleThread {
   }
   ~VehicleThread() { halt(); }
 
+  /// The vehicle's mode; only after halt(), when its loop no longer runs.
+  sim_vehicle::Mode mode() const { return vehicle_.mode(); }
+  /// Where the vehicle receives: a test can play a second ground station (a pilot's switch).
+  uint16_t port() const { return vehicle_.local_port(); }
+
   /// Stops the vehicle's loop, as if the vehicle vanished: no heartbeats any more.
   void halt() {
     if (!thread_.joinable()) return;
