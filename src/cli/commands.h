@@ -45,6 +45,7 @@ struct SimVehicleCommandOptions {
   std::string connection;   ///< any link URL instead of --udp; "" = use udp_port
   int sysid = 1;
   std::string autopilot = "px4";  ///< "px4" or "ardupilot": whose modes and rules it plays
+  double battery = 100.0;   ///< % at start; 0 makes it refuse to arm
   double speed = 1.0;       ///< mission time runs this many times as fast as the wall clock
   double duration = 0.0;    ///< stop after this many mission seconds; 0 = until SIGINT/SIGTERM
 };

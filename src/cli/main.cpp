@@ -135,6 +135,7 @@ int main(int argc, char** argv) {
   simv->add_option("--sysid", simv_opts.sysid, "MAVLink system id")->check(CLI::Range(1, 255));
   simv->add_option("--autopilot", simv_opts.autopilot, "Whose modes and rules to play: px4 (OFFBOARD) or ardupilot (Copter, GUIDED)")
       ->check(CLI::IsMember({"px4", "ardupilot"}));
+  simv->add_option("--battery", simv_opts.battery, "Charge at start, %; 0 makes it refuse to arm")->check(CLI::Range(0.0, 100.0));
   simv->add_option("--speed", simv_opts.speed, "Mission time runs X times as fast as the wall clock; the adapter's run must use the same")
       ->check(CLI::PositiveNumber);
   simv->add_option("--duration", simv_opts.duration, "Stop after this many mission seconds (default: until interrupted)")

@@ -20,6 +20,11 @@ using mid::ActionId;
 using mid::Outcome;
 
 namespace {
+
+/// MAV_CMD_NAV_LAND where the vehicle is: yaw NaN keeps the heading; latitude and longitude 0
+/// mean "here" to both autopilots.
+constexpr std::array<float, 7> kLandHere{0, 0, 0, NAN, 0, 0, 0};
+
 std::string metres(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.1f m", v);
@@ -68,9 +73,10 @@ ActionId MavlinkDrone::start(const mid::ActionRequest& request, mid::EndCallback
 }
 
 std::string MavlinkDrone::refusal(const mid::ActionRequest& r, const fleet::ActionSpec& spec) const {
-  // Only what the uniform rules demand and an autopilot would not check the same way;
-  // everything else (Arm preconditions, Takeoff while disarmed) the autopilot judges, and its
-  // MAV_RESULT becomes the reason.
+  // The uniform rules, checked here so every autopilot keeps them alike; what only the
+  // autopilot knows (arming checks, its own limits) it judges, and its MAV_RESULT becomes the
+  // reason. Takeoff while disarmed is refused here too: PX4 may accept the takeoff mode while
+  // disarmed and take off by itself once something arms it later.
   const auto& a = r.args;
   bool landed = vehicle_.landed();
   if (r.name == "Disarm") {
@@ -79,6 +85,7 @@ std::string MavlinkDrone::refusal(const mid::ActionRequest& r, const fleet::Acti
       return tracker_.request(tracker_.motion())->name + " is running: cannot disarm";
   }
   if (spec.action_class != fleet::ActionClass::motion) return "";
+  if (!vehicle_.armed) return "disarmed: arm before " + r.name;
   if (r.name == "Takeoff") {
     if (a[0] <= 0.0) return "takeoff altitude must be positive, got " + metres(a[0]);
     if (a[0] > settings_.limits.max_altitude_m)
@@ -86,7 +93,6 @@ std::string MavlinkDrone::refusal(const mid::ActionRequest& r, const fleet::Acti
              metres(settings_.limits.max_altitude_m);
     return "";
   }
-  if (!vehicle_.armed) return "disarmed: arm before " + r.name;
   if (r.name == "Land") return "";
   if (landed) return "on the ground: take off before " + r.name;
   if (r.name == "Orbit" && a.size() == 1 && a[0] <= 0.0)
@@ -155,7 +161,8 @@ void MavlinkDrone::start_motion(ActionId id, const mid::ActionRequest& r) {
       return;
     }
     until_ = Until::landed;
-    return command_motion(id, r.name == "Land" ? ml::cmd::NAV_LAND : ml::cmd::NAV_RETURN_TO_LAUNCH);
+    if (r.name == "ReturnHome") return command_motion(id, ml::cmd::NAV_RETURN_TO_LAUNCH);
+    return command_motion(id, ml::cmd::NAV_LAND, kLandHere);
   }
   if (auto goal = mid::goal_position(r, here, settings_.home)) {
     goal_.emplace(*goal, options_.tolerance);
@@ -192,6 +199,7 @@ void MavlinkDrone::start_takeoff(ActionId id, double altitude) {
     return;
   }
   std::array<float, 7> p{};
+  p[3] = NAN;         // yaw: keep the heading it has
   p[4] = p[5] = NAN;  // latitude, longitude: where it stands
   p[6] = static_cast<float>(altitude);
   if (autopilot_->takeoff_altitude_amsl) {
@@ -295,8 +303,9 @@ void MavlinkDrone::failsafe(fleet::Failsafe what) {
     return;
   }
   if (what == fleet::Failsafe::hover) return hold_here();
-  uint16_t cmd = what == fleet::Failsafe::land ? ml::cmd::NAV_LAND : ml::cmd::NAV_RETURN_TO_LAUNCH;
-  send_mode_command(command(cmd), [this](const CommandResult& result) {
+  ml::CommandLong c = what == fleet::Failsafe::land ? command(ml::cmd::NAV_LAND, kLandHere)
+                                                     : command(ml::cmd::NAV_RETURN_TO_LAUNCH);
+  send_mode_command(c, [this](const CommandResult& result) {
     if (!result.accepted) return;  // refused: keep holding where it is
     streaming_ = false;
     in_control_ = false;

@@ -14,10 +14,11 @@ using fleet::Vec3;
 
 namespace {
 
-fleet::DroneSettings vehicle_settings(uint8_t sysid) {
+fleet::DroneSettings vehicle_settings(uint8_t sysid, double battery) {
   fleet::DroneSettings s;
   s.name = "sim-vehicle-" + std::to_string(sysid);
   s.type = "Quad";
+  s.battery_percent = battery;
   return s;  // home at the origin: the local NED origin is home, as on a real vehicle
 }
 
@@ -52,7 +53,7 @@ const Dialect& ardupilot_dialect() {
 SimVehicle::SimVehicle(mid::EventLoop& loop, VehicleOptions options)
     : loop_(loop),
       options_(options),
-      drone_(vehicle_settings(options.sysid), fleet::generic_multirotor("Quad"), loop),
+      drone_(vehicle_settings(options.sysid, options.battery_percent), fleet::generic_multirotor("Quad"), loop),
       encoder_{options.sysid, ml::comp::AUTOPILOT1, 0},
       dialect_(*options.dialect),
       mode_(dialect_.boot) {}

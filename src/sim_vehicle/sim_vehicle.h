@@ -53,6 +53,7 @@ const Dialect& ardupilot_dialect();
 struct VehicleOptions {
   const Dialect* dialect = &px4_dialect();
   uint8_t sysid = 1;
+  double battery_percent = 100.0;  ///< charge at start (0: arming is refused)
   double home_amsl_m = 488.0;      ///< ground altitude above mean sea level (PX4 SITL's Zurich)
   double offboard_loss_s = 1.0;    ///< OFFBOARD without a fresh setpoint this long: hold
   double disarm_after_land_s = 2.0;

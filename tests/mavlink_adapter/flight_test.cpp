@@ -102,13 +102,23 @@ TEST(MavlinkFlight, ArduPilotTakesOffInGuidedToAnAltitudeAboveHome) {
   EXPECT_NEAR(f.drone->state().x, 0.0, 0.5);
 }
 
-TEST(MavlinkFlight, TakeoffWhileDisarmedFailsWithTheAutopilotsResult) {
-  test::VehicleThread vehicle(25313, 1, kSpeed);
+TEST(MavlinkFlight, ArmRefusedByTheAutopilotFailsWithItsResultInWords) {
+  test::VehicleThread vehicle(25313, 1, kSpeed, sim_vehicle::px4_dialect(), 0.0);  // empty battery
   Flight f(25313);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  mid::ActionEnd e = f.fly("Arm");
+  EXPECT_EQ(e.outcome, mid::Outcome::failed);
+  EXPECT_EQ(e.reason, "refused by PX4: MAV_CMD_COMPONENT_ARM_DISARM: MAV_RESULT_DENIED (denied by the autopilot)");
+  EXPECT_FALSE(f.drone->state().armed);
+}
+
+TEST(MavlinkFlight, TakeoffWhileDisarmedIsRefusedBeforeReachingTheAutopilot) {
+  test::VehicleThread vehicle(25310, 1, kSpeed);
+  Flight f(25310);
   ASSERT_TRUE(f.drone) << f.created.message;
   mid::ActionEnd e = f.fly("Takeoff", {3});
   EXPECT_EQ(e.outcome, mid::Outcome::failed);
-  EXPECT_EQ(e.reason, "refused by PX4: MAV_CMD_NAV_TAKEOFF: MAV_RESULT_DENIED (denied by the autopilot)");
+  EXPECT_EQ(e.reason, "disarmed: arm before Takeoff");
 }
 
 TEST(MavlinkFlight, LinkLossFailsTheRunningAction) {

@@ -38,10 +38,10 @@ int run(const std::string& args, std::string& output) {
   return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
 }
 
-pid_t spawn_vehicle(int port, int sysid, const char* duration = "400") {
+pid_t spawn_vehicle(int port, int sysid, const char* duration = "400", const char* battery = "100") {
   std::vector<std::string> args = {EAMOS_BINARY, "sim-vehicle", "--udp", std::to_string(port),
                                    "--sysid", std::to_string(sysid), "--speed", "4",
-                                   "--duration", duration};
+                                   "--duration", duration, "--battery", battery};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -134,19 +134,19 @@ TEST(MavlinkListing2, OneDexProcessPerDroneEachFlyingItsOwnVehicle) {
   fs::remove_all(dir);
 }
 
-TEST(MavlinkRun, RefusedTakeoffFailsTheMissionWithTheAutopilotsReasonAndEnds) {
-  pid_t vehicle = spawn_vehicle(25332, 1, "120");
+TEST(MavlinkRun, ARefusalFailsTheMissionWithTheAutopilotsReasonAndTheRunEnds) {
+  pid_t vehicle = spawn_vehicle(25332, 1, "120", "0");  // an empty battery: arming is refused
   std::string out;
   const std::string data = EAMOS_TEST_DATA;
   auto started = std::chrono::steady_clock::now();
-  int status = run("run " + data + "/data/takeoff-unarmed.eamos --fleet " + data +
-                   "/data/takeoff-unarmed.yaml --speed 4", out);
+  int status = run("run " + data + "/data/arm-refused.eamos --fleet " + data +
+                   "/data/arm-refused.yaml --speed 4", out);
   double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   kill(vehicle, SIGTERM);
   waitpid(vehicle, nullptr, 0);
   EXPECT_EQ(status, 1) << out;
-  EXPECT_NE(out.find("mission failed: Drone1.Takeoff (line 3) failed: refused by PX4: "
-                     "MAV_CMD_NAV_TAKEOFF: MAV_RESULT_DENIED"),
+  EXPECT_NE(out.find("mission failed: Drone1.Arm (line 4) failed: refused by PX4: "
+                     "MAV_CMD_COMPONENT_ARM_DISARM: MAV_RESULT_DENIED"),
             std::string::npos)
       << out;
   EXPECT_LT(wall, 15.0);  // not the time limit: a failed run ends once the drones are down

@@ -14,8 +14,10 @@ namespace eamos::test {
 class VehicleThread {
  public:
   VehicleThread(int port, uint8_t sysid, double speed,
-                const sim_vehicle::Dialect& dialect = sim_vehicle::px4_dialect())
-      : loop_({mid::ClockMode::real_time, speed}), vehicle_(loop_, {&dialect, sysid}) {
+                const sim_vehicle::Dialect& dialect = sim_vehicle::px4_dialect(),
+                double battery_percent = 100.0)
+      : loop_({mid::ClockMode::real_time, speed}),
+        vehicle_(loop_, {&dialect, sysid, battery_percent}) {
     std::string url = "udpout://127.0.0.1:" + std::to_string(port);
     if (std::string e = vehicle_.open(*mavlink::parse_url(url).endpoint); !e.empty())
       throw std::runtime_error(e);
