@@ -1,8 +1,8 @@
 // The mission as separate processes: `eamos launch` / `eamos run --distributed` start one
 // DEX per drone and a ground process, all over Cyclone DDS on loopback (the shipped
-// configuration). Each test has its own DDS domain. Missions run in real time at a speed-up,
-// so these tests take seconds, not minutes; nothing here sleeps: the tests block on the
-// processes' output.
+// configuration). Each test has its own DDS domain. Missions run in real time, five times
+// faster than the wall clock, so these tests take seconds, not minutes; nothing here
+// sleeps: the tests block on the processes' output.
 #include <gtest/gtest.h>
 
 #include <signal.h>
@@ -123,7 +123,7 @@ class Distributed : public ::testing::Test {
     std::string fleet_arg = fleet.empty() ? "" : " --fleet " + source(fleet);
     Output local = eamos("run -q " + mission_path + fleet_arg + " --trace " + (dir_ / "local.jsonl").string());
     ASSERT_EQ(local.status, 0) << local.out;
-    Output dist = eamos("run -q " + mission_path + fleet_arg + " --distributed --speed 10 --domain " +
+    Output dist = eamos("run -q " + mission_path + fleet_arg + " --distributed --speed 5 --domain " +
                         std::to_string(domain) + " --deploy-dir " + (dir_ / "deploy").string() + " --trace " +
                         (dir_ / "dist.jsonl").string() + " --summary " + (dir_ / "summary.json").string());
     ASSERT_EQ(dist.status, 0) << dist.out;
@@ -254,11 +254,11 @@ TEST_F(Distributed, SecondMissionOnTheSameDomainChangesNothing) {
   Output patrol_local = eamos("run -q " + source("patrol.eamos") + " --trace " + (patrol_dir / "local.jsonl").string());
   ASSERT_EQ(patrol_local.status, 0);
   std::string patrol_cmd = std::string(EAMOS_BINARY) + " run -q " + source("patrol.eamos") +
-                           " --distributed --speed 10 --domain 29 --deploy-dir " + (patrol_dir / "deploy").string() +
+                           " --distributed --speed 5 --domain 29 --deploy-dir " + (patrol_dir / "deploy").string() +
                            " --trace " + (patrol_dir / "dist.jsonl").string() + " > " +
                            (patrol_dir / "out.txt").string() + " 2>&1";
   FILE* patrol = popen(patrol_cmd.c_str(), "r");
-  Output r = eamos("run -q " + source("listing2.eamos") + " --distributed --speed 10 --domain 29 --deploy-dir " +
+  Output r = eamos("run -q " + source("listing2.eamos") + " --distributed --speed 5 --domain 29 --deploy-dir " +
                    (dir_ / "deploy").string() + " --trace " + (dir_ / "dist.jsonl").string());
   int patrol_status = pclose(patrol);
   ASSERT_EQ(r.status, 0) << r.out;

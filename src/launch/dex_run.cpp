@@ -1,0 +1,189 @@
+// The DEX process once the mission runs: what it receives, its status, how the mission
+// ends (FINISHED from the lead, or ABORT from anyone) and the failsafe. docs/faults.md
+// says per fault what happens.
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+
+#include "dex/runner.h"
+#include "launch/dex_state.h"
+
+namespace eamos::launch {
+
+void DexProcess::tick() {
+  // A heartbeat of the loop itself: liveliness is asserted only while the loop runs, so a
+  // hung DEX is lost like a dead one; status changes (busy/idle) are published here.
+  node_->assert_alive();
+  publish_status();
+  check_finished();
+  double every = tick_s() * o_.speed;
+  loop_->after(every, [this] { tick(); });
+}
+
+bool DexProcess::ours(const std::string& hash, std::uint64_t run) {
+  if (hash != mission_.hash) {
+    note_foreign(hash);
+    return false;
+  }
+  if (run != start_.run_id) {
+    if (stale_runs_.insert(run).second)
+      err_ << name() << ": ignoring messages of run " << run << " (this drone is in run " << start_.run_id << ")\n";
+    return false;
+  }
+  return true;
+}
+
+void DexProcess::note_foreign(const std::string& hash) {
+  if (foreign_.insert(hash).second)
+    err_ << name() << ": ignoring messages of another mission (hash " << hash.substr(0, 12)
+         << "…) on DDS domain " << o_.dds.domain << "\n";
+}
+
+void DexProcess::on_trigger(const TriggerSample& s) {
+  if (!ours(s.message.mission_hash, s.run_id) || s.to != mission_.self) return;
+  ++received_;
+  if (phase_ == Phase::running) engine_->receive(s.message);
+  publish_status();
+}
+
+void DexProcess::on_telemetry(const TelemetrySample& s) {
+  if (s.telemetry.mission_hash != mission_.hash) return note_foreign(s.telemetry.mission_hash);
+  if (s.telemetry.from == mission_.self) return;
+  // Telemetry of run 0 is what a drone publishes before any start: its initial state.
+  if (s.run_id != 0 && s.run_id != start_.run_id) return;
+  engine_->receive(std::make_shared<const dex::Telemetry>(s.telemetry));
+}
+
+void DexProcess::on_lifecycle(const LifecycleSample& s) {
+  if (s.kind == LifecycleKind::ready || s.kind == LifecycleKind::start) return;
+  if (!ours(s.mission_hash, s.run_id)) return;
+  if (s.kind == LifecycleKind::abort) {
+    std::string who = s.drone == transport::kGround ? "the ground" : mission_.fleet.at(s.drone);
+    abandon("aborted by " + who + ": " + s.reason, s.failure, false);
+  } else if (s.kind == LifecycleKind::finished && phase_ == Phase::running) {
+    complete();
+  }
+}
+
+void DexProcess::on_status(const StatusSample& s) {
+  if (s.mission_hash != mission_.hash) return note_foreign(s.mission_hash);
+  if (s.run_id != start_.run_id || s.drone == mission_.self) return;
+  statuses_[s.drone] = s;
+  ++status_changes_;
+}
+
+void DexProcess::on_lost(const std::string& hash, int drone) {
+  if (hash != mission_.hash || drone == mission_.self || phase_ != Phase::running) return;
+  auto it = statuses_.find(drone);
+  if (it != statuses_.end() && (it->second.phase == Phase::completed || it->second.phase == Phase::failed))
+    return;  // it finished and left: not lost
+  std::string lost = drone >= 0 && drone < static_cast<int>(mission_.fleet.size()) ? mission_.fleet[drone] : "?";
+  char lease[32];
+  std::snprintf(lease, sizeof lease, "%g", o_.dds.lease_s);
+  abandon(lost + " lost: no liveliness for " + lease + " s (its DEX stopped, hung or is unreachable)",
+          std::nullopt, true);
+}
+
+StatusSample DexProcess::status_now(Phase phase) const {
+  StatusSample s;
+  s.mission_hash = mission_.hash;
+  s.drone = mission_.self;
+  s.run_id = start_.run_id;
+  s.phase = phase;
+  s.busy = engine_ && engine_->busy();
+  s.end_reached = end_reached_;
+  s.sent = transport_ ? transport_->sent() : 0;
+  s.received = received_;
+  s.activations = engine_ ? engine_->activations() : 0;
+  s.since = last_status_ && last_status_->busy == s.busy ? last_status_->since : (loop_ ? loop_->now() : 0.0);
+  s.state = drone_->state();
+  return s;
+}
+
+void DexProcess::publish_status(bool force) {
+  StatusSample s = status_now(phase_);
+  if (!force && last_status_ && last_status_->phase == s.phase && last_status_->busy == s.busy &&
+      last_status_->end_reached == s.end_reached && last_status_->sent == s.sent &&
+      last_status_->received == s.received)
+    return;
+  node_->write(s);
+  last_status_ = s;
+}
+
+void DexProcess::check_finished() {
+  // Only the lead (it ran the end node) decides; everyone else follows its FINISHED.
+  if (phase_ != Phase::running || !end_reached_ || engine_->busy()) {
+    quiet_ticks_ = 0;
+    return;
+  }
+  std::uint64_t sent = transport_->sent(), received = received_;
+  double idle_since = last_status_ ? last_status_->since : loop_->now();
+  for (int d = 0; d < static_cast<int>(mission_.fleet.size()); ++d) {
+    if (d == mission_.self) continue;
+    auto it = statuses_.find(d);
+    if (it == statuses_.end() || it->second.busy || it->second.phase != Phase::running) {
+      quiet_ticks_ = 0;
+      return;
+    }
+    sent += it->second.sent;
+    received += it->second.received;
+    idle_since = std::max(idle_since, it->second.since);
+  }
+  auto signature = std::make_tuple(sent, received, status_changes_);
+  if (sent != received || (quiet_ticks_ > 0 && signature != quiet_signature_)) {
+    quiet_ticks_ = 0;
+    return;
+  }
+  quiet_signature_ = signature;
+  ++quiet_ticks_;
+  if (quiet_ticks_ * tick_s() < o_.settle_s) return;
+  LifecycleSample finished{mission_.hash, mission_.self, LifecycleKind::finished, start_.run_id};
+  // The mission ended when its last drone went idle, not when the lead noticed.
+  finished.t = idle_since;
+  node_->write(finished);
+  complete();
+}
+
+void DexProcess::complete() {
+  phase_ = Phase::completed;
+  publish_status(true);
+  loop_->stop();
+}
+
+void DexProcess::abandon(const std::string& reason, const std::optional<dex::Failure>& failure, bool broadcast) {
+  if (phase_ != Phase::running) return;
+  phase_ = Phase::failed;
+  error_ = reason;
+  err_ << name() << ": " << reason << "\n";
+  if (broadcast) {
+    LifecycleSample abort{mission_.hash, mission_.self, LifecycleKind::abort, start_.run_id};
+    abort.reason = reason;
+    abort.failure = failure;
+    abort.t = loop_->now();
+    node_->write(abort);
+  }
+  engine_->halt();
+  mid::DroneState now = drone_->state();
+  if (!now.landed || now.armed) {  // airborne, or armed on the ground: make it safe
+    tee_.record(dex::failsafe_event(loop_->now(), name(), mission_.settings.failsafe, reason));
+    drone_->failsafe(mission_.settings.failsafe);
+  }
+  failsafe_since_ = loop_->now();
+  wait_for_failsafe();
+}
+
+void DexProcess::wait_for_failsafe() {
+  // Stay up (and alive for the others) until the drone is down, hovering as told, or the
+  // failsafe has had ten minutes.
+  mid::DroneState s = drone_->state();
+  bool done = s.landed || mission_.settings.failsafe == fleet::Failsafe::hover ||
+              loop_->now() - failsafe_since_ > 600.0;
+  if (done) {
+    publish_status(true);
+    loop_->stop();
+    return;
+  }
+  loop_->after(0.1 * o_.speed, [this] { wait_for_failsafe(); });
+}
+
+}  // namespace eamos::launch

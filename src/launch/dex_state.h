@@ -1,0 +1,116 @@
+#pragma once
+// The DEX process's state (src/launch/dex_process.h is its interface): split over
+// dex_process.cpp (set-up, the start barrier, receiving) and dex_run.cpp (status, the
+// end of the mission, abandoning it).
+#include <condition_variable>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "dex/engine.h"
+#include "dex/mission.h"
+#include "dex/trace_writers.h"
+#include "launch/dex_process.h"
+#include "launch/inbox.h"
+#include "transport/dds_transport.h"
+
+namespace eamos::launch {
+
+using transport::LifecycleKind;
+using transport::LifecycleSample;
+using transport::Phase;
+using transport::StatusSample;
+using transport::TelemetrySample;
+using transport::TraceSample;
+using transport::TriggerSample;
+
+/// Writes each trace event of this drone to the ground's merged trace.
+class DdsTraceSink : public dex::TraceSink {
+ public:
+  DdsTraceSink(transport::DdsNode& node, std::string hash, std::uint64_t run, int drone)
+      : node_(node), hash_(std::move(hash)), run_(run), drone_(drone) {}
+  void record(const dex::TraceEvent& e) override { node_.write(TraceSample{hash_, run_, drone_, ++seq_, e}); }
+
+ private:
+  transport::DdsNode& node_;
+  std::string hash_;
+  std::uint64_t run_;
+  int drone_;
+  std::uint64_t seq_ = 0;
+};
+
+class DexProcess {
+ public:
+  DexProcess(const DexProcessOptions& o, std::ostream& out, std::ostream& err) : o_(o), out_(out), err_(err) {}
+  int run(const mid::AdapterRegistry& adapters);
+
+ private:
+  // --- before the start (main thread) ---
+  bool wait_for_start();
+  void on_lifecycle_waiting(const LifecycleSample& s);
+  // --- the mission (loop thread) ---
+  void begin();
+  void on_trigger(const TriggerSample& s);
+  void on_telemetry(const TelemetrySample& s);
+  void on_lifecycle(const LifecycleSample& s);
+  void on_status(const StatusSample& s);
+  void on_lost(const std::string& hash, int drone);
+  void tick();
+  void publish_status(bool force = false);
+  void check_finished();
+  void complete();
+  void abandon(const std::string& reason, const std::optional<dex::Failure>& failure, bool broadcast);
+  void wait_for_failsafe();
+  void finish_loop();
+  bool ours(const std::string& hash, std::uint64_t run);
+  void note_foreign(const std::string& hash);
+  StatusSample status_now(Phase phase) const;
+  std::string name() const { return mission_.fleet[mission_.self]; }
+  /// Wall seconds between ticks: how soon busy/idle changes are published.
+  double tick_s() const { return std::min(0.02, o_.dds.lease_s / 4); }
+
+  const DexProcessOptions& o_;
+  std::ostream& out_;
+  std::ostream& err_;
+  dex::Mission mission_;
+  std::uint64_t nonce_ = 0;  // this process, in READY; set in run()
+  std::unique_ptr<mid::EventLoop> loop_;
+  std::unique_ptr<mid::Drone> drone_;
+  std::unique_ptr<transport::DdsNode> node_;
+  Inbox inbox_;
+
+  // Shared with DDS threads until the start.
+  std::mutex wait_mutex_;
+  std::condition_variable wait_cv_;
+  std::vector<LifecycleSample> starts_;
+
+  // The run (loop thread only).
+  LifecycleSample start_;
+  std::unique_ptr<transport::DdsTransport> transport_;
+  std::unique_ptr<DdsTraceSink> dds_trace_;
+  std::ofstream trace_file_;
+  std::unique_ptr<dex::JsonlTrace> jsonl_;
+  std::unique_ptr<dex::LiveLog> live_;
+  dex::TeeTrace tee_;
+  std::unique_ptr<dex::Engine> engine_;
+  Phase phase_ = Phase::waiting;
+  bool end_reached_ = false;
+  std::uint64_t received_ = 0;
+  std::map<int, StatusSample> statuses_;  ///< other drones' newest status of this run
+  std::uint64_t status_changes_ = 0;
+  std::optional<StatusSample> last_status_;
+  int quiet_ticks_ = 0;
+  std::tuple<std::uint64_t, std::uint64_t, std::uint64_t> quiet_signature_{};
+  std::string error_;
+  std::set<std::string> foreign_;
+  std::set<std::uint64_t> stale_runs_;
+  double failsafe_since_ = 0.0;
+};
+
+}  // namespace eamos::launch
