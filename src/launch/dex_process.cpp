@@ -43,6 +43,11 @@ int DexProcess::run(const mid::AdapterRegistry& adapters) {
   transport::DdsHandlers h;
   h.trigger = [this](TriggerSample s) { inbox_.deliver([this, s = std::move(s)] { on_trigger(s); }); };
   h.telemetry = [this](TelemetrySample s) {
+    // Another mission's drone must not count as seen, nor overwrite ours in the inbox.
+    if (s.telemetry.mission_hash != mission_.hash) {
+      inbox_.deliver([this, hash = s.telemetry.mission_hash] { note_foreign(hash); });
+      return;
+    }
     inbox_.deliver_telemetry(s, [this, s] { on_telemetry(s); });
     wait_cv_.notify_all();
   };
@@ -51,14 +56,18 @@ int DexProcess::run(const mid::AdapterRegistry& adapters) {
     inbox_.deliver([this, s = std::move(s)] { on_lifecycle(s); });
   };
   h.status = [this](StatusSample s) { inbox_.deliver([this, s = std::move(s)] { on_status(s); }); };
-  h.lost = [this](const std::string& hash, int drone) { inbox_.deliver([this, hash, drone] { on_lost(hash, drone); }); };
+  h.lost = [this](const std::string& hash, int drone, std::uint64_t nonce) {
+    inbox_.deliver([this, hash, drone, nonce] { on_lost(hash, drone, nonce); });
+  };
   node_ = transport::DdsNode::open(o_.dds, std::move(h), error);
   if (!node_) {
     err_ << "eamos dex: error: " << error << "\n";
     return 1;
   }
-  if (!wait_for_start()) return 1;
-  begin();
+  if (!wait_for_start() || !begin()) {
+    node_->flush(1.0);
+    return 1;
+  }
   loop_->run_until(o_.time_limit_s + 1000.0);
   node_->flush(1.0);
   if (phase_ == Phase::completed) {
@@ -70,9 +79,10 @@ int DexProcess::run(const mid::AdapterRegistry& adapters) {
 }
 
 void DexProcess::on_lifecycle_waiting(const LifecycleSample& s) {
-  if (s.kind != LifecycleKind::start || s.mission_hash != mission_.hash) return;
+  if (s.mission_hash != mission_.hash) return;
   std::lock_guard<std::mutex> lock(wait_mutex_);
-  starts_.push_back(s);
+  if (s.kind == LifecycleKind::start) starts_.push_back(s);
+  if (s.kind == LifecycleKind::abort) aborts_.emplace(s.run_id, s.reason);
   wait_cv_.notify_all();
 }
 
@@ -87,10 +97,16 @@ bool DexProcess::wait_for_start() {
   for (;;) {
     node_->assert_alive();
     std::vector<LifecycleSample> starts;
+    std::optional<std::string> gave_up;
     {
       std::unique_lock<std::mutex> lock(wait_mutex_);
       wait_cv_.wait_for(lock, std::chrono::duration<double>(lease / 4));
       starts.swap(starts_);
+      if (aborts_.count(0)) gave_up = aborts_[0];
+    }
+    if (gave_up) {
+      err_ << "eamos dex: error: " << name() << ": the ground gave up before the start: " << *gave_up << "\n";
+      return false;
     }
     if (!ready_sent) {
       std::map<int, TelemetrySample> seen = inbox_.latest();
@@ -138,13 +154,25 @@ bool DexProcess::wait_for_start() {
   }
 }
 
-void DexProcess::begin() {
-  // Mission time 0 is the start instant the ground chose, the same on every drone.
+bool DexProcess::begin() {
+  // Mission time 0 is the start instant the ground chose, the same on every drone, also
+  // for a DEX that got START late: its loop runs from that instant, catching up.
   double lease = o_.dds.lease_s;
   while (unix_ns() < start_.start_at_ns) {
     node_->assert_alive();
     double left = (start_.start_at_ns - unix_ns()) / 1e9;
     std::this_thread::sleep_for(std::chrono::duration<double>(std::min(left, lease / 4)));
+  }
+  loop_->set_wall_origin(wall_s() + (start_.start_at_ns - unix_ns()) / 1e9);
+  {
+    // A drone that refused this run (speed mismatch) did so before anyone moved.
+    std::lock_guard<std::mutex> lock(wait_mutex_);
+    auto it = aborts_.find(start_.run_id);
+    if (it != aborts_.end()) {
+      error_ = "run " + std::to_string(start_.run_id) + " was aborted before it started: " + it->second;
+      err_ << "eamos dex: " << name() << ": " << error_ << "\n";
+      return false;
+    }
   }
   transport_ = std::make_unique<transport::DdsTransport>(*node_, start_.run_id);
   dds_trace_ = std::make_unique<DdsTraceSink>(*node_, mission_.hash, start_.run_id, mission_.self);
@@ -174,7 +202,7 @@ void DexProcess::begin() {
   };
   engine_ = std::make_unique<dex::Engine>(mission_, *drone_, *loop_, hooks);
   phase_ = Phase::running;
-  inbox_.attach(*loop_, [this](const TelemetrySample& s) { on_telemetry(s); });
+  inbox_.attach(*loop_, [this](const TelemetrySample& s) { seed_telemetry(s); });
   drone_->subscribe([this](const mid::DroneState& s) {
     engine_->properties_changed(mission_.self);
     transport_->publish(std::make_shared<const dex::Telemetry>(dex::Telemetry{mission_.hash, mission_.self, s}));
@@ -188,6 +216,7 @@ void DexProcess::begin() {
   publish_status(true);
   engine_->start();
   tick();
+  return true;
 }
 
 int run_dex_process(const DexProcessOptions& options, const mid::AdapterRegistry& adapters,

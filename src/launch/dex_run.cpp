@@ -14,6 +14,11 @@ void DexProcess::tick() {
   // A heartbeat of the loop itself: liveliness is asserted only while the loop runs, so a
   // hung DEX is lost like a dead one; status changes (busy/idle) are published here.
   node_->assert_alive();
+  if (phase_ == Phase::running && transport_->write_errors() > 0) {
+    // A trigger that did not go out would leave another drone waiting for ever.
+    abandon("DDS could not send a trigger or telemetry sample (write failed or blocked too long)", std::nullopt,
+            true);
+  }
   publish_status();
   check_finished();
   double every = tick_s() * o_.speed;
@@ -46,11 +51,20 @@ void DexProcess::on_trigger(const TriggerSample& s) {
   publish_status();
 }
 
+void DexProcess::seed_telemetry(const TelemetrySample& s) {
+  // Before the start: the newest state of each drone of this mission, run 0 (the initial
+  // state every DEX publishes while it waits) or this run (a drone that started first).
+  if (s.telemetry.mission_hash != mission_.hash || s.telemetry.from == mission_.self) return;
+  if (s.run_id != 0 && s.run_id != start_.run_id) return;
+  engine_->receive(std::make_shared<const dex::Telemetry>(s.telemetry));
+}
+
 void DexProcess::on_telemetry(const TelemetrySample& s) {
   if (s.telemetry.mission_hash != mission_.hash) return note_foreign(s.telemetry.mission_hash);
   if (s.telemetry.from == mission_.self) return;
-  // Telemetry of run 0 is what a drone publishes before any start: its initial state.
-  if (s.run_id != 0 && s.run_id != start_.run_id) return;
+  // Once running, only this run's telemetry: run 0 now comes from a DEX that was started
+  // again and stands at home, not from the drone that flies.
+  if (s.run_id != start_.run_id) return;
   engine_->receive(std::make_shared<const dex::Telemetry>(s.telemetry));
 }
 
@@ -72,8 +86,10 @@ void DexProcess::on_status(const StatusSample& s) {
   ++status_changes_;
 }
 
-void DexProcess::on_lost(const std::string& hash, int drone) {
+void DexProcess::on_lost(const std::string& hash, int drone, std::uint64_t nonce) {
   if (hash != mission_.hash || drone == mission_.self || phase_ != Phase::running) return;
+  // Only the processes START named: a leftover or restarted DEX going away is not a loss.
+  if (drone < 0 || drone >= static_cast<int>(start_.nonces.size()) || start_.nonces[drone] != nonce) return;
   auto it = statuses_.find(drone);
   if (it != statuses_.end() && (it->second.phase == Phase::completed || it->second.phase == Phase::failed))
     return;  // it finished and left: not lost
@@ -89,6 +105,7 @@ StatusSample DexProcess::status_now(Phase phase) const {
   s.mission_hash = mission_.hash;
   s.drone = mission_.self;
   s.run_id = start_.run_id;
+  s.nonce = nonce_;
   s.phase = phase;
   s.busy = engine_ && engine_->busy();
   s.end_reached = end_reached_;

@@ -55,12 +55,13 @@ class DexProcess {
   bool wait_for_start();
   void on_lifecycle_waiting(const LifecycleSample& s);
   // --- the mission (loop thread) ---
-  void begin();
+  bool begin();
   void on_trigger(const TriggerSample& s);
   void on_telemetry(const TelemetrySample& s);
+  void seed_telemetry(const TelemetrySample& s);
   void on_lifecycle(const LifecycleSample& s);
   void on_status(const StatusSample& s);
-  void on_lost(const std::string& hash, int drone);
+  void on_lost(const std::string& hash, int drone, std::uint64_t nonce);
   void tick();
   void publish_status(bool force = false);
   void check_finished();
@@ -82,13 +83,13 @@ class DexProcess {
   std::uint64_t nonce_ = 0;  // this process, in READY; set in run()
   std::unique_ptr<mid::EventLoop> loop_;
   std::unique_ptr<mid::Drone> drone_;
-  std::unique_ptr<transport::DdsNode> node_;
   Inbox inbox_;
 
   // Shared with DDS threads until the start.
   std::mutex wait_mutex_;
   std::condition_variable wait_cv_;
   std::vector<LifecycleSample> starts_;
+  std::map<std::uint64_t, std::string> aborts_;  ///< run id → reason, of ABORTs seen (0: the ground's barrier)
 
   // The run (loop thread only).
   LifecycleSample start_;
@@ -111,6 +112,9 @@ class DexProcess {
   std::set<std::string> foreign_;
   std::set<std::uint64_t> stale_runs_;
   double failsafe_since_ = 0.0;
+
+  // Last, so it goes first: its listener threads use everything above.
+  std::unique_ptr<transport::DdsNode> node_;
 };
 
 }  // namespace eamos::launch

@@ -3,6 +3,7 @@
 #include <signal.h>
 
 #include <algorithm>
+#include <csignal>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -34,6 +35,8 @@ struct DroneEntry {
   std::optional<std::uint64_t> ready_nonce;
   std::optional<StatusSample> final_status;
   std::vector<dex::Sample> track;
+  std::optional<mid::DroneState> last_state;  ///< newest telemetry of this run
+  bool lost = false;                          ///< its DEX lost liveliness during the run
   std::string log;
   double started_at = 0.0;  ///< wall time its DEX process was started
 };
@@ -90,6 +93,8 @@ class Ground {
   void on_telemetry(const TelemetrySample& s);
   bool ours(const std::string& hash);
   bool all_done();
+  void on_lost(const std::string& hash, int drone, std::uint64_t nonce);
+  void interrupt();
   void stop_all(int signal);
 
   const LaunchOptions& o_;
@@ -98,7 +103,7 @@ class Ground {
   std::ostream& out_;
   std::ostream& err_;
   mid::EventLoop loop_;
-  std::unique_ptr<transport::DdsNode> node_;
+  Inbox inbox_;
   std::string hash_;
   std::vector<DroneEntry> drones_;
   enum class Stage { barrier, running, done } stage_ = Stage::barrier;
@@ -109,7 +114,15 @@ class Ground {
   std::optional<LifecycleSample> finished_;
   std::string error_;
   std::set<std::string> foreign_;
+  std::vector<std::uint64_t> start_nonces_;
+  bool interrupted_ = false;
+
+  // Last, so it goes first: its listener threads post through inbox_ to loop_.
+  std::unique_ptr<transport::DdsNode> node_;
 };
+
+volatile std::sig_atomic_t g_signal = 0;
+void on_signal(int signal) { g_signal = signal; }
 
 int Ground::run() {
   std::string error;
@@ -127,28 +140,28 @@ int Ground::run() {
   for (auto& d : drones_)
     d.local = o_.local.empty() || std::find(o_.local.begin(), o_.local.end(), d.name) != o_.local.end();
 
-  Inbox* inbox = new Inbox();  // outlives node_: listeners may still deliver while it closes
-  std::unique_ptr<Inbox> inbox_owner(inbox);
   transport::DdsHandlers h;
-  h.lifecycle = [inbox, this](LifecycleSample s) { inbox->deliver([this, s] { on_lifecycle(s); }); };
-  h.status = [inbox, this](StatusSample s) { inbox->deliver([this, s] { on_status(s); }); };
-  h.trace = [inbox, this](TraceSample s) { inbox->deliver([this, s] { on_trace(s); }); };
-  h.telemetry = [inbox, this](TelemetrySample s) { inbox->deliver([this, s] { on_telemetry(s); }); };
-  h.lost = [inbox, this](const std::string& hash, int drone) {
-    inbox->deliver([this, hash, drone] {
-      if (hash == hash_ && drone >= 0 && drone < static_cast<int>(drones_.size()) && stage_ == Stage::running &&
-          !drones_[drone].final_status)
-        err_ << "ground: " << drones_[drone].name << " lost its liveliness\n";
-    });
+  h.lifecycle = [this](LifecycleSample s) { inbox_.deliver([this, s] { on_lifecycle(s); }); };
+  h.status = [this](StatusSample s) { inbox_.deliver([this, s] { on_status(s); }); };
+  h.trace = [this](TraceSample s) { inbox_.deliver([this, s] { on_trace(s); }); };
+  h.telemetry = [this](TelemetrySample s) { inbox_.deliver([this, s] { on_telemetry(s); }); };
+  h.lost = [this](const std::string& hash, int drone, std::uint64_t nonce) {
+    inbox_.deliver([this, hash, drone, nonce] { on_lost(hash, drone, nonce); });
   };
   node_ = transport::DdsNode::open(o_.dds, std::move(h), error);
   if (!node_) {
     err_ << "eamos launch: error: " << error << "\n";
     return 1;
   }
-  inbox->attach(loop_, [](const TelemetrySample&) {});
+  inbox_.attach(loop_, [](const TelemetrySample&) {});
+  // waitpid needs SIGCHLD at its default; Ctrl-C or a TERM aborts the run (every drone
+  // runs its failsafe) instead of killing the ground in the middle of it.
+  std::signal(SIGCHLD, SIG_DFL);
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
   if (!start_processes()) {
     stop_all(SIGTERM);
+    node_.reset();
     return 1;
   }
   barrier_deadline_ = wall_s() + o_.barrier_timeout_s;
@@ -172,7 +185,8 @@ int Ground::run() {
   }
   if (!error_.empty()) run.error = error_;
   for (auto& d : drones_) {
-    mid::DroneState state = d.final_status ? d.final_status->state : mid::DroneState{};
+    // A drone without a final status (its DEX died) is reported as last seen.
+    mid::DroneState state = d.final_status ? d.final_status->state : d.last_state.value_or(mid::DroneState{});
     run.drones.push_back({d.name, state, d.track});
     if (d.final_status) run.activations += d.final_status->activations;
   }
@@ -220,6 +234,10 @@ bool Ground::start_processes() {
 void Ground::tick() {
   for (auto& d : drones_)
     if (d.local) poll(d.child);
+  if (g_signal != 0 && stage_ != Stage::done) {
+    if (interrupted_) stop_all(SIGTERM);  // a second time: stop the DEXes now
+    interrupt();
+  }
   if (stage_ == Stage::barrier) {
     for (auto& d : drones_)
       if (d.local && d.child.exit_status && !d.ready_nonce)
@@ -253,9 +271,29 @@ void Ground::tick() {
 bool Ground::all_done() {
   for (auto& d : drones_) {
     if (d.local && !d.child.exit_status) return false;
-    if (!d.local && !d.final_status) return false;
+    if (!d.local && !d.final_status && !d.lost) return false;
   }
   return true;
+}
+
+void Ground::on_lost(const std::string& hash, int drone, std::uint64_t nonce) {
+  if (hash != hash_ || drone < 0 || drone >= static_cast<int>(drones_.size()) || stage_ != Stage::running) return;
+  DroneEntry& d = drones_[drone];
+  if (d.final_status || static_cast<int>(start_nonces_.size()) <= drone || start_nonces_[drone] != nonce) return;
+  d.lost = true;  // it will send nothing more: do not wait for its final status
+  err_ << "ground: " << d.name << " lost its liveliness\n";
+}
+
+void Ground::interrupt() {
+  interrupted_ = true;
+  std::string why = std::string("the ground was interrupted (") + (g_signal == SIGINT ? "SIGINT" : "SIGTERM") + ")";
+  g_signal = 0;
+  if (stage_ == Stage::barrier) return fail_barrier(why);
+  err_ << "ground: " << why << "; aborting the run: every drone runs its failsafe\n";
+  LifecycleSample abort{hash_, transport::kGround, LifecycleKind::abort, r_.run_id};
+  abort.reason = why;
+  node_->write(abort);
+  if (!abort_) abort_ = abort;
 }
 
 void Ground::send_start() {
@@ -268,6 +306,7 @@ void Ground::send_start() {
   start.start_at_ns = unix_ns() + static_cast<std::int64_t>(o_.start_delay_s * 1e9);
   start.speed = o_.speed;
   for (auto& d : drones_) start.nonces.push_back(*d.ready_nonce);
+  start_nonces_ = start.nonces;
   node_->write(start);
   r_.run_id = start.run_id;
   stage_ = Stage::running;
@@ -278,6 +317,11 @@ void Ground::send_start() {
 void Ground::fail_barrier(const std::string& why) {
   error_ = why;
   err_ << "eamos launch: error: " << why << "\n";
+  // DEXes started elsewhere wait for a start; tell them there will be none (run 0).
+  LifecycleSample abort{hash_, transport::kGround, LifecycleKind::abort, 0};
+  abort.reason = why;
+  node_->write(abort);
+  node_->flush(1.0);
   stop_all(SIGTERM);
   stage_ = Stage::done;
   loop_.stop();
@@ -334,8 +378,11 @@ void Ground::on_trace(TraceSample s) {
 void Ground::on_telemetry(const TelemetrySample& s) {
   const dex::Telemetry& t = s.telemetry;
   if (!ours(t.mission_hash) || t.from < 0 || t.from >= static_cast<int>(drones_.size())) return;
-  if (s.run_id != 0 && s.run_id != r_.run_id) return;
+  // Run 0 is a waiting DEX's initial state: the drone's, before the start; during the run
+  // it can only come from a DEX started again, which does not fly.
+  if (s.run_id != (stage_ == Stage::barrier ? 0 : r_.run_id)) return;
   dex::record_sample(drones_[t.from].track, t.state);
+  drones_[t.from].last_state = t.state;
 }
 
 }  // namespace

@@ -21,11 +21,26 @@ Child spawn(const std::vector<std::string>& argv, const std::string& log, std::s
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
   posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  // The ground's own DDS sockets are not the child's business.
+  posix_spawn_file_actions_addclosefrom_np(&actions, 3);
+  // Its own process group: a Ctrl-C at the terminal reaches the ground, which aborts the
+  // run so that every drone runs its failsafe, instead of killing every DEX mid-air.
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  posix_spawnattr_setpgroup(&attr, 0);
+  sigset_t defaults;
+  sigemptyset(&defaults);
+  sigaddset(&defaults, SIGINT);
+  sigaddset(&defaults, SIGTERM);
+  sigaddset(&defaults, SIGCHLD);
+  posix_spawnattr_setsigdefault(&attr, &defaults);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGDEF);
   std::vector<char*> args;
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
-  int rc = posix_spawn(&c.pid, args[0], &actions, nullptr, args.data(), environ);
+  int rc = posix_spawn(&c.pid, args[0], &actions, &attr, args.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attr);
   if (rc != 0) {
     error = "cannot start " + argv[0] + ": " + std::strerror(rc);
     c.pid = -1;
@@ -36,7 +51,12 @@ Child spawn(const std::vector<std::string>& argv, const std::string& log, std::s
 void poll(Child& c) {
   if (c.pid <= 0 || c.exit_status) return;
   int status = 0;
-  if (waitpid(c.pid, &status, WNOHANG) != c.pid) return;
+  pid_t r = waitpid(c.pid, &status, WNOHANG);
+  if (r < 0 && errno == ECHILD) {  // reaped elsewhere: it is gone, its status unknown
+    c.exit_status = 255;
+    return;
+  }
+  if (r != c.pid) return;
   c.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 

@@ -119,6 +119,11 @@ void EventLoop::start_wall_anchor() {
   // Anchor at the start of every run, so time spent outside the loop (compiling, loading)
   // is not "caught up" by running the first events late.
   if (options_.mode != ClockMode::real_time) return;
+  if (wall_origin_) {
+    wall_anchor_ = *wall_origin_;
+    mission_anchor_ = 0.0;
+    return;
+  }
   wall_anchor_ = options_.wall->now_s();
   mission_anchor_ = now_;
 }

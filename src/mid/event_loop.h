@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <queue>
 #include <unordered_map>
 #include <vector>
@@ -78,6 +79,11 @@ class EventLoop {
   /// touched by the loop's thread. A real-time loop waiting for its next timer wakes up.
   void post(std::function<void()> fn);
 
+  /// Real time: mission time 0 happens at steady wall time `wall_s` (system_wall_clock's
+  /// seconds), for every run of this loop, instead of "when run() is called". Processes
+  /// that share a start instant share their mission clock this way.
+  void set_wall_origin(double wall_s) { wall_origin_ = wall_s; }
+
   /// Callbacks run since construction (a cost measure: idle drones must not add to it).
   std::uint64_t events_run() const { return events_run_; }
 
@@ -109,6 +115,7 @@ class EventLoop {
   std::mutex post_mutex_;
   std::condition_variable post_cv_;
   std::vector<std::function<void()>> posted_;  ///< guarded by post_mutex_
+  std::optional<double> wall_origin_;
   double wall_anchor_ = 0.0;     ///< real time: wall time at which mission time ...
   double mission_anchor_ = 0.0;  ///< ... was this
 };

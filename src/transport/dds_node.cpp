@@ -25,9 +25,11 @@ bool looks_like_address(const std::string& s) {
 std::string retcode(dds_return_t rc) { return dds_strretcode(rc); }
 
 /// Reliable, transient-local: what a reader needs even when it matched late.
-dds_qos_t* durable_qos(bool keep_all) {
+dds_qos_t* durable_qos(bool keep_all, double lease_s) {
   dds_qos_t* q = dds_create_qos();
-  dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(10));
+  // A write may block while readers catch up; never as long as the lease, or a busy drone
+  // would look lost to the others.
+  dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, static_cast<dds_duration_t>(lease_s / 4 * 1e9));
   dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
   // What a late reader gets is the durability service's history, not the writer's:
   // its default (keep-last 1) would hand a late DEX only the newest trigger.
@@ -144,7 +146,7 @@ bool DdsNode::create(const DdsOptions& options, std::string& error) {
       {"eamos_trace", &eamos_wire_TraceRecord_desc, true, &w_trace_, &r_trace_, on_trace},
   };
   for (TopicSpec& spec : specs) {
-    dds_qos_t* qos = durable_qos(spec.keep_all);
+    dds_qos_t* qos = durable_qos(spec.keep_all, options.lease_s);
     dds_entity_t topic = dds_create_topic(participant_, spec.type, spec.name, qos, nullptr);
     if (topic < 0) {
       dds_delete_qos(qos);
@@ -245,7 +247,7 @@ void DdsNode::take_status(int reader) {
       [this, &handle](StatusSample s) {
         {
           std::lock_guard<std::mutex> lock(writers_mutex_);
-          status_writers_[handle] = {s.mission_hash, s.drone};
+          status_writers_[handle] = {s.mission_hash, s.drone, s.nonce};
         }
         if (handlers_.status) handlers_.status(std::move(s));
       },
@@ -259,14 +261,14 @@ void DdsNode::take_trace(int reader) {
 }
 
 void DdsNode::liveliness_changed(std::uint64_t publication_handle) {
-  std::pair<std::string, int> who;
+  Writer who;
   {
     std::lock_guard<std::mutex> lock(writers_mutex_);
     auto it = status_writers_.find(publication_handle);
     if (it == status_writers_.end()) return;  // a writer that never said which drone it is
     who = it->second;
   }
-  if (handlers_.lost) handlers_.lost(who.first, who.second);
+  if (handlers_.lost) handlers_.lost(who.mission_hash, who.drone, who.nonce);
 }
 
 }  // namespace eamos::transport

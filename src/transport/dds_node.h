@@ -37,8 +37,8 @@ struct DdsHandlers {
   std::function<void(StatusSample)> status;
   std::function<void(TraceSample)> trace;
   /// A status writer lost its liveliness (lease expired, or its process went away):
-  /// which mission and drone it belonged to.
-  std::function<void(const std::string& mission_hash, int drone)> lost;
+  /// the mission, drone and process (nonce) it belonged to.
+  std::function<void(const std::string& mission_hash, int drone, std::uint64_t nonce)> lost;
 };
 
 class DdsNode {
@@ -83,9 +83,17 @@ class DdsNode {
   int participant_ = 0;
   int w_trigger_ = 0, w_telemetry_ = 0, w_lifecycle_ = 0, w_status_ = 0, w_trace_ = 0;
   int r_trigger_ = 0, r_telemetry_ = 0, r_lifecycle_ = 0, r_status_ = 0, r_trace_ = 0;
-  std::mutex writers_mutex_;  ///< status writer's (mission, drone), for liveliness reports
-  std::map<std::uint64_t, std::pair<std::string, int>> status_writers_;
+  struct Writer {
+    std::string mission_hash;
+    int drone = 0;
+    std::uint64_t nonce = 0;
+  };
+  std::mutex writers_mutex_;  ///< per status writer: whose it is, for liveliness reports
+  std::map<std::uint64_t, Writer> status_writers_;
 };
+
+/// Notes: a second node in one process joins the domain the first created, and the first
+/// one's destruction ends the domain for both: tests destroy them in reverse order.
 
 /// The Cyclone DDS XML for `options` (loopback, an interface, or the user's file).
 bool dds_config(const DdsOptions& options, std::string& xml, std::string& error);

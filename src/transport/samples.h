@@ -51,6 +51,7 @@ struct StatusSample {
   std::string mission_hash;
   int drone = 0;
   std::uint64_t run_id = 0;
+  std::uint64_t nonce = 0;     ///< the writing process, as in its READY
   Phase phase = Phase::waiting;
   bool busy = false;
   bool end_reached = false;

@@ -146,6 +146,7 @@ eamos_wire_Status to_wire(const StatusSample& s) {
   w.mission_hash = borrow(s.mission_hash);
   w.drone = s.drone;
   w.run_id = s.run_id;
+  w.nonce = s.nonce;
   w.phase = static_cast<eamos_wire_Phase>(s.phase);
   w.busy = s.busy;
   w.end_reached = s.end_reached;
@@ -162,6 +163,7 @@ StatusSample from_wire(const eamos_wire_Status& w) {
   s.mission_hash = copy(w.mission_hash);
   s.drone = w.drone;
   s.run_id = w.run_id;
+  s.nonce = w.nonce;
   s.phase = static_cast<Phase>(w.phase);
   s.busy = w.busy;
   s.end_reached = w.end_reached;

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
+#include <tuple>
 
 #include "transport/dds_node.h"
 
@@ -18,7 +19,8 @@ struct Received {
   std::condition_variable cv;
   std::vector<TriggerSample> triggers;
   std::vector<TelemetrySample> telemetry;
-  std::vector<std::pair<std::string, int>> lost;
+  std::vector<StatusSample> status;
+  std::vector<std::tuple<std::string, int, std::uint64_t>> lost;
 
   bool wait(const std::function<bool()>& done) {
     std::unique_lock<std::mutex> lock(mutex);
@@ -38,9 +40,14 @@ DdsHandlers record_into(Received& r) {
     r.telemetry.push_back(std::move(s));
     r.cv.notify_all();
   };
-  h.lost = [&r](const std::string& hash, int drone) {
+  h.status = [&r](StatusSample s) {
     std::lock_guard<std::mutex> lock(r.mutex);
-    r.lost.emplace_back(hash, drone);
+    r.status.push_back(std::move(s));
+    r.cv.notify_all();
+  };
+  h.lost = [&r](const std::string& hash, int drone, std::uint64_t nonce) {
+    std::lock_guard<std::mutex> lock(r.mutex);
+    r.lost.emplace_back(hash, drone, nonce);
     r.cv.notify_all();
   };
   return h;
@@ -96,6 +103,29 @@ TEST(DdsNode, LateReaderGetsOnlyTheNewestTelemetryPerDrone) {
   for (const TelemetrySample& s : got.telemetry) EXPECT_EQ(s.telemetry.state.x, 10);
   reader.reset();
   writer.reset();
+}
+
+TEST(DdsNode, ReportsWhoseStatusWriterWentAway) {
+  std::string error;
+  DdsOptions options;
+  options.domain = 43;
+  Received watcher;
+  auto observer = DdsNode::open(options, record_into(watcher), error);  // created first: owns the domain
+  ASSERT_TRUE(observer) << error;
+  Received ignored;
+  auto drone = DdsNode::open(options, record_into(ignored), error);
+  ASSERT_TRUE(drone) << error;
+  StatusSample s;
+  s.mission_hash = "h";
+  s.drone = 2;
+  s.nonce = 99;
+  ASSERT_TRUE(drone->write(s));
+  ASSERT_TRUE(watcher.wait([&] { return !watcher.status.empty(); }));
+  drone.reset();  // the process goes away
+  ASSERT_TRUE(watcher.wait([&] { return !watcher.lost.empty(); }));
+  std::lock_guard<std::mutex> lock(watcher.mutex);
+  EXPECT_EQ(watcher.lost.front(), std::make_tuple(std::string("h"), 2, std::uint64_t{99}));
+  observer.reset();
 }
 
 TEST(DdsNode, RejectsADomainIdOutOfRange) {

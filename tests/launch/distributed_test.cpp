@@ -6,10 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <signal.h>
+#include <sys/types.h>
 #include <sys/wait.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -230,6 +232,7 @@ TEST_F(Distributed, RestartedDexDoesNotResumeTheAbandonedMission) {
                      }
                    });
   EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("Drone2 lost"), std::string::npos) << r.out;  // the others gave up on the old process
   EXPECT_EQ(restarted.status, 1) << restarted.out;
   EXPECT_NE(restarted.out.find("not joining run"), std::string::npos) << restarted.out;
   EXPECT_EQ(restarted.out.find("Drone2   start"), std::string::npos) << restarted.out;  // ran nothing
@@ -241,7 +244,9 @@ TEST_F(Distributed, StartBarrierTimeoutAbortsWithTheMissingDrones) {
   Output r = eamos("launch " + deploy.string() + " --drones Drone1 --barrier-timeout 1 --domain 28");
   EXPECT_EQ(r.status, 1) << r.out;
   EXPECT_NE(r.out.find("start barrier timed out after 1 s; not ready: Drone2, Drone3"), std::string::npos) << r.out;
-  EXPECT_EQ(r.out.find("Drone1   start"), std::string::npos) << r.out;  // nothing flew
+  std::string log = read_text(deploy / "Drone1" / "dex.log");
+  EXPECT_NE(log.find("waiting for its peers"), std::string::npos) << log;
+  EXPECT_EQ(log.find("Drone1   start"), std::string::npos) << log;  // nothing flew
 }
 
 TEST_F(Distributed, SecondMissionOnTheSameDomainChangesNothing) {
@@ -269,6 +274,86 @@ TEST_F(Distributed, SecondMissionOnTheSameDomainChangesNothing) {
   std::string logs = r.out + read_text(patrol_dir / "out.txt");
   for (const char* d : {"Drone1", "Drone2", "Drone3"}) logs += read_text(dir_ / "deploy" / d / "dex.log");
   EXPECT_NE(logs.find("ignoring messages of another mission"), std::string::npos) << logs;
+}
+
+/// Starts `eamos args` in the background with its output in `log`; returns its pid.
+pid_t eamos_background(const std::string& args, const fs::path& log) {
+  std::string cmd = std::string(EAMOS_BINARY) + " " + args + " > " + log.string() + " 2>&1 & echo $!";
+  FILE* p = popen(cmd.c_str(), "r");
+  char buf[64] = {0};
+  if (!fgets(buf, sizeof buf, p)) buf[0] = '\0';
+  pclose(p);
+  return static_cast<pid_t>(std::atoi(buf));
+}
+
+TEST_F(Distributed, GroundEndsWhenADexStartedElsewhereIsLost) {
+  fs::path deploy = deploy_listing2(dir_);
+  // Drone2's DEX runs "on the drone": not started by the ground.
+  pid_t remote = eamos_background("dex " + (deploy / "Drone2").string() +
+                                      " --speed 5 --liveliness-timeout 1 --domain 32 --start-timeout 30",
+                                  dir_ / "drone2.log");
+  ASSERT_GT(remote, 0);
+  bool killed = false;
+  // A ground that waited for Drone2's final status would run into ctest's timeout (120 s).
+  Output r = eamos("launch " + deploy.string() + " --drones Drone1,Drone3 --speed 5 --liveliness-timeout 1 " +
+                       "--domain 32 --summary " + (dir_ / "summary.json").string(),
+                   [&](const std::string& line) {
+                     if (!killed && line.find("Drone3.Takeoff(3)  succeeded") != std::string::npos) {
+                       kill(remote, SIGKILL);
+                       killed = true;
+                     }
+                   });
+  ASSERT_TRUE(killed) << r.out;
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("Drone2 lost"), std::string::npos) << r.out;
+  nlohmann::json summary = read_json(dir_ / "summary.json");
+  EXPECT_EQ(summary["status"], "failed");
+  // Reported where it was last seen (airborne), not as a drone that landed at home.
+  EXPECT_FALSE(summary["drones"]["Drone2"]["landed"]) << summary.dump(2);
+}
+
+TEST_F(Distributed, FailedActionOnOneDroneFailsTheMissionOnEveryDrone) {
+  std::string mission = std::string(EAMOS_SOURCE_DIR) + "/tests/launch/missions/refused_takeoff.eamos";
+  Output r = eamos("run -q " + mission + " --distributed --speed 5 --domain 33 --deploy-dir " +
+                   (dir_ / "deploy").string() + " --trace " + (dir_ / "trace.jsonl").string() + " --summary " +
+                   (dir_ / "summary.json").string());
+  EXPECT_EQ(r.status, 1) << r.out;
+  nlohmann::json summary = read_json(dir_ / "summary.json");
+  EXPECT_EQ(summary["status"], "failed");
+  ASSERT_TRUE(summary.contains("failure")) << summary.dump(2);
+  EXPECT_EQ(summary["failure"]["drone"], "Late");
+  EXPECT_EQ(summary["failure"]["action"], "Takeoff");
+  EXPECT_EQ(summary["failure"]["line"], 20);
+  EXPECT_NE(summary["error"].get<std::string>().find("arm before Takeoff"), std::string::npos);
+  // Lead, in the air on another process, got the ABORT and landed.
+  std::string trace = read_text(dir_ / "trace.jsonl");
+  EXPECT_NE(trace.find("\"drone\":\"Lead\",\"event\":\"failsafe\""), std::string::npos) << trace;
+  EXPECT_TRUE(summary["drones"]["Lead"]["landed"]);
+  EXPECT_FALSE(summary["drones"]["Lead"]["armed"]);
+}
+
+TEST_F(Distributed, TimeLimitFailsTheMissionOnEveryDrone) {
+  Output r = eamos("run -q " + source("listing2.eamos") + " --distributed --speed 5 --time-limit 3 --domain 34 " +
+                   "--deploy-dir " + (dir_ / "deploy").string() + " --summary " + (dir_ / "summary.json").string());
+  EXPECT_EQ(r.status, 1) << r.out;
+  nlohmann::json summary = read_json(dir_ / "summary.json");
+  EXPECT_NE(summary["error"].get<std::string>().find("did not complete within 3"), std::string::npos) << summary.dump(2);
+  for (const char* d : {"Drone1", "Drone2", "Drone3"}) EXPECT_TRUE(summary["drones"][d]["landed"]) << d;
+}
+
+TEST_F(Distributed, SpeedMismatchAbortsBeforeAnyDroneMoves) {
+  fs::path deploy = deploy_listing2(dir_);
+  pid_t remote = eamos_background("dex " + (deploy / "Drone2").string() + " --speed 1 --domain 35 --start-timeout 30",
+                                  dir_ / "drone2.log");
+  ASSERT_GT(remote, 0);
+  Output r = eamos("launch " + deploy.string() + " --drones Drone1,Drone3 --speed 5 --domain 35");
+  EXPECT_EQ(r.status, 1) << r.out;
+  for (const char* d : {"Drone1", "Drone3"}) {
+    std::string log = read_text(deploy / d / "dex.log");
+    EXPECT_NE(log.find("aborted before it started"), std::string::npos) << log;
+    EXPECT_EQ(log.find(std::string(d) + "   start"), std::string::npos) << log;  // nothing moved
+  }
+  EXPECT_NE(read_text(dir_ / "drone2.log").find("--speed 5"), std::string::npos) << read_text(dir_ / "drone2.log");
 }
 
 TEST_F(Distributed, DexRefusesAFolderWithoutAMission) {

@@ -178,5 +178,15 @@ TEST(EventLoop, PostFromAnotherThreadWakesAWaitingRealTimeLoop) {
   EXPECT_LT(loop.now(), 3600.0);
 }
 
+TEST(EventLoop, WallOriginFixesWhenMissionTimeZeroHappened) {
+  FakeWall wall;  // now 100
+  EventLoop loop({ClockMode::real_time, 2.0, &wall});
+  loop.set_wall_origin(99.0);  // mission time 0 was a wall second ago: mission time is now 2
+  loop.at(1.0, [] {});         // already due: no wait
+  loop.at(4.0, [] {});         // wall 99 + 4 / 2 = 101
+  loop.run_until_idle();
+  EXPECT_EQ(wall.sleeps, (std::vector<double>{101.0}));
+}
+
 }  // namespace
 }  // namespace eamos::mid
