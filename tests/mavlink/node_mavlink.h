@@ -45,8 +45,8 @@ inline std::string node_mavlink_missing() {
   std::filesystem::path dir = EAMOS_NODE_MAVLINK_DIR;
   if (std::filesystem::exists(dir / "node_modules" / "node-mavlink" / "package.json")) return "";
   return "node-mavlink is not installed in " + dir.string() +
-         "/node_modules: the build runs `npm ci` there when it finds npm (CMake found: '" +
-         std::string(EAMOS_NPM) + "'). Install Node.js and npm (scripts/install-deps.sh), " +
+         "/node_modules: the build runs `npm ci` there when CMake finds npm (it found: " +
+         std::string(EAMOS_NPM) + "). Install Node.js and npm (scripts/install-deps.sh), " +
          "re-run cmake and build, or run `npm ci` in that folder by hand.";
 }
 
