@@ -15,26 +15,33 @@ namespace {
 using nlohmann::json;
 using test::NodeRun;
 
-/// How a generated message is filled: every field non-zero (nothing to truncate), only the
-/// first field in wire order with a value whose high bytes are zero (truncated mid-field),
-/// or all zero (truncated to the one byte MAVLink v2 keeps).
+/// How a generated message is filled: every field non-zero (nothing to truncate); only the
+/// first field in wire order, set small (0x0102 for integers, so an integer field is cut
+/// after its low bytes; 2.0 for floats); or all zero (cut to the one byte MAVLink v2 keeps).
 enum class Fill { every_field, first_field_small, zero };
 
-/// A distinct non-zero value of field type `type` for element number `k` (1, 2, ...).
+/// Element `index` of field `f`, number `k` (1, 2, ...) of the message: distinct and non-zero
+/// in its top byte, or the small value of Fill::first_field_small.
 void set_element(FieldWriter& w, const FieldDef& f, int index, int k, bool small) {
-  auto i = [&](long long big, long long little) { return small ? little : big; };
+  auto put = [&]<typename T>(T value, T small_value) {
+    w.set<T>(f.name, small ? small_value : value, index);
+  };
   switch (f.type) {
-    case FieldType::u8: w.set<uint8_t>(f.name, static_cast<uint8_t>(i(0x80 + k, 2)), index); break;
-    case FieldType::i8: w.set<int8_t>(f.name, static_cast<int8_t>(i(-3 - k, 2)), index); break;
-    case FieldType::u16: w.set<uint16_t>(f.name, static_cast<uint16_t>(i(0xA000 + 7 * k, 0x0102)), index); break;
-    case FieldType::i16: w.set<int16_t>(f.name, static_cast<int16_t>(i(-1000 - k, 0x0102)), index); break;
-    case FieldType::u32: w.set<uint32_t>(f.name, static_cast<uint32_t>(i(0xC0000000LL + 12345LL * k, 0x0102)), index); break;
-    case FieldType::i32: w.set<int32_t>(f.name, static_cast<int32_t>(i(-100000 - 77 * k, 0x0102)), index); break;
-    case FieldType::u64: w.set<uint64_t>(f.name, small ? 0x0102u : 0xF000000000000000ULL + k, index); break;
-    case FieldType::i64: w.set<int64_t>(f.name, small ? 0x0102 : -(1LL << 40) - k, index); break;
-    case FieldType::f32: w.set<float>(f.name, small ? 2.0f : -12.375f + 1.5f * static_cast<float>(k) + 0.1f, index); break;
-    case FieldType::f64: w.set<double>(f.name, small ? 2.0 : -1e9 - 0.1 * k, index); break;
-    case FieldType::char_: w.set<uint8_t>(f.name, static_cast<uint8_t>('a' + k % 26), index); break;
+    case FieldType::u8: put(static_cast<uint8_t>(0x80 + k), uint8_t{2}); break;
+    case FieldType::i8: put(static_cast<int8_t>(-3 - k), int8_t{2}); break;
+    case FieldType::u16: put(static_cast<uint16_t>(0xA000 + 7 * k), uint16_t{0x0102}); break;
+    case FieldType::i16: put(static_cast<int16_t>(-1000 - k), int16_t{0x0102}); break;
+    case FieldType::u32:
+      put(0xC0000000u + 12345u * static_cast<uint32_t>(k), uint32_t{0x0102});
+      break;
+    case FieldType::i32: put(int32_t{-100000} - 77 * k, int32_t{0x0102}); break;
+    case FieldType::u64:
+      put(uint64_t{0xF000000000000000ULL} + static_cast<uint64_t>(k), uint64_t{0x0102});
+      break;
+    case FieldType::i64: put(int64_t{-(1LL << 40)} - k, int64_t{0x0102}); break;
+    case FieldType::f32: put(-12.275f + 1.5f * static_cast<float>(k), 2.0f); break;
+    case FieldType::f64: put(-1e9 - 0.1 * k, 2.0); break;
+    case FieldType::char_: put(static_cast<uint8_t>('a' + k % 26), uint8_t{'b'}); break;
   }
 }
 
@@ -150,7 +157,8 @@ std::string spec_lines(const std::vector<Sample>& all) {
         continue;
       }
       json values = json::array();
-      for (int e = 0; e < f.array_length; ++e) values.push_back(test::our_value(*s.def, s.message, f, e));
+      for (int e = 0; e < f.array_length; ++e)
+        values.push_back(test::our_value(*s.def, s.message, f, e));
       fields[std::string(f.name)] = values;
     }
     out += json{{"msgid", s.def->id}, {"sysid", s.sysid}, {"compid", s.compid}, {"seq", s.seq},
@@ -173,7 +181,8 @@ TEST(NodeMavlinkCrosscheck, WeDecodeEveryMessageItEncodesAndWriteTheSameBytes) {
   std::vector<std::vector<uint8_t>> their_frames;
   for (size_t at = 0; at + kHeaderLength <= theirs.size();) {
     size_t n = kHeaderLength + theirs[at + 1] + kCrcLength;
-    their_frames.emplace_back(theirs.begin() + at, theirs.begin() + std::min(at + n, theirs.size()));
+    size_t end = std::min(at + n, theirs.size());
+    their_frames.emplace_back(theirs.begin() + at, theirs.begin() + end);
     at += n;
   }
 
@@ -211,9 +220,12 @@ TEST(NodeMavlinkCrosscheck, AdapterMessagesFromNodeMavlinkUnpackToTheirKnownValu
   ASSERT_EQ(test::node_mavlink_missing(), "");
   test::ScratchDir dir;
   std::ofstream(dir.file("spec.jsonl"))
-      << R"({"msgid":0,"sysid":1,"compid":1,"seq":7,"fields":{"type":2,"autopilot":12,"base_mode":157,"custom_mode":393216,"system_status":4,"mavlink_version":3}})" "\n"
+      << R"({"msgid":0,"sysid":1,"compid":1,"seq":7,"fields":{"type":2,"autopilot":12,)"
+         R"("base_mode":157,"custom_mode":393216,"system_status":4,"mavlink_version":3}})" "\n"
       << R"({"msgid":77,"sysid":1,"compid":1,"seq":8,"fields":{"command":400,"result":4}})" "\n"
-      << R"({"msgid":84,"sysid":1,"compid":191,"seq":9,"fields":{"time_boot_ms":123456,"target_system":1,"target_component":1,"coordinate_frame":1,"type_mask":3576,"x":10.5,"y":-4.25,"z":-3,"yaw":"NaN"}})" "\n"
+      << R"({"msgid":84,"sysid":1,"compid":191,"seq":9,"fields":{"time_boot_ms":123456,)"
+         R"("target_system":1,"target_component":1,"coordinate_frame":1,"type_mask":3576,)"
+         R"("x":10.5,"y":-4.25,"z":-3,"yaw":"NaN"}})" "\n"
       << R"({"msgid":245,"sysid":1,"compid":1,"seq":10,"fields":{"landed_state":2}})" "\n";
   NodeRun run = test::run_node_mavlink("encode '" + dir.file("spec.jsonl") + "' '" +
                                        dir.file("theirs.bin") + "'");

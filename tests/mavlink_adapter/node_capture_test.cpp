@@ -57,7 +57,8 @@ std::set<uint32_t> expect_both_decode_alike(const std::vector<uint8_t>& bytes,
   std::set<uint32_t> ids;
   mavlink::test::ScratchDir dir;
   mavlink::test::write_file(dir.file(who + ".bin"), bytes);
-  mavlink::test::NodeRun run = mavlink::test::run_node_mavlink("decode '" + dir.file(who + ".bin") + "'");
+  mavlink::test::NodeRun run =
+      mavlink::test::run_node_mavlink("decode '" + dir.file(who + ".bin") + "'");
   EXPECT_EQ(run.exit_code, 0) << run.other_output;
   EXPECT_EQ(run.summary()["crc_errors"], 0) << who << ": node-mavlink rejected some checksums";
   EXPECT_EQ(run.summary()["unknown"], 0) << who << ": ids node-mavlink does not know";

@@ -76,7 +76,8 @@ class UdpTap {
       if (fds[1].revents & POLLIN) {
         sockaddr_in from{};
         socklen_t len = sizeof from;
-        ssize_t n = recvfrom(vehicle_fd_, buf, sizeof buf, 0, reinterpret_cast<sockaddr*>(&from), &len);
+        ssize_t n =
+            recvfrom(vehicle_fd_, buf, sizeof buf, 0, reinterpret_cast<sockaddr*>(&from), &len);
         if (n > 0) {
           std::lock_guard lock(mutex_);
           from_vehicle_.insert(from_vehicle_.end(), buf, buf + n);

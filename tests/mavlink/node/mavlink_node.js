@@ -75,7 +75,9 @@ function encode(specFile, outFile) {
     const message = new clazz()
     // Every field starts at zero, not at node-mavlink's defaults (first enum value, etc.),
     // so a field the spec leaves out is zero on both sides.
-    for (const f of clazz.FIELDS) message[f.name] = fromJson(f.length ? new Array(f.length).fill(0) : 0, f.type)
+    for (const f of clazz.FIELDS) {
+      message[f.name] = fromJson(f.length ? new Array(f.length).fill(0) : 0, f.type)
+    }
     const known = new Set(clazz.FIELDS.map(f => f.source))
     for (const [name, value] of Object.entries(spec.fields || {})) {
       // A misspelt name would otherwise be sent as zero and the test would compare zeros.
