@@ -58,13 +58,14 @@ Message make_message(const MessageDef& def, Fill fill) {
   return w.take();
 }
 
-/// Every message of our table in each fill, with distinct header values.
+/// One generated message and the header it is sent with.
 struct Sample {
   Message message;
   uint8_t seq, sysid, compid;
   const MessageDef* def;
 };
 
+/// Every message of our table in each fill, with distinct header values.
 std::vector<Sample> samples() {
   std::vector<Sample> out;
   uint8_t n = 250;  // sequence numbers wrap from 255 to 0 along the way
