@@ -10,6 +10,7 @@ packages=(
   graphviz
   cyclonedds-dev cyclonedds-tools
   clang libclang-rt-14-dev
+  nodejs
 )
 
 missing=()
@@ -18,6 +19,11 @@ for p in "${packages[@]}"; do
     missing+=("$p")
   fi
 done
+# npm (test-side tools only: node-mavlink for the MAVLink cross-check) is checked by command,
+# not by package: a NodeSource nodejs bundles npm and conflicts with Debian's npm package.
+if ! command -v npm >/dev/null 2>&1; then
+  missing+=(npm)
+fi
 
 if [ ${#missing[@]} -eq 0 ]; then
   exit 0
