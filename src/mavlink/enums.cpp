@@ -21,6 +21,7 @@ std::string command_name(uint16_t c) {
     case cmd::NAV_RETURN_TO_LAUNCH: return "MAV_CMD_NAV_RETURN_TO_LAUNCH";
     case cmd::NAV_LAND: return "MAV_CMD_NAV_LAND";
     case cmd::NAV_TAKEOFF: return "MAV_CMD_NAV_TAKEOFF";
+    case cmd::DO_ORBIT: return "MAV_CMD_DO_ORBIT";
     case cmd::DO_SET_MODE: return "MAV_CMD_DO_SET_MODE";
     case cmd::COMPONENT_ARM_DISARM: return "MAV_CMD_COMPONENT_ARM_DISARM";
     case cmd::SET_MESSAGE_INTERVAL: return "MAV_CMD_SET_MESSAGE_INTERVAL";

@@ -10,6 +10,7 @@ namespace cmd {  // MAV_CMD
 inline constexpr uint16_t NAV_RETURN_TO_LAUNCH = 20;
 inline constexpr uint16_t NAV_LAND = 21;
 inline constexpr uint16_t NAV_TAKEOFF = 22;
+inline constexpr uint16_t DO_ORBIT = 34;
 inline constexpr uint16_t DO_SET_MODE = 176;
 inline constexpr uint16_t COMPONENT_ARM_DISARM = 400;
 inline constexpr uint16_t SET_MESSAGE_INTERVAL = 511;
@@ -75,11 +76,13 @@ inline constexpr uint32_t mode(uint8_t main, uint8_t sub = 0) {
 }
 inline constexpr uint8_t MAIN_POSCTL = 3, MAIN_AUTO = 4, MAIN_OFFBOARD = 6;
 inline constexpr uint8_t AUTO_TAKEOFF = 2, AUTO_LOITER = 3, AUTO_RTL = 5, AUTO_LAND = 6;
+inline constexpr uint8_t POSCTL_ORBIT = 1;  ///< DO_ORBIT's mode; DO_SET_MODE cannot select it
 inline constexpr uint32_t OFFBOARD = mode(MAIN_OFFBOARD);
 inline constexpr uint32_t LOITER = mode(MAIN_AUTO, AUTO_LOITER);
 inline constexpr uint32_t TAKEOFF = mode(MAIN_AUTO, AUTO_TAKEOFF);
 inline constexpr uint32_t LAND = mode(MAIN_AUTO, AUTO_LAND);
 inline constexpr uint32_t RTL = mode(MAIN_AUTO, AUTO_RTL);
+inline constexpr uint32_t ORBIT = mode(MAIN_POSCTL, POSCTL_ORBIT);
 }  // namespace px4
 
 /// "MAV_RESULT_DENIED (denied)" and so on; an unknown value as its number.

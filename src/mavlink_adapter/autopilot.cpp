@@ -8,13 +8,16 @@ namespace {
 
 // ArduCopter mode numbers (ArduPilot's Copter/mode.h).
 constexpr uint32_t kCopterGuided = 4;
+constexpr uint32_t kCopterLoiter = 5;
 
 const Autopilot kPx4{"PX4", mavlink::autopilot::PX4, px4::OFFBOARD, "OFFBOARD",
                      /*stream_before_switch=*/true, /*takeoff_in_setpoint_mode=*/false,
-                     /*takeoff_altitude_amsl=*/true, /*main_sub_modes=*/true};
+                     /*takeoff_altitude_amsl=*/true, /*main_sub_modes=*/true,
+                     /*do_orbit=*/true, px4::ORBIT, px4::LOITER};
 const Autopilot kArduPilot{"ArduPilot", mavlink::autopilot::ARDUPILOTMEGA, kCopterGuided, "GUIDED",
                            /*stream_before_switch=*/false, /*takeoff_in_setpoint_mode=*/true,
-                           /*takeoff_altitude_amsl=*/false, /*main_sub_modes=*/false};
+                           /*takeoff_altitude_amsl=*/false, /*main_sub_modes=*/false,
+                           /*do_orbit=*/false, 0, kCopterLoiter};
 
 }  // namespace
 
@@ -40,12 +43,13 @@ std::string mode_name(const Autopilot& a, uint32_t m) {
       case px4::LAND: return "AUTO.LAND";
       case px4::RTL: return "AUTO.RTL";
       case px4::mode(px4::MAIN_POSCTL): return "POSCTL";
+      case px4::ORBIT: return "ORBIT";
     }
   } else {
     switch (m) {
       case 0: return "STABILIZE";
       case kCopterGuided: return "GUIDED";
-      case 5: return "LOITER";
+      case kCopterLoiter: return "LOITER";
       case 6: return "RTL";
       case 9: return "LAND";
     }

@@ -25,6 +25,13 @@ struct Autopilot {
   /// PX4 packs custom_mode as main mode << 16 | sub mode << 24 and DO_SET_MODE takes them
   /// as param2/param3; ArduPilot's custom_mode is the mode number, DO_SET_MODE param2.
   bool main_sub_modes;
+  /// PX4 flies MAV_CMD_DO_ORBIT itself, in a mode of its own (`orbit_mode`); ArduPilot Copter
+  /// has no DO_ORBIT, so the adapter flies the circle with setpoints there.
+  bool do_orbit;
+  uint32_t orbit_mode;  ///< custom_mode while flying DO_ORBIT (unused without do_orbit)
+  /// Where a cancelled DO_ORBIT goes at once: the autopilot's hold (PX4: AUTO.LOITER), so the
+  /// vehicle stops circling before the setpoint stream has earned the setpoint mode.
+  uint32_t hold_mode;
 };
 
 /// The row for a HEARTBEAT.autopilot value; nullptr for autopilots we do not fly.

@@ -172,11 +172,7 @@ void MavlinkDrone::start_motion(ActionId id, const mid::ActionRequest& r) {
     return;
   }
   setpoint_ = here;
-  if (r.name == "Orbit") {
-    orbit_ = {true, here, r.args.empty() ? 5.0 : r.args[0], 0.0, false};
-    stream_setpoints();
-    return;
-  }
+  if (r.name == "Orbit") return start_orbit(id, here, r.args.empty() ? 5.0 : r.args[0]);
   stream_setpoints();  // Hover: hold where it is; Hover(s) ends after s seconds
   if (r.args.size() == 1) {
     action_timers_[id] = loop_.after(r.args[0], [this, id] {
@@ -261,7 +257,9 @@ void MavlinkDrone::stop_action(ActionId id) {
   motion_owner_ = mid::kNoAction;
   goal_.reset();
   holding_.reset();
+  bool autopilot_orbits = orbit_.commanded;
   orbit_ = {};
+  if (autopilot_orbits) leave_orbit();
   hold_here();
 }
 

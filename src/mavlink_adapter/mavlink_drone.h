@@ -8,8 +8,8 @@
 //   ReturnHome      MAV_CMD_NAV_RETURN_TO_LAUNCH, done when on ground
 //   FlyTo, FlyBy*   position setpoints (SET_POSITION_TARGET_LOCAL_NED) in OFFBOARD/GUIDED
 //   Hover           a position setpoint where the drone is
-//   Orbit           setpoints moving around the circle, computed here (ArduPilot Copter has
-//                   no DO_ORBIT, and PX4's needs a global position, so one way for both)
+//   Orbit           PX4: MAV_CMD_DO_ORBIT around where it is, flown in PX4's Orbit mode;
+//                   ArduPilot (Copter has no DO_ORBIT): setpoints moving around the circle
 //   TakePicture     MAV_CMD_IMAGE_START_CAPTURE to the autopilot
 //   SensorK         the fleet file's sensor model at the drone's position (MAVLink has no
 //                   standard "mission sensor"; a real payload needs its own adapter code)
@@ -80,6 +80,8 @@ class MavlinkDrone final : public mid::Drone {
     double radius = 0.0;
     double angle = 0.0;     ///< rad from east, counter-clockwise
     bool on_circle = false;
+    bool commanded = false; ///< the autopilot flies it (DO_ORBIT accepted), not our setpoints
+    bool mode_seen = false; ///< a HEARTBEAT has shown the autopilot's orbit mode
   };
 
   // actions (mavlink_drone.cpp)
@@ -107,6 +109,13 @@ class MavlinkDrone final : public mid::Drone {
   mavlink::CommandLong command(uint16_t id, std::array<float, 7> params = {}) const;
   void stream_setpoints();
   void stream_tick();
+
+  // orbit (mavlink_drone_orbit.cpp)
+  double orbit_speed(double radius) const;
+  void start_orbit(mid::ActionId id, fleet::Vec3 centre, double radius);
+  void orbit_stopped_in_flight();
+  void leave_orbit();
+  bool left_orbit_mode();  ///< the vehicle left DO_ORBIT's mode: the orbit failed
   void advance_orbit(double dt);
   void switch_to_setpoint_mode();
   void send_mode_command(mavlink::CommandLong c, CommandDone done);
@@ -150,7 +159,7 @@ class MavlinkDrone final : public mid::Drone {
   bool in_control_ = false;       ///< the vehicle entered the setpoint mode for our stream; if
                                   ///< it leaves it (a pilot, a failsafe), we do not fight it
   fleet::Vec3 setpoint_;          ///< mission frame
-  Orbit orbit_;
+  Orbit orbit_;  ///< active: our setpoints fly it; commanded: the autopilot does
   int setpoints_sent_ = 0;
   /// Commands in flight that change the flight mode (DO_SET_MODE, NAV_TAKEOFF, NAV_LAND,
   /// NAV_RETURN_TO_LAUNCH): meanwhile a HEARTBEAT in another mode is expected, not a takeover,

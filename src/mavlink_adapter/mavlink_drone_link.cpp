@@ -107,6 +107,7 @@ void MavlinkDrone::on_heartbeat() {
   link_lost_ = false;
   link_watchdog();
   if (!telemetry_requested_) request_telemetry();
+  if (left_orbit_mode()) return;
   if (streaming_ && in_control_ && mode_commands_pending_ == 0 &&
       vehicle_.custom_mode != autopilot_->setpoint_mode) {
     // Someone else (a pilot's switch, the autopilot's own failsafe) took the vehicle out of
@@ -265,21 +266,6 @@ void MavlinkDrone::send_mode_command(ml::CommandLong c, CommandDone done) {
     --mode_commands_pending_;
     if (done) done(r);
   });
-}
-
-void MavlinkDrone::advance_orbit(double dt) {
-  const double r = orbit_.radius;
-  if (!orbit_.on_circle) {
-    // Out to the circle's east point first, like the simulator, then around it.
-    setpoint_ = {orbit_.centre.x + r, orbit_.centre.y, orbit_.centre.z};
-    if (horizontal_norm(position() - setpoint_) <= options_.tolerance.horizontal_m) orbit_.on_circle = true;
-    return;
-  }
-  const fleet::Limits& l = settings_.limits;
-  double speed = std::min(l.max_speed_mps, std::sqrt(0.8 * l.max_accel_mps2 * r));
-  orbit_.angle = std::fmod(orbit_.angle + speed * dt / r, 2.0 * M_PI);
-  setpoint_ = {orbit_.centre.x + r * std::cos(orbit_.angle),
-               orbit_.centre.y + r * std::sin(orbit_.angle), orbit_.centre.z};
 }
 
 }  // namespace eamos::mavlink_adapter

@@ -38,15 +38,16 @@ constexpr uint8_t kAckLater = 255;
 const Dialect& px4_dialect() {
   static const Dialect d{"PX4", ml::autopilot::PX4,
                          {px4::mode(px4::MAIN_POSCTL), px4::LOITER, px4::OFFBOARD, px4::TAKEOFF,
-                          px4::LAND, px4::RTL},
-                         Mode::hold, true, true, false, true, true, Mode::hold};
+                          px4::LAND, px4::RTL, px4::ORBIT},
+                         Mode::hold, true, true, false, true, true, Mode::hold, true};
   return d;
 }
 
 const Dialect& ardupilot_dialect() {
-  // ArduCopter: STABILIZE 0, GUIDED 4, LOITER 5, RTL 6, LAND 9; a GUIDED takeoff stays GUIDED.
-  static const Dialect d{"ArduPilot", ml::autopilot::ARDUPILOTMEGA, {0, 5, 4, 4, 9, 6},
-                         Mode::manual, false, false, true, false, false, Mode::setpoint};
+  // ArduCopter: STABILIZE 0, GUIDED 4, LOITER 5, RTL 6, CIRCLE 7, LAND 9; a GUIDED takeoff
+  // stays GUIDED. CIRCLE is never entered here: no DO_ORBIT, and DO_SET_MODE cannot ask for it.
+  static const Dialect d{"ArduPilot", ml::autopilot::ARDUPILOTMEGA, {0, 5, 4, 4, 9, 6, 7},
+                         Mode::manual, false, false, true, false, false, Mode::setpoint, false};
   return d;
 }
 
@@ -63,6 +64,7 @@ SimVehicle::~SimVehicle() {
   for (auto& [id, timer] : streams_) loop_.cancel(timer);
   loop_.cancel(offboard_timer_);
   loop_.cancel(disarm_timer_);
+  loop_.cancel(orbit_timer_);
 }
 
 std::string SimVehicle::open(const ml::Endpoint& endpoint) {
@@ -96,6 +98,7 @@ void SimVehicle::on_command(const ml::CommandLong& c) {
   if (c.target_system != options_.sysid && c.target_system != 0) return;
   // A resend means our ACK was lost: answer again, but do not arm or take off twice.
   if (c.confirmation > 0 && has_last_ && last_command_ == c.command) return ack(c.command, last_result_);
+  ++received_[c.command];
   if (c.command == ml::cmd::IMAGE_START_CAPTURE) return start_then_ack(c.command, "TakePicture");
   uint8_t result = execute(c);
   if (result == kAckLater) return;
@@ -128,6 +131,7 @@ uint8_t SimVehicle::execute(const ml::CommandLong& c) {
     }
     case ml::cmd::NAV_LAND: return set_mode(Mode::land);
     case ml::cmd::NAV_RETURN_TO_LAUNCH: return set_mode(Mode::rtl);
+    case ml::cmd::DO_ORBIT: return start_orbit(c);
     case ml::cmd::DO_SET_MODE: {
       Mode m;
       return requested_mode(c, m) ? set_mode(m) : ml::result::DENIED;
@@ -149,7 +153,8 @@ bool SimVehicle::requested_mode(const ml::CommandLong& c, Mode& out) const {
   auto p2 = static_cast<uint32_t>(c.param[1]), p3 = static_cast<uint32_t>(c.param[2]);
   uint32_t custom = dialect_.main_sub_modes ? (p2 << 16 | p3 << 24) : p2;
   for (int m = 0; m < kModes; ++m)
-    if (dialect_.custom_mode[m] == custom && Mode(m) != Mode::takeoff) {
+    // Takeoff and Orbit need their commands' parameters: DO_SET_MODE cannot enter them.
+    if (dialect_.custom_mode[m] == custom && Mode(m) != Mode::takeoff && Mode(m) != Mode::orbit) {
       out = Mode(m);
       return true;
     }
@@ -185,6 +190,7 @@ uint8_t SimVehicle::set_mode(Mode mode) {
       start("ReturnHome", {});
       return ml::result::ACCEPTED;
     case Mode::takeoff:
+    case Mode::orbit:
       break;
   }
   return ml::result::DENIED;

@@ -7,7 +7,8 @@
 //  - COMMAND_LONG answered with COMMAND_ACK: ARM_DISARM, NAV_TAKEOFF (param7 above mean
 //    sea level; refused while disarmed), NAV_LAND, NAV_RETURN_TO_LAUNCH, DO_SET_MODE
 //    (OFFBOARD only while setpoints stream, AUTO.LOITER/LAND/RTL), SET_MESSAGE_INTERVAL,
-//    IMAGE_START_CAPTURE (acknowledged once the 0.5 s picture is taken); anything else
+//    IMAGE_START_CAPTURE (acknowledged once the 0.5 s picture is taken), DO_ORBIT (PX4 only:
+//    around where it is, in PX4's Orbit mode; ArduPilot Copter has none); anything else
 //    MAV_RESULT_UNSUPPORTED. A resend (confirmation > 0) of the last command is
 //    acknowledged again, not executed twice;
 //  - SET_POSITION_TARGET_LOCAL_NED flown in OFFBOARD; setpoints older than 1 s there fall
@@ -29,8 +30,8 @@
 namespace eamos::sim_vehicle {
 
 /// What the vehicle is doing, whatever the autopilot calls it.
-enum class Mode : uint8_t { manual, hold, setpoint, takeoff, land, rtl };
-inline constexpr int kModes = 6;
+enum class Mode : uint8_t { manual, hold, setpoint, takeoff, land, rtl, orbit };
+inline constexpr int kModes = 7;
 
 /// How one autopilot names and rules its modes: the vehicle plays PX4 or ArduPilot Copter.
 /// This is the vehicle's own description, written from the autopilots' documentation and
@@ -46,6 +47,7 @@ struct Dialect {
   bool setpoints_before_switch;  ///< PX4: no OFFBOARD without a setpoint stream
   bool setpoint_loss_holds;      ///< PX4: OFFBOARD falls back to hold when setpoints stop
   Mode after_takeoff;            ///< PX4: AUTO.LOITER; ArduPilot: stays in GUIDED
+  bool do_orbit;                 ///< PX4 flies MAV_CMD_DO_ORBIT; ArduPilot Copter does not know it
 };
 const Dialect& px4_dialect();
 const Dialect& ardupilot_dialect();
@@ -74,6 +76,12 @@ class SimVehicle {
   /// The local port it receives on (anyone may send there, as a second GCS could).
   uint16_t local_port() const { return link_ ? link_->local_port() : 0; }
   const sim::SimDrone& drone() const { return drone_; }
+  /// How many COMMAND_LONGs of this id it answered, accepted or refused (resends of the last
+  /// one not counted): what a test asks the vehicle it flies against.
+  int received(uint16_t command) const {
+    auto it = received_.find(command);
+    return it == received_.end() ? 0 : it->second;
+  }
 
  private:
   void on_frame(const mavlink::Frame& frame);
@@ -91,6 +99,9 @@ class SimVehicle {
   void ack(uint16_t command, uint8_t result);
   void after_touchdown();
   void check_offboard();
+  // DO_ORBIT (sim_vehicle_orbit.cpp)
+  uint8_t start_orbit(const mavlink::CommandLong& c);
+  void orbit_tick();
 
   void set_rate(uint32_t message_id, double hz);
   void send_stream(uint32_t message_id);
@@ -120,6 +131,20 @@ class SimVehicle {
   std::map<uint32_t, double> rates_hz_;
   mid::TimerId offboard_timer_ = mid::kNoTimer;
   mid::TimerId disarm_timer_ = mid::kNoTimer;
+  std::map<uint16_t, int> received_;
+
+  /// The orbit flown in Mode::orbit: like PX4's orbit task, a point moved around the circle
+  /// that the vehicle follows.
+  struct Orbit {
+    fleet::Vec3 centre;
+    double radius = 0.0;
+    double speed = 0.0;      ///< m/s along the circle
+    double direction = 1.0;  ///< +1 counter-clockwise seen from above, -1 clockwise
+    double angle = 0.0;      ///< rad from east, counter-clockwise
+    bool on_circle = false;
+  };
+  Orbit orbit_;
+  mid::TimerId orbit_timer_ = mid::kNoTimer;
 };
 
 }  // namespace eamos::sim_vehicle

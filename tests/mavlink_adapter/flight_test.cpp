@@ -7,44 +7,13 @@
 #include "mavlink/enums.h"
 #include "mavlink/link.h"
 #include "mavlink/payloads.h"
-#include "mavlink_adapter/adapter.h"
-#include "vehicle_thread.h"
+#include "flight.h"
 
 namespace eamos::mavlink_adapter {
 namespace {
 
-constexpr double kSpeed = 4.0;
-
-struct Flight {
-  mid::EventLoop loop{{mid::ClockMode::real_time, kSpeed}};
-  mid::AdapterRegistry registry;
-  std::unique_ptr<mid::Drone> drone;
-  mid::CreateResult created;
-
-  explicit Flight(int port, MavlinkOptions options = {}) {
-    options.real_time = true;
-    options.speed = kSpeed;
-    register_adapter(registry, options);
-    fleet::DroneSettings s;
-    s.name = "Drone1";
-    s.adapter = "mavlink";
-    s.connection = "udp://127.0.0.1:" + std::to_string(port);
-    s.sysid = 1;
-    created = registry.create("mavlink", s, fleet::generic_multirotor("Quad"), loop);
-    drone = std::move(created.drone);
-  }
-
-  /// Starts an action and runs the loop until it ends (at most `max_s` mission seconds).
-  mid::ActionEnd fly(const std::string& name, std::vector<double> args = {}, double max_s = 60) {
-    std::optional<mid::ActionEnd> end;
-    drone->start({name, std::move(args)}, [&](const mid::ActionEnd& e) {
-      end = e;
-      loop.stop();
-    });
-    loop.run_until(loop.now() + max_s);
-    return end.value_or(mid::ActionEnd{mid::Outcome::failed, "test: no end within the limit"});
-  }
-};
+using test::Flight;
+using test::kSpeed;
 
 TEST(MavlinkFlight, ConnectsAndRecognisesPx4) {
   test::VehicleThread vehicle(25311, 1, kSpeed);

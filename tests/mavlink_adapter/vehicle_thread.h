@@ -2,6 +2,7 @@
 // A simulated MAVLink vehicle on its own thread and real-time loop, as a separate process
 // would be, for the adapter's loopback tests. It sends to udpout://127.0.0.1:PORT.
 #include <atomic>
+#include <future>
 #include <stdexcept>
 #include <thread>
 
@@ -31,6 +32,16 @@ class VehicleThread {
   sim_vehicle::Mode mode() const { return vehicle_.mode(); }
   /// Where the vehicle receives: a test can play a second ground station (a pilot's switch).
   uint16_t port() const { return vehicle_.local_port(); }
+
+  /// Runs `f(vehicle)` on the running vehicle's loop and returns what it returns: how a test
+  /// looks at the vehicle without racing its thread.
+  template <typename F>
+  auto inspect(F f) {
+    std::promise<decltype(f(vehicle_))> result;
+    auto future = result.get_future();
+    loop_.post([&] { result.set_value(f(vehicle_)); });
+    return future.get();
+  }
 
   /// Stops the vehicle's loop, as if the vehicle vanished: no heartbeats any more.
   void halt() {

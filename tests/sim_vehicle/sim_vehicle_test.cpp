@@ -145,5 +145,48 @@ TEST(SimVehicle, AnswersUnknownCommandsAsUnsupported) {
   EXPECT_EQ(companion.command(31000), ml::result::UNSUPPORTED);
 }
 
+/// DO_ORBIT around where the vehicle is: radius (negative = counter-clockwise), speed.
+std::array<float, 7> orbit(float radius, float speed = 2) { return {radius, speed, 0, NAN, NAN, NAN, NAN}; }
+
+TEST(SimVehicle, Px4FliesDoOrbitInTheAirInItsOrbitMode) {
+  Companion companion(25345);
+  test::VehicleThread vehicle(25345, 1, kSpeed);
+  await_first_frame(companion);
+  ASSERT_EQ(companion.command(ml::cmd::COMPONENT_ARM_DISARM, {1}), ml::result::ACCEPTED);
+  EXPECT_EQ(companion.command(ml::cmd::DO_ORBIT, orbit(-3)), ml::result::DENIED);  // on the ground
+  ASSERT_EQ(companion.command(ml::cmd::NAV_TAKEOFF, {0, 0, 0, 0, NAN, NAN, 491}), ml::result::ACCEPTED);
+  ASSERT_GE(companion.wait_for(companion.count(), [](const ml::Message& m) {
+    auto e = ml::unpack_extended_sys_state(m);
+    return e && e->landed_state == ml::landed::IN_AIR;
+  }), 0);
+  EXPECT_EQ(companion.command(ml::cmd::DO_ORBIT, orbit(-3)), ml::result::ACCEPTED);
+  int hb = companion.wait_for(companion.count(), [](const ml::Message& m) {
+    auto h = ml::unpack_heartbeat(m);
+    return h && h->custom_mode == px4::ORBIT;
+  });
+  EXPECT_GE(hb, 0);
+  EXPECT_EQ(vehicle.inspect([](const SimVehicle& v) { return v.mode(); }), Mode::orbit);
+}
+
+TEST(SimVehicle, Px4RefusesAnOrbitLargerThanItsLargest) {
+  Companion companion(25346);
+  test::VehicleThread vehicle(25346, 1, kSpeed);
+  await_first_frame(companion);
+  ASSERT_EQ(companion.command(ml::cmd::COMPONENT_ARM_DISARM, {1}), ml::result::ACCEPTED);
+  ASSERT_EQ(companion.command(ml::cmd::NAV_TAKEOFF, {0, 0, 0, 0, NAN, NAN, 491}), ml::result::ACCEPTED);
+  ASSERT_GE(companion.wait_for(companion.count(), [](const ml::Message& m) {
+    auto e = ml::unpack_extended_sys_state(m);
+    return e && e->landed_state == ml::landed::IN_AIR;
+  }), 0);
+  EXPECT_EQ(companion.command(ml::cmd::DO_ORBIT, orbit(2000)), ml::result::DENIED);
+}
+
+TEST(SimVehicle, ArduPilotAnswersDoOrbitAsUnsupported) {
+  Companion companion(25347);
+  test::VehicleThread vehicle(25347, 1, kSpeed, ardupilot_dialect());
+  await_first_frame(companion);
+  EXPECT_EQ(companion.command(ml::cmd::DO_ORBIT, orbit(-3)), ml::result::UNSUPPORTED);
+}
+
 }  // namespace
 }  // namespace eamos::sim_vehicle
