@@ -25,12 +25,9 @@ namespace {
 /// mean "here" to both autopilots.
 constexpr std::array<float, 7> kLandHere{0, 0, 0, NAN, 0, 0, 0};
 
-std::string metres(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f m", v);
-  return buf;
-}
 }  // namespace
+
+using mid::metres;
 
 MavlinkDrone::MavlinkDrone(fleet::DroneSettings settings, fleet::DroneType type,
                            mid::EventLoop& loop, MavlinkOptions options)
@@ -77,37 +74,10 @@ std::string MavlinkDrone::refusal(const mid::ActionRequest& r, const fleet::Acti
   // autopilot knows (arming checks, its own limits) it judges, and its MAV_RESULT becomes the
   // reason. Takeoff while disarmed is refused here too: PX4 may accept the takeoff mode while
   // disarmed and take off by itself once something arms it later.
-  const auto& a = r.args;
-  bool landed = vehicle_.landed();
-  if (r.name == "Disarm") {
-    if (!landed) return "in the air at z = " + metres(position().z) + ": land before disarming";
-    if (tracker_.motion() != mid::kNoAction)
-      return tracker_.request(tracker_.motion())->name + " is running: cannot disarm";
-  }
-  if (spec.action_class != fleet::ActionClass::motion) return "";
-  if (!vehicle_.armed) return "disarmed: arm before " + r.name;
-  if (r.name == "Takeoff") {
-    if (a[0] <= 0.0) return "takeoff altitude must be positive, got " + metres(a[0]);
-    if (a[0] > settings_.limits.max_altitude_m)
-      return "takeoff altitude " + metres(a[0]) + " is above max_altitude " +
-             metres(settings_.limits.max_altitude_m);
-    return "";
-  }
-  if (r.name == "Land") return "";
-  if (landed) return "on the ground: take off before " + r.name;
-  if (r.name == "Orbit" && a.size() == 1 && a[0] <= 0.0)
-    return "orbit radius must be positive, got " + metres(a[0]);
-  if (r.name == "Hover" && a.size() == 1 && a[0] < 0.0) return "hover duration must not be negative";
-  if (r.name == "ReturnHome") return "";
-  if (auto goal = mid::goal_position(r, reference(), settings_.home)) {
-    if (goal->z <= ground_z())
-      return "target z = " + metres(goal->z) + " is not above the ground (z = " +
-             metres(ground_z()) + "); use Land to land";
-    if (goal->z > ground_z() + settings_.limits.max_altitude_m)
-      return "target z = " + metres(goal->z) + " is above max_altitude " +
-             metres(settings_.limits.max_altitude_m) + " over the ground";
-  }
-  return "";
+  mid::VehicleFacts v{vehicle_.armed, vehicle_.landed(), reference(), ""};
+  if (tracker_.motion() != mid::kNoAction) v.running_motion = tracker_.request(tracker_.motion())->name;
+  if (r.name == "Disarm") v.position = position();
+  return mid::uniform_refusal(r, spec, v, settings_);
 }
 
 void MavlinkDrone::start_system(ActionId id, const mid::ActionRequest& r) {

@@ -1,5 +1,7 @@
 #include "mid/requests.h"
 
+#include <cstdio>
+
 #include <algorithm>
 #include <cmath>
 
@@ -29,6 +31,44 @@ std::optional<fleet::Vec3> goal_position(const ActionRequest& r, fleet::Vec3 p, 
   if (r.name == "FlyByZ" && a.size() == 1) return fleet::Vec3{p.x, p.y, p.z + a[0]};
   if (r.name == "ReturnHome") return home;
   return std::nullopt;
+}
+
+std::string metres(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f m", v);
+  return buf;
+}
+
+std::string uniform_refusal(const ActionRequest& r, const fleet::ActionSpec& spec, const VehicleFacts& v,
+                            const fleet::DroneSettings& settings) {
+  const auto& a = r.args;
+  const double ground_z = settings.home.z;
+  if (r.name == "Disarm") {
+    if (!v.landed) return "in the air at z = " + metres(v.position.z) + ": land before disarming";
+    if (!v.running_motion.empty()) return v.running_motion + " is running: cannot disarm";
+  }
+  if (spec.action_class != fleet::ActionClass::motion) return "";
+  if (!v.armed) return "disarmed: arm before " + r.name;
+  if (r.name == "Takeoff") {
+    if (a[0] <= 0.0) return "takeoff altitude must be positive, got " + metres(a[0]);
+    if (a[0] > settings.limits.max_altitude_m)
+      return "takeoff altitude " + metres(a[0]) + " is above max_altitude " + metres(settings.limits.max_altitude_m);
+    return "";
+  }
+  if (r.name == "Land") return "";
+  if (v.landed) return "on the ground: take off before " + r.name;
+  if (r.name == "Orbit" && a.size() == 1 && a[0] <= 0.0) return "orbit radius must be positive, got " + metres(a[0]);
+  if (r.name == "Hover" && a.size() == 1 && a[0] < 0.0) return "hover duration must not be negative";
+  if (r.name == "ReturnHome") return "";
+  if (auto goal = goal_position(r, v.position, settings.home)) {
+    if (goal->z <= ground_z)
+      return "target z = " + metres(goal->z) + " is not above the ground (z = " + metres(ground_z) +
+             "); use Land to land";
+    if (goal->z > ground_z + settings.limits.max_altitude_m)
+      return "target z = " + metres(goal->z) + " is above max_altitude " + metres(settings.limits.max_altitude_m) +
+             " over the ground";
+  }
+  return "";
 }
 
 }  // namespace eamos::mid

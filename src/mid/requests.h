@@ -27,4 +27,24 @@ RequestCheck check_request(const ActionRequest& request, const fleet::DroneType&
 std::optional<fleet::Vec3> goal_position(const ActionRequest& request, fleet::Vec3 position,
                                          fleet::Vec3 home);
 
+/// What the Uniform Space must know of a vehicle to judge a request by the rules every
+/// adapter keeps (drone_api.h).
+struct VehicleFacts {
+  bool armed = false;
+  bool landed = true;
+  fleet::Vec3 position;         ///< where a relative motion would start from
+  std::string running_motion;   ///< the name of the motion action running now; "" none
+};
+
+/// "" when `request` (already passed check_request, whose spec is `spec`) may start on a
+/// vehicle in the state `v`, otherwise why not, in words: Disarm in the air or while a
+/// motion runs, motion while disarmed, anything but Takeoff or Land on the ground, targets
+/// below the ground or above max_altitude, non-positive radii and altitudes. What only a
+/// platform knows (battery, the autopilot's own checks) each adapter adds.
+std::string uniform_refusal(const ActionRequest& request, const fleet::ActionSpec& spec, const VehicleFacts& v,
+                            const fleet::DroneSettings& settings);
+
+/// "12.3 m": how refusals print lengths.
+std::string metres(double v);
+
 }  // namespace eamos::mid

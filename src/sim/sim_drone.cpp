@@ -14,13 +14,7 @@ using fleet::Vec3;
 using mid::ActionId;
 using mid::Outcome;
 
-namespace {
-std::string metres(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f m", v);
-  return buf;
-}
-}  // namespace
+using mid::metres;
 
 SimDrone::SimDrone(fleet::DroneSettings settings, fleet::DroneType type, mid::EventLoop& loop,
                    SimOptions options)
@@ -63,39 +57,10 @@ ActionId SimDrone::start(const mid::ActionRequest& request, mid::EndCallback on_
 }
 
 std::string SimDrone::refusal(const mid::ActionRequest& r, const fleet::ActionSpec& spec) const {
-  const auto& a = r.args;
   if (r.name == "Arm" && battery_.at(loop_.now()) <= 0.0) return "battery empty: cannot arm";
-  if (r.name == "Disarm") {
-    if (!landed_) return "in the air at z = " + metres(kin_.position.z) + ": land before disarming";
-    if (tracker_.motion() != mid::kNoAction)
-      return tracker_.request(tracker_.motion())->name + " is running: cannot disarm";
-  }
-  if (spec.action_class != fleet::ActionClass::motion) return "";
-
-  if (!armed_) return "disarmed: arm before " + r.name;
-  const double ceiling = ground_z() + settings_.limits.max_altitude_m;
-  if (r.name == "Takeoff") {
-    if (a[0] <= 0.0) return "takeoff altitude must be positive, got " + metres(a[0]);
-    if (a[0] > settings_.limits.max_altitude_m)
-      return "takeoff altitude " + metres(a[0]) + " is above max_altitude " +
-             metres(settings_.limits.max_altitude_m);
-    return "";
-  }
-  if (r.name == "Land") return "";
-  if (landed_) return "on the ground: take off before " + r.name;
-  if (r.name == "Orbit" && a.size() == 1 && a[0] <= 0.0)
-    return "orbit radius must be positive, got " + metres(a[0]);
-  if (r.name == "Hover" && a.size() == 1 && a[0] < 0.0) return "hover duration must not be negative";
-  if (r.name == "ReturnHome") return "";
-  if (auto goal = mid::goal_position(r, kin_.position, settings_.home)) {
-    if (goal->z <= ground_z())
-      return "target z = " + metres(goal->z) + " is not above the ground (z = " +
-             metres(ground_z()) + "); use Land to land";
-    if (goal->z > ceiling)
-      return "target z = " + metres(goal->z) + " is above max_altitude " +
-             metres(settings_.limits.max_altitude_m) + " over the ground";
-  }
-  return "";
+  mid::VehicleFacts v{armed_, landed_, kin_.position, ""};
+  if (tracker_.motion() != mid::kNoAction) v.running_motion = tracker_.request(tracker_.motion())->name;
+  return mid::uniform_refusal(r, spec, v, settings_);
 }
 
 void SimDrone::start_system(ActionId id, const mid::ActionRequest& r) {
