@@ -48,14 +48,20 @@ class InProcessTransport : public Transport {
 
 }  // namespace
 
-TraceEvent failsafe_event(double t, const std::string& drone, fleet::Failsafe what, const std::string& reason) {
-  TraceEvent e;
-  e.t = t;
-  e.drone = drone;
-  e.event = "failsafe";
-  e.name = fleet::failsafe_name(what);
-  e.reason = reason;
-  return e;
+void enter_failsafe(mid::Drone& drone, const fleet::DroneSettings& settings, double t, const std::string& reason,
+                    TraceSink* trace) {
+  mid::DroneState s = drone.state();
+  if (s.landed && !s.armed) return;  // already safe; an armed drone on the ground is disarmed
+  if (trace) {
+    TraceEvent e;
+    e.t = t;
+    e.drone = settings.name;
+    e.event = "failsafe";
+    e.name = fleet::failsafe_name(settings.failsafe);
+    e.reason = reason;
+    trace->record(e);
+  }
+  drone.failsafe(settings.failsafe);
 }
 
 void record_sample(std::vector<Sample>& track, const mid::DroneState& s) {
@@ -108,12 +114,7 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
   // fleet file says) every drone still in the air.
   auto abandon = [&] {
     for (auto& e : engines) e->halt();
-    for (int d = 0; d < n; ++d) {
-      mid::DroneState s = drones[d]->state();
-      if (s.landed && !s.armed) continue;  // already safe; an armed drone on the ground is disarmed
-      if (trace) trace->record(failsafe_event(loop.now(), missions[d].settings.name, missions[d].settings.failsafe, result.error));
-      drones[d]->failsafe(missions[d].settings.failsafe);
-    }
+    for (int d = 0; d < n; ++d) enter_failsafe(*drones[d], missions[d].settings, loop.now(), result.error, trace);
   };
   auto fail = [&](const Failure& f) {
     if (failed) return;

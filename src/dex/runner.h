@@ -28,8 +28,12 @@ struct Sample {
   bool landed;
 };
 
-/// The trace event of a drone entering its failsafe because the mission was abandoned.
-TraceEvent failsafe_event(double t, const std::string& drone, fleet::Failsafe what, const std::string& reason);
+/// The mission was abandoned: makes `drone` safe with its fleet failsafe when it is in the air
+/// or armed on the ground, and records a `failsafe` event (at mission time `t`) in `trace`
+/// (may be null). A drone already landed and disarmed is left alone. In-process and
+/// distributed runs both end this way.
+void enter_failsafe(mid::Drone& drone, const fleet::DroneSettings& settings, double t, const std::string& reason,
+                    TraceSink* trace);
 
 /// Appends `s` to `track` when position or phase differ from the last sample.
 void record_sample(std::vector<Sample>& track, const mid::DroneState& s);

@@ -180,11 +180,7 @@ void DexProcess::abandon(const std::string& reason, const std::optional<dex::Fai
     node_->write(abort);
   }
   engine_->halt();
-  mid::DroneState now = drone_->state();
-  if (!now.landed || now.armed) {  // airborne, or armed on the ground: make it safe
-    tee_.record(dex::failsafe_event(loop_->now(), name(), mission_.settings.failsafe, reason));
-    drone_->failsafe(mission_.settings.failsafe);
-  }
+  dex::enter_failsafe(*drone_, mission_.settings, loop_->now(), reason, &tee_);
   failsafe_since_ = loop_->now();
   wait_for_failsafe();
 }

@@ -101,18 +101,17 @@ void EventLoop::post(std::function<void()> fn) {
   post_cv_.notify_one();
 }
 
-bool EventLoop::take_posted() {
+void EventLoop::take_posted() {
   std::vector<std::function<void()>> taken;
   {
     std::lock_guard<std::mutex> lock(post_mutex_);
     taken.swap(posted_);
   }
-  if (taken.empty()) return false;
+  if (taken.empty()) return;
   double t = now_;
   if (options_.mode == ClockMode::real_time)
     t = std::max(now_, mission_anchor_ + (options_.wall->now_s() - wall_anchor_) * options_.speed);
   for (auto& fn : taken) at(t, std::move(fn));
-  return true;
 }
 
 void EventLoop::start_wall_anchor() {

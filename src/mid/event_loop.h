@@ -101,8 +101,8 @@ class EventLoop {
   /// Real time: waits until the wall time of mission time `t`; false when a post() came
   /// first (the caller runs the posted callbacks and looks again).
   bool wait_for(double t);
-  /// Moves posted callbacks into the queue at the current mission time; true if any.
-  bool take_posted();
+  /// Moves posted callbacks into the queue at the current mission time.
+  void take_posted();
 
   ClockOptions options_;
   double now_ = 0.0;
