@@ -10,26 +10,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/run_eamos.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Output {
-  int status = -1;
-  std::string out;  ///< stdout and stderr together
-};
-
-Output eamos(const std::string& args) {
-  std::string cmd = std::string(EAMOS_BINARY) + " " + args + " 2>&1";
-  Output r;
-  FILE* p = popen(cmd.c_str(), "r");
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  int raw = pclose(p);
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return r;
-}
+using eamos_test::Output;
+Output eamos(const std::string& args) { return eamos_test::run_eamos(args); }
 
 std::string read_file(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);

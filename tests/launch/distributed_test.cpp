@@ -22,28 +22,15 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/run_eamos.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Output {
-  int status = -1;
-  std::string out;  ///< stdout and stderr together
-};
-
-/// Runs `eamos args`; `on_line` sees each output line as it comes (and may act on it).
+using eamos_test::Output;
 Output eamos(const std::string& args, const std::function<void(const std::string&)>& on_line = {}) {
-  std::string cmd = std::string(EAMOS_BINARY) + " " + args + " 2>&1";
-  Output r;
-  FILE* p = popen(cmd.c_str(), "r");
-  char buf[4096];
-  while (fgets(buf, sizeof buf, p)) {
-    r.out += buf;
-    if (on_line) on_line(buf);
-  }
-  int raw = pclose(p);
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return r;
+  return eamos_test::run_eamos(args, on_line);
 }
 
 std::string source(const std::string& name) { return std::string(EAMOS_SOURCE_DIR) + "/examples/" + name; }

@@ -21,6 +21,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/run_eamos.h"
+
 extern char** environ;
 
 namespace {
@@ -29,13 +31,9 @@ namespace fs = std::filesystem;
 using Sequences = std::map<std::string, std::vector<std::string>>;
 
 int run(const std::string& args, std::string& output) {
-  std::string cmd = std::string(EAMOS_BINARY) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) output.append(buf, n);
-  int raw = pclose(p);
-  return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  eamos_test::Output r = eamos_test::run_eamos(args);
+  output += r.out;
+  return r.status;
 }
 
 pid_t spawn_vehicle(int port, int sysid, const char* duration = "400", const char* battery = "100") {

@@ -1,0 +1,34 @@
+#pragma once
+// Runs the `eamos` binary under test (EAMOS_BINARY) the way a user would, for the tests
+// that check commands end to end.
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <functional>
+#include <string>
+
+namespace eamos_test {
+
+struct Output {
+  int status = -1;
+  std::string out;  ///< stdout and stderr together
+};
+
+/// Runs `eamos args`; `on_line`, if given, sees each output line as it comes (and may act
+/// on it, e.g. kill a process the output names).
+inline Output run_eamos(const std::string& args, const std::function<void(const std::string&)>& on_line = {}) {
+  std::string cmd = std::string(EAMOS_BINARY) + " " + args + " 2>&1";
+  Output r;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  while (fgets(buf, sizeof buf, p)) {
+    r.out += buf;
+    if (on_line) on_line(buf);
+  }
+  int raw = pclose(p);
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  return r;
+}
+
+}  // namespace eamos_test
