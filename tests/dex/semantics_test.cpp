@@ -208,6 +208,31 @@ TEST(Semantics, DisarmInTheAirFailsTheMissionAndAirborneDronesRunTheirFailsafe) 
   EXPECT_LT(f.find("start", "B.Orbit()"), 0);                // nothing new starts
 }
 
+TEST(Semantics, AbandonedMissionTracesAFailsafeForEveryDroneNotYetSafe) {
+  // A fails on the ground while B is in the air and C is armed on the ground: B lands, C is
+  // disarmed, A (landed, never armed) is already safe. Each failsafe is a trace event.
+  Flight f = fly("package p\nvar A Quad\nvar B Quad\nvar C Quad\n"
+                 "func INIT() { PAR_all() }\n"
+                 "func PAR_all() { SEQ_a(); SEQ_b(); C.Arm() }\n"
+                 "func SEQ_a() { PauseFor(3); A.Takeoff(3) }\n"
+                 "func SEQ_b() { B.Arm(); B.Takeoff(5); B.Orbit() }\n");
+  ASSERT_TRUE(f.result.failure.has_value());
+  EXPECT_EQ(f.result.failure->drone, "A");
+  std::map<std::string, const dex::TraceEvent*> failsafe;
+  for (const auto& e : f.events)
+    if (e.event == "failsafe") failsafe[e.drone] = &e;
+  EXPECT_EQ(failsafe.count("A"), 0u);
+  ASSERT_EQ(failsafe.count("B"), 1u);
+  ASSERT_EQ(failsafe.count("C"), 1u);
+  EXPECT_EQ(failsafe["B"]->name, "land");
+  EXPECT_EQ(failsafe["B"]->reason, f.result.error);
+  EXPECT_DOUBLE_EQ(failsafe["B"]->t, f.time_of("end", "A.Takeoff(3)"));
+  for (const auto& d : f.result.drones) {
+    EXPECT_TRUE(d.state.landed) << d.name;
+    EXPECT_FALSE(d.state.armed) << d.name;
+  }
+}
+
 TEST(Semantics, ActionExceedingItsFleetTimeoutFails) {
   fleet::Fleet fleet;
   Diagnostics diags;
