@@ -18,16 +18,13 @@ bool compile_and_report(const CommonOptions& o, graph::Compilation& c, graph::Ke
   // Re-list what the run found: -q drops warnings, --werror turns them into errors.
   Diagnostics shown;
   shown.max_errors = 0;
-  for (const auto& d : diags.items()) {
+  for (Diagnostic d : diags.items()) {
     if (d.severity == Severity::warning && o.quiet) continue;
-    if (d.severity == Severity::warning && o.werror)
-      shown.error(d.file, d.loc, d.message + " [-Werror]");
-    else if (d.severity == Severity::warning)
-      shown.warning(d.file, d.loc, d.message);
-    else if (d.severity == Severity::note)
-      shown.note(d.file, d.loc, d.message);
-    else
-      shown.error(d.file, d.loc, d.message);
+    if (d.severity == Severity::warning && o.werror) {
+      d.severity = Severity::error;
+      d.message += " [-Werror]";
+    }
+    shown.add(std::move(d));
   }
   std::cerr << shown.format();
   if (diags.saturated())

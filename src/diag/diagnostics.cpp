@@ -15,19 +15,37 @@ void Diagnostics::note(const SourceFile* file, SourceLocation loc, std::string m
   add(Severity::note, file, loc, std::move(message));
 }
 
-void Diagnostics::add(Severity severity, const SourceFile* file, SourceLocation loc,
-                      std::string message) {
+// Counts the diagnostic and says whether to keep it (errors past max_errors are dropped).
+bool Diagnostics::count(Severity severity) {
   if (severity == Severity::error) {
-    if (saturated()) {
-      ++dropped_;
-      ++error_count_;
-      return;
-    }
     ++error_count_;
+    if (max_errors != 0 && error_count_ > max_errors) {
+      ++dropped_;
+      return false;
+    }
   } else if (severity == Severity::warning) {
     ++warning_count_;
   }
-  items_.push_back({severity, file, loc, std::move(message)});
+  return true;
+}
+
+void Diagnostics::add(Severity severity, const SourceFile* file, SourceLocation loc,
+                      std::string message) {
+  if (!count(severity)) return;
+  Diagnostic d;
+  d.severity = severity;
+  d.loc = loc;
+  d.message = std::move(message);
+  if (file) {
+    d.has_file = true;
+    d.path = file->path;
+    if (loc.known()) d.source_line = std::string(file->line(loc.line));
+  }
+  items_.push_back(std::move(d));
+}
+
+void Diagnostics::add(Diagnostic d) {
+  if (count(d.severity)) items_.push_back(std::move(d));
 }
 
 namespace {
@@ -62,33 +80,35 @@ std::string caret_line(std::string_view line, int col) {
 
 std::string Diagnostics::format() const {
   // Files in the order they were first reported, then by position within each file.
-  std::vector<const SourceFile*> file_order;
-  auto rank = [&](const SourceFile* f) {
-    auto it = std::find(file_order.begin(), file_order.end(), f);
+  // Diagnostics without a file rank as the path "" with has_file false.
+  std::vector<std::pair<bool, std::string>> file_order;
+  auto key = [](const Diagnostic* d) { return std::make_pair(d->has_file, d->path); };
+  auto rank = [&](const Diagnostic* d) {
+    auto it = std::find(file_order.begin(), file_order.end(), key(d));
     return static_cast<std::size_t>(it - file_order.begin());
   };
   for (const auto& d : items_)
-    if (std::find(file_order.begin(), file_order.end(), d.file) == file_order.end())
-      file_order.push_back(d.file);
+    if (std::find(file_order.begin(), file_order.end(), key(&d)) == file_order.end())
+      file_order.push_back(key(&d));
   std::vector<const Diagnostic*> sorted;
   for (const auto& d : items_) sorted.push_back(&d);
   std::stable_sort(sorted.begin(), sorted.end(), [&](const Diagnostic* a, const Diagnostic* b) {
-    std::size_t ra = rank(a->file), rb = rank(b->file);
+    std::size_t ra = rank(a), rb = rank(b);
     if (ra != rb) return ra < rb;
     if (a->loc.line != b->loc.line) return a->loc.line < b->loc.line;
     return a->loc.col < b->loc.col;
   });
   std::string out;
   for (const Diagnostic* d : sorted) {
-    if (d->file) {
-      out += d->file->path;
+    if (d->has_file) {
+      out += d->path;
       if (d->loc.known()) out += ":" + std::to_string(d->loc.line) + ":" + std::to_string(d->loc.col);
       out += ": ";
     }
     out += severity_name(d->severity);
     out += ": " + d->message + "\n";
-    if (d->file && d->loc.known()) {
-      std::string_view line = d->file->line(d->loc.line);
+    if (d->has_file && d->loc.known()) {
+      std::string_view line = d->source_line;
       out += " " + printable_line(line) + "\n";
       out += " " + caret_line(line, d->loc.col) + "\n";
     }

@@ -11,11 +11,16 @@ namespace eamos {
 
 enum class Severity { error, warning, note };
 
+/// A diagnostic owns the text it prints (the file's path and the one source line it points
+/// at) instead of pointing into the SourceFile: a fleet or mission source is often gone by
+/// the time the CLI prints, and a diagnostic must never be able to outlive what it shows.
 struct Diagnostic {
   Severity severity = Severity::error;
-  const SourceFile* file = nullptr;  ///< nullptr: not tied to a file (e.g. a CLI problem)
+  bool has_file = false;    ///< false: not tied to a file (e.g. a CLI problem)
+  std::string path;         ///< the file as the user named it
   SourceLocation loc;
-  std::string message;  ///< "what; how to fix" — no trailing newline
+  std::string source_line;  ///< the text of line loc.line, copied when reported
+  std::string message;      ///< "what; how to fix" — no trailing newline
 };
 
 class Diagnostics {
@@ -33,6 +38,8 @@ class Diagnostics {
   /// True once max_errors is reached: stages may stop early to bound the work on garbage.
   bool saturated() const { return max_errors != 0 && error_count_ >= max_errors; }
   const std::vector<Diagnostic>& items() const { return items_; }
+  /// Adds an already-made diagnostic (e.g. one re-listed from another run's list).
+  void add(Diagnostic d);
 
   /// GCC-style text: `file:line:col: error: message`, then the source line and a caret,
   /// ordered by file position; ends with a count line when anything was dropped.
@@ -40,6 +47,7 @@ class Diagnostics {
 
  private:
   void add(Severity severity, const SourceFile* file, SourceLocation loc, std::string message);
+  bool count(Severity severity);
   std::vector<Diagnostic> items_;
   std::size_t error_count_ = 0;
   std::size_t warning_count_ = 0;

@@ -23,15 +23,18 @@ bool compile(std::shared_ptr<SourceFile> source, const fleet::Fleet& fleet, Diag
 
 bool compile_file(const std::string& path, const std::string& fleet_path, Diagnostics& diags,
                   Compilation& out, Keep keep) {
+  // A fleet file with errors still yields the parts that parsed, and the mission is checked
+  // against them, so one run lists the errors of both files.
   fleet::Fleet fleet;
-  if (!fleet_path.empty() && !fleet::load_fleet(fleet_path, fleet, diags)) return false;
+  if (!fleet_path.empty()) fleet::load_fleet(fleet_path, fleet, diags);
   auto source = std::make_shared<SourceFile>();
   std::string error;
   if (!read_source_file(path, *source, error)) {
     diags.error(nullptr, {}, "cannot read mission file '" + path + "': " + error);
     return false;
   }
-  return compile(std::move(source), fleet, diags, out, {}, keep);
+  bool fleet_ok = !diags.has_errors();
+  return compile(std::move(source), fleet, diags, out, {}, keep) && fleet_ok;
 }
 
 }  // namespace eamos::graph

@@ -27,6 +27,23 @@ TEST(Errors, UnknownKeyReportsLineColumnAndSuggestion) {
   EXPECT_TRUE(contains(d.message, "did you mean 'limits'?")) << d.message;
 }
 
+// The CLI prints after the fleet's SourceFile is gone (compile_file returns, the Fleet and
+// its source die); a diagnostic pointing into the source printed freed memory or crashed.
+TEST(Errors, DiagnosticsStayPrintableAfterTheirSourceIsFreed) {
+  Diagnostics diags;
+  {
+    Fleet fleet;
+    parse_fleet(std::make_shared<SourceFile>("gone.yaml", "drones:\n  D1: {home: [0, 0]}\n"),
+                fleet, diags);
+  }
+  // Overwrite freed memory so a dangling pointer would show as garbage, not the old text.
+  std::vector<std::string> filler(64, std::string(256, 'X'));
+  std::string text = diags.format();
+  EXPECT_TRUE(contains(text, "gone.yaml:2:")) << text;
+  EXPECT_TRUE(contains(text, " D1: {home: [0, 0]}\n")) << text;
+  EXPECT_FALSE(contains(text, "XXXX")) << text;
+}
+
 TEST(Errors, UnknownKeyFarFromAnyListsTheAllowedKeys) {
   auto p = parse("planes: {}\n");
   EXPECT_FALSE(p.ok);

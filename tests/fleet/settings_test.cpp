@@ -137,7 +137,7 @@ TEST(Settings, CheckDroneReportsSensorsTheTypeLacksAtTheirKey) {
   p.fleet.check_drone("Drone1", p.fleet.type_for("Lifter"), diags);
   ASSERT_EQ(diags.error_count(), 2u);
   const Diagnostic& d = diags.items()[0];
-  EXPECT_EQ(d.file, p.fleet.source.get());
+  EXPECT_EQ(d.path, p.fleet.source->path);
   EXPECT_EQ(d.loc.line, 12);
   EXPECT_EQ(d.loc.col, 15);
   EXPECT_NE(d.message.find("has 0 sensors"), std::string::npos) << d.message;

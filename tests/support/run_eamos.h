@@ -16,8 +16,11 @@ struct Output {
 
 /// Runs `eamos args`; `on_line`, if given, sees each output line as it comes (and may act
 /// on it, e.g. kill a process the output names).
-inline Output run_eamos(const std::string& args, const std::function<void(const std::string&)>& on_line = {}) {
+inline Output run_eamos(const std::string& args, const std::function<void(const std::string&)>& on_line = {},
+                        const std::string& working_dir = "") {
   std::string cmd = std::string(EAMOS_BINARY) + " " + args + " 2>&1";
+  // The working directory is quoted as a whole; callers pass paths of the test tree.
+  if (!working_dir.empty()) cmd = "cd '" + working_dir + "' && " + cmd;
   Output r;
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;
