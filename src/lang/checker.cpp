@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "lang/concurrency.h"
+#include "lang/loop_time.h"
 
 namespace eamos::lang {
 
@@ -115,6 +116,7 @@ CheckedMission Checker::run() {
   for (auto& f : m_.functions)
     for (auto& s : f.body) check_statement(f, s);
   check_call_graph();
+  check_loops_take_time(m_, diags_);
   if (!diags_.has_errors()) {
     check_unused();
     warn_concurrent_motion(m_, out_.drone_types, diags_);
@@ -351,14 +353,6 @@ void Checker::check_control(Statement& s) {
         break;
     }
   }
-  // A repeat branch without statements would loop without mission time passing.
-  bool is_repeat = s.control == ControlKind::RepeatUntil || s.control == ControlKind::RepeatWhile ||
-                   s.control == ControlKind::RepeatFor;
-  if (is_repeat && !s.branch_functions.empty() && s.branch_functions[0] >= 0 &&
-      m_.functions[s.branch_functions[0]].body.empty())
-    error(s.args[1]->loc, "repeat branch '" + m_.functions[s.branch_functions[0]].name +
-                              "' is empty; an empty loop would spin without mission time passing, "
-                              "use PauseUntil/PauseWhile to wait instead");
 }
 
 ValueType Checker::type_of(Expr& e) {

@@ -95,3 +95,53 @@ TEST(Checker, ErrorCarriesFileLineColumnSourceLineAndCaret) {
 
 }  // namespace
 }  // namespace eamos
+
+namespace eamos {
+namespace {
+
+// Each of these repeat branches has to wait on every path, so the loop-time rule accepts it.
+TEST(Checker, LoopsWhoseBodiesWaitOnEveryPathAreAccepted) {
+  const char* bodies[] = {
+      "Drone1.FlyByX(1)",
+      "PauseFor(0.5)",
+      "PauseUntil(Drone1.X() > 3)",
+      "WaitUntil(Drone1.X() > 3, SEQ_none)",
+      "PAR_both()",
+      "If(Drone1.X() > 3, SEQ_fly, SEQ_pause)",
+      "If(true, SEQ_fly, SEQ_none)",
+      "RepeatFor(true, SEQ_fly, SEQ_none, 2)",
+      "RepeatWhile(Drone1.X() > 3, SEQ_pause, SEQ_fly)",
+      "DoWhileSync(true, SEQ_fly, SEQ_none)",
+      "async(SEQ_fly)\n  Drone1.TakePicture()",
+  };
+  for (const char* body : bodies) {
+    std::string text = std::string("var Drone1 Quad\nfunc INIT() {\n  Drone1.Takeoff(5)\n") +
+                       "  RepeatWhile(Drone1.Z() > 1, SEQ_body, SEQ_none)\n  Drone1.Land()\n}\n" +
+                       "func SEQ_body() {\n  " + body + "\n}\n" +
+                       "func SEQ_fly() {Drone1.FlyByX(1)}\nfunc SEQ_pause() {PauseFor(1)}\n" +
+                       "func SEQ_none() {}\nfunc PAR_both() {async(SEQ_fly)\n  Drone1.TakePicture()}\n";
+    Result r = check(text);
+    EXPECT_EQ(r.text.find("without mission time passing"), std::string::npos) << body << "\n" << r.text;
+  }
+}
+
+// The rule runs beside the other checks, so one run lists a typo and a spinning loop.
+TEST(Checker, SpinningLoopIsReportedTogetherWithOtherErrors) {
+  Result r = check("var Drone1 Quad\nfunc INIT() {\n  Drone1.Takof(5)\n"
+                   "  RepeatWhile(true, SEQ_r, SEQ_n)\n}\nfunc SEQ_r() {SEQ_e()}\n"
+                   "func SEQ_e() {}\nfunc SEQ_n() {Drone1.Land()}\n");
+  EXPECT_EQ(r.errors, 2u) << r.text;
+  EXPECT_NE(r.text.find("m.eamos:4:3: error: RepeatWhile can repeat without mission time passing"),
+            std::string::npos) << r.text;
+}
+
+// Recursion is its own error; the loop rule must neither loop for ever nor add a second one.
+TEST(Checker, LoopRuleToleratesRecursiveBlocks) {
+  Result r = check("var Drone1 Quad\nfunc INIT() {\n  RepeatWhile(true, SEQ_a, SEQ_n)\n}\n"
+                   "func SEQ_a() {SEQ_b()}\nfunc SEQ_b() {SEQ_a()}\nfunc SEQ_n() {Drone1.Land()}\n");
+  EXPECT_NE(r.text.find("recursion"), std::string::npos) << r.text;
+  EXPECT_EQ(r.text.find("without mission time passing"), std::string::npos) << r.text;
+}
+
+}  // namespace
+}  // namespace eamos

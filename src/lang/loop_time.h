@@ -1,0 +1,15 @@
+#pragma once
+// The "every loop iteration takes mission time" rule. A repeat branch that can end without
+// waiting for anything runs its next iteration at the same instant, for ever (RepeatWhile)
+// or a billion times in a row (RepeatFor): timers, telemetry and the time limit starve.
+#include "diag/diagnostics.h"
+#include "lang/ast.h"
+
+namespace eamos::lang {
+
+/// Reports an error at each Repeat* whose repeat branch can end, on some path, without
+/// running an action, a PauseFor of more than 0 s, or a wait on a condition. Tolerates
+/// unresolved names and recursion (other checks report those), so it runs on any mission.
+void check_loops_take_time(const Mission& mission, Diagnostics& diags);
+
+}  // namespace eamos::lang
