@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "lang/concurrency.h"
+#include "lang/exact_compare.h"
 #include "lang/loop_time.h"
 
 namespace eamos::lang {
@@ -120,6 +121,7 @@ CheckedMission Checker::run() {
   if (!diags_.has_errors()) {
     check_unused();
     warn_concurrent_motion(m_, out_.drone_types, diags_);
+    warn_exact_comparisons(m_, diags_);
     warn_detached_work_in_loops(m_, diags_);
   }
   return std::move(out_);

@@ -127,7 +127,7 @@ TEST(Semantics, DoInsideRepeatIsCancelledAndRestartedOnEveryDroneEachIteration) 
   Flight f = fly(kTwo + "func INIT() { PAR_up(); RepeatFor(true, SEQ_iter, SEQ_end, 3) }\n"
                         "func PAR_up() { SEQ_a(); SEQ_b() }\n"
                         "func SEQ_a() { A.Arm(); A.Takeoff(3) }\nfunc SEQ_b() { B.Arm(); B.Takeoff(3) }\n"
-                        "func SEQ_iter() { DoWhileSync(A.Z() < 6, PAR_work, SEQ_reset) }\n"
+                        "func SEQ_iter() { DoWhileSync(A.Z() < 6, PAR_work, SEQ_reset); PauseFor(0.5) }\n"
                         "func PAR_work() { A.FlyByZ(5); SEQ_bw() }\n"
                         "func SEQ_bw() { B.TakePicture(); B.Hover(30) }\n"
                         "func SEQ_reset() { A.FlyTo(0, 0, 3) }\n"
