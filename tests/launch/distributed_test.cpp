@@ -93,6 +93,14 @@ std::string read_text(const fs::path& p) {
   return s.str();
 }
 
+nlohmann::json last_event(const fs::path& trace) {
+  std::ifstream in(trace);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (!line.empty()) last = line;
+  return last.empty() ? nlohmann::json::object() : nlohmann::json::parse(last);
+}
+
 class Distributed : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -120,7 +128,16 @@ class Distributed : public ::testing::Test {
     Events a = per_drone(dir_ / "local.jsonl"), b = per_drone(dir_ / "dist.jsonl");
     EXPECT_FALSE(a.empty());
     EXPECT_EQ(order_difference(a, b), "") << dist.out;
-    EXPECT_EQ(read_json(dir_ / "summary.json")["status"], "completed");
+    nlohmann::json summary = read_json(dir_ / "summary.json");
+    EXPECT_EQ(summary["status"], "completed");
+    // Both traces end with the mission's end, the distributed one at the reported duration.
+    for (const char* trace : {"local.jsonl", "dist.jsonl"}) {
+      nlohmann::json last = last_event(dir_ / trace);
+      EXPECT_EQ(last["event"], "mission") << trace;
+      EXPECT_EQ(last["outcome"], "completed") << trace;
+    }
+    // (trace times are rounded to the microsecond)
+    EXPECT_NEAR(last_event(dir_ / "dist.jsonl")["t"].get<double>(), summary["duration"].get<double>(), 1e-6);
   }
   fs::path dir_;
 };
@@ -315,6 +332,11 @@ TEST_F(Distributed, FailedActionOnOneDroneFailsTheMissionOnEveryDrone) {
   // Lead, in the air on another process, got the ABORT and landed.
   std::string trace = read_text(dir_ / "trace.jsonl");
   EXPECT_NE(trace.find("\"drone\":\"Lead\",\"event\":\"failsafe\""), std::string::npos) << trace;
+  nlohmann::json last = last_event(dir_ / "trace.jsonl");
+  EXPECT_EQ(last["event"], "mission") << trace;
+  EXPECT_EQ(last["outcome"], "failed");
+  EXPECT_EQ(last["reason"], summary["error"]);
+  EXPECT_NEAR(last["t"].get<double>(), summary["duration"].get<double>(), 1e-6);  // trace: to the µs
   EXPECT_TRUE(summary["drones"]["Lead"]["landed"]);
   EXPECT_FALSE(summary["drones"]["Lead"]["armed"]);
 }
