@@ -118,7 +118,6 @@ CheckedMission Checker::run() {
   if (!diags_.has_errors()) {
     check_unused();
     warn_concurrent_motion(m_, out_.drone_types, diags_);
-    warn_detached_work_in_loops(m_, diags_);
   }
   return std::move(out_);
 }
