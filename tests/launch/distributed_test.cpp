@@ -350,6 +350,38 @@ TEST_F(Distributed, TimeLimitFailsTheMissionOnEveryDrone) {
   for (const char* d : {"Drone1", "Drone2", "Drone3"}) EXPECT_TRUE(summary["drones"][d]["landed"]) << d;
 }
 
+// A mission file whose loop takes no time (made by hand here: `eamos check` refuses the
+// source): the DEX must neither hang nor starve its liveliness; it fails the mission, lands,
+// and the ground reports it, all well within the time limit.
+TEST_F(Distributed, LoopThatTakesNoTimeFailsTheMissionInsteadOfHangingTheDex) {
+  fs::path deploy = dir_ / "deploy";
+  Output c = eamos("compile -q " + std::string(EAMOS_SOURCE_DIR) + "/tests/dex/missions/zero_time_loop.eamos -o " +
+                   deploy.string());
+  ASSERT_EQ(c.status, 0) << c.out;
+  fs::path file = deploy / "Drone1" / "mission.json";
+  nlohmann::json m = read_json(file);
+  int changed = 0;
+  for (auto& n : m["nodes"])
+    if (n.value("text", "") == "Drone1.TakePicture()") n["kind"] = "fork", ++changed;
+  ASSERT_EQ(changed, 1);
+  std::ofstream(file) << m.dump();
+  Output r = eamos("launch " + deploy.string() + " --speed 5 --time-limit 20 --domain 41 --trace " +
+                   (dir_ / "trace.jsonl").string() + " --summary " + (dir_ / "summary.json").string());
+  EXPECT_EQ(r.status, 1) << r.out;
+  nlohmann::json summary = read_json(dir_ / "summary.json");
+  EXPECT_EQ(summary["status"], "failed");
+  EXPECT_NE(summary["error"].get<std::string>().find("RepeatWhile (line 5) failed: 10000 iterations in a row took "
+                                                     "no mission time"),
+            std::string::npos)
+      << summary.dump(2);
+  EXPECT_LT(summary["duration"].get<double>(), 20.0);
+  EXPECT_TRUE(summary["drones"]["Drone1"]["landed"]);
+  EXPECT_FALSE(summary["drones"]["Drone1"]["armed"]);
+  nlohmann::json last = last_event(dir_ / "trace.jsonl");
+  EXPECT_EQ(last["event"], "mission");
+  EXPECT_EQ(last["outcome"], "failed");
+}
+
 TEST_F(Distributed, SpeedMismatchAbortsBeforeAnyDroneMoves) {
   fs::path deploy = deploy_listing2(dir_);
   pid_t remote = eamos_background("dex " + (deploy / "Drone2").string() + " --speed 1 --domain 35 --start-timeout 30",
