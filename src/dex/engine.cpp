@@ -15,6 +15,14 @@ bool says_do(lang::ControlKind k, bool v) {
   bool is_while = k == lang::ControlKind::DoWhileSync || k == lang::ControlKind::DoWhileAsync;
   return is_while ? v : !v;
 }
+
+// A body's epoch counts its runs in the high bits and a Repeat's iterations in the low
+// ones. A trigger from an earlier run is stale (that run was cancelled or is over); one
+// from an earlier iteration of the same run is not: at a back arc everything of the
+// iteration has ended except async work, which goes on in parallel and keeps its triggers.
+constexpr int kIterationBits = 32;
+long long run_of(long long epoch) { return epoch >> kIterationBits; }
+long long next_run(long long epoch) { return (run_of(epoch) + 1) << kIterationBits; }
 }  // namespace
 
 using graph::ArcKind;
@@ -115,7 +123,7 @@ void Engine::drain() {
       case ArcKind::back:
         if (--s.back_pending <= 0) {
           s.back_pending = n.back_in;
-          activate(d.node, true);
+          schedule_iteration(d.node);
         }
         break;
       case ArcKind::partner:
@@ -128,6 +136,32 @@ void Engine::drain() {
     }
   }
   draining_ = false;
+  if (active_ == 0 && !halted_ && hooks_.on_idle) hooks_.on_idle();
+}
+
+// Every iteration goes through the event loop: a loop whose body takes no time would
+// otherwise hold the loop's thread for ever, and no timer (the time limit), liveliness
+// assertion or signal would get its turn. One that keeps taking no time fails.
+void Engine::schedule_iteration(int node) {
+  const Node& n = m_.nodes[node];
+  State& s = state_[node];
+  if (loop_.now() > s.iteration_started) {
+    s.instant_iterations = 0;
+  } else if (++s.instant_iterations >= kMaxInstantIterations) {
+    if (hooks_.on_failure)
+      hooks_.on_failure({m_.fleet[m_.self], lang::control_name(n.control), n.line,
+                         std::to_string(kMaxInstantIterations) +
+                             " iterations in a row took no mission time; its repeat branch must wait for "
+                             "something that takes time (an action, PauseFor, Wait*)"});
+    return;
+  }
+  ++active_;  // not idle while the next iteration waits for its turn
+  s.next_iteration = loop_.defer([this, node] {
+    state_[node].next_iteration = mid::kNoTimer;
+    --active_;
+    activate(node, true);
+    drain();
+  });
 }
 
 void Engine::receive(const Message& msg) {
@@ -136,8 +170,10 @@ void Engine::receive(const Message& msg) {
   if (from < 0) return;
   if (msg.scope >= 0) {
     long long& known = epoch_[msg.scope];
-    if (msg.epoch < known) return;  // from a run of that body that has been superseded
-    known = msg.epoch;
+    // A cancel belongs to one iteration; a trigger to its run (see kIterationBits).
+    bool stale = msg.kind == Message::Kind::cancel ? msg.epoch < known : run_of(msg.epoch) < run_of(known);
+    if (stale) return;
+    known = std::max(known, msg.epoch);
   }
   if (msg.body_epoch > 0) {
     long long& known = epoch_[msg.meg];
@@ -145,6 +181,7 @@ void Engine::receive(const Message& msg) {
   }
   if (msg.kind == Message::Kind::cancel) {
     cancel_local(m_.nodes[from].cancels);
+    drain();  // settles: the cancel may have left this drone idle
     return;
   }
   for (int a : m_.nodes[from].out) {
@@ -174,17 +211,7 @@ void Engine::activate(int node, bool by_back_arc) {
       if (hooks_.on_end) hooks_.on_end();
       return;
     case MegKind::action: activate_action(node); return;
-    case MegKind::pause: {
-      State& s = state_[node];
-      ++active_;
-      s.timer = loop_.after(n.seconds, [this, node] {
-        state_[node].timer = mid::kNoTimer;
-        --active_;
-        end(node, Branch::any);
-        drain();
-      });
-      return;
-    }
+    case MegKind::pause: activate_pause(node); return;
     case MegKind::condition: activate_condition(node, by_back_arc); return;
   }
 }
@@ -197,15 +224,39 @@ void Engine::activate_action(int node) {
   for (const Expr& a : n.args) req.args.push_back(evaluate(a, read).number);
   trace(n, "start");
   ++active_;
-  std::uint64_t seq = ++state_[node].action_seq;
-  state_[node].action =
-      drone_.start(req, [this, node, seq](const mid::ActionEnd& e) { on_action_end(node, seq, e); });
+  // Its own instance: an earlier activation of this node may still run (async work in a
+  // loop); both end, each once. The drone never calls on_end inside start().
+  std::uint64_t id = ++next_instance_;
+  mid::ActionId action =
+      drone_.start(req, [this, node, id](const mid::ActionEnd& e) { on_action_end(node, id, e); });
+  state_[node].running.push_back({id, action, mid::kNoTimer});
 }
 
-void Engine::on_action_end(int node, std::uint64_t seq, const mid::ActionEnd& e) {
-  if (state_[node].action_seq != seq) return;  // closed when it was cancelled
+void Engine::activate_pause(int node) {
   const Node& n = m_.nodes[node];
-  state_[node].action = mid::kNoAction;
+  ++active_;
+  std::uint64_t id = ++next_instance_;
+  mid::TimerId timer = loop_.after(n.seconds, [this, node, id] {
+    if (!take_instance(node, id)) return;
+    --active_;
+    end(node, Branch::any);
+    drain();
+  });
+  state_[node].running.push_back({id, mid::kNoAction, timer});
+}
+
+/// Removes a running instance of `node`; false when it is no longer running (cancelled).
+bool Engine::take_instance(int node, std::uint64_t id) {
+  std::vector<Instance>& running = state_[node].running;
+  auto it = std::find_if(running.begin(), running.end(), [id](const Instance& i) { return i.id == id; });
+  if (it == running.end()) return false;
+  running.erase(it);
+  return true;
+}
+
+void Engine::on_action_end(int node, std::uint64_t instance, const mid::ActionEnd& e) {
+  if (!take_instance(node, instance)) return;  // closed when it was cancelled
+  const Node& n = m_.nodes[node];
   --active_;
   trace_end(n, e);
   switch (e.outcome) {
@@ -214,7 +265,9 @@ void Engine::on_action_end(int node, std::uint64_t seq, const mid::ActionEnd& e)
       end(node, Branch::any);
       drain();
       return;
-    case mid::Outcome::cancelled: return;  // cancelled by a Do flip or the failsafe: no successors
+    case mid::Outcome::cancelled:  // cancelled by a Do flip or the failsafe: no successors
+      drain();
+      return;
     case mid::Outcome::failed:
       if (hooks_.on_failure) hooks_.on_failure({m_.fleet[m_.self], n.name, n.line, e.reason});
       return;
@@ -249,7 +302,7 @@ bool Engine::condition_value(int node) {
   // only when it changes, so the trace shows decisions, not samples.
   State& s = state_[node];
   bool changed = s.last_value != static_cast<int>(v);
-  s.last_value = s.watching ? static_cast<int>(v) : -1;
+  s.last_value = s.watchers > 0 ? static_cast<int>(v) : -1;
   if (hooks_.trace && changed) {
     TraceEvent t;
     t.t = loop_.now();
@@ -273,47 +326,63 @@ void Engine::activate_condition(int node, bool by_back_arc) {
     case ControlKind::WaitWhile:
     case ControlKind::PauseUntil:
     case ControlKind::PauseWhile:
-      s.watching = true;
       ++active_;
-      watched_.push_back(node);
+      if (s.watchers++ == 0) watched_.push_back(node);
       evaluate_watch(node);
       return;
     case ControlKind::RepeatUntil:
     case ControlKind::RepeatWhile:
-    case ControlKind::RepeatFor: {
-      if (!by_back_arc) s.iterations = 0;
-      bool v = condition_value(node);
-      bool again = n.control == ControlKind::RepeatUntil ? !v
-                   : n.control == ControlKind::RepeatWhile ? v
-                                                           : v && s.iterations < n.count;
-      if (again) {
-        ++s.iterations;
-        ++epoch_[n.meg];  // a new run of the repeat branch
-      }
-      end(node, again ? Branch::repeat : Branch::exit);
-      return;
-    }
+    case ControlKind::RepeatFor: activate_repeat(node, by_back_arc); return;
     case ControlKind::DoUntilSync:
     case ControlKind::DoWhileSync:
     case ControlKind::DoUntilAsync:
-    case ControlKind::DoWhileAsync: {
-      bool v = condition_value(node);
-      bool async = n.control == ControlKind::DoUntilAsync || n.control == ControlKind::DoWhileAsync;
-      if (says_do(n.control, v)) {
-        s.watching = true;
-        s.last_value = static_cast<int>(v);  // traced just now: log again only on a change
-        ++active_;
-        watched_.push_back(node);
-        ++epoch_[n.meg];  // a new run of the do-branch
-        end(node, Branch::do_);
-      } else {
-        end(node, Branch::skip);
-      }
-      if (async) end(node, Branch::continue_);
-      return;
-    }
+    case ControlKind::DoWhileAsync: activate_do(node); return;
     default: end(node, Branch::any); return;
   }
+}
+
+void Engine::activate_repeat(int node, bool by_back_arc) {
+  const Node& n = m_.nodes[node];
+  State& s = state_[node];
+  if (!by_back_arc) {
+    s.iterations = 0;
+    s.instant_iterations = 0;
+    epoch_[n.meg] = next_run(epoch_[n.meg]);  // a new run of the loop
+  }
+  s.iteration_started = loop_.now();
+  bool v = condition_value(node);
+  bool again = n.control == ControlKind::RepeatUntil ? !v
+               : n.control == ControlKind::RepeatWhile ? v
+                                                       : v && s.iterations < n.count;
+  if (again) {
+    ++s.iterations;
+    ++epoch_[n.meg];  // a new iteration of the repeat branch
+  }
+  end(node, again ? Branch::repeat : Branch::exit);
+}
+
+void Engine::activate_do(int node) {
+  const Node& n = m_.nodes[node];
+  State& s = state_[node];
+  // Started again while its do-branch still runs (a Do*Async in a loop): one condition,
+  // one run; the earlier run is cancelled on every drone, without its done-branch.
+  if (s.watchers > 0) {
+    stop_watching(node);
+    cancel_do_run(node);
+  }
+  bool v = condition_value(node);
+  bool async = n.control == ControlKind::DoUntilAsync || n.control == ControlKind::DoWhileAsync;
+  if (says_do(n.control, v)) {
+    s.watchers = 1;
+    s.last_value = static_cast<int>(v);  // traced just now: log again only on a change
+    ++active_;
+    watched_.push_back(node);
+    epoch_[n.meg] = next_run(epoch_[n.meg]);  // a new run of the do-branch
+    end(node, Branch::do_);
+  } else {
+    end(node, Branch::skip);
+  }
+  if (async) end(node, Branch::continue_);
 }
 
 // Wait* and Pause*: "go" once the awaited state holds (Until: true, While: false).
@@ -322,15 +391,22 @@ void Engine::evaluate_watch(int node) {
   bool v = condition_value(node);
   bool until = n.control == ControlKind::WaitUntil || n.control == ControlKind::PauseUntil;
   if (v == until) {
+    int waiting = state_[node].watchers;
     stop_watching(node);
-    end(node, Branch::go);
+    for (int i = 0; i < waiting; ++i) end(node, Branch::go);  // each activation goes on
   }
 }
 
 void Engine::flip_do(int node) {
-  const Node& n = m_.nodes[node];
   stop_watching(node);
-  ++epoch_[n.meg];  // the cancelled run is over: anything still in flight from it is stale
+  cancel_do_run(node);
+  end(node, Branch::done);
+}
+
+// Ends the running do-branch of `node` on every drone.
+void Engine::cancel_do_run(int node) {
+  const Node& n = m_.nodes[node];
+  epoch_[n.meg] = next_run(epoch_[n.meg]);  // the cancelled run is over: anything still in flight from it is stale
   cancel_local(n.cancels);
   Message msg{Message::Kind::cancel, m_.hash, m_.self, n.meg, Branch::any};
   msg.body_epoch = epoch_[n.meg];
@@ -340,14 +416,13 @@ void Engine::flip_do(int node) {
   }
   for (int d = 0; d < static_cast<int>(m_.fleet.size()); ++d)
     if (d != m_.self && hooks_.transport) hooks_.transport->send(d, msg);
-  end(node, Branch::done);
 }
 
 void Engine::properties_changed(int drone) {
   if (halted_ || watched_.empty()) return;
   std::vector<int> now = watched_;  // ending a watch edits watched_
   for (int node : now) {
-    if (!state_[node].watching) continue;
+    if (state_[node].watchers == 0) continue;
     const Node& n = m_.nodes[node];
     const std::vector<int>& reads = n.condition_reads;
     if (std::find(reads.begin(), reads.end(), drone) == reads.end()) continue;
@@ -362,10 +437,10 @@ void Engine::properties_changed(int drone) {
 
 void Engine::stop_watching(int node) {
   State& s = state_[node];
-  if (!s.watching) return;
-  s.watching = false;
+  if (s.watchers == 0) return;
+  active_ -= s.watchers;
+  s.watchers = 0;
   s.last_value = -1;
-  --active_;
   watched_.erase(std::remove(watched_.begin(), watched_.end(), node), watched_.end());
 }
 
@@ -376,15 +451,24 @@ void Engine::cancel_local(const std::vector<int>& nodes) {
     // A cancelled action is over for the mission now, not when the drone's end callback
     // comes: its end is traced here, in the order the cancel arrived (the same order on
     // every transport), and the callback, when it comes, is ignored.
-    if (s.action != mid::kNoAction && drone_.cancel(s.action)) {
-      s.action = mid::kNoAction;
-      ++s.action_seq;
-      --active_;
-      trace_end(n, {mid::Outcome::cancelled, "cancelled", std::nullopt});
+    // An action the drone could not cancel has ended already: its end callback is on its
+    // way and stands.
+    std::vector<Instance> still;
+    for (const Instance& i : s.running) {
+      if (i.timer != mid::kNoTimer) {
+        loop_.cancel(i.timer);
+        --active_;
+      } else if (drone_.cancel(i.action)) {
+        --active_;
+        trace_end(n, {mid::Outcome::cancelled, "cancelled", std::nullopt});
+      } else {
+        still.push_back(i);
+      }
     }
-    if (s.timer != mid::kNoTimer) {
-      loop_.cancel(s.timer);
-      s.timer = mid::kNoTimer;
+    s.running = std::move(still);
+    if (s.next_iteration != mid::kNoTimer) {
+      loop_.cancel(s.next_iteration);
+      s.next_iteration = mid::kNoTimer;
       --active_;
     }
     stop_watching(node);
@@ -427,10 +511,14 @@ void Engine::halt() {
   queue_.clear();
   for (std::size_t i = 0; i < state_.size(); ++i) {
     State& s = state_[i];
-    if (s.action != mid::kNoAction) drone_.cancel(s.action);
-    if (s.timer != mid::kNoTimer) loop_.cancel(s.timer);
-    s.timer = mid::kNoTimer;
-    s.watching = false;
+    // Cancelled actions stay listed: their ends, when the drone reports them, are traced.
+    for (const Instance& r : s.running) {
+      if (r.timer != mid::kNoTimer) loop_.cancel(r.timer);
+      else drone_.cancel(r.action);
+    }
+    loop_.cancel(s.next_iteration);
+    s.next_iteration = mid::kNoTimer;
+    s.watchers = 0;
   }
   watched_.clear();
 }

@@ -36,7 +36,14 @@ struct EngineHooks {
   TraceSink* trace = nullptr;
   std::function<void(const Failure&)> on_failure;
   std::function<void()> on_end;  ///< the mission's end node ran (this drone is the lead)
+  /// The engine has just settled (handled an event completely) with nothing active: the
+  /// moment a runner checks whether the mission is complete.
+  std::function<void()> on_idle;
 };
+
+/// Iterations in a row a Repeat may run without mission time passing before the engine
+/// calls it a loop that makes no progress and fails the mission (its failsafe runs).
+inline constexpr int kMaxInstantIterations = 10000;
 
 class Engine {
  public:
@@ -60,15 +67,24 @@ class Engine {
   double property(int drone, const std::string& name) const;
 
  private:
+  /// One running activation of an action or PauseFor node. A node started again while
+  /// an earlier activation still runs (async work in a loop) has several; each ends once.
+  struct Instance {
+    std::uint64_t id = 0;
+    mid::ActionId action = mid::kNoAction;
+    mid::TimerId timer = mid::kNoTimer;
+  };
   struct State {
     int exec_pending = 0;
     int back_pending = 0;
-    mid::ActionId action = mid::kNoAction;
-    /// Counts the node's actions: an end callback of an action the engine already closed
-    /// (cancelled by a Do flip) carries an older number and is ignored.
-    std::uint64_t action_seq = 0;
-    mid::TimerId timer = mid::kNoTimer;
-    bool watching = false;
+    std::vector<Instance> running;
+    /// Watched conditions: activations waiting on the condition (Wait*/Pause* started
+    /// again while waiting wait together; a Do has at most one run).
+    int watchers = 0;
+    /// Repeat conditions: the next iteration, waiting for its turn on the event loop.
+    mid::TimerId next_iteration = mid::kNoTimer;
+    double iteration_started = 0.0;  ///< mission time the current iteration began
+    int instant_iterations = 0;      ///< iterations in a row that took no mission time
     long long iterations = 0;
     int last_value = -1;  ///< watched conditions: last traced value (-1 none), to log changes only
     long long epoch = 0;  ///< run of the node's body (Mission::Node::scope) its counters belong to
@@ -83,13 +99,19 @@ class Engine {
   void drain();
   void activate(int node, bool by_back_arc);
   void activate_action(int node);
+  void activate_pause(int node);
+  void activate_repeat(int node, bool by_back_arc);
+  void activate_do(int node);
+  void schedule_iteration(int node);
+  bool take_instance(int node, std::uint64_t id);
+  void cancel_do_run(int node);
   void activate_condition(int node, bool by_back_arc);
   void end(int node, graph::Branch branch, bool released_by_partner = false);
   void evaluate_watch(int node);
   void flip_do(int node);
   void cancel_local(const std::vector<int>& nodes);
   void stop_watching(int node);
-  void on_action_end(int node, std::uint64_t seq, const mid::ActionEnd& e);
+  void on_action_end(int node, std::uint64_t instance, const mid::ActionEnd& e);
   void trace_end(const Node& n, const mid::ActionEnd& e);
   bool condition_value(int node);
   void trace(const Node& n, const std::string& event, const std::string& outcome = "");
@@ -103,6 +125,7 @@ class Engine {
   bool draining_ = false;
   bool halted_ = false;
   int active_ = 0;
+  std::uint64_t next_instance_ = 0;
   std::uint64_t activations_ = 0;
   std::vector<int> watched_;  ///< condition nodes currently watching
   std::vector<std::shared_ptr<const Telemetry>> board_;  ///< other drones' newest telemetry

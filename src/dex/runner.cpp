@@ -10,12 +10,13 @@ namespace {
 
 /// Delivers messages through the event loop, in send order, with no latency. Telemetry
 /// goes only to the drones whose mission reads the sender (Mission::reads), the way a DDS
-/// reader subscribes to what it needs.
+/// reader subscribes to what it needs. `on_delivered` runs after each message is handled:
+/// the last message in flight may be what completes the mission.
 class InProcessTransport : public Transport {
  public:
   InProcessTransport(mid::EventLoop& loop, std::vector<std::unique_ptr<Engine>>& engines,
-                     const std::vector<Mission>& missions)
-      : loop_(loop), engines_(engines), readers_(missions.size()) {
+                     const std::vector<Mission>& missions, std::function<void()> on_delivered)
+      : loop_(loop), engines_(engines), readers_(missions.size()), on_delivered_(std::move(on_delivered)) {
     for (std::size_t to = 0; to < missions.size(); ++to)
       for (int d : missions[to].reads)
         if (d >= 0 && d < static_cast<int>(readers_.size())) readers_[d].push_back(static_cast<int>(to));
@@ -25,6 +26,7 @@ class InProcessTransport : public Transport {
     loop_.after(0.0, [this, to, m] {
       --in_flight_;
       engines_[to]->receive(m);
+      on_delivered_();
     });
   }
   void publish(std::shared_ptr<const Telemetry> t) override {
@@ -43,10 +45,25 @@ class InProcessTransport : public Transport {
   mid::EventLoop& loop_;
   std::vector<std::unique_ptr<Engine>>& engines_;
   std::vector<std::vector<int>> readers_;  ///< per drone: the drones that read its telemetry
+  std::function<void()> on_delivered_;
   int in_flight_ = 0;
 };
 
+/// The trace's last event: how the mission ended, at the instant it did.
+void trace_mission_end(TraceSink* trace, const RunResult& r) {
+  if (trace) trace->record(mission_end_event(r));
+}
+
 }  // namespace
+
+TraceEvent mission_end_event(const RunResult& r) {
+  TraceEvent e;
+  e.t = r.duration;
+  e.event = "mission";
+  e.outcome = r.completed ? "completed" : "failed";
+  e.reason = r.completed ? "" : r.error;
+  return e;
+}
 
 void enter_failsafe(mid::Drone& drone, const fleet::DroneSettings& settings, double t, const std::string& reason,
                     TraceSink* trace) {
@@ -98,12 +115,15 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
   for (int d = 0; d < n; ++d) record_sample(tracks[d], drones[d]->state());
 
   std::vector<std::unique_ptr<Engine>> engines;
-  InProcessTransport transport(loop, engines, missions);
   bool end_reached = false;
   bool failed = false;
   double finished_at = 0.0;
-  auto check_done = [&] {
-    if (!end_reached || failed || transport.in_flight() > 0) return;
+  // Checked whenever an engine settles idle and after every delivered message: the mission
+  // completes at that instant, not at the next event that happens to come by.
+  std::function<void()> check_done;
+  InProcessTransport transport(loop, engines, missions, [&] { check_done(); });
+  check_done = [&] {
+    if (!end_reached || failed || result.completed || transport.in_flight() > 0) return;
     for (const auto& e : engines)
       if (e->busy()) return;
     result.completed = true;
@@ -130,10 +150,8 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     hooks.transport = &transport;
     hooks.trace = trace;
     hooks.on_failure = fail;
-    hooks.on_end = [&] {
-      end_reached = true;
-      loop.after(0.0, check_done);
-    };
+    hooks.on_end = [&] { end_reached = true; };  // the lead's engine settles next: check_done then
+    hooks.on_idle = [&] { check_done(); };
     engines.push_back(std::make_unique<Engine>(missions[d], *drones[d], loop, hooks));
   }
   // Each drone's broker feeds its own engine directly and every other drone through the
@@ -149,17 +167,12 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
       record_sample(tracks[d], s);
       engines[d]->properties_changed(d);
       transport.publish(std::make_shared<const Telemetry>(Telemetry{missions[d].hash, d, s}));
-      loop.after(0.0, check_done);
     });
   }
   for (auto& e : engines) e->start();
 
   // Endless motions (an Orbit nobody preempts) keep the loop busy: bound the run.
   loop.run_until(options.time_limit_s);
-  if (!result.completed && !failed) {
-    loop.after(0.0, check_done);
-    loop.run_until(loop.now());
-  }
   if (!result.completed && !failed) {
     finished_at = loop.now();
     char limit[32];
@@ -186,6 +199,7 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     result.drones.push_back({missions[d].settings.name, drones[d]->state(), std::move(tracks[d])});
     result.activations += engines[d]->activations();
   }
+  trace_mission_end(trace, result);
   return result;
 }
 

@@ -53,6 +53,11 @@ struct RunResult {
   std::uint64_t activations = 0;      ///< node activations over all drones
 };
 
+/// The event a trace ends with: `mission`, outcome `completed` or `failed` (reason: the
+/// error), at the mission time the mission ended (RunResult::duration). Every runner, in
+/// process or distributed, writes it last.
+TraceEvent mission_end_event(const RunResult& r);
+
 /// Runs `missions` (one per drone, same hash, index order = fleet order). Setup problems
 /// (unknown adapter, mismatched hashes) come back as a failed result before anything runs.
 RunResult run_in_process(const std::vector<Mission>& missions, const mid::AdapterRegistry& adapters,

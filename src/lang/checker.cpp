@@ -122,7 +122,6 @@ CheckedMission Checker::run() {
     check_unused();
     warn_concurrent_motion(m_, out_.drone_types, diags_);
     warn_exact_comparisons(m_, diags_);
-    warn_detached_work_in_loops(m_, diags_);
   }
   return std::move(out_);
 }

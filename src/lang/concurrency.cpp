@@ -94,45 +94,4 @@ void warn_concurrent_motion(const Mission& mission, const std::vector<fleet::Dro
   MotionAnalysis(mission, types, diags).run();
 }
 
-namespace {
-
-bool is_detaching(const Statement& s) {
-  return s.kind == StatementKind::async_call || s.control == ControlKind::DoUntilAsync ||
-         s.control == ControlKind::DoWhileAsync;
-}
-
-/// Whether a block (or anything it calls or branches to) launches detached work; memoised.
-bool launches(const Mission& m, int fn, std::vector<signed char>& memo) {
-  if (memo[fn] >= 0) return memo[fn] == 1;
-  memo[fn] = 0;  // recursion is ruled out by the checker; this only guards re-entry
-  bool found = false;
-  for (const auto& s : m.functions[fn].body) {
-    if (is_detaching(s)) found = true;
-    if (!found && s.function_index >= 0) found = launches(m, s.function_index, memo);
-    for (int b : s.branch_functions)
-      if (!found && b >= 0) found = launches(m, b, memo);
-    if (found) break;
-  }
-  memo[fn] = found ? 1 : 0;
-  return found;
-}
-
-}  // namespace
-
-void warn_detached_work_in_loops(const Mission& mission, Diagnostics& diags) {
-  std::vector<signed char> memo(mission.functions.size(), -1);
-  for (const auto& f : mission.functions)
-    for (const auto& s : f.body) {
-      bool repeat = s.control == ControlKind::RepeatUntil || s.control == ControlKind::RepeatWhile ||
-                    s.control == ControlKind::RepeatFor;
-      if (!repeat || s.branch_functions.empty() || s.branch_functions[0] < 0) continue;
-      if (!launches(mission, s.branch_functions[0], memo)) continue;
-      diags.warning(mission.file, s.loc,
-                    "repeat branch '" + mission.functions[s.branch_functions[0]].name +
-                        "' launches work with async(...) or Do*Async that may still run when the next "
-                        "iteration starts; its messages to other drones are then dropped as stale. Wait for it inside the branch "
-                        "(a PAR block or Do*Sync) instead");
-    }
-}
-
 }  // namespace eamos::lang

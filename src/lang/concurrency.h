@@ -18,9 +18,4 @@ namespace eamos::lang {
 void warn_concurrent_motion(const Mission& mission, const std::vector<fleet::DroneType>& types,
                             Diagnostics& diags);
 
-/// Work launched with async(...) or Do*Async inside a Repeat's repeat branch may still run
-/// when the next iteration starts; the DEX then treats its later messages as stale (each
-/// iteration is one run of the body). Warns at each such Repeat.
-void warn_detached_work_in_loops(const Mission& mission, Diagnostics& diags);
-
 }  // namespace eamos::lang

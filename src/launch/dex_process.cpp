@@ -200,6 +200,9 @@ bool DexProcess::begin() {
     end_reached_ = true;
     publish_status();
   };
+  // Idle now, not at the next tick: the lead's FINISHED carries the instant the last drone
+  // went idle (StatusSample::since), which is the mission's duration.
+  hooks.on_idle = [this] { publish_status(); };
   engine_ = std::make_unique<dex::Engine>(mission_, *drone_, *loop_, hooks);
   phase_ = Phase::running;
   inbox_.attach(*loop_, [this](const TelemetrySample& s) { seed_telemetry(s); });

@@ -184,6 +184,10 @@ int Ground::run() {
     run.duration = finished_->t;
   }
   if (!error_.empty()) run.error = error_;
+  // The merged trace ends like an in-process one: how and when the mission ended.
+  dex::TraceEvent end = dex::mission_end_event(run);
+  if (live_) live_->record(end);
+  r_.events.push_back(end);
   for (auto& d : drones_) {
     // A drone without a final status (its DEX died) is reported as last seen.
     mid::DroneState state = d.final_status ? d.final_status->state : d.last_state.value_or(mid::DroneState{});

@@ -45,6 +45,13 @@ TimerId EventLoop::after(double dt, std::function<void()> fn) {
   return at(now_ + dt, std::move(fn));
 }
 
+TimerId EventLoop::defer(std::function<void()> fn) {
+  double t = now_;
+  if (options_.mode == ClockMode::real_time && running_)
+    t = std::max(now_, mission_anchor_ + (options_.wall->now_s() - wall_anchor_) * options_.speed);
+  return at(t, std::move(fn));
+}
+
 bool EventLoop::cancel(TimerId id) { return callbacks_.erase(id) != 0; }
 
 std::size_t EventLoop::run_until_idle() {
@@ -68,6 +75,7 @@ std::size_t EventLoop::run(double limit, bool bounded) {
   start_wall_anchor();
   bool real = options_.mode == ClockMode::real_time;
   std::size_t ran = 0;
+  running_ = true;
   while (!stop_requested_) {
     take_posted();
     while (!queue_.empty() && callbacks_.count(queue_.top().seq) == 0) queue_.pop();  // cancelled
@@ -90,6 +98,7 @@ std::size_t EventLoop::run(double limit, bool bounded) {
     ++ran;
     ++events_run_;
   }
+  running_ = false;
   return ran;
 }
 

@@ -57,6 +57,11 @@ class EventLoop {
   TimerId at(double t, std::function<void()> fn);
   /// at(now() + dt, fn).
   TimerId after(double dt, std::function<void()> fn);
+  /// Schedules `fn` behind everything already due, so that work which takes no mission time
+  /// (a loop iteration) cannot starve the rest: on virtual time at now(); on real time, while
+  /// the loop runs, at the mission time the wall clock shows now, so input that I/O threads
+  /// posted meanwhile (DDS samples, MAVLink frames, signals) and due timers run first.
+  TimerId defer(std::function<void()> fn);
   /// Unschedules a pending callback; false when it already ran, was cancelled or is unknown.
   bool cancel(TimerId id);
   bool pending(TimerId id) const { return callbacks_.count(id) != 0; }
@@ -109,6 +114,7 @@ class EventLoop {
   std::uint64_t next_seq_ = 1;
   std::uint64_t events_run_ = 0;
   bool stop_requested_ = false;
+  bool running_ = false;  ///< inside run(): the wall anchor is valid
   /// Cancelled timers stay in the heap and are skipped when popped: cancel is O(1).
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue_;
   std::unordered_map<TimerId, std::function<void()>> callbacks_;

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -152,6 +154,51 @@ TEST_F(Cli, HelpAndVersion) {
     EXPECT_NE(h.out.find("Usage"), std::string::npos) << sub;
   }
   EXPECT_EQ(eamos("frobnicate").status, 1);
+}
+
+std::string mission(const std::string& name) { return std::string(EAMOS_SOURCE_DIR) + "/tests/dex/missions/" + name; }
+
+std::vector<nlohmann::json> trace_lines(const fs::path& p) {
+  std::vector<nlohmann::json> out;
+  std::ifstream in(p);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) out.push_back(nlohmann::json::parse(line));
+  return out;
+}
+
+TEST_F(Cli, RunReportsCompletionWhenTheLastAsyncWorkEndsAndTheTraceEndsWithIt) {
+  Output r = eamos("run -q " + mission("async_last.eamos") + " --trace " + (dir_ / "t.jsonl").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("mission completed in 2.1 s (mission time)"), std::string::npos) << r.out;
+  std::vector<nlohmann::json> trace = trace_lines(dir_ / "t.jsonl");
+  ASSERT_GE(trace.size(), 2u);
+  EXPECT_EQ(trace.back()["event"], "mission");
+  EXPECT_EQ(trace.back()["outcome"], "completed");
+  EXPECT_EQ(trace.back()["t"], 2.1);
+  const nlohmann::json& before = trace[trace.size() - 2];  // the sensor reading of the read that ended last
+  EXPECT_EQ(before["text"], "Drone1.Sensor1()");
+  EXPECT_EQ(before["t"], 2.1);
+}
+
+TEST_F(Cli, AsyncWorkInALoopIsNotWarnedAboutAndEveryPictureEndsOnce) {
+  Output c = eamos("check " + mission("async_in_loop.eamos"));
+  EXPECT_EQ(c.status, 0) << c.out;
+  EXPECT_EQ(c.out.find("warning"), std::string::npos) << c.out;
+  Output r = eamos("run -q " + mission("async_in_loop.eamos") + " --trace " + (dir_ / "t.jsonl").string() +
+                   " --summary " + (dir_ / "s.json").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  int started = 0, succeeded = 0;
+  for (const nlohmann::json& e : trace_lines(dir_ / "t.jsonl")) {
+    if (e.value("text", "") != "Drone1.TakePicture()") continue;
+    started += e["event"] == "start";
+    succeeded += e["event"] == "end" && e["outcome"] == "succeeded";
+  }
+  EXPECT_EQ(started, 3);
+  EXPECT_EQ(succeeded, 3);
+  std::ifstream in(dir_ / "s.json");
+  nlohmann::json summary = nlohmann::json::parse(in);
+  EXPECT_EQ(summary["drones"]["Drone1"]["pictures"], 3);
+  EXPECT_LT(summary["duration"].get<double>(), 60.0);  // not the time limit
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <optional>
 
 #include "flight.h"
 
@@ -244,6 +245,203 @@ TEST(Semantics, ActionExceedingItsFleetTimeoutFails) {
   ASSERT_TRUE(f.result.failure.has_value());
   EXPECT_EQ(f.result.failure->action, "FlyTo");
   EXPECT_NE(f.result.failure->reason.find("timed out"), std::string::npos) << f.result.failure->reason;
+}
+
+// --- Loops that take no time (issue 11.2). `eamos check` refuses such loops; the DEX must
+// still never hang on one, since a mission file is input like any other. The missions are
+// compiled with a picture in the loop, which the test then turns into a fork (no time).
+
+const std::string kOne = "var A Quad\n";
+
+int count_of(const Flight& f, const std::string& event, const std::string& text, const std::string& outcome = "") {
+  int n = 0;
+  for (const auto& e : f.events)
+    n += e.event == event && e.text == text && (outcome.empty() || e.outcome == outcome);
+  return n;
+}
+
+TEST(Semantics, LoopThatTakesNoTimeFailsTheMissionAndRunsTheFailsafeInsteadOfSpinning) {
+  Flight f = test::fly_missions(test::missions_of(
+      kOne + "func INIT() { A.Arm(); A.Takeoff(3); RepeatWhile(true, SEQ_r, SEQ_n) }\n"
+             "func SEQ_r() { A.TakePicture() }\nfunc SEQ_n() { A.Land() }\n",
+      {}, test::without_action("A.TakePicture()")));
+  EXPECT_FALSE(f.result.completed);
+  ASSERT_TRUE(f.result.failure.has_value()) << f.result.error;
+  EXPECT_EQ(f.result.failure->action, "RepeatWhile");
+  EXPECT_EQ(f.result.failure->line, 2);
+  EXPECT_NE(f.result.error.find("took no mission time"), std::string::npos) << f.result.error;
+  EXPECT_DOUBLE_EQ(f.result.duration, f.time_of("end", "A.Takeoff(3)"));
+  int failsafe = -1;
+  for (std::size_t i = 0; i < f.events.size(); ++i)
+    if (f.events[i].event == "failsafe") failsafe = static_cast<int>(i);
+  ASSERT_GE(failsafe, 0);
+  EXPECT_EQ(f.events[failsafe].drone, "A");
+  EXPECT_TRUE(f.result.drones[0].state.landed);
+  EXPECT_FALSE(f.result.drones[0].state.armed);
+}
+
+// Each iteration is one event of the loop: work of other drones at the same instant (here
+// B's Arm, a trigger through the transport) gets its turn while the loop spins.
+TEST(Semantics, LoopThatTakesNoTimeYieldsToTheEventLoopAtEveryIteration) {
+  Flight f = test::fly_missions(test::missions_of(
+      kTwo + "func INIT() { PAR_x() }\nfunc PAR_x() { SEQ_loop(); SEQ_b() }\n"
+             "func SEQ_loop() { RepeatFor(A.Battery() > 0, SEQ_r, SEQ_n, 1000000000) }\n"
+             "func SEQ_r() { A.TakePicture() }\nfunc SEQ_n() { A.Disarm() }\n"
+             "func SEQ_b() { B.Arm(); B.TakePicture() }\n",
+      {}, test::without_action("A.TakePicture()")));
+  ASSERT_TRUE(f.result.failure.has_value());
+  EXPECT_EQ(f.result.failure->action, "RepeatFor");
+  EXPECT_GE(f.find("end", "B.Arm()", "succeeded"), 0);
+  EXPECT_GE(f.find("start", "B.TakePicture()"), 0);
+  EXPECT_EQ(count_of(f, "condition", "A.Battery() > 0"), dex::kMaxInstantIterations);
+  EXPECT_FALSE(f.result.drones[1].state.armed);  // B's failsafe disarmed it on the ground
+}
+
+// A RepeatFor of 10^9 instant iterations, driven one loop event at a time: starting the
+// engine returns at once, and every event runs exactly one iteration (no call stack, no
+// inner loop that holds the thread).
+TEST(Semantics, LoopThatTakesNoTimeRunsOneIterationPerEventLoopCallback) {
+  std::vector<dex::Mission> missions = test::missions_of(
+      kOne + "func INIT() { RepeatFor(true, SEQ_r, SEQ_n, 1000000000) }\n"
+             "func SEQ_r() { A.TakePicture() }\nfunc SEQ_n() { A.Arm() }\n",
+      {}, test::without_action("A.TakePicture()"));
+  ASSERT_EQ(missions.size(), 1u);
+  mid::AdapterRegistry adapters;
+  sim::register_adapter(adapters);
+  mid::EventLoop loop;
+  mid::CreateResult made = adapters.create(missions[0].settings.adapter, missions[0].settings, missions[0].type, loop);
+  ASSERT_EQ(made.status, mid::CreateStatus::success) << made.message;
+  // Each evaluation of the condition stops the loop after the callback it happened in.
+  struct StopAtEachEvaluation : dex::TraceSink {
+    mid::EventLoop& loop;
+    std::size_t evaluations = 0;
+    explicit StopAtEachEvaluation(mid::EventLoop& l) : loop(l) {}
+    void record(const dex::TraceEvent& e) override {
+      evaluations += e.event == "condition";
+      loop.stop();
+    }
+  } trace(loop);
+  std::optional<dex::Failure> failure;
+  dex::EngineHooks hooks;
+  hooks.trace = &trace;
+  hooks.on_failure = [&](const dex::Failure& f) { failure = f; };
+  dex::Engine engine(missions[0], *made.drone, loop, hooks);
+  engine.start();
+  EXPECT_EQ(trace.evaluations, 1u);  // the first iteration, then back to the caller
+  EXPECT_TRUE(engine.busy());        // the next one waits for its turn
+  for (std::size_t i = 2; i <= 100; ++i) {
+    ASSERT_EQ(loop.run_until(0.0), 1u);  // one callback ...
+    ASSERT_EQ(trace.evaluations, i);     // ... one iteration
+  }
+  while (!failure && loop.size() > 0) loop.run_until(0.0);  // it fails; it does not run for ever
+  ASSERT_TRUE(failure.has_value());
+  EXPECT_EQ(failure->action, "RepeatFor");
+  EXPECT_EQ(trace.evaluations, static_cast<std::size_t>(dex::kMaxInstantIterations));
+}
+
+// --- async work started again by a loop while it still runs (issue 11.3): each start is an
+// instance of its own that ends, and is traced, exactly once.
+
+TEST(Semantics, AsyncWorkStartedAgainByALoopBeforeItEndedEndsOnceForEveryStart) {
+  // Iterations take 0.2 s, a picture 0.5 s: three pictures overlap.
+  Flight f = fly(kOne + "func INIT() { A.Arm(); A.Takeoff(3); RepeatFor(true, SEQ_r, SEQ_n, 3) }\n"
+                        "func SEQ_r() { async(SEQ_pic); PauseFor(0.2) }\nfunc SEQ_pic() { A.TakePicture() }\n"
+                        "func SEQ_n() { A.Land(); A.Disarm() }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_EQ(count_of(f, "start", "A.TakePicture()"), 3);
+  EXPECT_EQ(count_of(f, "end", "A.TakePicture()", "succeeded"), 3);
+  EXPECT_EQ(f.result.drones[0].state.pictures, 3);
+  EXPECT_LT(f.result.duration, 60.0);  // not the time limit
+}
+
+TEST(Semantics, AsyncMotionStartedAgainByALoopPreemptsTheRunningOneWhichEndsPreempted) {
+  Flight f = fly(kOne + "func INIT() { A.Arm(); A.Takeoff(3); RepeatFor(true, SEQ_r, SEQ_n, 2) }\n"
+                        "func SEQ_r() { async(SEQ_up); PauseFor(0.2) }\nfunc SEQ_up() { A.FlyByZ(2) }\n"
+                        "func SEQ_n() { PauseFor(20); A.Land(); A.Disarm() }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_EQ(count_of(f, "start", "A.FlyByZ(2)"), 2);
+  EXPECT_EQ(count_of(f, "end", "A.FlyByZ(2)"), 2);
+  int first = f.find("end", "A.FlyByZ(2)");
+  EXPECT_EQ(f.events[first].outcome, "preempted");
+  EXPECT_EQ(f.events[first].reason, "preempted by FlyByZ");
+  EXPECT_EQ(count_of(f, "end", "A.FlyByZ(2)", "succeeded"), 1);
+  EXPECT_LT(f.result.duration, 60.0);
+}
+
+// Async work spanning drones goes on while the next iteration runs: C's second picture of
+// iteration 1 follows B's picture, which ends (at 1.0 s) after C has heard of iteration 2
+// (at 0.75 s) and B has not. Its trigger belongs to iteration 1 and is not stale.
+TEST(Semantics, AsyncWorkAcrossDronesKeepsItsTriggersWhileTheNextIterationRuns) {
+  Flight f = fly("var A Quad\nvar B Quad\nvar C Quad\n"
+                 "func INIT() { RepeatFor(A.Battery() > 0, SEQ_r, SEQ_n, 2) }\n"
+                 "func SEQ_r() { async(SEQ_w); PauseFor(0.75) }\n"
+                 "func SEQ_w() { C.TakePicture(); B.TakePicture(); C.TakePicture() }\n"
+                 "func SEQ_n() { A.Arm(); A.Disarm() }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_EQ(f.result.drones[1].state.pictures, 2);
+  EXPECT_EQ(f.result.drones[2].state.pictures, 4);
+  EXPECT_DOUBLE_EQ(f.result.duration, 2.25);  // iteration 2's last picture: 0.75 + 3 × 0.5
+}
+
+TEST(Semantics, DoAsyncStartedAgainWhileItsDoBranchRunsCancelsThatRunFirst) {
+  Flight f = fly(kTwo + "func INIT() { PAR_up(); RepeatFor(true, SEQ_r, SEQ_n, 2) }\n"
+                        "func PAR_up() { SEQ_a(); SEQ_b() }\n"
+                        "func SEQ_a() { A.Arm(); A.Takeoff(3) }\nfunc SEQ_b() { B.Arm(); B.Takeoff(3) }\n"
+                        "func SEQ_r() { DoWhileAsync(A.Z() < 100, SEQ_do, SEQ_done); PauseFor(1) }\n"
+                        "func SEQ_do() { B.Orbit() }\nfunc SEQ_done() { B.TakePicture() }\n"
+                        "func SEQ_n() { PAR_land() }\nfunc PAR_land() { SEQ_la(); SEQ_lb() }\n"
+                        "func SEQ_la() { A.Land(); A.Disarm() }\nfunc SEQ_lb() { B.Land(); B.Disarm() }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_EQ(count_of(f, "start", "B.Orbit()"), 2);
+  EXPECT_EQ(count_of(f, "end", "B.Orbit()", "cancelled"), 1);  // the first run, by the second
+  EXPECT_EQ(count_of(f, "end", "B.Orbit()", "preempted"), 1);  // the second, by B.Land()
+  EXPECT_EQ(count_of(f, "start", "B.TakePicture()"), 0);       // a superseded run has no done-branch
+  EXPECT_FALSE(f.result.drones[1].state.armed);
+}
+
+// --- Completion (issue 11.4): the mission completes at the instant its last work ends, and
+// the trace says so last.
+
+TEST(Semantics, MissionWhoseLastWorkIsAsyncCompletesWhenThatWorkEnds) {
+  // A sensor read changes no published state: nothing but the engine going idle says it ended.
+  Flight f = fly(kOne + "func INIT() { A.Arm(); async(SEQ_read) }\nfunc SEQ_read() { PauseFor(2); A.Sensor1() }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_DOUBLE_EQ(f.result.duration, f.time_of("end", "A.Sensor1()"));
+  EXPECT_DOUBLE_EQ(f.result.duration, 2.1);
+}
+
+TEST(Semantics, DoAsyncDoneBranchThatEndsLastCompletesTheMissionWhenItEnds) {
+  Flight f = fly(kOne + "func INIT() { A.Arm(); A.Takeoff(3); DoWhileAsync(A.Z() < 5, SEQ_do, SEQ_done); A.FlyByZ(4) }\n"
+                        "func SEQ_do() { PauseFor(100) }\nfunc SEQ_done() { PauseFor(3); A.Sensor1() }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  double last_end = 0;
+  for (const auto& e : f.events)
+    if (e.event == "end") last_end = e.t;
+  EXPECT_DOUBLE_EQ(f.result.duration, last_end);
+  EXPECT_EQ(f.events[f.events.size() - 2].text, "A.Sensor1()");
+}
+
+TEST(Semantics, TraceEndsWithTheMissionEventAtTheInstantTheMissionEnded) {
+  Flight done = fly(kOne + "func INIT() { A.Arm(); A.Disarm() }\n");
+  ASSERT_TRUE(done.result.completed) << done.result.error;
+  ASSERT_FALSE(done.events.empty());
+  const dex::TraceEvent& last = done.events.back();
+  EXPECT_EQ(last.event, "mission");
+  EXPECT_EQ(last.outcome, "completed");
+  EXPECT_EQ(last.t, done.result.duration);
+  EXPECT_EQ(last.reason, "");
+  EXPECT_NE(done.jsonl.find("{\"t\":0.0,\"drone\":\"\",\"event\":\"mission\",\"name\":\"\",\"line\":0,"
+                            "\"outcome\":\"completed\"}\n"),
+            std::string::npos)
+      << done.jsonl;
+
+  Flight failed = fly(kOne + "func INIT() { A.Arm(); A.Takeoff(3); A.Disarm() }\n");
+  ASSERT_FALSE(failed.result.completed);
+  const dex::TraceEvent& end = failed.events.back();
+  EXPECT_EQ(end.event, "mission");
+  EXPECT_EQ(end.outcome, "failed");
+  EXPECT_EQ(end.reason, failed.result.error);
+  EXPECT_EQ(end.t, failed.time_of("end", "A.Disarm()"));
 }
 
 }  // namespace

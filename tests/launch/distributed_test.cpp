@@ -93,6 +93,14 @@ std::string read_text(const fs::path& p) {
   return s.str();
 }
 
+nlohmann::json last_event(const fs::path& trace) {
+  std::ifstream in(trace);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (!line.empty()) last = line;
+  return last.empty() ? nlohmann::json::object() : nlohmann::json::parse(last);
+}
+
 class Distributed : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -120,7 +128,16 @@ class Distributed : public ::testing::Test {
     Events a = per_drone(dir_ / "local.jsonl"), b = per_drone(dir_ / "dist.jsonl");
     EXPECT_FALSE(a.empty());
     EXPECT_EQ(order_difference(a, b), "") << dist.out;
-    EXPECT_EQ(read_json(dir_ / "summary.json")["status"], "completed");
+    nlohmann::json summary = read_json(dir_ / "summary.json");
+    EXPECT_EQ(summary["status"], "completed");
+    // Both traces end with the mission's end, the distributed one at the reported duration.
+    for (const char* trace : {"local.jsonl", "dist.jsonl"}) {
+      nlohmann::json last = last_event(dir_ / trace);
+      EXPECT_EQ(last["event"], "mission") << trace;
+      EXPECT_EQ(last["outcome"], "completed") << trace;
+    }
+    // (trace times are rounded to the microsecond)
+    EXPECT_NEAR(last_event(dir_ / "dist.jsonl")["t"].get<double>(), summary["duration"].get<double>(), 1e-6);
   }
   fs::path dir_;
 };
@@ -315,6 +332,11 @@ TEST_F(Distributed, FailedActionOnOneDroneFailsTheMissionOnEveryDrone) {
   // Lead, in the air on another process, got the ABORT and landed.
   std::string trace = read_text(dir_ / "trace.jsonl");
   EXPECT_NE(trace.find("\"drone\":\"Lead\",\"event\":\"failsafe\""), std::string::npos) << trace;
+  nlohmann::json last = last_event(dir_ / "trace.jsonl");
+  EXPECT_EQ(last["event"], "mission") << trace;
+  EXPECT_EQ(last["outcome"], "failed");
+  EXPECT_EQ(last["reason"], summary["error"]);
+  EXPECT_NEAR(last["t"].get<double>(), summary["duration"].get<double>(), 1e-6);  // trace: to the µs
   EXPECT_TRUE(summary["drones"]["Lead"]["landed"]);
   EXPECT_FALSE(summary["drones"]["Lead"]["armed"]);
 }
@@ -326,6 +348,38 @@ TEST_F(Distributed, TimeLimitFailsTheMissionOnEveryDrone) {
   nlohmann::json summary = read_json(dir_ / "summary.json");
   EXPECT_NE(summary["error"].get<std::string>().find("did not complete within 3"), std::string::npos) << summary.dump(2);
   for (const char* d : {"Drone1", "Drone2", "Drone3"}) EXPECT_TRUE(summary["drones"][d]["landed"]) << d;
+}
+
+// A mission file whose loop takes no time (made by hand here: `eamos check` refuses the
+// source): the DEX must neither hang nor starve its liveliness; it fails the mission, lands,
+// and the ground reports it, all well within the time limit.
+TEST_F(Distributed, LoopThatTakesNoTimeFailsTheMissionInsteadOfHangingTheDex) {
+  fs::path deploy = dir_ / "deploy";
+  Output c = eamos("compile -q " + std::string(EAMOS_SOURCE_DIR) + "/tests/dex/missions/zero_time_loop.eamos -o " +
+                   deploy.string());
+  ASSERT_EQ(c.status, 0) << c.out;
+  fs::path file = deploy / "Drone1" / "mission.json";
+  nlohmann::json m = read_json(file);
+  int changed = 0;
+  for (auto& n : m["nodes"])
+    if (n.value("text", "") == "Drone1.TakePicture()") n["kind"] = "fork", ++changed;
+  ASSERT_EQ(changed, 1);
+  std::ofstream(file) << m.dump();
+  Output r = eamos("launch " + deploy.string() + " --speed 5 --time-limit 20 --domain 41 --trace " +
+                   (dir_ / "trace.jsonl").string() + " --summary " + (dir_ / "summary.json").string());
+  EXPECT_EQ(r.status, 1) << r.out;
+  nlohmann::json summary = read_json(dir_ / "summary.json");
+  EXPECT_EQ(summary["status"], "failed");
+  EXPECT_NE(summary["error"].get<std::string>().find("RepeatWhile (line 5) failed: 10000 iterations in a row took "
+                                                     "no mission time"),
+            std::string::npos)
+      << summary.dump(2);
+  EXPECT_LT(summary["duration"].get<double>(), 20.0);
+  EXPECT_TRUE(summary["drones"]["Drone1"]["landed"]);
+  EXPECT_FALSE(summary["drones"]["Drone1"]["armed"]);
+  nlohmann::json last = last_event(dir_ / "trace.jsonl");
+  EXPECT_EQ(last["event"], "mission");
+  EXPECT_EQ(last["outcome"], "failed");
 }
 
 TEST_F(Distributed, SpeedMismatchAbortsBeforeAnyDroneMoves) {

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -148,6 +149,38 @@ TEST(EventLoop, RealTimeDoesNotWaitForLateEvents) {
   loop.at(2.0, [] {});
   loop.run_until_idle();
   EXPECT_EQ(wall.sleeps, (std::vector<double>{101.0}));
+}
+
+TEST(EventLoop, DeferredCallbackRunsAfterEverythingAlreadyDueOnVirtualTime) {
+  EventLoop loop;
+  std::vector<int> order;
+  loop.at(0.0, [&] {
+    loop.defer([&] { order.push_back(2); });
+    loop.at(0.0, [&] { order.push_back(3); });
+  });
+  loop.at(0.0, [&] { order.push_back(1); });
+  loop.at(1.0, [&] { order.push_back(4); });
+  loop.run_until_idle();
+  EXPECT_EQ(order, (std::vector<int>{1, 2, 3, 4}));
+}
+
+// A callback that keeps deferring itself (a loop iteration taking no time) lets mission
+// time follow the wall on real time, so a later timer (the time limit) still comes.
+TEST(EventLoop, DeferredCallbackOnRealTimeRunsAtTheWallsMissionTimeSoLaterTimersComeDue) {
+  FakeWall wall;
+  EventLoop loop({ClockMode::real_time, 1.0, &wall});
+  bool limit = false;
+  int spins = 0;
+  std::function<void()> spin = [&] {
+    ++spins;
+    wall.t += 0.25;  // the work of one iteration
+    if (!limit) loop.defer(spin);
+  };
+  loop.at(0.0, spin);
+  loop.at(2.0, [&] { limit = true; });
+  loop.run_until_idle();
+  EXPECT_TRUE(limit);
+  EXPECT_EQ(spins, 9);  // at 0, 0.25, … 2.0: the last deferred after the limit ran
 }
 
 TEST(EventLoop, VirtualTimeNeverTouchesTheWallClock) {
