@@ -85,6 +85,9 @@ std::vector<MessageDef> build_table() {
                     ext(T::u32, "fault_bitmask")}));
   t.push_back(make(msg::EXTENDED_SYS_STATE, "EXTENDED_SYS_STATE",
                    {{T::u8, "vtol_state"}, {T::u8, "landed_state"}}));
+  t.push_back(make(msg::STATUSTEXT, "STATUSTEXT",
+                   {{T::u8, "severity"}, {T::char_, "text", 50}, ext(T::u16, "id"),
+                    ext(T::u8, "chunk_seq")}));
   return t;
 }
 

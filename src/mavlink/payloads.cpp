@@ -249,4 +249,24 @@ std::optional<BatteryStatus> unpack_battery_status(const Message& m) {
   return b;
 }
 
+Message pack(const Statustext& m) {
+  FieldWriter w(def_of(msg::STATUSTEXT));
+  w.set("severity", m.severity);
+  w.set_chars("text", m.text);
+  w.set("id", m.id);
+  w.set("chunk_seq", m.chunk_seq);
+  return w.take();
+}
+
+std::optional<Statustext> unpack_statustext(const Message& m) {
+  if (m.id != msg::STATUSTEXT) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  // The text goes into logs, traces and JSON: anything but printable ASCII (a hostile or
+  // broken sender's bytes, invalid UTF-8) becomes '?'.
+  std::string text = r.get_chars("text");
+  for (char& c : text)
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) c = '?';
+  return Statustext{r.get<uint8_t>("severity"), text, r.get<uint16_t>("id"), r.get<uint8_t>("chunk_seq")};
+}
+
 }  // namespace eamos::mavlink

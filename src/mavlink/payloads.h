@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <string>
 
 #include "mavlink/fields.h"
 
@@ -106,6 +107,15 @@ struct BatteryStatus {
   uint8_t charge_state = 0;         ///< MAV_BATTERY_CHARGE_STATE
 };
 
+/// An autopilot's message to its operator: pre-arm failures, refusals, EKF state. Texts
+/// longer than 50 characters arrive in chunks sharing an id (chunk_seq counts up).
+struct Statustext {
+  uint8_t severity = 6;  ///< MAV_SEVERITY: 0 emergency … 3 error, 4 warning, 6 info, 7 debug
+  std::string text;      ///< up to 50 characters; not NUL-terminated on the wire when full
+  uint16_t id = 0;       ///< 0: a message of one chunk
+  uint8_t chunk_seq = 0;
+};
+
 Message pack(const Heartbeat& m);
 Message pack(const SysStatus& m);
 Message pack(const LocalPositionNed& m);
@@ -116,6 +126,7 @@ Message pack(const CommandAck& m);
 Message pack(const SetPositionTargetLocalNed& m);
 Message pack(const ExtendedSysState& m);
 Message pack(const BatteryStatus& m);
+Message pack(const Statustext& m);
 
 std::optional<Heartbeat> unpack_heartbeat(const Message& m);
 std::optional<SysStatus> unpack_sys_status(const Message& m);
@@ -127,5 +138,6 @@ std::optional<CommandAck> unpack_command_ack(const Message& m);
 std::optional<SetPositionTargetLocalNed> unpack_set_position_target_local_ned(const Message& m);
 std::optional<ExtendedSysState> unpack_extended_sys_state(const Message& m);
 std::optional<BatteryStatus> unpack_battery_status(const Message& m);
+std::optional<Statustext> unpack_statustext(const Message& m);
 
 }  // namespace eamos::mavlink

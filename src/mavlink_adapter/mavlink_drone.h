@@ -158,6 +158,11 @@ class MavlinkDrone final : public mid::Drone {
   bool streaming_ = false;        ///< setpoints are the vehicle's control (else: its own modes)
   bool in_control_ = false;       ///< the vehicle entered the setpoint mode for our stream; if
                                   ///< it leaves it (a pilot, a failsafe), we do not fight it
+  /// A HEARTBEAT has shown the setpoint mode since we last asked for it. Until then a
+  /// HEARTBEAT in another mode is one sent before the switch took effect (PX4 acknowledges
+  /// DO_SET_MODE a cycle before its mode changes), not somebody taking over.
+  bool mode_confirmed_ = false;
+  int heartbeats_unconfirmed_ = 0;  ///< HEARTBEATs since acceptance without the setpoint mode
   fleet::Vec3 setpoint_;          ///< mission frame
   Orbit orbit_;  ///< active: our setpoints fly it; commanded: the autopilot does
   int setpoints_sent_ = 0;

@@ -108,22 +108,25 @@ void MavlinkDrone::on_heartbeat() {
   link_watchdog();
   if (!telemetry_requested_) request_telemetry();
   if (left_orbit_mode()) return;
-  if (streaming_ && in_control_ && mode_commands_pending_ == 0 &&
-      vehicle_.custom_mode != autopilot_->setpoint_mode) {
-    // Someone else (a pilot's switch, the autopilot's own failsafe) took the vehicle out of
-    // the setpoint mode: give way instead of switching back.
-    streaming_ = false;
-    in_control_ = false;
-    if (motion_owner_ != mid::kNoAction) {
-      ActionId id = motion_owner_;
-      motion_owner_ = mid::kNoAction;
-      goal_.reset();
-      orbit_ = {};
-      tracker_.end(id, Outcome::failed,
-                   std::string("the vehicle left ") + autopilot_->setpoint_mode_name + " for " +
-                       mode_name(*autopilot_, vehicle_.custom_mode));
-    }
+  if (!streaming_ || !in_control_ || mode_commands_pending_ > 0) return;
+  if (vehicle_.custom_mode == autopilot_->setpoint_mode) {
+    mode_confirmed_ = true;
+    return;
   }
+  // Three HEARTBEATs (about 3 s) without the mode we were granted: it never took effect.
+  if (!mode_confirmed_ && ++heartbeats_unconfirmed_ < 3) return;
+  // Someone else (a pilot's switch, the autopilot's own failsafe) took the vehicle out of
+  // the setpoint mode: give way instead of switching back.
+  streaming_ = false;
+  in_control_ = false;
+  if (motion_owner_ == mid::kNoAction) return;
+  ActionId id = motion_owner_;
+  motion_owner_ = mid::kNoAction;
+  goal_.reset();
+  orbit_ = {};
+  tracker_.end(id, Outcome::failed,
+               std::string("the vehicle left ") + autopilot_->setpoint_mode_name + " for " +
+                   mode_name(*autopilot_, vehicle_.custom_mode));
 }
 
 void MavlinkDrone::link_watchdog() {
@@ -239,13 +242,15 @@ void MavlinkDrone::stream_tick() {
 void MavlinkDrone::switch_to_setpoint_mode() {
   if (vehicle_.custom_mode == autopilot_->setpoint_mode) {
     in_control_ = true;
+    mode_confirmed_ = true;
     return;
   }
   auto p = set_mode_params(*autopilot_, autopilot_->setpoint_mode);
   send_mode_command(command(ml::cmd::DO_SET_MODE, {p[0], p[1], p[2]}), [this](const CommandResult& r) {
     if (r.accepted) {
       in_control_ = true;
-      vehicle_.custom_mode = autopilot_->setpoint_mode;  // until the next HEARTBEAT says otherwise
+      mode_confirmed_ = false;
+      heartbeats_unconfirmed_ = 0;
       return;
     }
     streaming_ = false;

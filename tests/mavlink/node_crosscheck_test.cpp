@@ -157,6 +157,10 @@ std::string spec_lines(const std::vector<Sample>& all) {
         fields[std::string(f.name)] = test::our_value(*s.def, s.message, f, 0);
         continue;
       }
+      if (f.type == FieldType::char_) {
+        fields[std::string(f.name)] = FieldReader(*s.def, s.message).get_chars(f.name);
+        continue;
+      }
       json values = json::array();
       for (int e = 0; e < f.array_length; ++e)
         values.push_back(test::our_value(*s.def, s.message, f, e));

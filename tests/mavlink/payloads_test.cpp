@@ -202,3 +202,33 @@ TEST(Unpack, OtherMessageIdGivesNothing) {
 
 }  // namespace
 }  // namespace eamos::mavlink
+
+namespace eamos::mavlink {
+namespace {
+
+TEST(RoundTrip, StatustextKeepsSeverityTextAndChunk) {
+  Statustext in{3, "PreArm: Need Position Estimate", 7, 1};
+  auto out = unpack_statustext(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->severity, 3);
+  EXPECT_EQ(out->text, "PreArm: Need Position Estimate");
+  EXPECT_EQ(out->id, 7);
+  EXPECT_EQ(out->chunk_seq, 1);
+}
+
+// A full 50-character text has no NUL on the wire; bytes outside printable ASCII (which
+// would be invalid UTF-8 in a JSON trace) arrive as '?'.
+TEST(RoundTrip, StatustextOfFiftyCharactersAndForeignBytesIsReadSafely) {
+  std::string fifty(50, 'a');
+  fifty[10] = '\xff';
+  fifty[20] = '\x01';
+  auto out = unpack_statustext(through_the_wire(pack(Statustext{6, fifty, 0, 0})));
+  ASSERT_TRUE(out);
+  ASSERT_EQ(out->text.size(), 50u);
+  EXPECT_EQ(out->text[10], '?');
+  EXPECT_EQ(out->text[20], '?');
+  EXPECT_EQ(out->text[49], 'a');
+}
+
+}  // namespace
+}  // namespace eamos::mavlink

@@ -1,0 +1,71 @@
+#pragma once
+// Real autopilot firmware for the tests: N ArduCopter or PX4 (SIH) SITL instances, started
+// from the binary named by EAMOS_ARDUPILOT_SITL / EAMOS_PX4_SITL, each in its own temporary
+// folder with its geographic home placed where the fleet file puts the drone. The fleet owns
+// exactly the processes it started: its destructor stops them by pid, also when a test
+// fails half-way, and nothing else on the machine is touched.
+#include <sys/types.h>
+
+#include <string>
+#include <vector>
+
+namespace eamos_test {
+
+enum class Autopilot { ardupilot, px4 };
+
+/// A drone's home in the mission frame (docs/adapters.md "Frames": x east, y north, metres).
+struct SitlHome {
+  double x = 0;
+  double y = 0;
+};
+
+struct SitlOptions {
+  Autopilot autopilot = Autopilot::ardupilot;
+  std::vector<SitlHome> homes;  ///< one instance per home; instance i has system id i + 1
+  double speedup = 1;           ///< simulation speed: ArduPilot --speedup, PX4_SIM_SPEED_FACTOR
+};
+
+class SitlFleet {
+ public:
+  /// The binary from the environment, or "" when the variable is unset or names no file.
+  static std::string binary(Autopilot autopilot);
+  /// Why the SITL tests skip, and how to run them.
+  static std::string skip_message(Autopilot autopilot);
+
+  explicit SitlFleet(SitlOptions options);
+  ~SitlFleet();
+  SitlFleet(const SitlFleet&) = delete;
+  SitlFleet& operator=(const SitlFleet&) = delete;
+
+  /// Starts every instance; false with `error` set when one cannot be started.
+  bool start(std::string& error);
+  /// Waits (wall time, bounded) until every instance passes its pre-arm checks and reports a
+  /// position: the state in which a pilot would arm. False with the instances not ready.
+  bool wait_ready(double timeout_s, std::string& error);
+  /// Kills one instance at once (a vehicle whose link is lost mid-flight).
+  void kill_instance(int i);
+  /// SIGTERM, then SIGKILL after a grace period, for every instance still running.
+  void stop();
+
+  int size() const { return static_cast<int>(instances_.size()); }
+  /// The `connection:` URL that reaches instance i, as a fleet file writes it.
+  std::string connection(int i) const;
+  int sysid(int i) const { return sysid_of(i); }
+  static int sysid_of(int i) { return i + 1; }
+  /// The last lines the instance printed, for failure messages.
+  std::string log_tail(int i) const;
+
+ private:
+  struct Instance {
+    pid_t pid = -1;
+    std::string dir;
+  };
+  bool start_one(int i, std::string& error);
+  std::vector<std::string> command_line(int i, const std::string& binary) const;
+  void prepare_px4_bin(const std::string& dir, const std::string& binary) const;
+
+  SitlOptions options_;
+  std::vector<Instance> instances_;
+};
+
+}  // namespace eamos_test
