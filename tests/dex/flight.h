@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "deploy/synthesize.h"
+#include "deploy/mission_file.h"
 #include "dex/runner.h"
 #include "dex/trace_writers.h"
 #include "graph/pipeline.h"
@@ -44,8 +44,9 @@ inline Flight fly(const std::string& text, const fleet::Fleet& fleet = {}) {
   std::string hash = deploy::mission_hash(c);
   std::vector<dex::Mission> missions(c.drone_count());
   for (int d = 0; d < c.drone_count(); ++d) {
-    std::string error;
-    EXPECT_TRUE(dex::load_mission(deploy::drone_mission(c, d, hash), missions[d], error)) << error;
+    std::vector<std::string> errors;
+    EXPECT_TRUE(deploy::read_mission(deploy::mission_text(c, d, hash), c.drone_name(d), missions[d], errors))
+        << errors.front();
   }
   mid::AdapterRegistry adapters;
   sim::register_adapter(adapters);
