@@ -54,6 +54,7 @@ std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
   ml::OpenResult opened = ml::Link::open(endpoint, handler);
   if (!opened.link) return opened.error;
   link_ = std::move(opened.link);
+  link_->follow_only(wanted);
 
   std::unique_lock lock(first->mutex);
   auto wait = std::chrono::duration<double>(options_.connect_timeout_s);
@@ -74,6 +75,7 @@ std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
            std::to_string(first->autopilot) + "; the mavlink adapter flies PX4 (12) and ArduPilot (3)";
   }
   lock.unlock();
+  link_->follow_only(sysid_);  // from now on only the vehicle's frames move a udp:// link
   encoder_ = {sysid_, ml::comp::ONBOARD_COMPUTER, 0};
   send_heartbeat();
   link_watchdog();
