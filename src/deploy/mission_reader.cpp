@@ -28,7 +28,19 @@ constexpr std::size_t kMaxDrones = 100000;
 constexpr std::size_t kMaxNameLength = 256;
 constexpr int kMaxArity = 16;
 
-struct TooDeep {};
+std::string at(const std::string& where, const std::string& key) { return where + "/" + key; }
+std::string at(const std::string& where, std::size_t i) { return where + "/" + std::to_string(i); }
+
+/// Where a value is, built into a JSON pointer only when there is a defect to report:
+/// a valid file of 500,000 nodes must not pay for a path string per member.
+struct Loc {
+  Loc(const std::string& base) : base(base) {}  // NOLINT: a path is a Loc
+  Loc(const char* base) : base(base) {}         // NOLINT
+  Loc(const std::string& base, const char* key) : base(base), key(key) {}
+  std::string_view base;  ///< what it points at outlives the Loc (a call's argument)
+  const char* key = nullptr;
+  std::string str() const { return key ? std::string(base) + "/" + key : std::string(base); }
+};
 
 /// Collects defects with where they are; stops collecting at kMaxMissionDefects.
 struct Defects {
@@ -36,18 +48,16 @@ struct Defects {
   std::vector<std::string>& out;
   std::size_t dropped = 0;
 
-  void add(const std::string& where, const std::string& what) {
+  void add(const Loc& loc, const std::string& what) {
     if (out.size() >= kMaxMissionDefects) {
       ++dropped;
       return;
     }
+    std::string where = loc.str();
     out.push_back(file + ": error: " + (where.empty() ? "" : where + ": ") + what);
   }
   bool any() const { return !out.empty(); }
 };
-
-std::string at(const std::string& where, const std::string& key) { return where + "/" + key; }
-std::string at(const std::string& where, std::size_t i) { return where + "/" + std::to_string(i); }
 
 const char* type_name(const json& j) {
   return j.is_discarded() ? "nothing" : j.type_name();
@@ -69,16 +79,16 @@ class Fields {
     return &*it;
   }
 
-  bool object(const json& j, const std::string& where) { return expect(j.is_object(), j, "an object", where); }
-  bool array(const json& j, const std::string& where) { return expect(j.is_array(), j, "an array", where); }
+  bool object(const json& j, const Loc& where) { return expect(j.is_object(), j, "an object", where); }
+  bool array(const json& j, const Loc& where) { return expect(j.is_array(), j, "an array", where); }
 
   bool string(const json& obj, const char* key, const std::string& where, std::string& out,
               bool required = true, std::size_t max_length = kMaxNameLength) {
     const json* j = member(obj, key, where, required);
-    return j ? string_value(*j, at(where, key), out, max_length) : !required;
+    return j ? string_value(*j, Loc(where, key), out, max_length) : !required;
   }
 
-  bool string_value(const json& j, const std::string& where, std::string& out,
+  bool string_value(const json& j, const Loc& where, std::string& out,
                     std::size_t max_length = kMaxNameLength) {
     if (!expect(j.is_string(), j, "a string", where)) return false;
     const std::string& s = j.get_ref<const std::string&>();
@@ -95,11 +105,11 @@ class Fields {
   bool integer(const json& obj, const char* key, const std::string& where, Int& out, long long lo,
                long long hi, bool required = true) {
     const json* j = member(obj, key, where, required);
-    return j ? integer_value(*j, at(where, key), out, lo, hi) : !required;
+    return j ? integer_value(*j, Loc(where, key), out, lo, hi) : !required;
   }
 
   template <typename Int>
-  bool integer_value(const json& j, const std::string& where, Int& out, long long lo, long long hi) {
+  bool integer_value(const json& j, const Loc& where, Int& out, long long lo, long long hi) {
     if (!expect(j.is_number_integer(), j, "a whole number", where)) return false;
     // Non-negative whole numbers are held unsigned: compare them so, or 2^64-1 reads as -1.
     bool in_range = j.is_number_unsigned()
@@ -117,10 +127,10 @@ class Fields {
   bool number(const json& obj, const char* key, const std::string& where, double& out, double lo, double hi,
               bool required = true) {
     const json* j = member(obj, key, where, required);
-    return j ? number_value(*j, at(where, key), out, lo, hi) : !required;
+    return j ? number_value(*j, Loc(where, key), out, lo, hi) : !required;
   }
 
-  bool number_value(const json& j, const std::string& where, double& out, double lo, double hi) {
+  bool number_value(const json& j, const Loc& where, double& out, double lo, double hi) {
     // JSON has no NaN or infinity (the writer would have written null): a finite number only.
     if (!expect(j.is_number(), j, "a number", where)) return false;
     double v = j.get<double>();
@@ -135,7 +145,7 @@ class Fields {
   bool boolean(const json& obj, const char* key, const std::string& where, bool& out, bool required = true) {
     const json* j = member(obj, key, where, required);
     if (!j) return !required;
-    if (!expect(j->is_boolean(), *j, "true or false", at(where, key))) return false;
+    if (!expect(j->is_boolean(), *j, "true or false", Loc(where, key))) return false;
     out = j->get<bool>();
     return true;
   }
@@ -150,14 +160,14 @@ class Fields {
       if (names[i] == s) return out = static_cast<int>(i), true;
     std::string list;
     for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-    d_.add(at(where, key), "unknown value \"" + s + "\" (expected one of: " + list + ")");
+    d_.add(Loc(where, key), "unknown value \"" + s + "\" (expected one of: " + list + ")");
     return false;
   }
 
   Defects& defects() { return d_; }
 
  private:
-  bool expect(bool ok, const json& j, const char* what, const std::string& where) {
+  bool expect(bool ok, const json& j, const char* what, const Loc& where) {
     if (!ok) d_.add(where, std::string("expected ") + what + ", found " + type_name(j));
     return ok;
   }
@@ -292,7 +302,7 @@ class Reader {
   }
 
   /// The index in the fleet of the drone named by `j`, or -1 (and a defect).
-  int drone_index(const json& j, const std::string& where) {
+  int drone_index(const json& j, const Loc& where) {
     std::string name;
     if (!f_.string_value(j, where, name)) return -1;
     auto it = std::find(m_.fleet.begin(), m_.fleet.end(), name);
@@ -305,7 +315,7 @@ class Reader {
 
   void drone_list(const json& obj, const char* key, const std::string& where, std::vector<int>& out) {
     const json* list = f_.member(obj, key, where);
-    if (!list || !f_.array(*list, at(where, key))) return;
+    if (!list || !f_.array(*list, Loc(where, key))) return;
     for (std::size_t i = 0; i < list->size(); ++i) {
       int d = drone_index((*list)[i], at(at(where, key), i));
       if (d >= 0) out.push_back(d);
@@ -441,7 +451,7 @@ class Reader {
       if (!f_.string(j, "prop", where, out.property)) return false;
       if (out.property.empty()) return d_.add(at(where, "prop"), "empty property name"), false;
       const json* drone = f_.member(j, "drone", where);
-      return drone && (out.drone = drone_index(*drone, at(where, "drone"))) >= 0;
+      return drone && (out.drone = drone_index(*drone, Loc(where, "drone"))) >= 0;
     }
     if (j.contains("op")) return operation(j, where, out, depth);
     d_.add(where, "not an expression (expected a member \"num\", \"bool\", \"prop\" or \"op\")");
@@ -450,7 +460,7 @@ class Reader {
 
   bool operation(const json& j, const std::string& where, dex::Expr& out, int depth) {
     const json* args = f_.member(j, "args", where);
-    if (!f_.string(j, "op", where, out.op) || !args || !f_.array(*args, at(where, "args"))) return false;
+    if (!f_.string(j, "op", where, out.op) || !args || !f_.array(*args, Loc(where, "args"))) return false;
     std::size_t n = args->size();
     bool known = n == 1 ? contains(kUnaryOps, out.op) : n == 2 && contains(kBinaryOps, out.op);
     if (!known) {
@@ -490,7 +500,7 @@ class Reader {
                                      std::to_string(i) + ")");
     bool ok = f_.integer(j, "meg", where, n.meg, 0, std::numeric_limits<int>::max());
     const json* drone = f_.member(j, "drone", where);
-    ok &= drone && (n.drone = drone_index(*drone, at(where, "drone"))) >= 0;
+    ok &= drone && (n.drone = drone_index(*drone, Loc(where, "drone"))) >= 0;
     ok &= f_.boolean(j, "internal", where, n.internal);
     if (ok && m_.self >= 0 && n.internal != (n.drone == m_.self))
       ok = false, d_.add(at(where, "internal"), n.internal ? "an internal node held by another drone"
@@ -519,7 +529,7 @@ class Reader {
 
   bool action(const json& j, const std::string& where, dex::Node& n) {
     const json* args = f_.member(j, "args", where);
-    if (!args || !f_.array(*args, at(where, "args"))) return false;
+    if (!args || !f_.array(*args, Loc(where, "args"))) return false;
     n.args.resize(args->size());
     bool ok = true;
     for (std::size_t i = 0; i < args->size(); ++i) ok &= expr((*args)[i], at(at(where, "args"), i), n.args[i], 1);
@@ -549,7 +559,7 @@ class Reader {
     if (n.control == lang::ControlKind::RepeatFor)
       ok &= f_.integer(j, "count", where, n.count, 0, std::numeric_limits<long long>::max());
     if (const json* cancels = f_.member(j, "cancels", where, false);
-        cancels && f_.array(*cancels, at(where, "cancels")))
+        cancels && f_.array(*cancels, Loc(where, "cancels")))
       for (std::size_t i = 0; i < cancels->size(); ++i) {
         int c = 0;
         if (node_index((*cancels)[i], at(at(where, "cancels"), i), c)) n.cancels.push_back(c);
@@ -558,7 +568,7 @@ class Reader {
     return ok;
   }
 
-  bool node_index(const json& j, const std::string& where, int& out) {
+  bool node_index(const json& j, const Loc& where, int& out) {
     if (m_.nodes.empty()) return d_.add(where, "names a node, and the file has none"), false;
     return f_.integer_value(j, where, out, 0, static_cast<long long>(m_.nodes.size()) - 1);
   }
@@ -574,8 +584,8 @@ class Reader {
       if (!f_.object(j, where)) continue;
       const json* from = f_.member(j, "from", where);
       const json* to = f_.member(j, "to", where);
-      bool ok = from && node_index(*from, at(where, "from"), a.from);
-      ok &= to && node_index(*to, at(where, "to"), a.to);
+      bool ok = from && node_index(*from, Loc(where, "from"), a.from);
+      ok &= to && node_index(*to, Loc(where, "to"), a.to);
       ok &= f_.one_of(j, "kind", where, arc_kinds(), kind);
       if (j.contains("branch")) ok &= f_.one_of(j, "branch", where, branches(), branch);
       if (!ok) continue;
@@ -639,21 +649,40 @@ void check_file_hash(std::string_view text, Defects& d) {
           "(compile the mission again)");
 }
 
-/// Parses JSON no deeper than kMaxJsonDepth (the DEX reads expressions recursively).
+/// True when brackets outside strings nest deeper than `limit`. A scan of the text before
+/// parsing: cheaper than a parser callback on every value, and the DEX reads expressions
+/// recursively, so depth is bounded before anything is built.
+bool nests_deeper_than(std::string_view text, int limit) {
+  int depth = 0;
+  const char* p = text.data();
+  const char* end = p + text.size();
+  while (p < end) {
+    char c = *p++;
+    if (c == '"') {
+      // Skip the string: to its closing quote, stepping over escapes.
+      while (p < end && *p != '"') p += *p == '\\' ? 2 : 1;
+      ++p;
+    } else if (c == '[' || c == '{') {
+      if (++depth > limit) return true;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return false;
+}
+
+/// Parses JSON no deeper than kMaxJsonDepth; discarded (and a defect) otherwise.
 json parse_bounded(std::string_view text, Defects& d) {
-  json::parser_callback_t limit_depth = [](int depth, json::parse_event_t event, json&) {
-    if ((event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) &&
-        depth >= kMaxJsonDepth)
-      throw TooDeep{};
-    return true;
-  };
-  try {
-    json j = json::parse(text.begin(), text.end(), limit_depth, true);
-    return j;
-  } catch (const TooDeep&) {
+  if (nests_deeper_than(text, kMaxJsonDepth)) {
     d.add("", "nested more than " + std::to_string(kMaxJsonDepth) + " levels deep");
+    return json(json::value_t::discarded);
+  }
+  try {
+    return json::parse(text.begin(), text.end());
   } catch (const json::parse_error& e) {
     d.add("", "not valid JSON (at byte " + std::to_string(e.byte) + ")");
+  } catch (const json::exception&) {
+    d.add("", "not valid JSON: a number too large for a double");  // e.g. 1e400 (out_of_range.406)
   }
   return json(json::value_t::discarded);
 }

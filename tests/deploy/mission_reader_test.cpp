@@ -149,6 +149,12 @@ TEST_F(MissionReader, RefusesTextThatIsNotJson) {
   EXPECT_NE(defects("").find("not valid JSON"), std::string::npos);
 }
 
+TEST_F(MissionReader, RefusesANumberTooLargeForADouble) {
+  // Found by fuzz_mission: the JSON parser throws out_of_range, not parse_error, for it.
+  std::string edited = reseal(replace_once(text_, "\"battery\":87.5", "\"battery\":3e8447"));
+  EXPECT_EQ(defects(edited), "Drone1/mission.json: error: not valid JSON: a number too large for a double\n");
+}
+
 TEST_F(MissionReader, RefusesAFileOfAnotherFormatVersion) {
   std::string edited = reseal(replace_once(text_, "\"format_version\":2", "\"format_version\":1"));
   EXPECT_EQ(defects(edited),
