@@ -5,6 +5,7 @@
 // engine indexes nodes, arcs and drones without checks; this is where they are made safe.
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <sstream>
 
@@ -246,6 +247,7 @@ class Reader {
 
   void read(const json& file) {
     if (!f_.object(file, "")) return;
+    m_.self = -1;  // until the drone's name is found in the fleet
     header(file);
     if (!fleet(file)) return;  // every later check names drones of the fleet
     settings(file);
@@ -330,9 +332,11 @@ class Reader {
       d_.add(here, "expected 3 numbers [x, y, z], found " + std::to_string(v->size()));
       return false;
     }
-    return f_.number_value((*v)[0], at(here, 0), out.x, -kAny, kAny) &
-           f_.number_value((*v)[1], at(here, 1), out.y, -kAny, kAny) &
-           f_.number_value((*v)[2], at(here, 2), out.z, -kAny, kAny);
+    // Each coordinate is checked, so that every bad one is reported.
+    bool ok = f_.number_value((*v)[0], at(here, 0), out.x, -kAny, kAny);
+    ok &= f_.number_value((*v)[1], at(here, 1), out.y, -kAny, kAny);
+    ok &= f_.number_value((*v)[2], at(here, 2), out.z, -kAny, kAny);
+    return ok;
   }
 
   void settings(const json& file) {
@@ -383,8 +387,9 @@ class Reader {
       std::string where = at("/drone/sensors", name);
       if (!f_.object(model, where)) continue;
       fleet::SensorModel s;
-      if (f_.number(model, "value", where, s.base, -kAny, kAny) & vec3(model, "gradient", where, s.gradient))
-        m_.settings.sensors[name] = s;
+      bool ok = f_.number(model, "value", where, s.base, -kAny, kAny);
+      ok &= vec3(model, "gradient", where, s.gradient);
+      if (ok) m_.settings.sensors[name] = s;
     }
   }
 
@@ -404,8 +409,10 @@ class Reader {
         std::string where = at("/type/properties", i);
         fleet::PropertySpec spec;
         int value_type = 0;
-        if (f_.object(p, where) && f_.string(p, "name", where, spec.name) &
-                                       f_.one_of(p, "type", where, kValueTypes, value_type)) {
+        if (!f_.object(p, where)) continue;
+        bool ok = f_.string(p, "name", where, spec.name);
+        ok &= f_.one_of(p, "type", where, kValueTypes, value_type);
+        if (ok) {
           spec.type = value_type == 1 ? fleet::ValueType::boolean : fleet::ValueType::number;
           type.properties.push_back(spec);
         }
@@ -416,7 +423,8 @@ class Reader {
     if (!f_.object(a, where)) return;
     fleet::ActionSpec spec;
     int action_class = 0;
-    bool ok = f_.string(a, "name", where, spec.name) & f_.one_of(a, "class", where, kActionClasses, action_class);
+    bool ok = f_.string(a, "name", where, spec.name);
+    ok &= f_.one_of(a, "class", where, kActionClasses, action_class);
     spec.action_class = action_class == 1   ? fleet::ActionClass::payload
                         : action_class == 2 ? fleet::ActionClass::system
                                             : fleet::ActionClass::motion;
@@ -708,12 +716,13 @@ bool read_mission(std::string_view text, const std::string& file, dex::Mission& 
 
 bool read_mission_file(const std::string& path, dex::Mission& out, std::vector<std::string>& errors) {
   std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  if (!(in && text << in.rdbuf())) {
+  std::string text;
+  if (in) text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  if (!in && !in.eof()) {
     errors.push_back(path + ": error: cannot read the mission file; check that the deployment folder holds it");
     return false;
   }
-  return read_mission(text.str(), path, out, errors);
+  return read_mission(text, path, out, errors);
 }
 
 }  // namespace eamos::deploy

@@ -110,6 +110,17 @@ mid::DroneState state_from_wire(const W& w, Check& check) {
 
 constexpr long long kBranches = static_cast<long long>(graph::Branch::continue_) + 1;
 
+/// An IDL enum field as the number the sender put there. A C enum can hold any value of
+/// its 32 bits, and reading one outside the enumeration as the C++ enum type is undefined,
+/// so the field's bytes are read as an integer and checked before any cast.
+template <typename Enum>
+uint32_t raw_enum(const Enum& e) {
+  static_assert(sizeof(Enum) == sizeof(uint32_t), "IDL enums are 32 bits on the wire");
+  uint32_t v;
+  std::memcpy(&v, &e, sizeof v);
+  return v;
+}
+
 }  // namespace
 
 const char* lifecycle_name(LifecycleKind k) {
@@ -157,15 +168,16 @@ bool from_wire(const eamos_wire_Trigger& w, const WireLimits& limits, TriggerSam
   s.to = w.to;
   s.seq = w.seq;
   dex::Message& m = s.message;
-  check.one_of("kind", w.kind, 2);
-  m.kind = w.kind == eamos_wire_TRIGGER_CANCEL ? dex::Message::Kind::cancel : dex::Message::Kind::ended;
+  uint32_t kind = raw_enum(w.kind);
+  check.one_of("kind", kind, 2);
+  m.kind = kind == eamos_wire_TRIGGER_CANCEL ? dex::Message::Kind::cancel : dex::Message::Kind::ended;
   m.mission_hash = check.text("mission_hash", w.mission_hash, kMaxWireHash);
   check.drone("from", w.from);
   m.from = w.from;
   check.at_least("meg", w.meg, 0);
   m.meg = w.meg;
   check.one_of("branch", w.branch, kBranches);
-  m.branch = static_cast<graph::Branch>(w.branch);
+  if (check.ok()) m.branch = static_cast<graph::Branch>(w.branch);
   check.at_least("scope", w.scope, -1);
   m.scope = w.scope;
   check.at_least("epoch", w.epoch, 0);
@@ -234,8 +246,9 @@ bool from_wire(const eamos_wire_Lifecycle& w, const WireLimits& limits, Lifecycl
   s.mission_hash = check.text("mission_hash", w.mission_hash, kMaxWireHash);
   check.drone("drone", w.drone, true);
   s.drone = w.drone;
-  check.one_of("kind", w.kind, 4);
-  s.kind = static_cast<LifecycleKind>(w.kind);
+  uint32_t kind = raw_enum(w.kind);
+  check.one_of("kind", kind, 4);
+  if (check.ok()) s.kind = static_cast<LifecycleKind>(kind);
   s.run_id = w.run_id;
   s.nonce = w.nonce;
   s.start_at_ns = w.start_at_ns;
@@ -279,8 +292,9 @@ bool from_wire(const eamos_wire_Status& w, const WireLimits& limits, StatusSampl
   s.drone = w.drone;
   s.run_id = w.run_id;
   s.nonce = w.nonce;
-  check.one_of("phase", w.phase, 4);
-  s.phase = static_cast<Phase>(w.phase);
+  uint32_t phase = raw_enum(w.phase);
+  check.one_of("phase", phase, 4);
+  if (check.ok()) s.phase = static_cast<Phase>(phase);
   s.busy = w.busy;
   s.end_reached = w.end_reached;
   s.sent = w.sent;

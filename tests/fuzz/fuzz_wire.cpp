@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <deque>
 #include <string>
 #include <vector>
@@ -38,6 +39,12 @@ double number(FuzzedDataProvider& in) {
   }
 }
 
+/// Any 32 bits into an IDL enum field, as a hostile writer's CDR could carry them.
+template <typename Enum>
+void set_raw(Enum& field, uint32_t v) {
+  std::memcpy(&field, &v, sizeof v);
+}
+
 void check(bool accepted, int drone, int drones) {
   if (accepted && (drone < -1 || drone >= drones)) __builtin_trap();
 }
@@ -55,7 +62,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   t.mission_hash = text(in, keep);
   t.from = in.ConsumeIntegral<int32_t>();
   t.to = in.ConsumeIntegral<int32_t>();
-  t.kind = static_cast<eamos_wire_TriggerKind>(in.ConsumeIntegral<uint32_t>());
+  set_raw(t.kind, in.ConsumeIntegral<uint32_t>());
   t.meg = in.ConsumeIntegral<int32_t>();
   t.branch = in.ConsumeIntegral<int32_t>();
   t.scope = in.ConsumeIntegral<int32_t>();
@@ -87,7 +94,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   eamos_wire_Lifecycle l{};
   l.mission_hash = text(in, keep);
   l.drone = in.ConsumeIntegral<int32_t>();
-  l.kind = static_cast<eamos_wire_LifecycleKind>(in.ConsumeIntegral<uint32_t>());
+  set_raw(l.kind, in.ConsumeIntegral<uint32_t>());
   l.speed = number(in), l.t = number(in);
   std::size_t nonces = in.ConsumeIntegralInRange<std::size_t>(0, 20);
   for (std::size_t i = 0; i < nonces; ++i) keep.nonces.push_back(in.ConsumeIntegral<uint64_t>());
@@ -103,7 +110,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   eamos_wire_Status s{};
   s.mission_hash = text(in, keep);
   s.drone = in.ConsumeIntegral<int32_t>();
-  s.phase = static_cast<eamos_wire_Phase>(in.ConsumeIntegral<uint32_t>());
+  set_raw(s.phase, in.ConsumeIntegral<uint32_t>());
   s.since = number(in), s.t = number(in), s.x = number(in), s.y = number(in), s.z = number(in);
   s.battery = number(in);
   s.pictures = in.ConsumeIntegral<int32_t>();

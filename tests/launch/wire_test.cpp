@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "transport/wire_convert.h"
@@ -174,16 +175,19 @@ TEST(WireRules, RefusesUnknownEnumValues) {
   w.branch = 77;
   EXPECT_EQ(refusal<TriggerSample>(w), "branch 77 is not a known value");
   w = to_wire(s);
-  w.kind = static_cast<eamos_wire_TriggerKind>(9);
+  uint32_t nine = 9;
+  std::memcpy(&w.kind, &nine, sizeof nine);  // as a hostile writer's CDR would carry it
   EXPECT_EQ(refusal<TriggerSample>(w), "kind 9 is not a known value");
 
   LifecycleSample l;
   eamos_wire_Lifecycle lw = to_wire(l);
-  lw.kind = static_cast<eamos_wire_LifecycleKind>(-3);  // the C enum is unsigned on the wire
+  uint32_t minus_three = static_cast<uint32_t>(-3);
+  std::memcpy(&lw.kind, &minus_three, sizeof minus_three);
   EXPECT_EQ(refusal<LifecycleSample>(lw), "kind 4294967293 is not a known value");
   StatusSample st;
   eamos_wire_Status sw = to_wire(st);
-  sw.phase = static_cast<eamos_wire_Phase>(4);
+  uint32_t four = 4;
+  std::memcpy(&sw.phase, &four, sizeof four);
   EXPECT_EQ(refusal<StatusSample>(sw), "phase 4 is not a known value");
 }
 
