@@ -7,7 +7,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "deploy/synthesize.h"
+#include "deploy/mission_file.h"
 #include "dex/runner.h"
 #include "graph/pipeline.h"
 #include "sim/sim_adapter.h"
@@ -35,7 +35,7 @@ std::unique_ptr<Compiled> compile(const std::string& text) {
     throw std::runtime_error(diags.format());
   std::string hash = eamos::deploy::mission_hash(out->c);
   for (int d = 0; d < out->c.drone_count(); ++d)
-    out->files.push_back(eamos::deploy::drone_mission(out->c, d, hash).dump());
+    out->files.push_back(eamos::deploy::mission_text(out->c, d, hash));
   return out;
 }
 
@@ -51,8 +51,8 @@ std::string stress_text() {
 void setup(benchmark::State& state, const std::string& file) {
   for (auto _ : state) {
     eamos::dex::Mission m;
-    std::string error;
-    if (!eamos::dex::load_mission(nlohmann::json::parse(file), m, error)) state.SkipWithError(error.c_str());
+    std::vector<std::string> errors;
+    if (!eamos::deploy::read_mission(file, "bench", m, errors)) state.SkipWithError(errors.front().c_str());
     benchmark::DoNotOptimize(m.nodes.data());
   }
 }
@@ -98,8 +98,8 @@ void BM_Fly5000Nodes20Drones(benchmark::State& state) {
   auto c = compile(stress_text());
   std::vector<eamos::dex::Mission> missions(c->files.size());
   for (std::size_t d = 0; d < c->files.size(); ++d) {
-    std::string error;
-    eamos::dex::load_mission(nlohmann::json::parse(c->files[d]), missions[d], error);
+    std::vector<std::string> errors;
+    eamos::deploy::read_mission(c->files[d], "bench", missions[d], errors);
   }
   eamos::mid::AdapterRegistry adapters;
   eamos::sim::register_adapter(adapters);
@@ -117,8 +117,8 @@ void BM_EngineActivations(benchmark::State& state) {
   auto c = compile("var A Quad\nfunc INIT() { A.Arm(); RepeatFor(A.Armed(), SEQ_r, SEQ_n, 100000) }\n"
                    "func SEQ_r() { PauseFor(0) }\nfunc SEQ_n() { A.Disarm() }\n");
   std::vector<eamos::dex::Mission> missions(1);
-  std::string error;
-  eamos::dex::load_mission(nlohmann::json::parse(c->files[0]), missions[0], error);
+  std::vector<std::string> errors;
+  eamos::deploy::read_mission(c->files[0], "bench", missions[0], errors);
   eamos::mid::AdapterRegistry adapters;
   eamos::sim::register_adapter(adapters);
   Totals t = fly_repeatedly(state, missions, adapters);

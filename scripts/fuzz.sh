@@ -11,7 +11,7 @@ if [ ! -f "$BUILD/build.ninja" ]; then
   CC=clang CXX=clang++ cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DEAMOS_FUZZ=ON -DEAMOS_TESTS=OFF -DEAMOS_BENCH=OFF >/dev/null
 fi
-cmake --build "$BUILD" -j "$(nproc)" --target fuzz_frontend fuzz_fleet fuzz_mavlink
+cmake --build "$BUILD" -j "$(nproc)" --target fuzz_frontend fuzz_fleet fuzz_mavlink fuzz_mission fuzz_wire
 
 run() {
   local target=$1 seeds=$2
@@ -32,4 +32,6 @@ run() {
 run fuzz_frontend "examples/*.eamos tests/lang/diagnostics/*.eamos"
 run fuzz_fleet "tests/fleet/data/*.yaml examples/*.yaml"
 run fuzz_mavlink "tests/fuzz/mavlink-seeds/*"
+run fuzz_mission "tests/fuzz/mission-seeds/*"
+run fuzz_wire "tests/fuzz/wire-seeds/*"
 echo "fuzz: every target ran without a crash, hang or leak"

@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
-#include "deploy/synthesize.h"
+#include "deploy/mission_file.h"
 #include "dex/plot.h"
 #include "dex/runner.h"
 #include "dex/trace_writers.h"
@@ -44,9 +44,10 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   std::string hash = deploy::mission_hash(c);
   std::vector<dex::Mission> missions(c.drone_count());
   for (int d = 0; d < c.drone_count(); ++d) {
-    std::string error;
-    if (!dex::load_mission(deploy::drone_mission(c, d, hash), missions[d], error)) {
-      std::cerr << "eamos: error: mission file of " << c.drone_name(d) << ": " << error << "\n";
+    std::vector<std::string> errors;
+    if (!deploy::read_mission(deploy::mission_text(c, d, hash), c.drone_name(d) + "/mission.json", missions[d],
+                              errors)) {
+      for (const std::string& e : errors) std::cerr << e << "\n";
       return 1;
     }
   }

@@ -1,13 +1,14 @@
 // The mission file and the mission hash, written as a stream: node by node from the
-// compiled graphs to the file (or the digest), never as a document in memory. The content
-// is exactly drone_mission()'s (synthesize.cpp builds the same file as nlohmann::json, and
-// tests/deploy checks both agree), in an order a reader can use: format and version first.
+// compiled graphs to the file (or the digest), never as a document in memory, in an order
+// a reader can use: format and version first, the file hash last. mission_reader.cpp is
+// the one reader of what is written here.
+#include <sstream>
 #include <streambuf>
 #include <unordered_map>
 
 #include "deploy/json_writer.h"
 #include "deploy/sha256.h"
-#include "deploy/synthesize.h"
+#include "deploy/mission_file.h"
 #include "graph/export.h"
 #include "version.h"
 
@@ -224,32 +225,42 @@ void write_mdg(JsonWriter& w, const Compilation& c, const graph::Mdg& g) {
   w.end_array();
 }
 
-/// A stream whose bytes go into a SHA-256 digest.
+/// A stream whose bytes go into a SHA-256 digest and, when `copy` is set, on to `copy`
+/// too: the mission file is hashed as it is written, in one pass.
 class DigestBuffer : public std::streambuf {
  public:
-  explicit DigestBuffer(Sha256& digest) : digest_(digest) {}
+  explicit DigestBuffer(Sha256& digest, std::ostream* copy = nullptr) : digest_(digest), copy_(copy) {}
+  /// Bytes written from now on go to `copy` only.
+  void stop_digest() { digesting_ = false; }
 
  protected:
   std::streamsize xsputn(const char* s, std::streamsize n) override {
-    digest_.update(s, static_cast<std::size_t>(n));
+    if (digesting_) digest_.update(s, static_cast<std::size_t>(n));
+    if (copy_ && !copy_->write(s, n)) return 0;
     return n;
   }
   int_type overflow(int_type ch) override {
-    if (!traits_type::eq_int_type(ch, traits_type::eof())) {
-      char c = traits_type::to_char_type(ch);
-      digest_.update(&c, 1);
-    }
-    return traits_type::not_eof(ch);
+    if (traits_type::eq_int_type(ch, traits_type::eof())) return traits_type::not_eof(ch);
+    char c = traits_type::to_char_type(ch);
+    return xsputn(&c, 1) == 1 ? ch : traits_type::eof();
   }
 
  private:
   Sha256& digest_;
+  std::ostream* copy_;
+  bool digesting_ = true;
 };
 
 }  // namespace
 
+// The file hash is the last member, over every byte before it (docs/architecture.md,
+// "Mission file"): the reader checks it without a canonical form of its own, and any edit
+// of the file, even of white space, is caught.
 bool write_drone_mission(std::ostream& out, const Compilation& c, int drone, const std::string& hash) {
-  JsonWriter w(out, kMissionFileWrap);
+  Sha256 sha;
+  DigestBuffer tee(sha, &out);
+  std::ostream both(&tee);
+  JsonWriter w(both, kMissionFileWrap);
   w.begin_object();
   w.member("format", "eamos-mission");
   w.member("format_version", kMissionFormatVersion);
@@ -272,8 +283,17 @@ bool write_drone_mission(std::ostream& out, const Compilation& c, int drone, con
   w.key("reads");
   write_drone_names(w, c, g.reads);
   write_mdg(w, c, g);
+  if (!w.flush()) return false;
+  tee.stop_digest();
+  w.member(kFileHashMember, sha.hex_digest());
   w.end_object();
-  return w.flush();
+  return w.flush() && static_cast<bool>(out);
+}
+
+std::string mission_text(const Compilation& c, int drone, const std::string& hash) {
+  std::ostringstream out;
+  write_drone_mission(out, c, drone, hash);
+  return out.str();
 }
 
 // The canonical form hashed is one line of JSON: every drone's settings and type, then

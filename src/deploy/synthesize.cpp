@@ -10,65 +10,6 @@ namespace eamos::deploy {
 
 using nlohmann::json;
 
-namespace {
-
-json vec3(const fleet::Vec3& v) { return json::array({v.x, v.y, v.z}); }
-
-json limits_json(const fleet::Limits& l) {
-  return {{"max_speed", l.max_speed_mps}, {"max_climb", l.max_climb_mps},
-          {"max_descent", l.max_descent_mps}, {"max_accel", l.max_accel_mps2},
-          {"max_altitude", l.max_altitude_m}};
-}
-
-json settings_json(const fleet::DroneSettings& s, int index) {
-  json sensors = json::object();
-  for (const auto& [name, model] : s.sensors)
-    sensors[name] = {{"value", model.base}, {"gradient", vec3(model.gradient)}};
-  json j = {{"name", s.name},
-            {"index", index},
-            {"type", s.type},
-            {"adapter", s.adapter},
-            {"home", vec3(s.home)},
-            {"battery", s.battery_percent},
-            {"failsafe", fleet::failsafe_name(s.failsafe)},
-            {"limits", limits_json(s.limits)},
-            {"sensors", sensors},
-            {"timeouts", s.timeouts_s}};
-  if (!s.connection.empty()) j["connection"] = s.connection;
-  if (s.sysid > 0) j["sysid"] = s.sysid;
-  return j;
-}
-
-json type_json(const fleet::DroneType& t) {
-  json actions = json::array();
-  for (const auto& a : t.actions)
-    actions.push_back({{"name", a.name}, {"arities", a.arities}, {"class", fleet::action_class_name(a.action_class)}});
-  json props = json::array();
-  for (const auto& p : t.properties)
-    props.push_back({{"name", p.name}, {"type", p.type == fleet::ValueType::boolean ? "boolean" : "number"}});
-  return {{"name", t.name}, {"adapter", t.adapter}, {"sensors", t.sensors},
-          {"actions", actions}, {"properties", props}};
-}
-
-}  // namespace
-
-json drone_mission(const graph::Compilation& c, int drone, const std::string& hash) {
-  json fleet_names = json::array();
-  for (int d = 0; d < c.drone_count(); ++d) fleet_names.push_back(c.drone_name(d));
-  json mdg = graph::mdg_json(c, drone);
-  return {{"format", "eamos-mission"},
-          {"format_version", kMissionFormatVersion},
-          {"compiler", std::string("eamos ") + EAMOS_VERSION},
-          {"mission_hash", hash},
-          {"source", {{"path", c.source->path}, {"package", c.mission.package}}},
-          {"drone", settings_json(c.settings[drone], drone)},
-          {"type", type_json(c.checked.drone_types[drone])},
-          {"fleet", fleet_names},
-          {"reads", mdg["reads"]},
-          {"nodes", std::move(mdg["nodes"])},
-          {"arcs", std::move(mdg["arcs"])}};
-}
-
 json manifest(const graph::Compilation& c, const std::string& hash) {
   json drones = json::array();
   for (int d = 0; d < c.drone_count(); ++d)

@@ -7,8 +7,6 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 namespace eamos::dex {
 
 struct Value {
@@ -30,10 +28,6 @@ struct Expr {
 /// (drone index, property name) → value; booleans are 0/1.
 using PropertyReader = std::function<double(int drone, const std::string& property)>;
 
-/// Parses {"num":…}, {"bool":…}, {"prop":…,"drone":…}, {"op":…,"args":[…]}; drone names
-/// resolve through `fleet`. False with `error` on anything else.
-bool parse_expr(const nlohmann::json& j, const std::vector<std::string>& fleet, Expr& out,
-                std::string& error);
 Value evaluate(const Expr& e, const PropertyReader& read);
 /// Drones whose properties the expression reads.
 void collect_drones(const Expr& e, std::vector<int>& out);

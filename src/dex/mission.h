@@ -1,12 +1,11 @@
 #pragma once
 // A drone's mission file as the DEX holds it: the MDG with every node linked to its
 // arcs, expressions ready to evaluate, and the drone's settings. Loaded once at start-up
-// (the paper's "setup part", IV.D.1); the engine never changes it.
+// (the paper's "setup part", IV.D.1) by deploy::read_mission, which checks every index
+// and enum in it; the engine relies on that and never changes it.
 #include <map>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "dex/expr.h"
 #include "fleet/fleet.h"
@@ -59,10 +58,5 @@ struct Mission {
   int find(int meg, int drone) const;
   std::map<std::pair<int, int>, int> index;  ///< (meg, drone) → node index
 };
-
-/// Builds a Mission from a mission file's JSON; false with `error` set (what and where)
-/// when the file is not a valid mission of a format version this DEX knows.
-bool load_mission(const nlohmann::json& file, Mission& out, std::string& error);
-bool load_mission_file(const std::string& path, Mission& out, std::string& error);
 
 }  // namespace eamos::dex

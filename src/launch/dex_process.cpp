@@ -5,6 +5,7 @@
 #include <random>
 #include <thread>
 
+#include "deploy/mission_file.h"
 #include "launch/dex_state.h"
 #include "launch/wall_time.h"
 
@@ -24,9 +25,9 @@ std::uint64_t process_nonce() {
 int DexProcess::run(const mid::AdapterRegistry& adapters) {
   nonce_ = process_nonce();
   std::string error;
-  std::string file = o_.folder + "/mission.json";
-  if (!dex::load_mission_file(file, mission_, error)) {
-    err_ << "eamos dex: error: " << error << "\n";
+  std::vector<std::string> defects;
+  if (!deploy::read_mission_file(o_.folder + "/mission.json", mission_, defects)) {
+    for (const std::string& d : defects) err_ << d << "\n";
     return 1;
   }
   mid::ClockOptions clock;
@@ -59,6 +60,11 @@ int DexProcess::run(const mid::AdapterRegistry& adapters) {
   h.lost = [this](const std::string& hash, int drone, std::uint64_t nonce) {
     inbox_.deliver([this, hash, drone, nonce] { on_lost(hash, drone, nonce); });
   };
+  // Logged on the DEX's own thread: the listener that dropped the sample only posts.
+  h.dropped = [this](const std::string& line) {
+    inbox_.deliver([this, line] { err_ << "eamos dex: " << name() << ": " << line << "\n"; });
+  };
+  h.limits.drones = static_cast<int>(mission_.fleet.size());
   node_ = transport::DdsNode::open(o_.dds, std::move(h), error);
   if (!node_) {
     err_ << "eamos dex: error: " << error << "\n";

@@ -148,6 +148,9 @@ int Ground::run() {
   h.lost = [this](const std::string& hash, int drone, std::uint64_t nonce) {
     inbox_.deliver([this, hash, drone, nonce] { on_lost(hash, drone, nonce); });
   };
+  // Logged on the ground's own thread: the listener that dropped the sample only posts.
+  h.dropped = [this](const std::string& line) { inbox_.deliver([this, line] { err_ << "ground: " << line << "\n"; }); };
+  h.limits.drones = static_cast<int>(drones_.size());
   node_ = transport::DdsNode::open(o_.dds, std::move(h), error);
   if (!node_) {
     err_ << "eamos launch: error: " << error << "\n";

@@ -102,6 +102,12 @@ Parser::Step Parser::try_frame(std::vector<Frame>& out) {
   return Step::consumed;
 }
 
+void Parser::discard_partial() {
+  stats_.skipped_bytes += buffer_.size() - head_;
+  buffer_.clear();
+  head_ = 0;
+}
+
 void Parser::compact() {
   // Erasing only now and then keeps feeding a long stream linear.
   if (head_ == buffer_.size()) {

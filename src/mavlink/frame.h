@@ -66,6 +66,9 @@ class Parser {
   /// Feeds more bytes and returns every frame they complete.
   std::vector<Frame> feed(std::span<const uint8_t> bytes);
   const ParserStats& stats() const { return stats_; }
+  /// Drops the bytes of an unfinished frame (counted as skipped): over UDP a frame never
+  /// spans two senders' datagrams, so another sender's bytes must not complete it.
+  void discard_partial();
 
  private:
   enum class Step { need_more, rejected, consumed };

@@ -169,12 +169,8 @@ void Link::receive_loop() {
       if (!reconnect()) return;  // the destructor came first
       continue;
     }
-    if (endpoint_.kind == LinkKind::udp_listen) {
-      std::lock_guard lock(mutex_);
-      peer_ = from;  // reply to whoever spoke last, as PX4's offboard link expects
-      has_peer_ = true;
-    }
-    handle_bytes(std::span(buffer.data(), static_cast<size_t>(n)));
+    bool listen = endpoint_.kind == LinkKind::udp_listen;
+    handle_bytes(std::span(buffer.data(), static_cast<size_t>(n)), listen ? &from : nullptr);
   }
 }
 
@@ -203,13 +199,39 @@ bool Link::reconnect() {
   }
 }
 
-void Link::handle_bytes(std::span<const uint8_t> bytes) {
+namespace {
+bool same_address(const sockaddr_in& a, const sockaddr_in& b) {
+  return a.sin_addr.s_addr == b.sin_addr.s_addr && a.sin_port == b.sin_port;
+}
+}  // namespace
+
+void Link::handle_bytes(std::span<const uint8_t> bytes, const sockaddr_in* from) {
+  if (from && !same_address(*from, last_from_)) {
+    parser_.discard_partial();
+    last_from_ = *from;
+  }
   std::vector<Frame> frames = parser_.feed(bytes);
+  if (from) follow_sender(frames, *from);
   {
     std::lock_guard lock(mutex_);
     stats_ = parser_.stats();
   }
   for (Frame& f : frames) on_frame_(std::move(f));
+}
+
+// Replies go where the vehicle is, as PX4's offboard link expects, and the vehicle is
+// where its valid frames come from: anybody can send a datagram to the port, but only
+// the vehicle's CRC-checked frames may move the link (a stray packet would otherwise turn
+// every command away from the aircraft).
+void Link::follow_sender(const std::vector<Frame>& frames, const sockaddr_in& from) {
+  uint8_t wanted = follow_sysid_;
+  for (const Frame& f : frames)
+    if (wanted == 0 || f.sysid == wanted) {
+      std::lock_guard lock(mutex_);
+      peer_ = from;
+      has_peer_ = true;
+      return;
+    }
 }
 
 }  // namespace eamos::mavlink

@@ -6,6 +6,7 @@
 // A TCP connection the peer closes is reopened (every second by default) until it is back.
 #include <netinet/in.h>
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -42,13 +43,19 @@ class Link {
   const Endpoint& endpoint() const { return endpoint_; }
   /// Parser counters so far (garbage, bad CRCs), copied under the lock.
   ParserStats stats() const;
+  /// udp:// only: replies go to whoever last sent a valid frame (CRC-checked and parsed)
+  /// from system `sysid`; 0 (the default, before the vehicle is known): from any system.
+  /// A datagram of garbage, or a frame of another system, never redirects the link.
+  void follow_only(uint8_t sysid) { follow_sysid_ = sysid; }
 
  private:
   Link(Endpoint endpoint, int fd, int wake_read, int wake_write, FrameHandler on_frame);
   void receive_loop();
   /// TCP: reconnects after the peer closed; false when the link is being destroyed.
   bool reconnect();
-  void handle_bytes(std::span<const uint8_t> bytes);
+  /// Parses one read; `from`: its sender (UDP), which the link may follow.
+  void handle_bytes(std::span<const uint8_t> bytes, const sockaddr_in* from);
+  void follow_sender(const std::vector<Frame>& frames, const sockaddr_in& from);
 
   Endpoint endpoint_;
   int fd_ = -1;
@@ -59,8 +66,10 @@ class Link {
   FrameHandler on_frame_;
   Parser parser_;               ///< only the receive thread feeds it
   mutable std::mutex mutex_;    ///< guards peer_ and stats_
-  sockaddr_in peer_{};          ///< the last sender (udp://) or the target (udpout://)
+  sockaddr_in peer_{};          ///< the vehicle's last address (udp://) or the target (udpout://)
   bool has_peer_ = false;
+  std::atomic<uint8_t> follow_sysid_{0};  ///< udp://: whose valid frames move peer_
+  sockaddr_in last_from_{};     ///< udp://: sender of the previous datagram (receive thread only)
   bool closed_ = false;         ///< TCP: the peer closed the connection; not yet reconnected
   ParserStats stats_;
   std::thread thread_;

@@ -99,6 +99,8 @@ class MavlinkDrone final : public mid::Drone {
 
   // link, telemetry, setpoints (mavlink_drone_link.cpp)
   void on_frame(const mavlink::Frame& frame);
+  /// A frame of the vehicle refused for its values: counted and logged, never applied.
+  void note_rejected(const char* what);
   void on_heartbeat();
   void link_watchdog();
   void lose_link();
@@ -132,6 +134,7 @@ class MavlinkDrone final : public mid::Drone {
   MavlinkOptions options_;
   const Autopilot* autopilot_ = nullptr;
   uint8_t sysid_ = 0;  ///< the vehicle's system id (0 until known)
+  uint64_t rejected_frames_ = 0;  ///< frames of the vehicle refused for their values
 
   /// Posted frames hold a weak pointer to this: a frame that reaches the loop after the
   /// drone is gone is dropped instead of touching freed memory.

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <iostream>
 #include <mutex>
 
 #include "mavlink/enums.h"
@@ -18,6 +19,8 @@ using mid::ActionId;
 using mid::Outcome;
 
 namespace {
+
+constexpr uint8_t kLastMavResult = 9;  ///< MAV_RESULT_UNSUPPORTED_MAV_FRAME
 
 /// The first autopilot HEARTBEAT, handed from the link's thread to connect().
 struct FirstHeartbeat {
@@ -54,6 +57,7 @@ std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
   ml::OpenResult opened = ml::Link::open(endpoint, handler);
   if (!opened.link) return opened.error;
   link_ = std::move(opened.link);
+  link_->follow_only(wanted);
 
   std::unique_lock lock(first->mutex);
   auto wait = std::chrono::duration<double>(options_.connect_timeout_s);
@@ -74,6 +78,7 @@ std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
            std::to_string(first->autopilot) + "; the mavlink adapter flies PX4 (12) and ArduPilot (3)";
   }
   lock.unlock();
+  link_->follow_only(sysid_);  // from now on only the vehicle's frames move a udp:// link
   encoder_ = {sysid_, ml::comp::ONBOARD_COMPUTER, 0};
   send_heartbeat();
   link_watchdog();
@@ -85,6 +90,9 @@ std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
 void MavlinkDrone::on_frame(const ml::Frame& frame) {
   if (frame.sysid != sysid_) return;  // another vehicle (or a GCS) on the same port
   if (auto ack = ml::unpack_command_ack(frame.message)) {
+    // MAV_RESULT ends at 9 (UNSUPPORTED_MAV_FRAME): an unknown result answers nothing;
+    // the command is sent again and times out as unanswered if it never gets a real one.
+    if (ack->result > kLastMavResult) return note_rejected("COMMAND_ACK with an unknown result");
     // An ACK addressed to another component (a GCS commanding the same vehicle) is not ours;
     // 0 means the autopilot did not say (older firmware).
     if (ack->target_component == 0 || ack->target_component == ml::comp::ONBOARD_COMPUTER)
@@ -94,6 +102,7 @@ void MavlinkDrone::on_frame(const ml::Frame& frame) {
   if (auto hb = ml::unpack_heartbeat(frame.message); hb && hb->autopilot == ml::autopilot::INVALID)
     return;  // a camera, gimbal or companion of the same system: not the autopilot
   Changes c = apply_telemetry(vehicle_, frame);
+  if (c.rejected) return note_rejected(c.rejected);
   if (c.heartbeat) on_heartbeat();
   if (c.landed && vehicle_.landed()) {
     streaming_ = false;  // on the ground: nothing to hold
@@ -101,6 +110,14 @@ void MavlinkDrone::on_frame(const ml::Frame& frame) {
   }
   if (c.position || c.landed) check_goal();
   if (c.position || c.armed || c.landed) publish();
+}
+
+void MavlinkDrone::note_rejected(const char* what) {
+  ++rejected_frames_;
+  // The first few, then every thousandth: a flood of bad frames must not flood the log.
+  if (rejected_frames_ <= 10 || rejected_frames_ % 1000 == 0)
+    std::cerr << "mavlink: " << settings_.name << ": dropped a frame of system " << int(sysid_) << ": " << what
+              << " (" << rejected_frames_ << " dropped so far)\n";
 }
 
 void MavlinkDrone::on_heartbeat() {

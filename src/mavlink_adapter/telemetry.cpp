@@ -1,5 +1,7 @@
 #include "mavlink_adapter/telemetry.h"
 
+#include <cmath>
+
 #include "mavlink/enums.h"
 #include "mavlink/payloads.h"
 
@@ -13,9 +15,45 @@ bool VehicleState::landed() const {
   return landed_state == ml::landed::ON_GROUND;
 }
 
+namespace {
+
+// Bounds beyond any vehicle the adapter flies: a value past them is a corrupt or hostile frame.
+constexpr double kMaxLocalPositionM = 1e6;   // 1,000 km from the local origin
+constexpr double kMaxVelocityMps = 1000;
+constexpr int32_t kMaxAltitudeMm = 100'000'000;  // 100 km
+
+bool within(float v, double bound) { return std::isfinite(v) && std::fabs(v) <= bound; }
+
+const char* refusal(const ml::Message& m) {
+  if (auto p = ml::unpack_local_position_ned(m)) {
+    bool ok = within(p->x, kMaxLocalPositionM) && within(p->y, kMaxLocalPositionM) &&
+              within(p->z, kMaxLocalPositionM) && within(p->vx, kMaxVelocityMps) &&
+              within(p->vy, kMaxVelocityMps) && within(p->vz, kMaxVelocityMps);
+    return ok ? nullptr : "LOCAL_POSITION_NED with NaN, an infinity or a value out of range";
+  }
+  if (auto e = ml::unpack_extended_sys_state(m))
+    return e->landed_state <= ml::landed::LANDING ? nullptr : "EXTENDED_SYS_STATE with an unknown landed state";
+  if (auto s = ml::unpack_sys_status(m))
+    return s->battery_remaining >= -1 && s->battery_remaining <= 100 ? nullptr
+                                                                      : "SYS_STATUS with a battery beyond 0 to 100 %";
+  if (auto b = ml::unpack_battery_status(m))
+    return b->battery_remaining >= -1 && b->battery_remaining <= 100
+               ? nullptr
+               : "BATTERY_STATUS with a battery beyond 0 to 100 %";
+  if (auto g = ml::unpack_global_position_int(m)) {
+    bool ok = g->alt >= -kMaxAltitudeMm && g->alt <= kMaxAltitudeMm && g->relative_alt >= -kMaxAltitudeMm &&
+              g->relative_alt <= kMaxAltitudeMm;
+    return ok ? nullptr : "GLOBAL_POSITION_INT with an altitude beyond 100 km";
+  }
+  return nullptr;
+}
+
+}  // namespace
+
 Changes apply_telemetry(VehicleState& v, const ml::Frame& frame) {
   Changes c;
   const ml::Message& m = frame.message;
+  if ((c.rejected = refusal(m))) return c;
   bool was_landed = v.landed();
   if (auto hb = ml::unpack_heartbeat(m)) {
     c.heartbeat = true;

@@ -36,10 +36,15 @@ struct Changes {
   bool position = false;
   bool armed = false;
   bool landed = false;
+  /// The frame was refused and changed nothing: which message and why (NaN, infinity, a
+  /// value beyond any vehicle, an unknown enum value). nullptr for a frame taken.
+  const char* rejected = nullptr;
 };
 
 /// Folds one telemetry frame (HEARTBEAT, LOCAL_POSITION_NED, EXTENDED_SYS_STATE,
 /// SYS_STATUS, BATTERY_STATUS, GLOBAL_POSITION_INT) into `v`; other messages change nothing.
+/// A frame has passed its CRC, but its values still come from outside: one with NaN, an
+/// infinity, a value out of range or an unknown enum value is refused whole (Changes::rejected).
 Changes apply_telemetry(VehicleState& v, const mavlink::Frame& frame);
 
 fleet::Vec3 ned_to_mission(fleet::Vec3 ned, fleet::Vec3 home);

@@ -1,5 +1,7 @@
 #include "transport/dds_node.h"
 
+#include <iostream>
+
 #include <dds/dds.h>
 
 #include <algorithm>
@@ -45,8 +47,11 @@ dds_qos_t* durable_qos(bool keep_all, double lease_s) {
   return q;
 }
 
-template <typename Wire, typename Fn>
-void take_all(dds_entity_t reader, Fn&& fn, std::function<void(std::uint64_t)> on_info = {}) {
+/// Takes every sample the reader holds. Each is checked as it is converted (from_wire):
+/// one that breaks a rule is dropped and reported to `node`, never handed on.
+template <typename Wire, typename Sample, typename Fn>
+void take_all(dds_entity_t reader, const char* topic, DdsNode& node, Fn&& fn,
+              std::function<void(std::uint64_t)> on_info = {}) {
   constexpr int kBatch = 64;
   void* samples[kBatch];
   dds_sample_info_t infos[kBatch];
@@ -56,8 +61,14 @@ void take_all(dds_entity_t reader, Fn&& fn, std::function<void(std::uint64_t)> o
     if (n <= 0) return;
     for (int i = 0; i < n; ++i) {
       if (!infos[i].valid_data) continue;  // dispose/unregister notices carry no sample
+      Sample s;
+      std::string why;
+      if (!from_wire(*static_cast<const Wire*>(samples[i]), node.wire_limits(), s, why)) {
+        node.dropped(topic, why);
+        continue;
+      }
       if (on_info) on_info(infos[i].publication_handle);
-      fn(from_wire(*static_cast<const Wire*>(samples[i])));
+      fn(std::move(s));
     }
     dds_return_loan(reader, samples, n);
     if (n < kBatch) return;
@@ -223,27 +234,27 @@ bool DdsNode::flush(double timeout_s) {
 }
 
 void DdsNode::take_triggers(int reader) {
-  take_all<eamos_wire_Trigger>(reader, [this](TriggerSample s) {
+  take_all<eamos_wire_Trigger, TriggerSample>(reader, "trigger", *this, [this](TriggerSample s) {
     if (handlers_.trigger) handlers_.trigger(std::move(s));
   });
 }
 
 void DdsNode::take_telemetry(int reader) {
-  take_all<eamos_wire_Telemetry>(reader, [this](TelemetrySample s) {
+  take_all<eamos_wire_Telemetry, TelemetrySample>(reader, "telemetry", *this, [this](TelemetrySample s) {
     if (handlers_.telemetry) handlers_.telemetry(std::move(s));
   });
 }
 
 void DdsNode::take_lifecycle(int reader) {
-  take_all<eamos_wire_Lifecycle>(reader, [this](LifecycleSample s) {
+  take_all<eamos_wire_Lifecycle, LifecycleSample>(reader, "lifecycle", *this, [this](LifecycleSample s) {
     if (handlers_.lifecycle) handlers_.lifecycle(std::move(s));
   });
 }
 
 void DdsNode::take_status(int reader) {
   std::uint64_t handle = 0;
-  take_all<eamos_wire_Status>(
-      reader,
+  take_all<eamos_wire_Status, StatusSample>(
+      reader, "status", *this,
       [this, &handle](StatusSample s) {
         {
           std::lock_guard<std::mutex> lock(writers_mutex_);
@@ -255,9 +266,19 @@ void DdsNode::take_status(int reader) {
 }
 
 void DdsNode::take_trace(int reader) {
-  take_all<eamos_wire_TraceRecord>(reader, [this](TraceSample s) {
+  take_all<eamos_wire_TraceRecord, TraceSample>(reader, "trace", *this, [this](TraceSample s) {
     if (handlers_.trace) handlers_.trace(std::move(s));
   });
+}
+
+void DdsNode::dropped(const char* topic, const std::string& why) {
+  std::uint64_t n = ++dropped_;
+  // A flood of bad samples must not flood the log: the first ten, then every thousandth.
+  if (n > 10 && n % 1000 != 0) return;
+  std::string line = std::string("dropped a ") + topic + " sample: " + why + " (" + std::to_string(n) +
+                     " dropped so far)";
+  if (handlers_.dropped) handlers_.dropped(line);
+  else std::cerr << "eamos: " << line << "\n";
 }
 
 void DdsNode::liveliness_changed(std::uint64_t publication_handle) {

@@ -10,6 +10,7 @@
 //  - trace: reliable, transient-local, keep-all, for the ground's merged trace.
 // Received samples are converted and handed to the handlers on a DDS thread: handlers
 // must only post() to their event loop.
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -39,6 +40,11 @@ struct DdsHandlers {
   /// A status writer lost its liveliness (lease expired, or its process went away):
   /// the mission, drone and process (nonce) it belonged to.
   std::function<void(const std::string& mission_hash, int drone, std::uint64_t nonce)> lost;
+  /// A received sample broke a rule of from_wire and was dropped: one log line saying
+  /// which topic and why (rate-limited). Unset: the line goes to stderr.
+  std::function<void(const std::string& line)> dropped;
+  /// What received samples are checked against: the mission's drone count.
+  WireLimits limits;
 };
 
 class DdsNode {
@@ -72,6 +78,11 @@ class DdsNode {
   void take_status(int reader);
   void take_trace(int reader);
   void liveliness_changed(std::uint64_t publication_handle);
+  /// Checks for received samples, and where a dropped one is reported.
+  const WireLimits& wire_limits() const { return handlers_.limits; }
+  void dropped(const char* topic, const std::string& why);
+  /// Samples dropped so far (for tests).
+  std::uint64_t dropped_count() const { return dropped_; }
 
  private:
   DdsNode() = default;
@@ -90,6 +101,7 @@ class DdsNode {
   };
   std::mutex writers_mutex_;  ///< per status writer: whose it is, for liveliness reports
   std::map<std::uint64_t, Writer> status_writers_;
+  std::atomic<std::uint64_t> dropped_{0};
 };
 
 /// Notes: a second node in one process joins the domain the first created, and the first

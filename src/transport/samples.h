@@ -70,4 +70,16 @@ struct TraceSample {
   dex::TraceEvent event;
 };
 
+/// What a received sample is checked against.
+struct WireLimits {
+  /// The mission's drone count: drone indices must be below it. 0: not known (a node
+  /// without a mission, in tests), then below kMaxWireDrones.
+  int drones = 0;
+};
+inline constexpr int kMaxWireDrones = 100000;
+inline constexpr std::size_t kMaxWireHash = 64;        ///< a SHA-256 in hex
+inline constexpr std::size_t kMaxWireName = 256;       ///< sensor, event, action names
+inline constexpr std::size_t kMaxWireText = 4096;      ///< reasons, labels
+inline constexpr std::size_t kMaxWireSensors = 64;     ///< fleet::kMaxSensors
+
 }  // namespace eamos::transport

@@ -1,11 +1,92 @@
 #include "transport/wire_convert.h"
 
+#include <cmath>
+#include <cstring>
+
 namespace eamos::transport {
 
 namespace {
 
 char* borrow(const std::string& s) { return const_cast<char*>(s.c_str()); }
-std::string copy(const char* s) { return s ? std::string(s) : std::string(); }
+
+/// True when the `n` bytes at `s` are well-formed UTF-8 (no overlong forms, surrogates
+/// or code points past U+10FFFF): names and reasons end up in logs and JSON traces.
+bool is_utf8(const unsigned char* s, std::size_t n) {
+  for (std::size_t i = 0; i < n;) {
+    unsigned char c = s[i];
+    std::size_t len = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+    if (len == 0 || i + len > n) return false;
+    std::uint32_t cp = len == 1 ? c : len == 2 ? c & 0x1F : len == 3 ? c & 0x0F : c & 0x07;
+    for (std::size_t k = 1; k < len; ++k) {
+      if ((s[i + k] & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (s[i + k] & 0x3F);
+    }
+    static const std::uint32_t kMin[] = {0, 0, 0x80, 0x800, 0x10000};
+    if (cp < kMin[len] || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return false;
+    i += len;
+  }
+  return true;
+}
+
+/// Checks one received sample field by field; the first broken rule is kept in `why`.
+class Check {
+ public:
+  Check(const WireLimits& limits, std::string& why) : limits_(limits), why_(why) {}
+
+  bool ok() const { return ok_; }
+
+  /// A drone index of the mission (`ground`: -1, the ground process, allowed too).
+  void drone(const char* field, long long v, bool ground = false) {
+    long long count = limits_.drones > 0 ? limits_.drones : kMaxWireDrones;
+    if (v >= count || v < (ground ? -1 : 0))
+      fail(std::string(field) + " " + std::to_string(v) + " is not a drone of the mission (" +
+           std::to_string(count) + " drones)");
+  }
+  void at_least(const char* field, long long v, long long lo) {
+    if (v < lo) fail(std::string(field) + " " + std::to_string(v) + " is below " + std::to_string(lo));
+  }
+  void in_range(const char* field, long long v, long long lo, long long hi) {
+    if (v < lo || v > hi)
+      fail(std::string(field) + " " + std::to_string(v) + " is outside " + std::to_string(lo) + " to " + std::to_string(hi));
+  }
+  void positive(const char* field, double v) {
+    if (!(v > 0)) fail(std::string(field) + " is not positive");
+  }
+  void one_of(const char* field, long long v, long long count) {
+    if (v < 0 || v >= count) fail(std::string(field) + " " + std::to_string(v) + " is not a known value");
+  }
+  void finite(const char* field, double v) {
+    if (!std::isfinite(v)) fail(std::string(field) + " is " + (std::isnan(v) ? "NaN" : "infinite"));
+  }
+  void count(const char* field, std::size_t n, std::size_t max) {
+    if (n > max) fail(std::string(field) + " holds " + std::to_string(n) + " entries, more than " + std::to_string(max));
+  }
+  /// A copy of a received string, "" (and the sample refused) when it is too long or not
+  /// UTF-8. strnlen: the string is never read further than its limit.
+  std::string text(const char* field, const char* s, std::size_t max) {
+    if (!s) return {};
+    std::size_t n = strnlen(s, max + 1);
+    if (n > max) {
+      fail(std::string(field) + " is longer than " + std::to_string(max) + " bytes");
+      return {};
+    }
+    if (!is_utf8(reinterpret_cast<const unsigned char*>(s), n)) {
+      fail(std::string(field) + " is not UTF-8");
+      return {};
+    }
+    return std::string(s, n);
+  }
+
+ private:
+  void fail(std::string why) {
+    if (ok_) why_ = std::move(why);
+    ok_ = false;
+  }
+
+  const WireLimits& limits_;
+  std::string& why_;
+  bool ok_ = true;
+};
 
 void state_to_wire(const mid::DroneState& s, double& t, double& x, double& y, double& z, double& battery,
                    bool& armed, bool& landed, int32_t& pictures) {
@@ -14,11 +95,30 @@ void state_to_wire(const mid::DroneState& s, double& t, double& x, double& y, do
 }
 
 template <typename W>
-mid::DroneState state_from_wire(const W& w) {
+mid::DroneState state_from_wire(const W& w, Check& check) {
+  check.finite("t", w.t);
+  check.finite("x", w.x);
+  check.finite("y", w.y);
+  check.finite("z", w.z);
+  check.finite("battery", w.battery);
+  check.at_least("pictures", w.pictures, 0);
   mid::DroneState s;
   s.t = w.t, s.x = w.x, s.y = w.y, s.z = w.z, s.battery = w.battery;
   s.armed = w.armed, s.landed = w.landed, s.pictures = w.pictures;
   return s;
+}
+
+constexpr long long kBranches = static_cast<long long>(graph::Branch::continue_) + 1;
+
+/// An IDL enum field as the number the sender put there. A C enum can hold any value of
+/// its 32 bits, and reading one outside the enumeration as the C++ enum type is undefined,
+/// so the field's bytes are read as an integer and checked before any cast.
+template <typename Enum>
+uint32_t raw_enum(const Enum& e) {
+  static_assert(sizeof(Enum) == sizeof(uint32_t), "IDL enums are 32 bits on the wire");
+  uint32_t v;
+  std::memcpy(&v, &e, sizeof v);
+  return v;
 }
 
 }  // namespace
@@ -60,21 +160,31 @@ eamos_wire_Trigger to_wire(const TriggerSample& s) {
   return w;
 }
 
-TriggerSample from_wire(const eamos_wire_Trigger& w) {
-  TriggerSample s;
+bool from_wire(const eamos_wire_Trigger& w, const WireLimits& limits, TriggerSample& s, std::string& why) {
+  Check check(limits, why);
+  s = {};
   s.run_id = w.run_id;
+  check.drone("to", w.to);
   s.to = w.to;
   s.seq = w.seq;
   dex::Message& m = s.message;
-  m.kind = w.kind == eamos_wire_TRIGGER_CANCEL ? dex::Message::Kind::cancel : dex::Message::Kind::ended;
-  m.mission_hash = copy(w.mission_hash);
+  uint32_t kind = raw_enum(w.kind);
+  check.one_of("kind", kind, 2);
+  m.kind = kind == eamos_wire_TRIGGER_CANCEL ? dex::Message::Kind::cancel : dex::Message::Kind::ended;
+  m.mission_hash = check.text("mission_hash", w.mission_hash, kMaxWireHash);
+  check.drone("from", w.from);
   m.from = w.from;
+  check.at_least("meg", w.meg, 0);
   m.meg = w.meg;
-  m.branch = static_cast<graph::Branch>(w.branch);
+  check.one_of("branch", w.branch, kBranches);
+  if (check.ok()) m.branch = static_cast<graph::Branch>(w.branch);
+  check.at_least("scope", w.scope, -1);
   m.scope = w.scope;
+  check.at_least("epoch", w.epoch, 0);
   m.epoch = w.epoch;
+  check.at_least("body_epoch", w.body_epoch, 0);
   m.body_epoch = w.body_epoch;
-  return s;
+  return check.ok();
 }
 
 void to_wire(const TelemetrySample& s, TelemetryOut& out) {
@@ -92,15 +202,21 @@ void to_wire(const TelemetrySample& s, TelemetryOut& out) {
   w.sensors._release = false;
 }
 
-TelemetrySample from_wire(const eamos_wire_Telemetry& w) {
-  TelemetrySample s;
+bool from_wire(const eamos_wire_Telemetry& w, const WireLimits& limits, TelemetrySample& s, std::string& why) {
+  Check check(limits, why);
+  s = {};
   s.run_id = w.run_id;
-  s.telemetry.mission_hash = copy(w.mission_hash);
+  s.telemetry.mission_hash = check.text("mission_hash", w.mission_hash, kMaxWireHash);
+  check.drone("from", w.from);
   s.telemetry.from = w.from;
-  s.telemetry.state = state_from_wire(w);
-  for (uint32_t i = 0; i < w.sensors._length; ++i)
-    s.telemetry.state.sensors[copy(w.sensors._buffer[i].name)] = w.sensors._buffer[i].value;
-  return s;
+  s.telemetry.state = state_from_wire(w, check);
+  check.count("sensors", w.sensors._length, kMaxWireSensors);
+  for (uint32_t i = 0; check.ok() && i < w.sensors._length; ++i) {
+    std::string name = check.text("sensor name", w.sensors._buffer[i].name, kMaxWireName);
+    check.finite("sensor value", w.sensors._buffer[i].value);
+    s.telemetry.state.sensors[name] = w.sensors._buffer[i].value;
+  }
+  return check.ok();
 }
 
 eamos_wire_Lifecycle to_wire(const LifecycleSample& s) {
@@ -124,21 +240,31 @@ eamos_wire_Lifecycle to_wire(const LifecycleSample& s) {
   return w;
 }
 
-LifecycleSample from_wire(const eamos_wire_Lifecycle& w) {
-  LifecycleSample s;
-  s.mission_hash = copy(w.mission_hash);
+bool from_wire(const eamos_wire_Lifecycle& w, const WireLimits& limits, LifecycleSample& s, std::string& why) {
+  Check check(limits, why);
+  s = {};
+  s.mission_hash = check.text("mission_hash", w.mission_hash, kMaxWireHash);
+  check.drone("drone", w.drone, true);
   s.drone = w.drone;
-  s.kind = static_cast<LifecycleKind>(w.kind);
+  uint32_t kind = raw_enum(w.kind);
+  check.one_of("kind", kind, 4);
+  if (check.ok()) s.kind = static_cast<LifecycleKind>(kind);
   s.run_id = w.run_id;
   s.nonce = w.nonce;
   s.start_at_ns = w.start_at_ns;
+  check.finite("speed", w.speed);
+  check.positive("speed", w.speed);
   s.speed = w.speed;
+  check.finite("t", w.t);
   s.t = w.t;
-  s.nonces.assign(w.nonces._buffer, w.nonces._buffer + w.nonces._length);
-  s.reason = copy(w.reason);
-  if (w.failed_drone && *w.failed_drone)
-    s.failure = dex::Failure{copy(w.failed_drone), copy(w.failed_action), w.failed_line, s.reason};
-  return s;
+  check.count("nonces", w.nonces._length, limits.drones > 0 ? limits.drones : kMaxWireDrones);
+  if (check.ok()) s.nonces.assign(w.nonces._buffer, w.nonces._buffer + w.nonces._length);
+  s.reason = check.text("reason", w.reason, kMaxWireText);
+  std::string failed_drone = check.text("failed_drone", w.failed_drone, kMaxWireName);
+  std::string failed_action = check.text("failed_action", w.failed_action, kMaxWireName);
+  check.at_least("failed_line", w.failed_line, 0);
+  if (!failed_drone.empty()) s.failure = dex::Failure{failed_drone, failed_action, w.failed_line, s.reason};
+  return check.ok();
 }
 
 eamos_wire_Status to_wire(const StatusSample& s) {
@@ -158,21 +284,26 @@ eamos_wire_Status to_wire(const StatusSample& s) {
   return w;
 }
 
-StatusSample from_wire(const eamos_wire_Status& w) {
-  StatusSample s;
-  s.mission_hash = copy(w.mission_hash);
+bool from_wire(const eamos_wire_Status& w, const WireLimits& limits, StatusSample& s, std::string& why) {
+  Check check(limits, why);
+  s = {};
+  s.mission_hash = check.text("mission_hash", w.mission_hash, kMaxWireHash);
+  check.drone("drone", w.drone);
   s.drone = w.drone;
   s.run_id = w.run_id;
   s.nonce = w.nonce;
-  s.phase = static_cast<Phase>(w.phase);
+  uint32_t phase = raw_enum(w.phase);
+  check.one_of("phase", phase, 4);
+  if (check.ok()) s.phase = static_cast<Phase>(phase);
   s.busy = w.busy;
   s.end_reached = w.end_reached;
   s.sent = w.sent;
   s.received = w.received;
   s.activations = w.activations;
+  check.finite("since", w.since);
   s.since = w.since;
-  s.state = state_from_wire(w);
-  return s;
+  s.state = state_from_wire(w, check);
+  return check.ok();
 }
 
 eamos_wire_TraceRecord to_wire(const TraceSample& s) {
@@ -195,23 +326,31 @@ eamos_wire_TraceRecord to_wire(const TraceSample& s) {
   return w;
 }
 
-TraceSample from_wire(const eamos_wire_TraceRecord& w) {
-  TraceSample s;
-  s.mission_hash = copy(w.mission_hash);
+bool from_wire(const eamos_wire_TraceRecord& w, const WireLimits& limits, TraceSample& s, std::string& why) {
+  Check check(limits, why);
+  s = {};
+  s.mission_hash = check.text("mission_hash", w.mission_hash, kMaxWireHash);
   s.run_id = w.run_id;
+  check.drone("drone", w.drone);
   s.drone = w.drone;
   s.seq = w.seq;
   dex::TraceEvent& e = s.event;
+  check.finite("t", w.t);
   e.t = w.t;
-  e.event = copy(w.event);
-  e.name = copy(w.name);
+  e.event = check.text("event", w.event, kMaxWireName);
+  e.name = check.text("name", w.name, kMaxWireName);
   e.line = w.line;
-  e.text = copy(w.text);
-  e.outcome = copy(w.outcome);
+  check.at_least("line", w.line, 0);
+  e.text = check.text("text", w.text, kMaxWireText);
+  e.outcome = check.text("outcome", w.outcome, kMaxWireName);
+  check.in_range("value", w.value, -1, 1);
   if (w.value >= 0) e.value = w.value == 1;
-  if (w.has_reading) e.reading = w.reading;
-  e.reason = copy(w.reason);
-  return s;
+  if (w.has_reading) {
+    check.finite("reading", w.reading);
+    e.reading = w.reading;
+  }
+  e.reason = check.text("reason", w.reason, kMaxWireText);
+  return check.ok();
 }
 
 }  // namespace eamos::transport

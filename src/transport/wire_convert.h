@@ -1,7 +1,9 @@
 #pragma once
 // Between the C++ samples (samples.h) and the C structs idlc generates from wire.idl.
 // Writing borrows the C++ strings (dds_write serialises before it returns); reading
-// copies out of the loaned sample.
+// copies out of the loaned sample, and checks it first: a sample comes from anyone on the
+// domain, so every field is checked against the rules of docs/faults.md ("What arrives
+// over DDS") and a sample that breaks one is refused, never converted.
 #include <string>
 #include <vector>
 
@@ -22,10 +24,14 @@ eamos_wire_Lifecycle to_wire(const LifecycleSample& s);
 eamos_wire_Status to_wire(const StatusSample& s);
 eamos_wire_TraceRecord to_wire(const TraceSample& s);
 
-TriggerSample from_wire(const eamos_wire_Trigger& w);
-TelemetrySample from_wire(const eamos_wire_Telemetry& w);
-LifecycleSample from_wire(const eamos_wire_Lifecycle& w);
-StatusSample from_wire(const eamos_wire_Status& w);
-TraceSample from_wire(const eamos_wire_TraceRecord& w);
+/// Converts a received sample into `out`; false with `why` (which field, what is wrong)
+/// when a field breaks its rule: a drone index outside the fleet, an unknown enum value,
+/// NaN or an infinity, a negative count, a string too long or not UTF-8. The caller
+/// drops such a sample and logs `why`.
+bool from_wire(const eamos_wire_Trigger& w, const WireLimits& limits, TriggerSample& out, std::string& why);
+bool from_wire(const eamos_wire_Telemetry& w, const WireLimits& limits, TelemetrySample& out, std::string& why);
+bool from_wire(const eamos_wire_Lifecycle& w, const WireLimits& limits, LifecycleSample& out, std::string& why);
+bool from_wire(const eamos_wire_Status& w, const WireLimits& limits, StatusSample& out, std::string& why);
+bool from_wire(const eamos_wire_TraceRecord& w, const WireLimits& limits, TraceSample& out, std::string& why);
 
 }  // namespace eamos::transport

@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/mission_edit.h"
 #include "support/run_eamos.h"
 
 namespace {
@@ -80,7 +81,7 @@ TEST_F(Cli, CompileWritesManifestAndOneMissionFilePerDrone) {
   for (const char* drone : {"Drone1", "Drone2", "Drone3"}) {
     auto m = nlohmann::json::parse(read_file(dir_ / "deploy" / drone / "mission.json"));
     EXPECT_EQ(m["format"], "eamos-mission");
-    EXPECT_EQ(m["format_version"], 1);
+    EXPECT_EQ(m["format_version"], 2);
     EXPECT_EQ(m["mission_hash"], hash);
     EXPECT_EQ(m["drone"]["name"], drone);
     EXPECT_FALSE(m["nodes"].empty());
@@ -202,3 +203,62 @@ TEST_F(Cli, AsyncWorkInALoopIsNotWarnedAboutAndEveryPictureEndsOnce) {
 }
 
 }  // namespace
+
+// `eamos dex` reads its mission through the one validating reader: a damaged or edited
+// file ends the process with "FILE: error: WHERE: WHAT" and exit 1, before it joins DDS.
+class CliDex : public Cli {
+ protected:
+  void SetUp() override {
+    Cli::SetUp();
+    Output r = eamos_test::run_eamos("compile -q " + kListing2 + " -o " + (dir_ / "deploy").string());
+    ASSERT_EQ(r.status, 0) << r.out;
+    file_ = dir_ / "deploy" / "Drone1" / "mission.json";
+    text_ = read_file(file_);
+  }
+  Output dex_with(const std::string& text) {
+    std::ofstream(file_, std::ios::binary | std::ios::trunc) << text;
+    return eamos_test::run_eamos("dex " + (dir_ / "deploy" / "Drone1").string() + " --domain 51 --start-timeout 1");
+  }
+  fs::path file_;
+  std::string text_;
+};
+
+TEST_F(CliDex, RefusesAMissionFileEditedAfterCompile) {
+  Output r = dex_with(eamos_test::replace_once(text_, "\"battery\":100.0", "\"battery\":99.0"));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.out, file_.string() + ": error: /file_hash: the file's content does not match its hash; it was "
+                                    "edited or damaged after `eamos compile` (compile the mission again)\n");
+}
+
+TEST_F(CliDex, RefusesAnArcToANodeThatIsNotInTheFile) {
+  auto doc = nlohmann::json::parse(text_);
+  const auto& arc = doc["arcs"][0];
+  std::string was = "{\"from\":" + arc["from"].dump() + ",\"to\":" + arc["to"].dump() + ",";
+  std::string now = "{\"from\":" + arc["from"].dump() + ",\"to\":123456,";
+  Output r = dex_with(eamos_test::reseal(eamos_test::replace_once(text_, was, now)));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.out, file_.string() + ": error: /arcs/0/to: 123456 is out of range (0 to " +
+                       std::to_string(doc["nodes"].size() - 1) + ")\n");
+}
+
+TEST_F(CliDex, RefusesAReadOfADroneOutsideTheFleet) {
+  bool none = nlohmann::json::parse(text_)["reads"].empty();
+  std::string now = none ? "\"reads\":[\"Ghost\"" : "\"reads\":[\"Ghost\",";
+  Output r = dex_with(eamos_test::reseal(eamos_test::replace_once(text_, "\"reads\":[", now)));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.out, file_.string() + ": error: /reads/0: drone \"Ghost\" is not in the mission's fleet\n");
+}
+
+TEST_F(CliDex, RefusesAnExpressionNestedTooDeeplyInsteadOfOverflowingTheStack) {
+  std::string deep;
+  for (int i = 0; i < 100000; ++i) deep += "{\"op\":\"-\",\"args\":[";
+  deep += "{\"num\":1.0}";
+  for (int i = 0; i < 100000; ++i) deep += "]}";
+  std::string text = text_;
+  std::size_t at = text.find("\"args\":[{\"num\":");
+  ASSERT_NE(at, std::string::npos);
+  text.insert(at + 8, deep + ",");
+  Output r = dex_with(eamos_test::reseal(text));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.out.rfind(file_.string() + ": error: nested more than", 0), 0u) << r.out.substr(0, 300);
+}

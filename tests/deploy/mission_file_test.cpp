@@ -1,9 +1,11 @@
-// Mission files are streamed to disk, never built as a document; they must hold exactly
-// what drone_mission() describes. And the mission hash names the mission: the same for
-// the same compiled mission, different as soon as a drone's setting or one node differs.
+// Mission files are streamed to disk, never built as a document; their MDG must be
+// exactly the one `eamos graph --kind mdg` exports, and the one reader must load every
+// file the writer writes. And the mission hash names the mission: the same for the same
+// compiled mission, different as soon as a drone's setting or one node differs.
 #include <sstream>
 
-#include "deploy/synthesize.h"
+#include "deploy/mission_file.h"
+#include "graph/export.h"
 #include "helpers.h"
 
 namespace eamos {
@@ -12,16 +14,25 @@ namespace {
 using nlohmann::json;
 using test::compile_mission;
 
-/// Compares the streamed file of every drone with the document drone_mission() builds.
+/// Compares the streamed file of every drone with the MDG the graph exporter builds, and
+/// reads it back through the validating reader.
 void expect_streamed_files_equal_documents(const graph::Compilation& c) {
   std::string hash = deploy::mission_hash(c);
   for (int d = 0; d < c.drone_count(); ++d) {
     std::ostringstream out;
     ASSERT_TRUE(deploy::write_drone_mission(out, c, d, hash));
     json streamed = json::parse(out.str());
-    json document = deploy::drone_mission(c, d, hash);
-    EXPECT_EQ(streamed, document) << "drone " << c.drone_name(d) << "\nstreamed:\n"
-                                  << streamed.dump(1) << "\ndocument:\n" << document.dump(1);
+    json mdg = graph::mdg_json(c, d);
+    EXPECT_EQ(streamed["nodes"], mdg["nodes"]) << "drone " << c.drone_name(d);
+    EXPECT_EQ(streamed["arcs"], mdg["arcs"]) << "drone " << c.drone_name(d);
+    EXPECT_EQ(streamed["reads"], mdg["reads"]) << "drone " << c.drone_name(d);
+    dex::Mission m;
+    std::vector<std::string> errors;
+    EXPECT_TRUE(deploy::read_mission(out.str(), c.drone_name(d), m, errors)) << errors.front();
+    EXPECT_EQ(m.nodes.size(), mdg["nodes"].size());
+    EXPECT_EQ(m.arcs.size(), mdg["arcs"].size());
+    EXPECT_EQ(m.self, d);
+    EXPECT_EQ(m.hash, hash);
   }
 }
 

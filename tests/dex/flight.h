@@ -8,7 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "deploy/synthesize.h"
+#include <nlohmann/json.hpp>
+
+#include "deploy/mission_file.h"
+#include "deploy/sha256.h"
 #include "dex/runner.h"
 #include "dex/trace_writers.h"
 #include "graph/pipeline.h"
@@ -56,6 +59,19 @@ inline Flight fly_missions(std::vector<dex::Mission> missions) {
   return f;
 }
 
+/// A mission file's text after `edit`, sealed again with its file hash (the hash covers the
+/// bytes before the member's comma), so only the edit itself is what the reader sees.
+inline std::string edited(const std::string& text, const MissionEdit& edit) {
+  nlohmann::json file = nlohmann::json::parse(text);
+  edit(file);
+  file.erase("file_hash");
+  std::string body = file.dump();
+  body.pop_back();  // the closing brace
+  deploy::Sha256 sha;
+  sha.update(body.data(), body.size());
+  return body + ",\"file_hash\":\"" + sha.hex_digest() + "\"}";
+}
+
 /// Every drone's mission of `text`, each passed through `edit` (if any) before loading.
 inline std::vector<dex::Mission> missions_of(const std::string& text, const fleet::Fleet& fleet = {},
                                              const MissionEdit& edit = {}) {
@@ -68,10 +84,11 @@ inline std::vector<dex::Mission> missions_of(const std::string& text, const flee
   std::string hash = deploy::mission_hash(c);
   std::vector<dex::Mission> missions(c.drone_count());
   for (int d = 0; d < c.drone_count(); ++d) {
-    nlohmann::json file = deploy::drone_mission(c, d, hash);
-    if (edit) edit(file);
-    std::string error;
-    EXPECT_TRUE(dex::load_mission(file, missions[d], error)) << error;
+    std::string text = deploy::mission_text(c, d, hash);
+    if (edit) text = edited(text, edit);
+    std::vector<std::string> errors;
+    EXPECT_TRUE(deploy::read_mission(text, c.drone_name(d), missions[d], errors))
+        << (errors.empty() ? "" : errors.front());
   }
   return missions;
 }

@@ -144,5 +144,45 @@ TEST(DdsNode, RejectsAMissingConfigFile) {
   EXPECT_NE(error.find("/nonexistent/cyclonedds.xml"), std::string::npos) << error;
 }
 
+TEST(DdsNode, DropsAndLogsASampleFromADroneOutsideTheFleetAndDeliversTheNext) {
+  std::string error;
+  DdsOptions options;
+  options.domain = 44;
+  Received ignored;
+  auto writer = DdsNode::open(options, record_into(ignored), error);
+  ASSERT_TRUE(writer) << error;
+  Received got;
+  std::vector<std::string> dropped;
+  DdsHandlers h = record_into(got);
+  h.limits.drones = 2;
+  h.dropped = [&](const std::string& line) {
+    std::lock_guard<std::mutex> lock(got.mutex);
+    dropped.push_back(line);
+    got.cv.notify_all();
+  };
+  auto reader = DdsNode::open(options, std::move(h), error);
+  ASSERT_TRUE(reader) << error;
+  // Triggers are reliable and kept in order: the bad one arrives before the good one.
+  TriggerSample bad;
+  bad.to = 1;
+  bad.seq = 1;
+  bad.message.mission_hash = "h";
+  bad.message.from = 99;
+  ASSERT_TRUE(writer->write(bad));
+  TriggerSample good = bad;
+  good.seq = 2;
+  good.message.from = 0;
+  ASSERT_TRUE(writer->write(good));
+  ASSERT_TRUE(got.wait([&] { return !got.triggers.empty(); }));
+  std::lock_guard<std::mutex> lock(got.mutex);
+  ASSERT_EQ(got.triggers.size(), 1u);
+  EXPECT_EQ(got.triggers[0].seq, 2u);
+  ASSERT_EQ(dropped.size(), 1u);
+  EXPECT_EQ(dropped[0], "dropped a trigger sample: from 99 is not a drone of the mission (2 drones) (1 dropped so far)");
+  EXPECT_EQ(reader->dropped_count(), 1u);
+  reader.reset();
+  writer.reset();
+}
+
 }  // namespace
 }  // namespace eamos::transport

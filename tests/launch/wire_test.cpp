@@ -1,10 +1,37 @@
-// The C++ samples survive the trip through the IDL's C structs field by field.
+// The C++ samples survive the trip through the IDL's C structs field by field, and a
+// received sample that breaks a rule (drone index outside the fleet, unknown enum, NaN or
+// infinity, a string too long or not UTF-8) is refused with the reason, never converted.
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
 
 #include "transport/wire_convert.h"
 
 namespace eamos::transport {
 namespace {
+
+/// The missions of these tests have five drones.
+const WireLimits kFiveDrones{5};
+
+/// The sample `w` converts back to; a test failure when it is refused.
+template <typename Sample, typename Wire>
+Sample back_from(const Wire& w) {
+  Sample s;
+  std::string why;
+  EXPECT_TRUE(from_wire(w, kFiveDrones, s, why)) << why;
+  return s;
+}
+
+/// Why `w` is refused; "" (and a test failure) when it is accepted.
+template <typename Sample, typename Wire>
+std::string refusal(const Wire& w) {
+  Sample s;
+  std::string why;
+  EXPECT_FALSE(from_wire(w, kFiveDrones, s, why));
+  return why;
+}
 
 TEST(Wire, TriggerKeepsEveryField) {
   TriggerSample s;
@@ -12,7 +39,7 @@ TEST(Wire, TriggerKeepsEveryField) {
   s.to = 2;
   s.seq = 9;
   s.message = {dex::Message::Kind::cancel, "abc", 1, 42, graph::Branch::false_, 17, 5, 6};
-  TriggerSample back = from_wire(to_wire(s));
+  TriggerSample back = back_from<TriggerSample>(to_wire(s));
   EXPECT_EQ(back.run_id, 77u);
   EXPECT_EQ(back.to, 2);
   EXPECT_EQ(back.seq, 9u);
@@ -34,7 +61,7 @@ TEST(Wire, TelemetryKeepsStateAndSensors) {
   s.telemetry.state = {1.5, 2, -3, 4.25, 88, true, false, {{"Sensor1", 0.5}, {"Sensor2", 7}}, 3};
   TelemetryOut out;
   to_wire(s, out);
-  TelemetrySample back = from_wire(out.c);
+  TelemetrySample back = back_from<TelemetrySample>(out.c);
   EXPECT_EQ(back.run_id, 3u);
   EXPECT_EQ(back.telemetry.from, 4);
   EXPECT_EQ(back.telemetry.mission_hash, "h");
@@ -63,7 +90,7 @@ TEST(Wire, LifecycleKeepsStartAndFailure) {
   s.nonces = {11, 12, 13};
   s.reason = "Drone1.Takeoff (line 3) failed: disarmed";
   s.failure = dex::Failure{"Drone1", "Takeoff", 3, s.reason};
-  LifecycleSample back = from_wire(to_wire(s));
+  LifecycleSample back = back_from<LifecycleSample>(to_wire(s));
   EXPECT_EQ(back.drone, kGround);
   EXPECT_EQ(back.kind, LifecycleKind::abort);
   EXPECT_EQ(back.run_id, 5u);
@@ -82,7 +109,7 @@ TEST(Wire, LifecycleKeepsStartAndFailure) {
 TEST(Wire, LifecycleWithoutFailureHasNone) {
   LifecycleSample s;
   s.kind = LifecycleKind::finished;
-  EXPECT_FALSE(from_wire(to_wire(s)).failure);
+  EXPECT_FALSE(back_from<LifecycleSample>(to_wire(s)).failure);
 }
 
 TEST(Wire, StatusKeepsCountersAndState) {
@@ -99,7 +126,7 @@ TEST(Wire, StatusKeepsCountersAndState) {
   s.since = 4.5;
   s.state.z = 12;
   s.state.landed = false;
-  StatusSample back = from_wire(to_wire(s));
+  StatusSample back = back_from<StatusSample>(to_wire(s));
   EXPECT_EQ(back.phase, Phase::failed);
   EXPECT_TRUE(back.busy);
   EXPECT_TRUE(back.end_reached);
@@ -116,17 +143,114 @@ TEST(Wire, TraceKeepsOptionalValueAndReading) {
   s.drone = 1;
   s.seq = 4;
   s.event = {2.5, "", "condition", "If", 12, "Drone1.X() > 3", "", false, std::nullopt, ""};
-  TraceSample back = from_wire(to_wire(s));
+  TraceSample back = back_from<TraceSample>(to_wire(s));
   ASSERT_TRUE(back.event.value);
   EXPECT_FALSE(*back.event.value);
   EXPECT_FALSE(back.event.reading);
   EXPECT_EQ(back.event.text, "Drone1.X() > 3");
   EXPECT_EQ(back.event.line, 12);
   s.event = {3, "", "sensor", "Sensor1", 13, "", "", std::nullopt, 41.5, ""};
-  back = from_wire(to_wire(s));
+  back = back_from<TraceSample>(to_wire(s));
   EXPECT_FALSE(back.event.value);
   ASSERT_TRUE(back.event.reading);
   EXPECT_EQ(*back.event.reading, 41.5);
+}
+
+TEST(WireRules, RefusesATriggerFromOrToADroneOutsideTheFleet) {
+  TriggerSample s;
+  s.to = 1;
+  s.message = {dex::Message::Kind::ended, "h", 99, 3, graph::Branch::any, -1, 0, 0};
+  EXPECT_EQ(refusal<TriggerSample>(to_wire(s)), "from 99 is not a drone of the mission (5 drones)");
+  s.message.from = -1;
+  EXPECT_EQ(refusal<TriggerSample>(to_wire(s)), "from -1 is not a drone of the mission (5 drones)");
+  s.message.from = 0;
+  s.to = 5;
+  EXPECT_EQ(refusal<TriggerSample>(to_wire(s)), "to 5 is not a drone of the mission (5 drones)");
+}
+
+TEST(WireRules, RefusesUnknownEnumValues) {
+  TriggerSample s;
+  s.message = {dex::Message::Kind::ended, "h", 0, 3, graph::Branch::any, -1, 0, 0};
+  eamos_wire_Trigger w = to_wire(s);
+  w.branch = 77;
+  EXPECT_EQ(refusal<TriggerSample>(w), "branch 77 is not a known value");
+  w = to_wire(s);
+  uint32_t nine = 9;
+  std::memcpy(&w.kind, &nine, sizeof nine);  // as a hostile writer's CDR would carry it
+  EXPECT_EQ(refusal<TriggerSample>(w), "kind 9 is not a known value");
+
+  LifecycleSample l;
+  eamos_wire_Lifecycle lw = to_wire(l);
+  uint32_t minus_three = static_cast<uint32_t>(-3);
+  std::memcpy(&lw.kind, &minus_three, sizeof minus_three);
+  EXPECT_EQ(refusal<LifecycleSample>(lw), "kind 4294967293 is not a known value");
+  StatusSample st;
+  eamos_wire_Status sw = to_wire(st);
+  uint32_t four = 4;
+  std::memcpy(&sw.phase, &four, sizeof four);
+  EXPECT_EQ(refusal<StatusSample>(sw), "phase 4 is not a known value");
+}
+
+TEST(WireRules, RefusesTelemetryWithNaNOrInfinity) {
+  TelemetrySample s;
+  s.telemetry.mission_hash = "h";
+  s.telemetry.from = 1;
+  s.telemetry.state.x = std::nan("");
+  TelemetryOut out;
+  to_wire(s, out);
+  EXPECT_EQ(refusal<TelemetrySample>(out.c), "x is NaN");
+  s.telemetry.state.x = 0;
+  s.telemetry.state.z = std::numeric_limits<double>::infinity();
+  to_wire(s, out);
+  EXPECT_EQ(refusal<TelemetrySample>(out.c), "z is infinite");
+  s.telemetry.state.z = 0;
+  s.telemetry.state.sensors["Sensor1"] = std::nan("");
+  to_wire(s, out);
+  EXPECT_EQ(refusal<TelemetrySample>(out.c), "sensor value is NaN");
+}
+
+TEST(WireRules, RefusesStringsTooLongOrNotUtf8) {
+  TraceSample s;
+  s.drone = 1;
+  s.event.event = "action";
+  s.event.text = std::string(kMaxWireText + 1, 'x');
+  EXPECT_EQ(refusal<TraceSample>(to_wire(s)), "text is longer than 4096 bytes");
+  s.event.text = "Drone1.FlyTo(\xC3\x28)";  // a lead byte without its continuation
+  EXPECT_EQ(refusal<TraceSample>(to_wire(s)), "text is not UTF-8");
+  s.event.text = "\xED\xA0\x80";  // a UTF-16 surrogate written as UTF-8
+  EXPECT_EQ(refusal<TraceSample>(to_wire(s)), "text is not UTF-8");
+  s.event.text = "Höhe 3 m";
+  EXPECT_EQ(back_from<TraceSample>(to_wire(s)).event.text, "Höhe 3 m");
+  TriggerSample t;
+  t.message.mission_hash = std::string(65, 'a');
+  EXPECT_EQ(refusal<TriggerSample>(to_wire(t)), "mission_hash is longer than 64 bytes");
+}
+
+TEST(WireRules, RefusesTooManySensorsAndNegativeCounts) {
+  TelemetrySample s;
+  s.telemetry.from = 0;
+  for (int i = 1; i <= 65; ++i) s.telemetry.state.sensors["Sensor" + std::to_string(i)] = i;
+  TelemetryOut out;
+  to_wire(s, out);
+  EXPECT_EQ(refusal<TelemetrySample>(out.c), "sensors holds 65 entries, more than 64");
+  StatusSample st;
+  st.state.pictures = -1;
+  EXPECT_EQ(refusal<StatusSample>(to_wire(st)), "pictures -1 is below 0");
+  TraceSample tr;
+  eamos_wire_TraceRecord tw = to_wire(tr);
+  tw.value = 2;
+  EXPECT_EQ(refusal<TraceSample>(tw), "value 2 is outside -1 to 1");
+}
+
+TEST(WireRules, AcceptsTheGroundAsALifecycleSenderButNotAsAStatusSender) {
+  LifecycleSample l;
+  l.drone = kGround;
+  back_from<LifecycleSample>(to_wire(l));
+  l.speed = 0;
+  EXPECT_EQ(refusal<LifecycleSample>(to_wire(l)), "speed is not positive");
+  StatusSample st;
+  st.drone = kGround;
+  EXPECT_EQ(refusal<StatusSample>(to_wire(st)), "drone -1 is not a drone of the mission (5 drones)");
 }
 
 }  // namespace

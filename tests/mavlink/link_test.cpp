@@ -62,6 +62,65 @@ TEST(UdpLink, ListenerRepliesToTheLastSender) {
   EXPECT_EQ(unpack_command_ack(vehicle_side.frames[0].message)->command, 400);
 }
 
+TEST(UdpLink, ListenerIgnoresAGarbageDatagramAndOtherSystemsButFollowsTheVehicleToANewPort) {
+  Mailbox adapter_side, vehicle_side, stranger_side, moved_side;
+  OpenResult listen = Link::open(endpoint("udp://127.0.0.1:25303"), adapter_side.handler());
+  ASSERT_TRUE(listen.link) << listen.error;
+  listen.link->follow_only(7);
+  OpenResult vehicle = Link::open(endpoint("udpout://127.0.0.1:25303"), vehicle_side.handler());
+  OpenResult stranger = Link::open(endpoint("udpout://127.0.0.1:25303"), stranger_side.handler());
+  ASSERT_TRUE(vehicle.link && stranger.link);
+
+  Encoder vehicle_enc{7, 1}, stranger_enc{99, 1}, adapter{7, 191};
+  ASSERT_TRUE(vehicle.link->send(vehicle_enc.encode(pack(Heartbeat{}))));
+  ASSERT_TRUE(adapter_side.wait_for(1));
+
+  // From another port: a datagram of garbage (with a MAVLink v2 start byte in it), then
+  // a valid frame of another system. The frame reaching the adapter shows both were read.
+  std::vector<uint8_t> garbage = {0xFD, 0x09, 0x00, 0x00, 0x01, 0x07, 0x01, 0x00, 0x00, 0x00, 0xAA, 0x55};
+  ASSERT_TRUE(stranger.link->send(garbage));
+  ASSERT_TRUE(stranger.link->send(stranger_enc.encode(pack(Heartbeat{}))));
+  ASSERT_TRUE(adapter_side.wait_for(2));
+  EXPECT_EQ(adapter_side.frames[1].sysid, 99);
+
+  // Replies still go to the vehicle: it gets the ACK, so the stranger did not.
+  ASSERT_TRUE(listen.link->send(adapter.encode(pack(CommandAck{400, 0}))));
+  ASSERT_TRUE(vehicle_side.wait_for(1));
+  EXPECT_EQ(unpack_command_ack(vehicle_side.frames[0].message)->command, 400);
+
+  // The vehicle's own valid frame from a new port (a restarted SITL) moves the link.
+  OpenResult moved = Link::open(endpoint("udpout://127.0.0.1:25303"), moved_side.handler());
+  ASSERT_TRUE(moved.link);
+  ASSERT_TRUE(moved.link->send(vehicle_enc.encode(pack(Heartbeat{}))));
+  ASSERT_TRUE(adapter_side.wait_for(3));
+  ASSERT_TRUE(listen.link->send(adapter.encode(pack(CommandAck{176, 0}))));
+  ASSERT_TRUE(moved_side.wait_for(1));
+  EXPECT_EQ(unpack_command_ack(moved_side.frames[0].message)->command, 176);
+  std::lock_guard lock(stranger_side.m);
+  EXPECT_TRUE(stranger_side.frames.empty());
+}
+
+TEST(UdpLink, ListenerBeforeTheVehicleIsKnownFollowsTheLastValidFrameOfAnySystem) {
+  Mailbox adapter_side, a_side, b_side;
+  OpenResult listen = Link::open(endpoint("udp://127.0.0.1:25304"), adapter_side.handler());
+  ASSERT_TRUE(listen.link) << listen.error;
+  OpenResult a = Link::open(endpoint("udpout://127.0.0.1:25304"), a_side.handler());
+  OpenResult b = Link::open(endpoint("udpout://127.0.0.1:25304"), b_side.handler());
+  ASSERT_TRUE(a.link && b.link);
+  Encoder a_enc{3, 1}, b_enc{4, 1}, adapter{1, 191};
+  ASSERT_TRUE(b.link->send(std::vector<uint8_t>(40, 0xFD)));  // garbage: nobody to reply to yet
+  EXPECT_FALSE(listen.link->send(adapter.encode(pack(CommandAck{1, 0}))));
+  ASSERT_TRUE(a.link->send(a_enc.encode(pack(Heartbeat{}))));
+  ASSERT_TRUE(adapter_side.wait_for(1));
+  ASSERT_TRUE(listen.link->send(adapter.encode(pack(CommandAck{400, 0}))));
+  ASSERT_TRUE(a_side.wait_for(1));
+  ASSERT_TRUE(b.link->send(b_enc.encode(pack(Heartbeat{}))));
+  ASSERT_TRUE(adapter_side.wait_for(2));
+  ASSERT_TRUE(listen.link->send(adapter.encode(pack(CommandAck{176, 0}))));
+  ASSERT_TRUE(b_side.wait_for(1));
+  EXPECT_EQ(unpack_command_ack(b_side.frames[0].message)->command, 176);
+}
+
 TEST(UdpLink, PortInUseIsAClearError) {
   Mailbox a;
   OpenResult first = Link::open(endpoint("udp://127.0.0.1:25302"), a.handler());

@@ -1,6 +1,9 @@
 // The autopilot's NED frame and the mission frame, and what telemetry frames change.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 #include "mavlink/enums.h"
 #include "mavlink/payloads.h"
 #include "mavlink_adapter/autopilot.h"
@@ -55,6 +58,42 @@ TEST(Telemetry, UnknownBatteryKeepsTheLastKnownCharge) {
   s.battery_remaining = -1;
   apply_telemetry(v, frame(ml::pack(s)));
   EXPECT_DOUBLE_EQ(v.battery, 80);
+}
+
+TEST(Telemetry, RefusesAPositionWithNaNOrInfinityOrBeyondAnyVehicle) {
+  VehicleState v;
+  ml::LocalPositionNed p;
+  p.x = 3;
+  ASSERT_FALSE(apply_telemetry(v, frame(ml::pack(p))).rejected);
+  for (float bad : {std::nanf(""), std::numeric_limits<float>::infinity(), 5e6f}) {
+    ml::LocalPositionNed q = p;
+    q.z = bad;
+    Changes c = apply_telemetry(v, frame(ml::pack(q)));
+    ASSERT_TRUE(c.rejected) << bad;
+    EXPECT_STREQ(c.rejected, "LOCAL_POSITION_NED with NaN, an infinity or a value out of range");
+    EXPECT_FALSE(c.position);
+    EXPECT_EQ(v.ned.z, 0);  // the last good position stays
+  }
+  ml::LocalPositionNed fast = p;
+  fast.vx = std::nanf("");
+  EXPECT_TRUE(apply_telemetry(v, frame(ml::pack(fast))).rejected);
+  EXPECT_EQ(v.ned.x, 3);
+}
+
+TEST(Telemetry, RefusesUnknownLandedStatesAndBatteriesBeyondAHundredPercent) {
+  VehicleState v;
+  apply_telemetry(v, frame(ml::pack(ml::ExtendedSysState{0, ml::landed::IN_AIR})));
+  Changes c = apply_telemetry(v, frame(ml::pack(ml::ExtendedSysState{0, 77})));
+  EXPECT_STREQ(c.rejected, "EXTENDED_SYS_STATE with an unknown landed state");
+  EXPECT_EQ(v.landed_state, ml::landed::IN_AIR);
+  ml::SysStatus s;
+  s.battery_remaining = 120;
+  EXPECT_STREQ(apply_telemetry(v, frame(ml::pack(s))).rejected, "SYS_STATUS with a battery beyond 0 to 100 %");
+  EXPECT_DOUBLE_EQ(v.battery, -1);
+  ml::GlobalPositionInt g;
+  g.alt = 2'000'000'000;
+  EXPECT_STREQ(apply_telemetry(v, frame(ml::pack(g))).rejected, "GLOBAL_POSITION_INT with an altitude beyond 100 km");
+  EXPECT_FALSE(v.have_altitude);
 }
 
 TEST(Autopilots, Px4AndArduPilotSelectTheirSetpointModes) {

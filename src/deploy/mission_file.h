@@ -1,0 +1,54 @@
+#pragma once
+// The mission file format, in one place: the streamed writer (mission_writer.cpp) that
+// `eamos compile` and `eamos run` use, and the validating reader (mission_reader.cpp) that
+// `eamos dex`, `eamos run` and the tests use. docs/architecture.md ("Mission file")
+// describes the format; src/deploy/README.md says why the reader lives here.
+#include <ostream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "dex/mission.h"
+#include "graph/pipeline.h"
+
+namespace eamos::deploy {
+
+/// Version of the mission file format; a DEX refuses files of another version.
+/// 2: every file ends with its `file_hash`.
+constexpr int kMissionFormatVersion = 2;
+
+/// The last member of every mission file: SHA-256 (hex) of every byte before it.
+inline constexpr const char* kFileHashMember = "file_hash";
+
+/// SHA-256 (hex) over the whole compiled mission: the MEG with every node's content and
+/// every drone's settings and type. Two drones holding files with the same hash run the
+/// same mission. One drone's file holds only its MDG, so a reader cannot recompute this
+/// hash; it checks the file's own `file_hash` instead.
+std::string mission_hash(const graph::Compilation& c);
+
+/// Writes the mission file of one drone to `out`, node by node, without building the
+/// document in memory: its settings and capabilities, the fleet's drone names, its MDG
+/// with every internal node and the external nodes it links to, and the file hash.
+/// Returns false when the stream failed.
+bool write_drone_mission(std::ostream& out, const graph::Compilation& c, int drone,
+                         const std::string& hash);
+
+/// write_drone_mission into a string: `eamos run` and the tests hand it to read_mission.
+std::string mission_text(const graph::Compilation& c, int drone, const std::string& hash);
+
+/// The most defects one read reports; a badly damaged file would otherwise print one
+/// line per node.
+inline constexpr std::size_t kMaxMissionDefects = 50;
+
+/// Reads and checks a mission file's text: its file hash, then every member, index,
+/// enum, count, number range and nesting depth. True with `out` filled when the file is
+/// a valid mission of this format version; false with every defect found (up to
+/// kMaxMissionDefects) as "FILE: error: WHERE: WHAT", WHERE a JSON pointer into the file.
+/// `file` names the file in the messages.
+bool read_mission(std::string_view text, const std::string& file, dex::Mission& out,
+                  std::vector<std::string>& errors);
+
+/// read_mission of the file at `path`; a file that cannot be read is one more defect.
+bool read_mission_file(const std::string& path, dex::Mission& out, std::vector<std::string>& errors);
+
+}  // namespace eamos::deploy

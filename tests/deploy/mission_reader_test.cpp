@@ -1,0 +1,197 @@
+// The mission reader trusts nothing in a mission file: every defect is reported as
+// "FILE: error: WHERE: WHAT" (WHERE a JSON pointer), all of them at once, and no file makes
+// it crash. Each test damages a file the writer wrote in one way; most recompute the file
+// hash afterwards so that the reader's own checks, not the hash, must find the defect.
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "deploy/mission_file.h"
+#include "helpers.h"
+#include "support/mission_edit.h"
+
+namespace eamos {
+namespace {
+
+using eamos_test::replace_once;
+using eamos_test::reseal;
+using nlohmann::json;
+
+class MissionReader : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    c_ = test::compile_mission(test::listing2_text(), test::kListing2Fleet);
+    ASSERT_TRUE(c_);
+    text_ = deploy::mission_text(*c_, 0, deploy::mission_hash(*c_));
+    doc_ = json::parse(text_);
+  }
+
+  /// Every defect the reader reports for `text`, one per line; "" when it accepts it.
+  std::string defects(const std::string& text) {
+    dex::Mission m;
+    std::vector<std::string> errors;
+    bool ok = deploy::read_mission(text, "Drone1/mission.json", m, errors);
+    EXPECT_EQ(ok, errors.empty());
+    std::string out;
+    for (const auto& e : errors) out += e + "\n";
+    return out;
+  }
+
+  /// The exact text of arc `i` as written: `{"from":F,"to":T,`.
+  std::string arc_start(std::size_t i) {
+    const json& a = doc_["arcs"][i];
+    return "{\"from\":" + a["from"].dump() + ",\"to\":" + a["to"].dump() + ",";
+  }
+
+  std::unique_ptr<graph::Compilation> c_;
+  std::string text_;
+  json doc_;
+};
+
+TEST_F(MissionReader, AcceptsTheFileTheWriterWrote) {
+  EXPECT_EQ(defects(text_), "");
+  EXPECT_EQ(defects(text_ + "\n"), "");  // as it lies on disk, with its final line break
+}
+
+TEST_F(MissionReader, RefusesAFileEditedAfterCompileWhoseHashNoLongerMatches) {
+  std::string edited = replace_once(text_, "\"battery\":87.5", "\"battery\":50.0");
+  EXPECT_EQ(defects(edited),
+            "Drone1/mission.json: error: /file_hash: the file's content does not match its hash; it was edited or "
+            "damaged after `eamos compile` (compile the mission again)\n");
+}
+
+TEST_F(MissionReader, RefusesAFileWithoutItsFileHash) {
+  std::size_t at = text_.rfind(",\n \"file_hash\"");
+  ASSERT_NE(at, std::string::npos);
+  std::string cut = text_.substr(0, at) + "\n}";
+  EXPECT_NE(defects(cut).find("Drone1/mission.json: error: the file does not end with its \"file_hash\""),
+            std::string::npos);
+}
+
+TEST_F(MissionReader, RefusesAnArcToANodeThatIsNotInTheFile) {
+  std::size_t nodes = doc_["nodes"].size();
+  std::string from = doc_["arcs"][0]["from"].dump();
+  std::string edited = reseal(replace_once(text_, arc_start(0), "{\"from\":" + from + ",\"to\":9999,"));
+  EXPECT_EQ(defects(edited), "Drone1/mission.json: error: /arcs/0/to: 9999 is out of range (0 to " +
+                                 std::to_string(nodes - 1) + ")\n");
+}
+
+TEST_F(MissionReader, RefusesANegativeNodeIndex) {
+  std::string to = doc_["arcs"][1]["to"].dump();
+  std::string edited = reseal(replace_once(text_, arc_start(1), "{\"from\":-1,\"to\":" + to + ","));
+  EXPECT_NE(defects(edited).find("error: /arcs/1/from: -1 is out of range (0 to "), std::string::npos);
+}
+
+TEST_F(MissionReader, RefusesANodeHeldByADroneOutsideTheFleet) {
+  std::string edited = reseal(replace_once(text_, "{\"index\":0,\"meg\":0,\"drone\":\"Drone1\"",
+                                           "{\"index\":0,\"meg\":0,\"drone\":\"Ghost\""));
+  EXPECT_EQ(defects(edited),
+            "Drone1/mission.json: error: /nodes/0/drone: drone \"Ghost\" is not in the mission's fleet\n");
+}
+
+TEST_F(MissionReader, RefusesUnknownEnumValues) {
+  std::string edited = reseal(replace_once(text_, "\"kind\":\"init\"", "\"kind\":\"teleport\""));
+  edited = reseal(replace_once(edited, "\"failsafe\":\"land\"", "\"failsafe\":\"crash\""));
+  std::string found = defects(edited);
+  EXPECT_NE(found.find("error: /nodes/0/kind: unknown value \"teleport\" (expected one of: init, action, fork, "
+                       "condition, terminal, pause, end)"),
+            std::string::npos)
+      << found;
+  EXPECT_NE(found.find("error: /drone/failsafe: unknown value \"crash\" (expected one of: land, return_home, hover)"),
+            std::string::npos)
+      << found;
+}
+
+TEST_F(MissionReader, RefusesNumbersOutOfRangeAndNullForANumber) {
+  // A NaN or infinity would have been written as null: JSON has neither.
+  std::string edited = reseal(replace_once(text_, "\"battery\":87.5", "\"battery\":150.0"));
+  edited = reseal(replace_once(edited, "\"max_speed\":5.5", "\"max_speed\":null"));
+  edited = reseal(replace_once(edited, "\"line\":", "\"line\":-"));
+  std::string found = defects(edited);
+  EXPECT_NE(found.find("error: /drone/battery: 150.0 is out of range (finite, 0 to 100)"), std::string::npos)
+      << found;
+  EXPECT_NE(found.find("error: /drone/limits/max_speed: expected a number, found null"), std::string::npos) << found;
+  EXPECT_NE(found.find("error: /nodes/0/line: -"), std::string::npos) << found;
+}
+
+TEST_F(MissionReader, RefusesAWholeNumberWrittenAsAFraction) {
+  std::string edited = reseal(replace_once(text_, "{\"index\":0,\"meg\":0,", "{\"index\":0,\"meg\":0.5,"));
+  EXPECT_NE(defects(edited).find("error: /nodes/0/meg: expected a whole number, found number"), std::string::npos);
+}
+
+TEST_F(MissionReader, RefusesAnOperatorWithTheWrongNumberOfOperands) {
+  // Listing 2's Drone1 file holds a condition; give its top operator a third operand.
+  std::size_t at = text_.find("\"condition\":{\"op\":\"");
+  ASSERT_NE(at, std::string::npos);
+  std::string edited = text_;
+  edited.insert(text_.find("\"args\":[", at) + 8, "{\"num\":1.0},");
+  std::string found = defects(reseal(edited));
+  EXPECT_NE(found.find("/condition/op: no operator"), std::string::npos) << found;
+  EXPECT_NE(found.find("takes 3 operands"), std::string::npos) << found;
+}
+
+TEST_F(MissionReader, RefusesExpressionsNestedDeeperThanTheCompilerAllows) {
+  // 100,000 nested negations: reading them recursively would overflow the stack.
+  std::string deep;
+  for (int i = 0; i < 100000; ++i) deep += "{\"op\":\"-\",\"args\":[";
+  deep += "{\"num\":1.0}";
+  for (int i = 0; i < 100000; ++i) deep += "]}";
+  std::size_t at = text_.find("\"args\":[{\"num\":");
+  ASSERT_NE(at, std::string::npos);
+  std::string edited = text_;
+  edited.insert(at + 8, deep + ",");
+  std::string found = defects(reseal(edited));
+  EXPECT_NE(found.find("Drone1/mission.json: error: nested more than"), std::string::npos) << found.substr(0, 400);
+}
+
+TEST_F(MissionReader, RefusesTextThatIsNotJson) {
+  EXPECT_NE(defects("{\"format\": ").find("Drone1/mission.json: error: not valid JSON (at byte "), std::string::npos);
+  EXPECT_NE(defects("").find("not valid JSON"), std::string::npos);
+}
+
+TEST_F(MissionReader, RefusesANumberTooLargeForADouble) {
+  // Found by fuzz_mission: the JSON parser throws out_of_range, not parse_error, for it.
+  std::string edited = reseal(replace_once(text_, "\"battery\":87.5", "\"battery\":3e8447"));
+  EXPECT_EQ(defects(edited), "Drone1/mission.json: error: not valid JSON: a number too large for a double\n");
+}
+
+TEST_F(MissionReader, RefusesAFileOfAnotherFormatVersion) {
+  std::string edited = reseal(replace_once(text_, "\"format_version\":2", "\"format_version\":1"));
+  EXPECT_EQ(defects(edited),
+            "Drone1/mission.json: error: /format_version: format version 1 is not supported by this DEX (knows 2); "
+            "compile the mission with a matching eamos\n");
+}
+
+TEST_F(MissionReader, ReportsEveryDefectAtOnce) {
+  std::string edited = replace_once(text_, "\"battery\":87.5", "\"battery\":-1.0");
+  edited = replace_once(edited, "\"kind\":\"init\"", "\"kind\":\"teleport\"");
+  std::string found = defects(edited);  // not resealed: the hash is a third defect
+  EXPECT_NE(found.find("/file_hash:"), std::string::npos) << found;
+  EXPECT_NE(found.find("/drone/battery:"), std::string::npos) << found;
+  EXPECT_NE(found.find("/nodes/0/kind:"), std::string::npos) << found;
+}
+
+TEST_F(MissionReader, StopsListingDefectsAfterFifty) {
+  auto stress = test::compile_mission(test::stress_text(3000, 3));
+  ASSERT_TRUE(stress);
+  std::string edited = deploy::mission_text(*stress, 0, deploy::mission_hash(*stress));
+  ASSERT_GT(json::parse(edited)["nodes"].size(), 60u);
+  for (std::size_t i = 0; i < 60; ++i)
+    edited = replace_once(edited, "{\"index\":" + std::to_string(i) + ",", "{\"index\":-" + std::to_string(i + 1) + ",");
+  dex::Mission m;
+  std::vector<std::string> errors;
+  EXPECT_FALSE(deploy::read_mission(edited, "f", m, errors));
+  ASSERT_EQ(errors.size(), deploy::kMaxMissionDefects + 1);
+  EXPECT_NE(errors.back().find("more defects not shown"), std::string::npos) << errors.back();
+}
+
+TEST_F(MissionReader, RefusesAFileThatCannotBeRead) {
+  dex::Mission m;
+  std::vector<std::string> errors;
+  EXPECT_FALSE(deploy::read_mission_file("/nonexistent/mission.json", m, errors));
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(errors[0].rfind("/nonexistent/mission.json: error: cannot read", 0), 0u) << errors[0];
+}
+
+}  // namespace
+}  // namespace eamos
