@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "deploy/mission_file.h"
-#include "deploy/sha256.h"
+#include "support/mission_edit.h"
 #include "dex/runner.h"
 #include "dex/trace_writers.h"
 #include "graph/pipeline.h"
@@ -59,19 +59,6 @@ inline Flight fly_missions(std::vector<dex::Mission> missions) {
   return f;
 }
 
-/// A mission file's text after `edit`, sealed again with its file hash (the hash covers the
-/// bytes before the member's comma), so only the edit itself is what the reader sees.
-inline std::string edited(const std::string& text, const MissionEdit& edit) {
-  nlohmann::json file = nlohmann::json::parse(text);
-  edit(file);
-  file.erase("file_hash");
-  std::string body = file.dump();
-  body.pop_back();  // the closing brace
-  deploy::Sha256 sha;
-  sha.update(body.data(), body.size());
-  return body + ",\"file_hash\":\"" + sha.hex_digest() + "\"}";
-}
-
 /// Every drone's mission of `text`, each passed through `edit` (if any) before loading.
 inline std::vector<dex::Mission> missions_of(const std::string& text, const fleet::Fleet& fleet = {},
                                              const MissionEdit& edit = {}) {
@@ -85,7 +72,11 @@ inline std::vector<dex::Mission> missions_of(const std::string& text, const flee
   std::vector<dex::Mission> missions(c.drone_count());
   for (int d = 0; d < c.drone_count(); ++d) {
     std::string text = deploy::mission_text(c, d, hash);
-    if (edit) text = edited(text, edit);
+    if (edit) {
+      nlohmann::json file = nlohmann::json::parse(text);
+      edit(file);
+      text = eamos_test::sealed(file);
+    }
     std::vector<std::string> errors;
     EXPECT_TRUE(deploy::read_mission(text, c.drone_name(d), missions[d], errors))
         << (errors.empty() ? "" : errors.front());

@@ -22,6 +22,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/mission_edit.h"
 #include "support/run_eamos.h"
 
 namespace {
@@ -364,7 +365,7 @@ TEST_F(Distributed, LoopThatTakesNoTimeFailsTheMissionInsteadOfHangingTheDex) {
   for (auto& n : m["nodes"])
     if (n.value("text", "") == "Drone1.TakePicture()") n["kind"] = "fork", ++changed;
   ASSERT_EQ(changed, 1);
-  std::ofstream(file) << m.dump();
+  std::ofstream(file) << eamos_test::sealed(m);  // re-sealed: the reader refuses a stale hash
   Output r = eamos("launch " + deploy.string() + " --speed 5 --time-limit 20 --domain 41 --trace " +
                    (dir_ / "trace.jsonl").string() + " --summary " + (dir_ / "summary.json").string());
   EXPECT_EQ(r.status, 1) << r.out;

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "deploy/sha256.h"
 
 namespace eamos_test {
@@ -26,6 +28,17 @@ inline std::string reseal(std::string text) {
   eamos::deploy::Sha256 sha;
   sha.update(text.data(), at);
   return text.replace(at + member.size(), 64, sha.hex_digest());
+}
+
+/// A mission file written from an edited document, sealed with a fresh file hash (over the
+/// bytes before the member's comma), so only the edit itself is what the reader judges.
+inline std::string sealed(nlohmann::json file) {
+  file.erase("file_hash");
+  std::string body = file.dump();
+  body.pop_back();  // the closing brace
+  eamos::deploy::Sha256 sha;
+  sha.update(body.data(), body.size());
+  return body + ",\"file_hash\":\"" + sha.hex_digest() + "\"}";
 }
 
 }  // namespace eamos_test
