@@ -3,6 +3,7 @@
 #include <dds/dds.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -45,8 +46,18 @@ dds_qos_t* durable_qos(bool keep_all, double lease_s) {
   return q;
 }
 
+/// A sample whose conversion or handler threw is dropped and said so on standard error;
+/// after the first 20, only every 1000th, so a peer sending garbage cannot flood the log.
+void log_dropped(const char* topic, const char* what) noexcept {
+  static std::atomic<std::uint64_t> dropped{0};
+  std::uint64_t n = ++dropped;
+  if (n <= 20 || n % 1000 == 0)
+    std::fprintf(stderr, "eamos: dropped a DDS sample of %s (%llu so far): %s\n", topic,
+                 static_cast<unsigned long long>(n), what);
+}
+
 template <typename Wire, typename Fn>
-void take_all(dds_entity_t reader, Fn&& fn, std::function<void(std::uint64_t)> on_info = {}) {
+void take_all(dds_entity_t reader, const char* topic, Fn&& fn, std::function<void(std::uint64_t)> on_info = {}) {
   constexpr int kBatch = 64;
   void* samples[kBatch];
   dds_sample_info_t infos[kBatch];
@@ -56,22 +67,52 @@ void take_all(dds_entity_t reader, Fn&& fn, std::function<void(std::uint64_t)> o
     if (n <= 0) return;
     for (int i = 0; i < n; ++i) {
       if (!infos[i].valid_data) continue;  // dispose/unregister notices carry no sample
-      if (on_info) on_info(infos[i].publication_handle);
-      fn(from_wire(*static_cast<const Wire*>(samples[i])));
+      // Per sample, so one bad sample neither loses the rest of the batch nor the loan.
+      try {
+        if (on_info) on_info(infos[i].publication_handle);
+        fn(from_wire(*static_cast<const Wire*>(samples[i])));
+      } catch (const std::exception& e) {
+        log_dropped(topic, e.what());
+      } catch (...) {
+        log_dropped(topic, "an exception that is not a std::exception");
+      }
     }
     dds_return_loan(reader, samples, n);
     if (n < kBatch) return;
   }
 }
 
-void on_trigger(dds_entity_t reader, void* arg) { static_cast<DdsNode*>(arg)->take_triggers(reader); }
-void on_telemetry(dds_entity_t reader, void* arg) { static_cast<DdsNode*>(arg)->take_telemetry(reader); }
-void on_lifecycle(dds_entity_t reader, void* arg) { static_cast<DdsNode*>(arg)->take_lifecycle(reader); }
-void on_status(dds_entity_t reader, void* arg) { static_cast<DdsNode*>(arg)->take_status(reader); }
-void on_trace(dds_entity_t reader, void* arg) { static_cast<DdsNode*>(arg)->take_trace(reader); }
-void on_liveliness(dds_entity_t, const dds_liveliness_changed_status_t s, void* arg) {
+// Cyclone calls these from its own threads, through C: nothing may be thrown into it.
+template <typename Take>
+void guarded(const char* topic, Take&& take) noexcept {
+  try {
+    take();
+  } catch (const std::exception& e) {
+    log_dropped(topic, e.what());
+  } catch (...) {
+    log_dropped(topic, "an exception that is not a std::exception");
+  }
+}
+
+void on_trigger(dds_entity_t reader, void* arg) noexcept {
+  guarded("eamos_trigger", [&] { static_cast<DdsNode*>(arg)->take_triggers(reader); });
+}
+void on_telemetry(dds_entity_t reader, void* arg) noexcept {
+  guarded("eamos_telemetry", [&] { static_cast<DdsNode*>(arg)->take_telemetry(reader); });
+}
+void on_lifecycle(dds_entity_t reader, void* arg) noexcept {
+  guarded("eamos_lifecycle", [&] { static_cast<DdsNode*>(arg)->take_lifecycle(reader); });
+}
+void on_status(dds_entity_t reader, void* arg) noexcept {
+  guarded("eamos_status", [&] { static_cast<DdsNode*>(arg)->take_status(reader); });
+}
+void on_trace(dds_entity_t reader, void* arg) noexcept {
+  guarded("eamos_trace", [&] { static_cast<DdsNode*>(arg)->take_trace(reader); });
+}
+void on_liveliness(dds_entity_t, const dds_liveliness_changed_status_t s, void* arg) noexcept {
   if (s.alive_count_change < 0 || s.not_alive_count_change > 0)
-    static_cast<DdsNode*>(arg)->liveliness_changed(s.last_publication_handle);
+    guarded("eamos_status (liveliness)",
+            [&] { static_cast<DdsNode*>(arg)->liveliness_changed(s.last_publication_handle); });
 }
 
 }  // namespace
@@ -223,19 +264,19 @@ bool DdsNode::flush(double timeout_s) {
 }
 
 void DdsNode::take_triggers(int reader) {
-  take_all<eamos_wire_Trigger>(reader, [this](TriggerSample s) {
+  take_all<eamos_wire_Trigger>(reader, "eamos_trigger", [this](TriggerSample s) {
     if (handlers_.trigger) handlers_.trigger(std::move(s));
   });
 }
 
 void DdsNode::take_telemetry(int reader) {
-  take_all<eamos_wire_Telemetry>(reader, [this](TelemetrySample s) {
+  take_all<eamos_wire_Telemetry>(reader, "eamos_telemetry", [this](TelemetrySample s) {
     if (handlers_.telemetry) handlers_.telemetry(std::move(s));
   });
 }
 
 void DdsNode::take_lifecycle(int reader) {
-  take_all<eamos_wire_Lifecycle>(reader, [this](LifecycleSample s) {
+  take_all<eamos_wire_Lifecycle>(reader, "eamos_lifecycle", [this](LifecycleSample s) {
     if (handlers_.lifecycle) handlers_.lifecycle(std::move(s));
   });
 }
@@ -243,7 +284,7 @@ void DdsNode::take_lifecycle(int reader) {
 void DdsNode::take_status(int reader) {
   std::uint64_t handle = 0;
   take_all<eamos_wire_Status>(
-      reader,
+      reader, "eamos_status",
       [this, &handle](StatusSample s) {
         {
           std::lock_guard<std::mutex> lock(writers_mutex_);
@@ -255,7 +296,7 @@ void DdsNode::take_status(int reader) {
 }
 
 void DdsNode::take_trace(int reader) {
-  take_all<eamos_wire_TraceRecord>(reader, [this](TraceSample s) {
+  take_all<eamos_wire_TraceRecord>(reader, "eamos_trace", [this](TraceSample s) {
     if (handlers_.trace) handlers_.trace(std::move(s));
   });
 }
