@@ -1,6 +1,7 @@
 // eamos: the command-line front of the Mission Compiler (and, later, of the DEX).
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
 #include <iostream>
 
 #include "cli/commands.h"
@@ -147,6 +148,10 @@ int main(int argc, char** argv) {
     int code = app.exit(e);
     return code == 0 ? 0 : 1;
   }
+
+  // A flight's live log goes out line by line also into a pipe (`| tee log`): what a person
+  // watches is now, not a buffer later, and a killed process loses at most half a line.
+  if (*run || *launch || *dexcmd || *simv) std::setvbuf(stdout, nullptr, _IOLBF, BUFSIZ);
 
   try {
     if (*check) return eamos::cli::cmd_check(o, list_caps);

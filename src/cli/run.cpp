@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
+#include "cli/signal_watch.h"
 #include "deploy/mission_file.h"
 #include "dex/plot.h"
 #include "dex/runner.h"
@@ -51,6 +52,12 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
       return 1;
     }
   }
+  // From here on drones may fly: Ctrl-C or SIGTERM lands them instead of killing the process
+  // under them. First, before an adapter starts a thread that would inherit the old mask.
+  dex::RunInterrupt interrupt;
+  SignalWatch signals([&interrupt](const char* name) {
+    interrupt.request(std::string("interrupted (") + name + ")");
+  });
   mid::AdapterRegistry adapters;
   sim::register_adapter(adapters);
   mavlink_adapter::register_adapter(adapters, {.real_time = r.realtime || r.speed > 0,
@@ -74,6 +81,7 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   if (!r.plot.empty()) tee.add(&memory);
   dex::RunOptions options;
   options.time_limit_s = r.time_limit;
+  options.interrupt = &interrupt;
   if (r.realtime || r.speed > 0) {
     options.clock.mode = mid::ClockMode::real_time;
     options.clock.speed = r.speed > 0 ? r.speed : 1.0;
@@ -84,7 +92,7 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
 }
 
 bool report_run(const RunCommandOptions& r, const dex::RunResult& result, const std::vector<dex::TraceEvent>& events) {
-  if (!r.summary.empty() && !write_output(r.summary, summary_json(result).dump(2) + "\n")) return false;
+  if (!r.summary.empty() && !write_output(r.summary, summary_json(result).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n")) return false;
   if (!r.plot.empty() && !write_output(r.plot, dex::plot_svg(result, events))) return false;
   if (result.completed)
     std::cout << "mission completed in " << result.duration << " s (mission time)\n";

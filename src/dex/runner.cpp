@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 
 namespace eamos::dex {
 
@@ -65,20 +66,54 @@ TraceEvent mission_end_event(const RunResult& r) {
   return e;
 }
 
+bool command_failsafe(mid::Drone& drone, const fleet::DroneSettings& settings) {
+  mid::DroneState s = drone.state();
+  if (s.landed && !s.armed) return false;  // already safe; an armed drone on the ground is disarmed
+  drone.failsafe(settings.failsafe);
+  return true;
+}
+
+void record_failsafe(const fleet::DroneSettings& settings, double t, const std::string& reason, TraceSink* trace) {
+  if (!trace) return;
+  TraceEvent e;
+  e.t = t;
+  e.drone = settings.name;
+  e.event = "failsafe";
+  e.name = fleet::failsafe_name(settings.failsafe);
+  e.reason = reason;
+  trace->record(e);
+}
+
 void enter_failsafe(mid::Drone& drone, const fleet::DroneSettings& settings, double t, const std::string& reason,
                     TraceSink* trace) {
-  mid::DroneState s = drone.state();
-  if (s.landed && !s.armed) return;  // already safe; an armed drone on the ground is disarmed
-  if (trace) {
-    TraceEvent e;
-    e.t = t;
-    e.drone = settings.name;
-    e.event = "failsafe";
-    e.name = fleet::failsafe_name(settings.failsafe);
-    e.reason = reason;
-    trace->record(e);
+  // Command first: a trace write (a DDS sample, a pipe) may block, the drone must not wait.
+  if (command_failsafe(drone, settings)) record_failsafe(settings, t, reason, trace);
+}
+
+void RunInterrupt::request(const std::string& reason) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (over_) return;
+  if (!loop_) {
+    if (!pending_) pending_ = reason;
+    return;
   }
-  drone.failsafe(settings.failsafe);
+  // on_request_ is copied: detach() may clear it before the loop runs this.
+  loop_->post([fn = on_request_, reason] { fn(reason); });
+}
+
+void RunInterrupt::attach(mid::EventLoop& loop, std::function<void(const std::string&)> on_request) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  loop_ = &loop;
+  on_request_ = std::move(on_request);
+  if (pending_) loop_->post([fn = on_request_, reason = *pending_] { fn(reason); });
+  pending_.reset();
+}
+
+void RunInterrupt::detach() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  loop_ = nullptr;
+  on_request_ = nullptr;
+  over_ = true;  // the run is over: later requests change nothing
 }
 
 void record_sample(std::vector<Sample>& track, const mid::DroneState& s) {
@@ -131,13 +166,29 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     loop.stop();
   };
   // The mission is over without completing: start nothing more, land (or whatever the
-  // fleet file says) every drone still in the air.
+  // fleet file says) every drone still in the air. Every drone is commanded before any
+  // failsafe is recorded: a trace write may block.
+  bool abandoned = false;
   auto abandon = [&] {
+    if (abandoned) return;
+    abandoned = true;
     for (auto& e : engines) e->halt();
-    for (int d = 0; d < n; ++d) enter_failsafe(*drones[d], missions[d].settings, loop.now(), result.error, trace);
+    std::vector<bool> commanded(n);
+    for (int d = 0; d < n; ++d) commanded[d] = command_failsafe(*drones[d], missions[d].settings);
+    for (int d = 0; d < n; ++d)
+      if (commanded[d]) record_failsafe(missions[d].settings, loop.now(), result.error, trace);
+  };
+  // Interrupted (Ctrl-C) or a failure inside the executor itself rather than in an action.
+  auto stop_mission = [&](const std::string& why) {
+    if (failed || result.completed || abandoned) return;
+    failed = true;
+    finished_at = loop.now();
+    result.error = why;
+    abandon();
+    loop.stop();
   };
   auto fail = [&](const Failure& f) {
-    if (failed) return;
+    if (failed || abandoned) return;
     failed = true;
     finished_at = loop.now();
     result.failure = f;
@@ -145,6 +196,10 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     abandon();
     loop.stop();  // a real-time loop would otherwise wait out the time limit; failsafes run below
   };
+  loop.on_callback_error([&](const std::string& what) {
+    std::cerr << "eamos: internal error in the executor: " << what << "\n";
+    stop_mission("internal error in the executor: " + what);
+  });
   for (int d = 0; d < n; ++d) {
     EngineHooks hooks;
     hooks.transport = &transport;
@@ -169,6 +224,7 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
       transport.publish(std::make_shared<const Telemetry>(Telemetry{missions[d].hash, d, s}));
     });
   }
+  if (options.interrupt) options.interrupt->attach(loop, stop_mission);
   for (auto& e : engines) e->start();
 
   // Endless motions (an Orbit nobody preempts) keep the loop busy: bound the run.
@@ -194,6 +250,7 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     do loop.run_until(std::min(until, loop.now() + 1.0));
     while (loop.now() < until && airborne());
   }
+  if (options.interrupt) options.interrupt->detach();
   result.duration = finished_at;
   for (int d = 0; d < n; ++d) {
     result.drones.push_back({missions[d].settings.name, drones[d]->state(), std::move(tracks[d])});

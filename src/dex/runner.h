@@ -3,7 +3,9 @@
 // own drone from the Adapter Space, all on one event loop, talking through the in-process
 // transport. The mission completes when the end node ran and nothing is active on any
 // drone; the first failed action fails it, and every airborne drone runs its failsafe.
+#include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,9 +17,30 @@
 
 namespace eamos::dex {
 
+/// Lets another thread end a running mission early: the signal watcher of `eamos run` on
+/// Ctrl-C or SIGTERM. The run abandons the mission like a failed one (every drone runs its
+/// failsafe, the run returns once they are down) with the request's reason.
+class RunInterrupt {
+ public:
+  /// Thread-safe, at any time. Before the run started it is abandoned as soon as it starts;
+  /// after it ended (or while it already lands every drone) this changes nothing.
+  void request(const std::string& reason);
+  /// For run_in_process: requests go to `on_request`, on `loop`'s thread, from now on.
+  void attach(mid::EventLoop& loop, std::function<void(const std::string&)> on_request);
+  void detach();
+
+ private:
+  std::mutex mutex_;
+  mid::EventLoop* loop_ = nullptr;
+  std::function<void(const std::string&)> on_request_;
+  std::optional<std::string> pending_;
+  bool over_ = false;
+};
+
 struct RunOptions {
   mid::ClockOptions clock;
   double time_limit_s = 3600.0;  ///< a mission still running then fails ("did not finish")
+  RunInterrupt* interrupt = nullptr;
 };
 
 /// One drone's position and phase at a moment its broker published a change of them.
@@ -29,11 +52,15 @@ struct Sample {
 };
 
 /// The mission was abandoned: makes `drone` safe with its fleet failsafe when it is in the air
-/// or armed on the ground, and records a `failsafe` event (at mission time `t`) in `trace`
+/// or armed on the ground, then records a `failsafe` event (at mission time `t`) in `trace`
 /// (may be null). A drone already landed and disarmed is left alone. In-process and
 /// distributed runs both end this way.
 void enter_failsafe(mid::Drone& drone, const fleet::DroneSettings& settings, double t, const std::string& reason,
                     TraceSink* trace);
+/// enter_failsafe in two steps, for callers with more to do between commanding and
+/// recording (a trace write can block): true when a failsafe was commanded.
+bool command_failsafe(mid::Drone& drone, const fleet::DroneSettings& settings);
+void record_failsafe(const fleet::DroneSettings& settings, double t, const std::string& reason, TraceSink* trace);
 
 /// Appends `s` to `track` when position or phase differ from the last sample.
 void record_sample(std::vector<Sample>& track, const mid::DroneState& s);

@@ -24,7 +24,9 @@ void JsonlTrace::record(const TraceEvent& e) {
   if (e.value) j["value"] = *e.value;
   if (e.reading) j["value"] = *e.reading;
   if (!e.reason.empty()) j["reason"] = e.reason;
-  out_ << j.dump() << '\n';
+  // Reasons come from outside (an autopilot's text, another process's ABORT): a byte that
+  // is not UTF-8 becomes U+FFFD instead of an exception that loses the rest of the trace.
+  out_ << j.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace) << '\n';
 }
 
 void LiveLog::record(const TraceEvent& e) {

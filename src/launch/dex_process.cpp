@@ -1,6 +1,9 @@
 #include "launch/dex_process.h"
 
+#include <unistd.h>
+
 #include <chrono>
+#include <csignal>
 #include <iostream>
 #include <random>
 #include <thread>
@@ -22,6 +25,20 @@ std::uint64_t process_nonce() {
 
 }  // namespace
 
+volatile std::sig_atomic_t g_dex_signal = 0;
+
+namespace {
+
+// SIGTERM (a service stopped, the ground's clean-up) or Ctrl-C on a DEX run by hand: the
+// loop notices at its next tick and abandons the mission into the failsafe. A second
+// signal ends the process at once (_exit is async-signal-safe; nothing else is done here).
+void on_dex_signal(int signal) {
+  if (g_dex_signal != 0) _exit(128 + signal);
+  g_dex_signal = signal;
+}
+
+}  // namespace
+
 int DexProcess::run(const mid::AdapterRegistry& adapters) {
   nonce_ = process_nonce();
   std::string error;
@@ -34,6 +51,9 @@ int DexProcess::run(const mid::AdapterRegistry& adapters) {
   clock.mode = mid::ClockMode::real_time;
   clock.speed = o_.speed;
   loop_ = std::make_unique<mid::EventLoop>(clock);
+  // Whatever throws on the loop (a bug, a sample nothing checked) ends the mission in the
+  // failsafe, never the process with the drone in the air.
+  loop_->on_callback_error([this](const std::string& what) { on_internal_error(what); });
   mid::CreateResult made = adapters.create(mission_.settings.adapter, mission_.settings, mission_.type, *loop_);
   if (made.status != mid::CreateStatus::success) {
     err_ << "eamos dex: error: " << name() << ": " << made.message << "\n";
@@ -70,11 +90,14 @@ int DexProcess::run(const mid::AdapterRegistry& adapters) {
     err_ << "eamos dex: error: " << error << "\n";
     return 1;
   }
+  std::signal(SIGINT, on_dex_signal);
+  std::signal(SIGTERM, on_dex_signal);
   if (!wait_for_start() || !begin()) {
     node_->flush(1.0);
     return 1;
   }
   loop_->run_until(o_.time_limit_s + 1000.0);
+  dds_trace_->flush();
   node_->flush(1.0);
   if (phase_ == Phase::completed) {
     out_ << name() << ": mission completed\n";
@@ -109,6 +132,10 @@ bool DexProcess::wait_for_start() {
       wait_cv_.wait_for(lock, std::chrono::duration<double>(lease / 4));
       starts.swap(starts_);
       if (aborts_.count(0)) gave_up = aborts_[0];
+    }
+    if (g_dex_signal != 0) {
+      err_ << "eamos dex: " << name() << ": interrupted (" << signal_name(g_dex_signal) << ") before the start\n";
+      return false;
     }
     if (gave_up) {
       err_ << "eamos dex: error: " << name() << ": the ground gave up before the start: " << *gave_up << "\n";
@@ -181,7 +208,7 @@ bool DexProcess::begin() {
     }
   }
   transport_ = std::make_unique<transport::DdsTransport>(*node_, start_.run_id);
-  dds_trace_ = std::make_unique<DdsTraceSink>(*node_, mission_.hash, start_.run_id, mission_.self);
+  dds_trace_ = std::make_unique<DdsTraceSink>(*node_, *loop_, mission_.hash, start_.run_id, mission_.self);
   tee_.add(dds_trace_.get());
   if (o_.log) {
     live_ = std::make_unique<dex::LiveLog>(out_);

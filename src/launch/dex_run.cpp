@@ -14,6 +14,8 @@ void DexProcess::tick() {
   // A heartbeat of the loop itself: liveliness is asserted only while the loop runs, so a
   // hung DEX is lost like a dead one; status changes (busy/idle) are published here.
   node_->assert_alive();
+  if (phase_ == Phase::running && g_dex_signal != 0)
+    abandon(name() + "'s DEX was interrupted (" + signal_name(g_dex_signal) + ")", std::nullopt, true);
   if (phase_ == Phase::running && transport_->write_errors() > 0) {
     // A trigger that did not go out would leave another drone waiting for ever.
     abandon("DDS could not send a trigger or telemetry sample (write failed or blocked too long)", std::nullopt,
@@ -72,7 +74,11 @@ void DexProcess::on_lifecycle(const LifecycleSample& s) {
   if (s.kind == LifecycleKind::ready || s.kind == LifecycleKind::start) return;
   if (!ours(s.mission_hash, s.run_id)) return;
   if (s.kind == LifecycleKind::abort) {
-    std::string who = s.drone == transport::kGround ? "the ground" : mission_.fleet.at(s.drone);
+    // The sender's number came over the network: an unknown one still aborts (safe), by number.
+    bool known = s.drone >= 0 && s.drone < static_cast<int>(mission_.fleet.size());
+    std::string who = s.drone == transport::kGround ? "the ground"
+                      : known                       ? mission_.fleet[s.drone]
+                                                    : "drone #" + std::to_string(s.drone);
     abandon("aborted by " + who + ": " + s.reason, s.failure, false);
   } else if (s.kind == LifecycleKind::finished && phase_ == Phase::running) {
     complete();
@@ -171,7 +177,10 @@ void DexProcess::abandon(const std::string& reason, const std::optional<dex::Fai
   if (phase_ != Phase::running) return;
   phase_ = Phase::failed;
   error_ = reason;
-  err_ << name() << ": " << reason << "\n";
+  // Safety first, words second: this drone's failsafe, then the ABORT that starts everyone
+  // else's (a DDS write may block), and only then the log and the trace.
+  engine_->halt();
+  bool commanded = dex::command_failsafe(*drone_, mission_.settings);
   if (broadcast) {
     LifecycleSample abort{mission_.hash, mission_.self, LifecycleKind::abort, start_.run_id};
     abort.reason = reason;
@@ -179,10 +188,15 @@ void DexProcess::abandon(const std::string& reason, const std::optional<dex::Fai
     abort.t = loop_->now();
     node_->write(abort);
   }
-  engine_->halt();
-  dex::enter_failsafe(*drone_, mission_.settings, loop_->now(), reason, &tee_);
+  err_ << name() << ": " << reason << "\n";
+  if (commanded) dex::record_failsafe(mission_.settings, loop_->now(), reason, &tee_);
   failsafe_since_ = loop_->now();
   wait_for_failsafe();
+}
+
+void DexProcess::on_internal_error(const std::string& what) {
+  err_ << name() << ": internal error: " << what << "\n";
+  abandon("internal error in the DEX of " + name() + ": " + what, std::nullopt, true);
 }
 
 void DexProcess::wait_for_failsafe() {

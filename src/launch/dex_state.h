@@ -3,6 +3,7 @@
 // dex_process.cpp (set-up, the start barrier, receiving) and dex_run.cpp (status, the
 // end of the mission, abandoning it).
 #include <condition_variable>
+#include <csignal>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -30,20 +31,42 @@ using transport::TelemetrySample;
 using transport::TraceSample;
 using transport::TriggerSample;
 
-/// Writes each trace event of this drone to the ground's merged trace.
+/// Writes each trace event of this drone to the ground's merged trace. A DDS write may
+/// block (a quarter of the lease), so events are queued and written after the running
+/// callback: the event that reports a failed action must not hold up the failsafe and the
+/// ABORT it leads to (docs/faults.md).
 class DdsTraceSink : public dex::TraceSink {
  public:
-  DdsTraceSink(transport::DdsNode& node, std::string hash, std::uint64_t run, int drone)
-      : node_(node), hash_(std::move(hash)), run_(run), drone_(drone) {}
-  void record(const dex::TraceEvent& e) override { node_.write(TraceSample{hash_, run_, drone_, ++seq_, e}); }
+  DdsTraceSink(transport::DdsNode& node, mid::EventLoop& loop, std::string hash, std::uint64_t run, int drone)
+      : node_(node), loop_(loop), hash_(std::move(hash)), run_(run), drone_(drone) {}
+  void record(const dex::TraceEvent& e) override {
+    queued_.push_back(TraceSample{hash_, run_, drone_, ++seq_, e});
+    if (scheduled_) return;
+    scheduled_ = true;
+    loop_.after(0.0, [this] { flush(); });
+  }
+  /// Writes what is queued; also called once the loop has stopped.
+  void flush() {
+    scheduled_ = false;
+    std::vector<TraceSample> out;
+    out.swap(queued_);
+    for (const TraceSample& s : out) node_.write(s);
+  }
 
  private:
   transport::DdsNode& node_;
+  mid::EventLoop& loop_;
   std::string hash_;
   std::uint64_t run_;
   int drone_;
   std::uint64_t seq_ = 0;
+  std::vector<TraceSample> queued_;
+  bool scheduled_ = false;
 };
+
+/// Set by the DEX's SIGINT/SIGTERM handler (dex_process.cpp); 0 until a signal came.
+extern volatile std::sig_atomic_t g_dex_signal;
+inline const char* signal_name(int signal) { return signal == SIGINT ? "SIGINT" : "SIGTERM"; }
 
 class DexProcess {
  public:
@@ -68,6 +91,7 @@ class DexProcess {
   void complete();
   void abandon(const std::string& reason, const std::optional<dex::Failure>& failure, bool broadcast);
   void wait_for_failsafe();
+  void on_internal_error(const std::string& what);
   void finish_loop();
   bool ours(const std::string& hash, std::uint64_t run);
   void note_foreign(const std::string& hash);

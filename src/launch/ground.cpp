@@ -156,6 +156,8 @@ int Ground::run() {
     err_ << "eamos launch: error: " << error << "\n";
     return 1;
   }
+  // A sample that makes a handler throw is dropped; the ground keeps collecting the report.
+  loop_.on_callback_error([this](const std::string& what) { err_ << "ground: dropped an input: " << what << "\n"; });
   inbox_.attach(loop_, [](const TelemetrySample&) {});
   // waitpid needs SIGCHLD at its default; Ctrl-C or a TERM aborts the run (every drone
   // runs its failsafe) instead of killing the ground in the middle of it.
@@ -239,10 +241,14 @@ bool Ground::start_processes() {
 }
 
 void Ground::tick() {
+  // The next tick first: should anything below throw, the ground still ticks and ends.
+  loop_.after(0.05, [this] { tick(); });
   for (auto& d : drones_)
     if (d.local) poll(d.child);
   if (g_signal != 0 && stage_ != Stage::done) {
-    if (interrupted_) stop_all(SIGTERM);  // a second time: stop the DEXes now
+    // A second time: stop the DEXes now (a DEX takes SIGTERM as "abandon the mission",
+    // which it already does), leaving each drone in the failsafe it was commanded.
+    if (interrupted_) stop_all(SIGKILL);
     interrupt();
   }
   if (stage_ == Stage::barrier) {
@@ -271,8 +277,7 @@ void Ground::tick() {
       if (wall_s() > *finish_at_) stage_ = Stage::done;
     }
   }
-  if (stage_ == Stage::done) return loop_.stop();
-  loop_.after(0.05, [this] { tick(); });
+  if (stage_ == Stage::done) loop_.stop();
 }
 
 bool Ground::all_done() {
@@ -296,11 +301,11 @@ void Ground::interrupt() {
   std::string why = std::string("the ground was interrupted (") + (g_signal == SIGINT ? "SIGINT" : "SIGTERM") + ")";
   g_signal = 0;
   if (stage_ == Stage::barrier) return fail_barrier(why);
-  err_ << "ground: " << why << "; aborting the run: every drone runs its failsafe\n";
   LifecycleSample abort{hash_, transport::kGround, LifecycleKind::abort, r_.run_id};
   abort.reason = why;
-  node_->write(abort);
+  node_->write(abort);  // first: the drones' failsafe must not wait for a terminal
   if (!abort_) abort_ = abort;
+  err_ << "ground: " << why << "; aborting the run: every drone runs its failsafe\n";
 }
 
 void Ground::send_start() {

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 
 namespace eamos::mavlink {
@@ -109,7 +110,17 @@ OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame, double re
     link->peer_ = addr;
     link->has_peer_ = true;
   }
-  link->thread_ = std::thread([l = link.get()] { l->receive_loop(); });
+  link->thread_ = std::thread([l = link.get()] {
+    // An exception leaving a thread ends the process (std::terminate), and with it the
+    // vehicle's link in mid-flight; receive_loop drops a bad datagram itself, this is the last net.
+    try {
+      l->receive_loop();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "eamos: MAVLink receive thread of '%s' stopped: %s\n", l->endpoint_.url.c_str(), e.what());
+    } catch (...) {
+      std::fprintf(stderr, "eamos: MAVLink receive thread of '%s' stopped\n", l->endpoint_.url.c_str());
+    }
+  });
   return {std::move(link), ""};
 }
 
@@ -170,7 +181,13 @@ void Link::receive_loop() {
       continue;
     }
     bool listen = endpoint_.kind == LinkKind::udp_listen;
-    handle_bytes(std::span(buffer.data(), static_cast<size_t>(n)), listen ? &from : nullptr);
+    try {
+      handle_bytes(std::span(buffer.data(), static_cast<size_t>(n)), listen ? &from : nullptr);
+    } catch (const std::exception& e) {  // drop this datagram, keep the link
+      std::fprintf(stderr, "eamos: dropped MAVLink input from '%s': %s\n", endpoint_.url.c_str(), e.what());
+    } catch (...) {
+      std::fprintf(stderr, "eamos: dropped MAVLink input from '%s'\n", endpoint_.url.c_str());
+    }
   }
 }
 

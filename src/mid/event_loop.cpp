@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <iostream>
 #include <thread>
 
 namespace eamos::mid {
@@ -94,12 +96,34 @@ std::size_t EventLoop::run(double limit, bool bounded) {
     std::function<void()> fn = std::move(it->second);
     callbacks_.erase(it);
     now_ = next.time;
-    fn();
+    run_callback(fn);
     ++ran;
     ++events_run_;
   }
   running_ = false;
   return ran;
+}
+
+void EventLoop::run_callback(std::function<void()>& fn) noexcept {
+  std::string what;
+  try {
+    fn();
+    return;
+  } catch (const std::exception& e) {
+    what = e.what();
+  } catch (...) {
+    what = "an exception that is not a std::exception";
+  }
+  report_error(what);
+}
+
+void EventLoop::report_error(const std::string& what) noexcept {
+  try {
+    if (on_error_) return on_error_(what);
+    std::cerr << "eamos: error in an event callback: " << what << "\n";
+  } catch (...) {
+    std::fputs("eamos: error while handling an error in an event callback\n", stderr);
+  }
 }
 
 void EventLoop::post(std::function<void()> fn) {

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <optional>
 #include <queue>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -89,6 +90,12 @@ class EventLoop {
   /// that share a start instant share their mission clock this way.
   void set_wall_origin(double wall_s) { wall_origin_ = wall_s; }
 
+  /// A callback that throws does not end the loop (and with it a process whose drones are in
+  /// the air): the exception is caught, `handler` gets its message, and the loop goes on
+  /// with the next callback. The DEX abandons the mission into the failsafe there. Without
+  /// a handler the message goes to standard error. A handler that throws is logged too.
+  void on_callback_error(std::function<void(const std::string& what)> handler) { on_error_ = std::move(handler); }
+
   /// Callbacks run since construction (a cost measure: idle drones must not add to it).
   std::uint64_t events_run() const { return events_run_; }
 
@@ -108,6 +115,8 @@ class EventLoop {
   bool wait_for(double t);
   /// Moves posted callbacks into the queue at the current mission time.
   void take_posted();
+  void run_callback(std::function<void()>& fn) noexcept;
+  void report_error(const std::string& what) noexcept;
 
   ClockOptions options_;
   double now_ = 0.0;
@@ -118,6 +127,7 @@ class EventLoop {
   /// Cancelled timers stay in the heap and are skipped when popped: cancel is O(1).
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue_;
   std::unordered_map<TimerId, std::function<void()>> callbacks_;
+  std::function<void(const std::string&)> on_error_;
   std::mutex post_mutex_;
   std::condition_variable post_cv_;
   std::vector<std::function<void()>> posted_;  ///< guarded by post_mutex_

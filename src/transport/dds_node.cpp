@@ -5,6 +5,7 @@
 #include <dds/dds.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -47,6 +48,16 @@ dds_qos_t* durable_qos(bool keep_all, double lease_s) {
   return q;
 }
 
+/// The last net of a Cyclone callback, when even DdsNode::dropped failed: standard error,
+/// after the first 20 only every 1000th, so a peer sending garbage cannot flood the log.
+void log_dropped(const char* topic, const char* what) noexcept {
+  static std::atomic<std::uint64_t> dropped{0};
+  std::uint64_t n = ++dropped;
+  if (n <= 20 || n % 1000 == 0)
+    std::fprintf(stderr, "eamos: dropped a DDS sample of %s (%llu so far): %s\n", topic,
+                 static_cast<unsigned long long>(n), what);
+}
+
 /// Takes every sample the reader holds. Each is checked as it is converted (from_wire):
 /// one that breaks a rule is dropped and reported to `node`, never handed on.
 template <typename Wire, typename Sample, typename Fn>
@@ -61,28 +72,58 @@ void take_all(dds_entity_t reader, const char* topic, DdsNode& node, Fn&& fn,
     if (n <= 0) return;
     for (int i = 0; i < n; ++i) {
       if (!infos[i].valid_data) continue;  // dispose/unregister notices carry no sample
-      Sample s;
-      std::string why;
-      if (!from_wire(*static_cast<const Wire*>(samples[i]), node.wire_limits(), s, why)) {
-        node.dropped(topic, why);
-        continue;
+      // Per sample, so one bad sample neither loses the rest of the batch nor the loan.
+      try {
+        Sample s;
+        std::string why;
+        if (!from_wire(*static_cast<const Wire*>(samples[i]), node.wire_limits(), s, why)) {
+          node.dropped(topic, why);
+          continue;
+        }
+        if (on_info) on_info(infos[i].publication_handle);
+        fn(std::move(s));
+      } catch (const std::exception& e) {
+        node.dropped(topic, e.what());  // if this throws too, guarded() below logs it
+      } catch (...) {
+        node.dropped(topic, "an exception that is not a std::exception");
       }
-      if (on_info) on_info(infos[i].publication_handle);
-      fn(std::move(s));
     }
     dds_return_loan(reader, samples, n);
     if (n < kBatch) return;
   }
 }
 
-void on_trigger(dds_entity_t reader, void* arg) { static_cast<DdsNode*>(arg)->take_triggers(reader); }
-void on_telemetry(dds_entity_t reader, void* arg) { static_cast<DdsNode*>(arg)->take_telemetry(reader); }
-void on_lifecycle(dds_entity_t reader, void* arg) { static_cast<DdsNode*>(arg)->take_lifecycle(reader); }
-void on_status(dds_entity_t reader, void* arg) { static_cast<DdsNode*>(arg)->take_status(reader); }
-void on_trace(dds_entity_t reader, void* arg) { static_cast<DdsNode*>(arg)->take_trace(reader); }
-void on_liveliness(dds_entity_t, const dds_liveliness_changed_status_t s, void* arg) {
+// Cyclone calls these from its own threads, through C: nothing may be thrown into it.
+template <typename Take>
+void guarded(const char* topic, Take&& take) noexcept {
+  try {
+    take();
+  } catch (const std::exception& e) {
+    log_dropped(topic, e.what());
+  } catch (...) {
+    log_dropped(topic, "an exception that is not a std::exception");
+  }
+}
+
+void on_trigger(dds_entity_t reader, void* arg) noexcept {
+  guarded("eamos_trigger", [&] { static_cast<DdsNode*>(arg)->take_triggers(reader); });
+}
+void on_telemetry(dds_entity_t reader, void* arg) noexcept {
+  guarded("eamos_telemetry", [&] { static_cast<DdsNode*>(arg)->take_telemetry(reader); });
+}
+void on_lifecycle(dds_entity_t reader, void* arg) noexcept {
+  guarded("eamos_lifecycle", [&] { static_cast<DdsNode*>(arg)->take_lifecycle(reader); });
+}
+void on_status(dds_entity_t reader, void* arg) noexcept {
+  guarded("eamos_status", [&] { static_cast<DdsNode*>(arg)->take_status(reader); });
+}
+void on_trace(dds_entity_t reader, void* arg) noexcept {
+  guarded("eamos_trace", [&] { static_cast<DdsNode*>(arg)->take_trace(reader); });
+}
+void on_liveliness(dds_entity_t, const dds_liveliness_changed_status_t s, void* arg) noexcept {
   if (s.alive_count_change < 0 || s.not_alive_count_change > 0)
-    static_cast<DdsNode*>(arg)->liveliness_changed(s.last_publication_handle);
+    guarded("eamos_status (liveliness)",
+            [&] { static_cast<DdsNode*>(arg)->liveliness_changed(s.last_publication_handle); });
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
+#include <stdexcept>
 #include <tuple>
 
 #include "transport/dds_node.h"
@@ -126,6 +127,41 @@ TEST(DdsNode, ReportsWhoseStatusWriterWentAway) {
   std::lock_guard<std::mutex> lock(watcher.mutex);
   EXPECT_EQ(watcher.lost.front(), std::make_tuple(std::string("h"), 2, std::uint64_t{99}));
   observer.reset();
+}
+
+// A handler runs on Cyclone's listener thread, called from C: an exception used to go up
+// through Cyclone itself (this test then hung; a DEX stopped hearing the others, or
+// died). Now the one sample is dropped and the rest of the batch still arrives.
+TEST(DdsNode, HandlerThatThrowsLosesOnlyItsSample) {
+  std::string error;
+  DdsOptions options;
+  options.domain = 44;
+  Received ignored;
+  auto writer = DdsNode::open(options, record_into(ignored), error);
+  ASSERT_TRUE(writer) << error;
+  for (int i = 1; i <= 3; ++i) {
+    TriggerSample s;
+    s.run_id = 1;
+    s.seq = static_cast<std::uint64_t>(i);
+    s.message.mission_hash = "h";
+    ASSERT_TRUE(writer->write(s));
+  }
+  Received got;
+  DdsHandlers h = record_into(got);
+  h.trigger = [&got](TriggerSample s) {
+    if (s.seq == 2) throw std::out_of_range("bad sample");
+    std::lock_guard<std::mutex> lock(got.mutex);
+    got.triggers.push_back(std::move(s));
+    got.cv.notify_all();
+  };
+  auto reader = DdsNode::open(options, std::move(h), error);
+  ASSERT_TRUE(reader) << error;
+  ASSERT_TRUE(got.wait([&] { return got.triggers.size() >= 2; })) << got.triggers.size();
+  std::lock_guard<std::mutex> lock(got.mutex);
+  EXPECT_EQ(got.triggers[0].seq, 1u);
+  EXPECT_EQ(got.triggers[1].seq, 3u);
+  reader.reset();
+  writer.reset();
 }
 
 TEST(DdsNode, RejectsADomainIdOutOfRange) {

@@ -16,6 +16,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -24,6 +25,7 @@
 
 #include "support/mission_edit.h"
 #include "support/run_eamos.h"
+#include "transport/dds_node.h"
 
 namespace {
 
@@ -396,6 +398,125 @@ TEST_F(Distributed, SpeedMismatchAbortsBeforeAnyDroneMoves) {
     EXPECT_EQ(log.find(std::string(d) + "   start"), std::string::npos) << log;  // nothing moved
   }
   EXPECT_NE(read_text(dir_ / "drone2.log").find("--speed 5"), std::string::npos) << read_text(dir_ / "drone2.log");
+}
+
+/// Launches long_hover.eamos on `domain` and, once both drones are airborne, writes an
+/// ABORT of the running run from this test process, as `sender` with `reason`: what an
+/// outside (buggy or hostile) participant on the domain could send.
+/// Launches long_hover.eamos and, once both drones are airborne, writes an ABORT from a
+/// participant of the test's own; with `then_valid`, a well-formed ABORT from the ground
+/// follows it, so a test can show that the first was dropped and the DEXes still obey.
+Output launch_and_abort_from_outside(const fs::path& dir, int domain, int sender, const std::string& reason,
+                                     bool then_valid = false) {
+  std::string mission = std::string(EAMOS_SOURCE_DIR) + "/tests/launch/missions/long_hover.eamos";
+  Output c = eamos("compile -q " + mission + " -o " + (dir / "deploy").string());
+  EXPECT_EQ(c.status, 0) << c.out;
+  std::string hash = read_json(dir / "deploy" / "manifest.json")["mission_hash"];
+  eamos::transport::DdsOptions dds;
+  dds.domain = domain;
+  std::string error;
+  std::unique_ptr<eamos::transport::DdsNode> node = eamos::transport::DdsNode::open(dds, {}, error);
+  EXPECT_TRUE(node) << error;
+  std::uint64_t run = 0;
+  int airborne = 0;
+  bool sent = false;
+  Output r = eamos("launch " + (dir / "deploy").string() + " --speed 5 --domain " + std::to_string(domain) +
+                       " --trace " + (dir / "trace.jsonl").string() + " --summary " + (dir / "summary.json").string(),
+                   [&](const std::string& line) {
+                     auto at = line.find("starting run ");
+                     if (at != std::string::npos) run = std::stoull(line.substr(at + 13));
+                     if (line.find(".Takeoff(5)  succeeded") != std::string::npos) ++airborne;
+                     if (!sent && airborne == 2 && node) {
+                       eamos::transport::LifecycleSample abort{hash, sender, eamos::transport::LifecycleKind::abort,
+                                                               run};
+                       abort.reason = reason;
+                       EXPECT_TRUE(node->write(abort));
+                       if (then_valid) {
+                         eamos::transport::LifecycleSample valid{hash, eamos::transport::kGround,
+                                                                 eamos::transport::LifecycleKind::abort, run};
+                         valid.reason = "valid abort after the bad one";
+                         EXPECT_TRUE(node->write(valid));
+                       }
+                       sent = true;
+                     }
+                   });
+  EXPECT_TRUE(sent) << r.out;
+  return r;
+}
+
+/// Expects every drone of long_hover.eamos to have run its failsafe and to be down.
+void expect_every_drone_in_failsafe(const fs::path& dir, const Output& r) {
+  EXPECT_EQ(r.status, 1) << r.out;
+  std::string logs = r.out;
+  for (const char* d : {"Lead", "Wing"}) logs += read_text(dir / "deploy" / d / "dex.log");
+  for (const char* leak : {"json.exception", "_M_range_check", "terminate called", "what():"})
+    EXPECT_EQ(logs.find(leak), std::string::npos) << leak << "\n" << logs;
+  std::map<std::string, int> failsafes;
+  std::ifstream in(dir / "trace.jsonl");
+  for (std::string line; std::getline(in, line);) {
+    nlohmann::json e = nlohmann::json::parse(line);
+    if (e["event"] == "failsafe") ++failsafes[e["drone"]];
+  }
+  EXPECT_EQ(failsafes, (std::map<std::string, int>{{"Lead", 1}, {"Wing", 1}})) << logs;
+  ASSERT_TRUE(fs::exists(dir / "summary.json")) << logs;
+  nlohmann::json summary = read_json(dir / "summary.json");
+  EXPECT_EQ(summary["status"], "failed");
+  for (const char* d : {"Lead", "Wing"}) {
+    EXPECT_TRUE(summary["drones"][d]["landed"]) << d << "\n" << summary.dump(2);
+    EXPECT_FALSE(summary["drones"][d]["armed"]) << d << "\n" << summary.dump(2);
+  }
+}
+
+// Bytes that are not UTF-8 in an ABORT's reason used to reach nlohmann::json::dump in the
+// ground's trace and summary, whose exception lost the whole report.
+// Text from outside that is not UTF-8 (here an ABORT's reason) used to make the ground's
+// JSON trace writer throw and die without a summary. Such a sample is now dropped where it
+// arrives (from_wire) and logged; the DEXes go on and obey the valid ABORT that follows.
+TEST_F(Distributed, AbortWithAReasonThatIsNotUtf8IsDroppedAndTheNextAbortIsObeyed) {
+  Output r = launch_and_abort_from_outside(dir_, 36, eamos::transport::kGround, "stop \xff\xfe now", true);
+  ASSERT_NO_FATAL_FAILURE(expect_every_drone_in_failsafe(dir_, r));
+  EXPECT_NE(read_json(dir_ / "summary.json")["error"].get<std::string>().find("valid abort after the bad one"),
+            std::string::npos);
+  std::string log = read_text(dir_ / "deploy" / "Lead" / "dex.log");
+  EXPECT_NE(log.find("dropped a lifecycle sample"), std::string::npos) << log;
+}
+
+// A sender number no drone of the mission has used to make each DEX throw (fleet.at) out
+// of its event loop and exit with its drone in the air. Now the sample is dropped and
+// logged where it arrives, and the DEXes still obey the valid ABORT after it.
+TEST_F(Distributed, AbortFromAnUnknownDroneNumberIsDroppedAndTheNextAbortIsObeyed) {
+  Output r = launch_and_abort_from_outside(dir_, 37, 7, "from nowhere", true);
+  ASSERT_NO_FATAL_FAILURE(expect_every_drone_in_failsafe(dir_, r));
+  std::string log = read_text(dir_ / "deploy" / "Lead" / "dex.log");
+  EXPECT_NE(log.find("dropped a lifecycle sample"), std::string::npos) << log;
+  EXPECT_EQ(log.find("from nowhere"), std::string::npos) << log;
+  EXPECT_NE(log.find("valid abort after the bad one"), std::string::npos) << log;
+}
+
+// A DEX stopped with SIGTERM (its service stopped, a shutdown) used to die at once: the
+// others failed on its lost liveliness, its own drone stayed in the air.
+TEST_F(Distributed, SigtermOnADexLandsItsDroneAndEveryOther) {
+  std::string mission = std::string(EAMOS_SOURCE_DIR) + "/tests/launch/missions/long_hover.eamos";
+  Output c = eamos("compile -q " + mission + " -o " + (dir_ / "deploy").string());
+  ASSERT_EQ(c.status, 0) << c.out;
+  int airborne = 0;
+  pid_t lead = -1;
+  Output r = eamos("launch " + (dir_ / "deploy").string() + " --speed 5 --domain 38 --trace " +
+                       (dir_ / "trace.jsonl").string() + " --summary " + (dir_ / "summary.json").string(),
+                   [&](const std::string& line) {
+                     static std::string seen;
+                     seen += line;
+                     if (line.find(".Takeoff(5)  succeeded") != std::string::npos && ++airborne == 2) {
+                       lead = dex_pid(seen, "Lead");
+                       ASSERT_GT(lead, 0) << seen;
+                       kill(lead, SIGTERM);
+                     }
+                   });
+  ASSERT_GT(lead, 0) << r.out;
+  ASSERT_NO_FATAL_FAILURE(expect_every_drone_in_failsafe(dir_, r));
+  std::string log = read_text(dir_ / "deploy" / "Lead" / "dex.log");
+  EXPECT_NE(log.find("Lead's DEX was interrupted (SIGTERM)"), std::string::npos) << log;
+  EXPECT_EQ(r.out.find("no liveliness"), std::string::npos) << r.out;  // it said why, it was not lost
 }
 
 TEST_F(Distributed, DexRefusesAFolderWithoutAMission) {

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
+#include <stdexcept>
 #include <vector>
 
 #include "mavlink/link.h"
@@ -119,6 +120,30 @@ TEST(UdpLink, ListenerBeforeTheVehicleIsKnownFollowsTheLastValidFrameOfAnySystem
   ASSERT_TRUE(listen.link->send(adapter.encode(pack(CommandAck{176, 0}))));
   ASSERT_TRUE(b_side.wait_for(1));
   EXPECT_EQ(unpack_command_ack(b_side.frames[0].message)->command, 176);
+}
+
+// The frame handler runs on the link's own thread: an exception there used to end the
+// process (std::terminate) with the vehicle in flight. Now that datagram is dropped and
+// the link goes on.
+TEST(UdpLink, HandlerThatThrowsLosesOnlyThatDatagram) {
+  Mailbox got;
+  int calls = 0;
+  FrameHandler throwing_once = [&got, &calls, inner = got.handler()](Frame f) {
+    if (++calls == 1) throw std::runtime_error("bad frame");
+    inner(std::move(f));
+  };
+  OpenResult listen = Link::open(endpoint("udp://127.0.0.1:25306"), throwing_once);
+  ASSERT_TRUE(listen.link) << listen.error;
+  Mailbox ignored;
+  OpenResult out = Link::open(endpoint("udpout://127.0.0.1:25306"), ignored.handler());
+  ASSERT_TRUE(out.link) << out.error;
+  Encoder vehicle{7, 1};
+  Heartbeat hb;
+  ASSERT_TRUE(out.link->send(vehicle.encode(pack(hb))));
+  hb.custom_mode = 2;
+  ASSERT_TRUE(out.link->send(vehicle.encode(pack(hb))));
+  ASSERT_TRUE(got.wait_for(1));
+  EXPECT_EQ(unpack_heartbeat(got.frames[0].message)->custom_mode, 2u);
 }
 
 TEST(UdpLink, PortInUseIsAClearError) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -56,6 +57,36 @@ TEST(EventLoop, EventLoopRunsSameScheduleIdentically) {
   std::vector<std::string> first = trace_of();
   EXPECT_GT(first.size(), 100u);
   EXPECT_EQ(first, trace_of());
+}
+
+// A callback that throws (a bug, a bad sample that got through) must not end the loop of
+// a process whose drone is in the air: the handler hears of it and the loop goes on.
+TEST(EventLoop, ThrowingCallbackReachesTheErrorHandlerAndTheLoopGoesOn) {
+  EventLoop loop;
+  std::vector<std::string> errors;
+  loop.on_callback_error([&](const std::string& what) { errors.push_back(what); });
+  std::string order;
+  loop.at(1.0, [&] {
+    order += 'a';
+    throw std::out_of_range("vector::_M_range_check");
+  });
+  loop.at(1.0, [&] { throw 42; });
+  loop.at(2.0, [&] { order += 'b'; });
+  EXPECT_EQ(loop.run_until_idle(), 3u);
+  EXPECT_EQ(order, "ab");
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0], "vector::_M_range_check");
+  EXPECT_EQ(errors[1], "an exception that is not a std::exception");
+}
+
+TEST(EventLoop, ThrowingErrorHandlerDoesNotEndTheLoopEither) {
+  EventLoop loop;
+  loop.on_callback_error([](const std::string&) { throw std::runtime_error("handler"); });
+  bool later = false;
+  loop.at(1.0, [] { throw std::runtime_error("callback"); });
+  loop.at(2.0, [&] { later = true; });
+  loop.run_until_idle();
+  EXPECT_TRUE(later);
 }
 
 TEST(EventLoop, CancelledTimerNeverRuns) {

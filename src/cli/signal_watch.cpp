@@ -1,0 +1,57 @@
+#include "cli/signal_watch.h"
+
+#include <pthread.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+
+namespace eamos::cli {
+
+namespace {
+
+sigset_t watched() {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  return set;
+}
+
+}  // namespace
+
+SignalWatch::SignalWatch(std::function<void(const char*)> on_first) : on_first_(std::move(on_first)) {
+  sigset_t set = watched();
+  pthread_sigmask(SIG_BLOCK, &set, &old_mask_);
+  thread_ = std::thread([this] { watch(); });
+}
+
+SignalWatch::~SignalWatch() {
+  stopping_ = true;
+  pthread_kill(thread_.native_handle(), SIGTERM);  // wakes sigwait; stopping_ says it is not a user's
+  thread_.join();
+  pthread_sigmask(SIG_SETMASK, &old_mask_, nullptr);
+}
+
+void SignalWatch::watch() {
+  sigset_t set = watched();
+  int seen = 0;
+  for (;;) {
+    int signal = 0;
+    if (sigwait(&set, &signal) != 0) continue;
+    if (stopping_) return;
+    const char* name = signal == SIGINT ? "SIGINT" : "SIGTERM";
+    if (++seen == 1) {
+      std::fprintf(stderr, "eamos: interrupted (%s): every drone runs its failsafe; interrupt again to exit at once\n",
+                   name);
+      on_first_(name);
+      continue;
+    }
+    // Nothing more is commanded: a drone keeps doing what its failsafe told it.
+    static const char kMessage[] = "eamos: interrupted again: exiting now, without waiting for the failsafe\n";
+    [[maybe_unused]] ssize_t n = write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
+    std::_Exit(128 + signal);
+  }
+}
+
+}  // namespace eamos::cli
