@@ -177,33 +177,34 @@ void check_battery(const Setup& s, const Flight& f, std::vector<Violation>& out)
 
 // --- speed and climb -----------------------------------------------------------------------
 
+double rate_between(const std::string& kind, const dex::Sample& a, const dex::Sample& b) {
+  double dt = b.t - a.t;
+  return kind == "speed" ? std::hypot(b.x - a.x, b.y - a.y) / dt : kind == "climb" ? (b.z - a.z) / dt : (a.z - b.z) / dt;
+}
+
 void check_rate(const Setup& s, const Flight& f, int d, const std::string& kind, double limit,
                 std::vector<Violation>& out) {
   const auto& track = f.result.drones[d].track;
+  // A timing-perturbed flight flies 1/f as fast on purpose: judge it at nominal speed.
+  double factor = f.factors[d];
+  double peak = 0.0, first = -1.0;
   for (std::size_t i = 1; i < track.size(); ++i) {
-    const dex::Sample& a = track[i - 1];
-    const dex::Sample& b = track[i];
-    double dt = b.t - a.t;
-    if (dt <= 1e-9 || a.landed) continue;
-    // A timing-perturbed flight flies 1/f as fast on purpose: judge it at nominal speed.
-    double f_nominal = f.factors[d];
-    double rate = kind == "speed" ? std::hypot(b.x - a.x, b.y - a.y) / dt
-                  : kind == "climb" ? (b.z - a.z) / dt
-                                    : (a.z - b.z) / dt;
-    rate *= f_nominal;
+    if (track[i].t - track[i - 1].t <= 1e-9 || track[i - 1].landed) continue;
+    double rate = rate_between(kind, track[i - 1], track[i]) * factor;
     if (rate <= limit * 1.01 + 1e-6) continue;
-    const ActionRun* r = responsible(f, d, b.t);
-    std::string key = kind == "speed" ? "max_speed" : kind == "climb" ? "max_climb" : "max_descent";
-    std::string what = name_of(s, d) + " flies " + (kind == "speed" ? "at " : kind == "climb" ? "up at " : "down at ") +
-                       num(std::round(rate * 100) / 100) + " m/s at " + seconds(b.t) + ", above the fleet's " + key +
-                       " of " + num(limit) + " m/s";
-    out.push_back(make(kind, b.t, {name_of(s, d)},
-                       r ? at_action(*r, what + " during " + r->node->text + "; set `limits: {" + key + ": " +
-                                             num(limit) + "}` for " + name_of(s, d) +
-                                             " in the fleet file so its autopilot keeps to it")
-                         : Located{0, 0, what}));
-    return;  // once per drone and kind: every later step would say the same
+    if (first < 0) first = track[i].t;
+    peak = std::max(peak, rate);
   }
+  if (first < 0) return;  // once per drone and kind: every later step would say the same
+  const ActionRun* r = responsible(f, d, first);
+  std::string key = kind == "speed" ? "max_speed" : kind == "climb" ? "max_climb" : "max_descent";
+  std::string what = name_of(s, d) + (kind == "speed" ? " flies at up to " : kind == "climb" ? " climbs at up to " : " descends at up to ") +
+                     num(std::round(peak * 100) / 100) + " m/s, above the fleet's " + key + " of " + num(limit) +
+                     " m/s, from " + seconds(first);
+  out.push_back(make(kind, first, {name_of(s, d)},
+                     r ? at_action(*r, what + " during " + r->node->text + "; set `limits: {" + key + ": " + num(limit) +
+                                           "}` for " + name_of(s, d) + " in the fleet file so its autopilot keeps to it")
+                       : Located{0, 0, what}));
 }
 
 void check_rates(const Setup& s, const Flight& f, std::vector<Violation>& out) {
@@ -316,7 +317,8 @@ void check_never_ends(const Setup& s, const Flight& f, std::vector<Violation>& o
     const std::string& drone = name_of(s, key.first);
     Violation v = make("never_ends", f.result.duration, {drone},
                        {c.node->line, c.node->col,
-                        drone + "'s " + lang::control_name(c.node->control) + " never ends: still waiting at the " +
+                        std::string(lang::control_name(c.node->control)) + " on `" + c.node->text +
+                            "` never ends: still waiting at the " +
                             limit + " time limit; it last read " + last_reads(c) + " (at " + seconds(c.t) +
                             "); make sure something makes `" + c.node->text + "` come true, or raise --time-limit"});
     out.push_back(std::move(v));
