@@ -67,3 +67,13 @@ std::string format_report(const graph::Compilation& c, const VerifyReport& r);
 std::string json_report(const graph::Compilation& c, const VerifyReport& r);
 
 }  // namespace eamos::verify
+
+namespace eamos::verify {
+
+/// The picture of the first path (every condition as the simulated sensors read it, nominal
+/// timing) as `eamos run --plot` draws it, with each violation on that path as a red mark
+/// where and when it happened.
+std::string plot_first_path(const graph::Compilation& c, const std::vector<dex::Mission>& missions,
+                            const VerifyOptions& options);
+
+}  // namespace eamos::verify

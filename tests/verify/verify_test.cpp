@@ -11,6 +11,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <unistd.h>
+
 #include <nlohmann/json.hpp>
 
 #include "support/run_eamos.h"
@@ -91,6 +93,20 @@ TEST(VerifyJson, ReportsEachViolationWithItsKindLineAndPath) {
   ASSERT_EQ(v["path"].size(), 1u);
   EXPECT_EQ(v["path"][0]["value"], false);
   EXPECT_EQ(v["path"][0]["forced"], true);
+}
+
+TEST(VerifyPlot, MarksEachViolationOfTheFirstPathInRed) {
+  fs::path svg = fs::temp_directory_path() / ("verify_plot_" + std::to_string(::getpid()) + ".svg");
+  eamos_test::Output run = eamos_test::run_eamos(
+      "verify occupied_home.eamos --fleet occupied_home.fleet.yaml --plot " + svg.string(), {}, kMissions.string());
+  EXPECT_EQ(run.status, 1) << run.out;
+  std::string picture = read_file(svg);
+  fs::remove(svg);
+  std::size_t rings = 0;
+  for (std::size_t at = 0; (at = picture.find("<circle data-violation=\"occupied_home\"", at)) != std::string::npos; ++at)
+    ++rings;
+  EXPECT_EQ(rings, 3u) << "one ring per violation on the map";
+  EXPECT_NE(picture.find("<line data-violation=\"occupied_home\""), std::string::npos);
 }
 
 TEST(VerifyPaths, StopsAtTheBoundAndSaysTheExplorationIsIncomplete) {
