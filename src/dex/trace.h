@@ -12,12 +12,12 @@ struct TraceEvent {
   std::string event;        ///< start | end | condition | sensor | failsafe | error
   std::string name;         ///< action or control structure
   int line = 0;
-  int col = 0;              ///< source column of `name` (0 when unknown); not in the JSONL trace
   std::string text;         ///< "Drone1.Takeoff(3)", "Drone1.Sensor1() >= 100"
   std::string outcome;      ///< end: succeeded | preempted | cancelled | failed
   std::optional<bool> value;      ///< condition
   std::optional<double> reading;  ///< sensor
   std::string reason;       ///< end failed / preempted: why
+  int col = 0;              ///< source column of `name` (0 when unknown); not in the JSONL trace
 };
 
 class TraceSink {

@@ -70,10 +70,9 @@ TEST_P(VerifyMission, EamosVerifyPrintsExpectedOutput) {
   EXPECT_EQ(read_file(expected), run.out) << "for " << name;
 }
 
-TEST_P(VerifyMission, EveryRuleMissionHasAFixedTwin) {
-  std::string name = GetParam();
-  if (is_fixed_twin(name)) GTEST_SKIP() << "a twin itself";
-  EXPECT_TRUE(fs::exists(kMissions / (name + "_fixed.eamos"))) << name;
+TEST(VerifyMissions, EveryRuleMissionHasAFixedTwin) {
+  for (const std::string& name : cases())
+    if (!is_fixed_twin(name)) EXPECT_TRUE(fs::exists(kMissions / (name + "_fixed.eamos"))) << name;
 }
 
 INSTANTIATE_TEST_SUITE_P(Files, VerifyMission, ::testing::ValuesIn(cases()),
