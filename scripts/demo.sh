@@ -18,6 +18,14 @@ done
 "$EAMOS" stats "$MISSION" -o "$OUT/stats.json" -q
 "$EAMOS" run "$MISSION" -q --fleet examples/listing2-right.yaml \
   --trace "$OUT/trace.jsonl" --summary "$OUT/summary.json" --plot "$OUT/plot.svg"
+# Pre-flight verification of every example (docs/verify.md); Listing 2 with its sensor's
+# range and timing perturbations finds Drone2 landing beside a parked drone (explained there).
+echo
+for mission in examples/patrol.eamos examples/relay.eamos examples/survey.eamos; do
+  "$EAMOS" verify -q "$mission" --jitter
+done
+"$EAMOS" verify -q "$MISSION" --fleet examples/listing2-range.yaml --jitter \
+  --plot "$OUT/verify.svg" --json > "$OUT/verify.json" || echo "verify: Listing 2's findings in $OUT/verify.json and $OUT/verify.svg"
 # The same deployment as separate processes: one DEX per drone over Cyclone DDS (loopback),
 # started together by the ground process, five times faster than real time.
 echo

@@ -36,6 +36,15 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r);
 /// Writes the summary and plot of a finished run as `eamos run` does; false when a file
 /// could not be written.
 bool report_run(const RunCommandOptions& r, const dex::RunResult& result, const std::vector<dex::TraceEvent>& events);
+struct VerifyCommandOptions {
+  int paths = 64;          ///< flights at most
+  bool jitter = false;     ///< also fly each path with drones 10 % slower and faster
+  double time_limit = 3600.0;
+  bool json = false;       ///< the report as JSON on standard output
+  std::string plot;        ///< SVG of the first path with the violations marked; "" = none
+};
+/// `eamos verify`: exit 0 when no path breaks a rule, 1 otherwise (or on bad input).
+int cmd_verify(const CommonOptions& o, const VerifyCommandOptions& v);
 int cmd_dex(const launch::DexProcessOptions& options);
 int cmd_launch(const launch::LaunchOptions& options, const RunCommandOptions& r);
 /// `eamos run --distributed`: compiles into options.dir (a temporary folder when ""), then launches.

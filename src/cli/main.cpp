@@ -80,6 +80,17 @@ int main(int argc, char** argv) {
   run->add_option("--time-limit", run_opts.time_limit, "Fail a mission still running after this many mission seconds")
       ->check(CLI::PositiveNumber);
 
+  auto* verify = app.add_subcommand("verify", "Fly every explored path of a mission in the simulator and report each broken rule (separation, geofence, battery, ...) at its action; exit 1 on any");
+  add_common(verify, o);
+  eamos::cli::VerifyCommandOptions verify_opts;
+  verify->add_option("--paths", verify_opts.paths, "Fly at most N paths (combinations of condition outcomes and timings)")
+      ->check(CLI::Range(1, 1000000));
+  verify->add_flag("--jitter", verify_opts.jitter, "Also fly each path with drones 10 % slower and faster");
+  verify->add_option("--time-limit", verify_opts.time_limit, "A path still running after this many mission seconds never ends")
+      ->check(CLI::PositiveNumber);
+  verify->add_flag("--json", verify_opts.json, "Print the report as JSON");
+  verify->add_option("--plot", verify_opts.plot, "Draw the first path with the violations marked in red as SVG to this file");
+
   bool distributed = false;
   eamos::launch::LaunchOptions launch_opts;
   run->add_flag("--distributed", distributed,
@@ -164,6 +175,7 @@ int main(int argc, char** argv) {
       return eamos::cli::cmd_run_distributed(o, run_opts, launch_opts);
     }
     if (*run) return eamos::cli::cmd_run(o, run_opts);
+    if (*verify) return eamos::cli::cmd_verify(o, verify_opts);
     if (*launch) return eamos::cli::cmd_launch(launch_opts, launch_report);
     if (*dexcmd) return eamos::cli::cmd_dex(dex_opts);
     if (*simv) return eamos::cli::cmd_sim_vehicle(simv_opts);

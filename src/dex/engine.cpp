@@ -75,6 +75,7 @@ void Engine::trace(const Node& n, const std::string& event, const std::string& o
   e.event = event;
   e.name = n.kind == MegKind::condition ? lang::control_name(n.control) : n.name;
   e.line = n.line;
+  e.col = n.col;
   e.text = n.text;
   e.outcome = outcome;
   hooks_.trace->record(e);
@@ -222,6 +223,7 @@ void Engine::activate_action(int node) {
   req.name = n.name;
   auto read = [this](int d, const std::string& p) { return property(d, p); };
   for (const Expr& a : n.args) req.args.push_back(evaluate(a, read).number);
+  if (hooks_.observer) hooks_.observer->action_started(loop_.now(), m_.self, n, req, drone_.state());
   trace(n, "start");
   ++active_;
   // Its own instance: an earlier activation of this node may still run (async work in a
@@ -282,6 +284,7 @@ void Engine::trace_end(const Node& n, const mid::ActionEnd& e) {
   t.event = "end";
   t.name = n.name;
   t.line = n.line;
+  t.col = n.col;
   t.text = n.text;
   t.outcome = mid::outcome_name(e.outcome);
   t.reason = e.reason;
@@ -298,6 +301,7 @@ bool Engine::condition_value(int node) {
   const Node& n = m_.nodes[node];
   auto read = [this](int d, const std::string& p) { return property(d, p); };
   bool v = evaluate(n.condition, read).boolean;
+  if (hooks_.observer) v = hooks_.observer->condition(loop_.now(), m_.self, n, v, read);
   // Watched conditions are re-evaluated at the telemetry rate: trace a value once, then
   // only when it changes, so the trace shows decisions, not samples.
   State& s = state_[node];
@@ -310,6 +314,7 @@ bool Engine::condition_value(int node) {
     t.event = "condition";
     t.name = lang::control_name(n.control);
     t.line = n.line;
+    t.col = n.col;
     t.text = n.text;
     t.value = v;
     hooks_.trace->record(t);

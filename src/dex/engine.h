@@ -13,6 +13,7 @@
 
 #include "dex/bridge.h"
 #include "dex/mission.h"
+#include "dex/observer.h"
 #include "dex/trace.h"
 #include "mid/drone_api.h"
 #include "mid/event_loop.h"
@@ -39,6 +40,8 @@ struct EngineHooks {
   /// The engine has just settled (handled an event completely) with nothing active: the
   /// moment a runner checks whether the mission is complete.
   std::function<void()> on_idle;
+  /// `eamos verify` only: sees action starts and may decide conditions (dex/observer.h).
+  RunObserver* observer = nullptr;
 };
 
 /// Iterations in a row a Repeat may run without mission time passing before the engine

@@ -362,9 +362,32 @@ void timeline_legend(std::ostream& out, double y) {
   out << "</g>\n";
 }
 
+void map_marks(std::ostream& out, const MapFrame& f, const std::vector<PlotMark>& marks) {
+  if (marks.empty()) return;
+  out << "<g class=\"violations\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\">\n";
+  for (const PlotMark& m : marks) {
+    double px = f.to_x(m.x), py = f.to_y(m.y);
+    out << "<circle data-violation=\"" << xml(m.label) << "\" cx=\"" << num(px) << "\" cy=\"" << num(py)
+        << "\" r=\"9\"/>\n";
+    out << text(px + 12, py - 8, m.label + " " + num(m.t) + " s", "fill=\"#d62728\" stroke=\"none\" font-size=\"11\"");
+  }
+  out << "</g>\n";
+}
+
+void timeline_marks(std::ostream& out, const std::vector<PlotMark>& marks, double top, double bottom, double until) {
+  if (marks.empty()) return;
+  out << "<g class=\"violation-times\" stroke=\"#d62728\" stroke-width=\"1.5\">\n";
+  for (const PlotMark& m : marks) {
+    double px = time_x(m.t, until);
+    out << "<line data-violation=\"" << xml(m.label) << "\" x1=\"" << num(px) << "\" y1=\"" << num(top)
+        << "\" x2=\"" << num(px) << "\" y2=\"" << num(bottom) << "\"/>\n";
+  }
+  out << "</g>\n";
+}
+
 }  // namespace
 
-std::string plot_svg(const RunResult& run, const std::vector<TraceEvent>& events) {
+std::string plot_svg(const RunResult& run, const std::vector<TraceEvent>& events, const std::vector<PlotMark>& marks) {
   std::ostringstream body;
   double y = 20;
   std::string status = run.completed ? "completed in " + num(run.duration) + " s"
@@ -376,6 +399,7 @@ std::string plot_svg(const RunResult& run, const std::vector<TraceEvent>& events
   MapFrame frame = map_frame(run, y);
   map_axes(body, frame);
   for (std::size_t d = 0; d < run.drones.size(); ++d) map_track(body, frame, run.drones[d], static_cast<int>(d));
+  map_marks(body, frame, marks);
   map_legend(body, run, frame.top);
   y = frame.bottom + 64;
 
@@ -384,7 +408,9 @@ std::string plot_svg(const RunResult& run, const std::vector<TraceEvent>& events
   if (until <= 0) until = 1;
   body << text(kLeft - 100, y, "Actions over time", "font-size=\"13\" font-weight=\"bold\" fill=\"#444444\"");
   y += 12;
+  double timeline_top = y;
   y = timeline(body, run, events, y, until);
+  timeline_marks(body, marks, timeline_top, y, until);
   timeline_legend(body, y);
   y += 16;
 

@@ -14,6 +14,15 @@ namespace eamos::dex {
 /// it armed, a green diamond where it landed. Bottom panel: one row per drone over mission
 /// time, a bar per action start (`data-action` attribute) from start to end, coloured by
 /// outcome, and a tick per condition decision. `events` is the run's trace.
-std::string plot_svg(const RunResult& run, const std::vector<TraceEvent>& events);
+/// A problem to show on the picture (`eamos verify`): a red ring at (x, y) on the map and a
+/// red line at mission time t across the timeline, both labelled.
+struct PlotMark {
+  double t = 0.0;
+  double x = 0.0, y = 0.0;  ///< m, mission frame
+  std::string label;        ///< "separation", ...
+};
+
+std::string plot_svg(const RunResult& run, const std::vector<TraceEvent>& events,
+                     const std::vector<PlotMark>& marks = {});
 
 }  // namespace eamos::dex

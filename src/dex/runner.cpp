@@ -117,7 +117,7 @@ void RunInterrupt::detach() {
 }
 
 void record_sample(std::vector<Sample>& track, const mid::DroneState& s) {
-  Sample now{s.t, s.x, s.y, s.z, s.armed, s.landed};
+  Sample now{s.t, s.x, s.y, s.z, s.armed, s.landed, s.battery};
   if (!track.empty()) {
     const Sample& last = track.back();
     if (last.x == now.x && last.y == now.y && last.z == now.z && last.armed == now.armed &&
@@ -207,6 +207,7 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     hooks.on_failure = fail;
     hooks.on_end = [&] { end_reached = true; };  // the lead's engine settles next: check_done then
     hooks.on_idle = [&] { check_done(); };
+    hooks.observer = options.observer;
     engines.push_back(std::make_unique<Engine>(missions[d], *drones[d], loop, hooks));
   }
   // Each drone's broker feeds its own engine directly and every other drone through the

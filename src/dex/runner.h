@@ -12,6 +12,7 @@
 
 #include "dex/engine.h"
 #include "dex/mission.h"
+#include "dex/observer.h"
 #include "mid/adapter_registry.h"
 #include "mid/event_loop.h"
 
@@ -41,6 +42,7 @@ struct RunOptions {
   mid::ClockOptions clock;
   double time_limit_s = 3600.0;  ///< a mission still running then fails ("did not finish")
   RunInterrupt* interrupt = nullptr;
+  RunObserver* observer = nullptr;  ///< `eamos verify` only (dex/observer.h)
 };
 
 /// One drone's position and phase at a moment its broker published a change of them.
@@ -49,6 +51,7 @@ struct Sample {
   double x, y, z;  ///< m east, north, up of the mission origin
   bool armed;
   bool landed;
+  double battery;  ///< %
 };
 
 /// The mission was abandoned: makes `drone` safe with its fleet failsafe when it is in the air

@@ -17,6 +17,7 @@ struct TraceEvent {
   std::optional<bool> value;      ///< condition
   std::optional<double> reading;  ///< sensor
   std::string reason;       ///< end failed / preempted: why
+  int col = 0;              ///< source column of `name` (0 when unknown); not in the JSONL trace
 };
 
 class TraceSink {

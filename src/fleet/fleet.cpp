@@ -1,5 +1,8 @@
 #include "fleet/fleet.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace eamos::fleet {
 
 const char* failsafe_name(Failsafe f) {
@@ -55,6 +58,41 @@ void Fleet::check_drone(const std::string& drone, const DroneType& type, Diagnos
                   "drone '" + drone + "' is of type '" + type.name + "', which has " +
                       std::to_string(type.sensors) + " sensors, so it has no " + sensor +
                       "; remove it or raise `sensors:` in type '" + type.name + "'");
+}
+
+bool Geofence::contains_xy(double x, double y) const {
+  if (polygon.size() < 3) return true;
+  // Even-odd rule; a point on an edge counts as inside, so a track along the fence is legal.
+  bool inside = false;
+  for (std::size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
+    auto [xi, yi] = polygon[i];
+    auto [xj, yj] = polygon[j];
+    double cross = (xj - xi) * (y - yi) - (yj - yi) * (x - xi);
+    bool on_segment = std::abs(cross) < 1e-9 && x >= std::min(xi, xj) - 1e-9 && x <= std::max(xi, xj) + 1e-9 &&
+                      y >= std::min(yi, yj) - 1e-9 && y <= std::max(yi, yj) + 1e-9;
+    if (on_segment) return true;
+    if ((yi > y) != (yj > y) && x < (xj - xi) * (y - yi) / (yj - yi) + xi) inside = !inside;
+  }
+  return inside;
+}
+
+bool Geofence::contains(double x, double y, double z) const {
+  if (min_altitude_m && z < *min_altitude_m - 1e-9) return false;
+  if (max_altitude_m && z > *max_altitude_m + 1e-9) return false;
+  return contains_xy(x, y);
+}
+
+const Geofence* Fleet::geofence_for(const std::string& drone) const {
+  auto it = overrides.find(drone);
+  if (it != overrides.end() && it->second.geofence) return &*it->second.geofence;
+  return safety.geofence ? &*safety.geofence : nullptr;
+}
+
+const SensorRange* Fleet::sensor_range(const std::string& drone, const std::string& sensor) const {
+  auto it = overrides.find(drone);
+  if (it == overrides.end()) return nullptr;
+  auto r = it->second.sensor_ranges.find(sensor);
+  return r == it->second.sensor_ranges.end() ? nullptr : &r->second;
 }
 
 bool load_fleet(const std::string& path, Fleet& out, Diagnostics& diags) {

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "diag/diagnostics.h"
@@ -41,6 +42,44 @@ struct DroneSettings {
   std::map<std::string, double> timeouts_s;  ///< per action name; overrides derived ones
 };
 
+/// Where drones may fly (docs/fleet.md, `geofence:`): inside a polygon of the mission frame's
+/// x/y plane (none: anywhere) and between two altitudes (each optional). `eamos verify`
+/// checks the flown tracks and every motion target against it; nothing in flight uses it.
+struct Geofence {
+  std::vector<std::pair<double, double>> polygon;  ///< (x east, y north), m; empty = no polygon
+  std::optional<double> min_altitude_m;
+  std::optional<double> max_altitude_m;
+  /// True when (x, y, z) lies inside (a point on the boundary is inside).
+  bool contains(double x, double y, double z) const;
+  bool contains_xy(double x, double y) const;
+};
+
+/// Two airborne drones are too close when they are nearer than `horizontal_m` horizontally
+/// and nearer than `vertical_m` vertically at the same time.
+struct Separation {
+  double horizontal_m = 2.0;
+  double vertical_m = 1.0;
+};
+
+/// The fleet's operating rules (`safety:`), checked by `eamos verify` before a flight.
+/// The speed limits here are the operator's, not the vehicle's: a drone able to fly 10 m/s
+/// may be allowed 5 m/s over a site.
+struct Safety {
+  Separation min_separation;
+  double battery_reserve_percent = 20.0;  ///< land (or failsafe) with at least this much
+  std::optional<double> max_speed_mps;     ///< horizontal
+  std::optional<double> max_climb_mps;
+  std::optional<double> max_descent_mps;
+  std::optional<Geofence> geofence;        ///< every drone's, unless a drone gives its own
+};
+
+/// The values a sensor may read in flight (`range: [low, high]`): what `eamos verify`
+/// explores a condition on that sensor over, both ways where the range allows.
+struct SensorRange {
+  double low = 0.0;
+  double high = 0.0;
+};
+
 /// Limits a fleet file sets; the unset ones keep the value they override (the defaults for
 /// a type, the type's for a drone).
 struct LimitOverrides {
@@ -60,6 +99,8 @@ struct DroneOverrides {
   bool adapter = false;  ///< false: the type's adapter
   LimitOverrides limits;  ///< unset: the type's limits
   std::map<std::string, SourceLocation> sensor_locations;  ///< where each SensorK is set
+  std::map<std::string, SensorRange> sensor_ranges;        ///< SensorK → declared range
+  std::optional<Geofence> geofence;                        ///< replaces the fleet's
 };
 
 struct Fleet {
@@ -70,6 +111,12 @@ struct Fleet {
   std::map<std::string, DroneOverrides> overrides;  ///< per described drone: what it sets
   std::map<std::string, SourceLocation> drone_locations;  ///< where each drone is described
   std::shared_ptr<SourceFile> source;        ///< keeps the file text for diagnostics
+  Safety safety;                             ///< operating rules for `eamos verify`
+
+  /// The geofence `drone` must stay in: its own, else the fleet's; null when neither is set.
+  const Geofence* geofence_for(const std::string& drone) const;
+  /// The declared range of `sensor` ("Sensor1") of `drone`; null when none is declared.
+  const SensorRange* sensor_range(const std::string& drone, const std::string& sensor) const;
 
   /// The type for a name in the mission; an undescribed name is the generic multirotor.
   DroneType type_for(const std::string& type_name) const;

@@ -1,5 +1,7 @@
 // parse_fleet: the fleet file's schema (docs/fleet.md), one function per map in it.
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <optional>
 
 #include "fleet/fleet.h"
@@ -9,14 +11,19 @@ namespace eamos::fleet {
 
 namespace {
 
-const std::vector<std::string> kRootKeys = {"types", "drones"};
+const std::vector<std::string> kRootKeys = {"types", "drones", "safety"};
+const std::vector<std::string> kSafetyKeys = {"min_separation", "battery_reserve", "max_speed",
+                                              "max_climb",      "max_descent",     "geofence"};
+const std::vector<std::string> kSeparationKeys = {"horizontal", "vertical"};
+const std::vector<std::string> kGeofenceKeys = {"polygon", "min_altitude", "max_altitude"};
 const std::vector<std::string> kTypeKeys = {"adapter", "capabilities", "sensors", "limits"};
 const std::vector<std::string> kDroneKeys = {"home",     "battery",  "sensors",
                                              "limits",   "failsafe", "adapter",
-                                             "connection", "sysid",  "timeouts"};
+                                             "connection", "sysid",  "timeouts",
+                                             "geofence"};
 const std::vector<std::string> kLimitKeys = {"max_speed", "max_climb", "max_descent",
                                              "max_accel", "max_altitude"};
-const std::vector<std::string> kSensorKeys = {"value", "gradient"};
+const std::vector<std::string> kSensorKeys = {"value", "gradient", "range"};
 const std::vector<std::string> kAdapters = {"sim", "mavlink"};
 const std::vector<std::string> kFailsafes = {"land", "return_home", "hover"};
 
@@ -29,6 +36,12 @@ std::vector<std::string> standard_action_names() {
 bool is_standard_property(const std::string& name) {
   const auto& props = standard_properties();
   return std::any_of(props.begin(), props.end(), [&](const PropertySpec& p) { return p.name == name; });
+}
+
+std::string format_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
 }
 
 Failsafe failsafe_from(const std::string& name) {
@@ -52,7 +65,14 @@ class FleetParser {
   void drone(const std::string& name, const YAML::Node& node);
   void sensors(const YAML::Node& node, const std::string& where, DroneSettings& settings,
                DroneOverrides& overrides);
-  void sensor(const YAML::Node& node, const std::string& what, SensorModel& out);
+  void sensor(const YAML::Node& node, const std::string& what, SensorModel& out,
+              std::optional<SensorRange>& range);
+  void range(const YAML::Node& node, const std::string& what, std::optional<SensorRange>& out);
+  void safety(const YAML::Node& node);
+  void separation(const YAML::Node& node, Separation& out);
+  bool positive(const YAML::Node& node, const std::string& what, double& out);
+  void geofence(const YAML::Node& node, const std::string& where, std::optional<Geofence>& out);
+  void polygon(const YAML::Node& node, const std::string& what, Geofence& out);
   void timeouts(const YAML::Node& node, const std::string& where, DroneSettings& settings);
   bool saturated() const { return r_.diags.saturated(); }
 
@@ -66,15 +86,17 @@ class FleetParser {
 void FleetParser::parse(const YAML::Node& root) {
   if (!r_.map(root, "the fleet file")) return;
   // Types first wherever they are written: a drone's sensors are checked against them.
-  std::optional<YAML::Node> types_node, drones_node;
+  std::optional<YAML::Node> types_node, drones_node, safety_node;
   std::set<std::string> seen;
   for (const auto& kv : root) {
     std::string key = r_.field(kv.first, kRootKeys, seen, "the fleet file");
     if (key == "types") types_node = kv.second;
     if (key == "drones") drones_node = kv.second;
+    if (key == "safety") safety_node = kv.second;
   }
   if (types_node) types(*types_node);
   if (drones_node) drones(*drones_node);
+  if (safety_node) safety(*safety_node);
 }
 
 void FleetParser::types(const YAML::Node& node) {
@@ -214,6 +236,7 @@ void FleetParser::drone(const std::string& name, const YAML::Node& node) {
         else r_.error(v, what + " must be a MAVLink system id from 1 to 255; got " + describe(v));
       }
       if (key == "timeouts") timeouts(v, where, s);
+      if (key == "geofence") geofence(v, where, o.geofence);
     }
   }
   out_.drones[name] = std::move(s);
@@ -238,11 +261,14 @@ void FleetParser::sensors(const YAML::Node& node, const std::string& where,
       continue;
     }
     overrides.sensor_locations[name] = location_of(kv.first.Mark());
-    sensor(kv.second, name + " of " + where, settings.sensors[name]);
+    std::optional<SensorRange> range;
+    sensor(kv.second, name + " of " + where, settings.sensors[name], range);
+    if (range) overrides.sensor_ranges[name] = *range;
   }
 }
 
-void FleetParser::sensor(const YAML::Node& node, const std::string& what, SensorModel& out) {
+void FleetParser::sensor(const YAML::Node& node, const std::string& what, SensorModel& out,
+                         std::optional<SensorRange>& range_out) {
   if (!node.IsMap()) {
     if (!r_.number(node, what, out.base))
       r_.diags.note(r_.file, location_of(node.Mark()),
@@ -254,7 +280,140 @@ void FleetParser::sensor(const YAML::Node& node, const std::string& what, Sensor
     std::string key = r_.field(kv.first, kSensorKeys, seen, what);
     if (key == "value") r_.number(kv.second, "value of " + what, out.base);
     if (key == "gradient") r_.vec3(kv.second, "gradient of " + what, out.gradient);
+    if (key == "range") range(kv.second, "range of " + what, range_out);
   }
+}
+
+void FleetParser::range(const YAML::Node& node, const std::string& what, std::optional<SensorRange>& out) {
+  if (!node.IsSequence() || node.size() != 2) {
+    r_.error(node, what + " must be a list of two numbers [low, high], the least and the most the sensor "
+                          "can read; got " + (node.IsSequence() ? "a list of " + std::to_string(node.size())
+                                                                 : describe(node)));
+    return;
+  }
+  SensorRange r;
+  bool ok = r_.number(node[0], "low end of " + what, r.low);
+  ok = r_.number(node[1], "high end of " + what, r.high) && ok;
+  if (!ok) return;
+  if (r.low > r.high) {
+    r_.error(node, what + " must be [low, high] with low <= high; got [" + describe(node[0]) + ", " +
+                       describe(node[1]) + "]; swap them");
+    return;
+  }
+  out = r;
+}
+
+void FleetParser::safety(const YAML::Node& node) {
+  if (!r_.map(node, "safety")) return;
+  Safety& s = out_.safety;
+  std::set<std::string> seen;
+  for (const auto& kv : node) {
+    std::string key = r_.field(kv.first, kSafetyKeys, seen, "safety");
+    const YAML::Node& v = kv.second;
+    double value = 0;
+    if (key == "min_separation") separation(v, s.min_separation);
+    if (key == "battery_reserve" && r_.number(v, "battery_reserve of safety", value)) {
+      if (value < 0 || value > 100)
+        r_.error(v, "battery_reserve of safety must be a charge from 0 to 100 (%); got " + describe(v));
+      else
+        s.battery_reserve_percent = value;
+    }
+    if (key == "max_speed" && positive(v, "max_speed of safety", value)) s.max_speed_mps = value;
+    if (key == "max_climb" && positive(v, "max_climb of safety", value)) s.max_climb_mps = value;
+    if (key == "max_descent" && positive(v, "max_descent of safety", value)) s.max_descent_mps = value;
+    if (key == "geofence") geofence(v, "safety", s.geofence);
+  }
+}
+
+bool FleetParser::positive(const YAML::Node& node, const std::string& what, double& out) {
+  double value = 0;
+  if (!r_.number(node, what, value)) return false;
+  if (value <= 0) {
+    r_.error(node, what + " must be positive; got " + describe(node));
+    return false;
+  }
+  out = value;
+  return true;
+}
+
+void FleetParser::separation(const YAML::Node& node, Separation& out) {
+  const std::string where = "min_separation of safety";
+  if (!node.IsMap()) {
+    r_.error(node, where + " must be a map {horizontal: M, vertical: M}; got " + describe(node));
+    return;
+  }
+  std::set<std::string> seen;
+  for (const auto& kv : node) {
+    std::string key = r_.field(kv.first, kSeparationKeys, seen, where);
+    double value = 0;
+    if (key == "horizontal" && positive(kv.second, "horizontal of " + where, value)) out.horizontal_m = value;
+    if (key == "vertical" && positive(kv.second, "vertical of " + where, value)) out.vertical_m = value;
+  }
+}
+
+void FleetParser::geofence(const YAML::Node& node, const std::string& where, std::optional<Geofence>& out) {
+  const std::string what = "geofence of " + where;
+  if (!node.IsMap()) {
+    r_.error(node, what + " must be a map {polygon: [[x, y], ...], min_altitude: M, max_altitude: M}; got " +
+                       describe(node));
+    return;
+  }
+  Geofence g;
+  std::set<std::string> seen;
+  std::optional<YAML::Node> max_node;
+  for (const auto& kv : node) {
+    std::string key = r_.field(kv.first, kGeofenceKeys, seen, what);
+    double value = 0;
+    if (key == "polygon") polygon(kv.second, "polygon of " + what, g);
+    if (key == "min_altitude" && r_.number(kv.second, "min_altitude of " + what, value)) g.min_altitude_m = value;
+    if (key == "max_altitude" && r_.number(kv.second, "max_altitude of " + what, value)) {
+      g.max_altitude_m = value;
+      max_node = kv.second;
+    }
+  }
+  if (g.min_altitude_m && g.max_altitude_m && *g.min_altitude_m >= *g.max_altitude_m) {
+    r_.error(*max_node, "max_altitude of " + what + " must be above its min_altitude (" +
+                            describe(*max_node) + " is not above " + format_number(*g.min_altitude_m) +
+                            "); swap them or widen the band");
+    return;
+  }
+  out = std::move(g);
+}
+
+void FleetParser::polygon(const YAML::Node& node, const std::string& what, Geofence& out) {
+  if (!node.IsSequence() || node.size() < 3) {
+    r_.error(node, what + " must be a list of at least three corners [[x, y], [x, y], [x, y]] in metres of "
+                          "the mission frame; got " +
+                       (node.IsSequence() ? "a list of " + std::to_string(node.size()) : describe(node)));
+    return;
+  }
+  std::vector<std::pair<double, double>> corners;
+  bool ok = true;
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    const YAML::Node& c = node[i];
+    std::string corner = "corner " + std::to_string(i + 1) + " of " + what;
+    if (!c.IsSequence() || c.size() != 2) {
+      r_.error(c, corner + " must be a list of two numbers [x, y]; got " +
+                      (c.IsSequence() ? "a list of " + std::to_string(c.size()) : describe(c)));
+      ok = false;
+      continue;
+    }
+    double x = 0, y = 0;
+    bool good = r_.number(c[0], corner + " [x]", x);
+    good = r_.number(c[1], corner + " [y]", y) && good;
+    ok = ok && good;
+    corners.emplace_back(x, y);
+  }
+  if (!ok) return;
+  double twice_area = 0;
+  for (std::size_t i = 0, j = corners.size() - 1; i < corners.size(); j = i++)
+    twice_area += corners[j].first * corners[i].second - corners[i].first * corners[j].second;
+  if (std::abs(twice_area) < 1e-9) {
+    r_.error(node, what + " encloses no area (its corners lie on one line); give the corners of the area "
+                          "the drones may fly in");
+    return;
+  }
+  out.polygon = std::move(corners);
 }
 
 void FleetParser::timeouts(const YAML::Node& node, const std::string& where, DroneSettings& settings) {

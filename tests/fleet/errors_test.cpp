@@ -47,7 +47,7 @@ TEST(Errors, DiagnosticsStayPrintableAfterTheirSourceIsFreed) {
 TEST(Errors, UnknownKeyFarFromAnyListsTheAllowedKeys) {
   auto p = parse("planes: {}\n");
   EXPECT_FALSE(p.ok);
-  EXPECT_TRUE(contains(first_error(p.diags).message, "expected types or drones"))
+  EXPECT_TRUE(contains(first_error(p.diags).message, "expected types, drones or safety"))
       << first_error(p.diags).message;
 }
 

@@ -155,3 +155,58 @@ TEST(Parse, NegativeHomeCoordinatesAndFractionsAreFine) {
 
 }  // namespace
 }  // namespace eamos::fleet
+
+namespace eamos::fleet {
+namespace {
+
+// The safety section and the keys `eamos verify` reads; their errors are golden files under
+// tests/lang/diagnostics/fleet_*.
+TEST(Safety, DefaultsWhenTheFileSaysNothing) {
+  Fleet f;
+  Diagnostics d;
+  ASSERT_TRUE(parse_fleet(std::make_shared<SourceFile>(SourceFile{"f.yaml", ""}), f, d));
+  EXPECT_EQ(f.safety.min_separation.horizontal_m, 2.0);
+  EXPECT_EQ(f.safety.min_separation.vertical_m, 1.0);
+  EXPECT_EQ(f.safety.battery_reserve_percent, 20.0);
+  EXPECT_FALSE(f.safety.geofence);
+  EXPECT_EQ(f.geofence_for("Drone1"), nullptr);
+}
+
+TEST(Safety, ReadsEveryKeyAndADroneFenceReplacesTheFleets) {
+  const char* text =
+      "safety:\n"
+      "  min_separation: {horizontal: 3, vertical: 1.5}\n"
+      "  battery_reserve: 25\n"
+      "  max_speed: 5\n"
+      "  geofence: {polygon: [[0, 0], [10, 0], [10, 10], [0, 10]], max_altitude: 30}\n"
+      "drones:\n"
+      "  Drone2:\n"
+      "    geofence: {min_altitude: 2}\n"
+      "    sensors:\n"
+      "      Sensor1: {value: 4, range: [0, 9]}\n";
+  Fleet f;
+  Diagnostics d;
+  ASSERT_TRUE(parse_fleet(std::make_shared<SourceFile>(SourceFile{"f.yaml", text}), f, d)) << d.format();
+  EXPECT_EQ(f.safety.min_separation.horizontal_m, 3.0);
+  EXPECT_EQ(f.safety.min_separation.vertical_m, 1.5);
+  EXPECT_EQ(f.safety.battery_reserve_percent, 25.0);
+  EXPECT_EQ(*f.safety.max_speed_mps, 5.0);
+  const Geofence* g1 = f.geofence_for("Drone1");
+  ASSERT_NE(g1, nullptr);
+  EXPECT_TRUE(g1->contains(5, 5, 10));
+  EXPECT_TRUE(g1->contains(10, 5, 10));  // on the boundary
+  EXPECT_FALSE(g1->contains(11, 5, 10));
+  EXPECT_FALSE(g1->contains(5, 5, 31));
+  const Geofence* g2 = f.geofence_for("Drone2");
+  ASSERT_NE(g2, nullptr);
+  EXPECT_TRUE(g2->contains(100, 100, 3));  // its own fence has no polygon
+  EXPECT_FALSE(g2->contains(0, 0, 1));
+  const SensorRange* r = f.sensor_range("Drone2", "Sensor1");
+  ASSERT_NE(r, nullptr);
+  EXPECT_EQ(r->low, 0.0);
+  EXPECT_EQ(r->high, 9.0);
+  EXPECT_EQ(f.drones.at("Drone2").sensors.at("Sensor1").base, 4.0);
+}
+
+}  // namespace
+}  // namespace eamos::fleet

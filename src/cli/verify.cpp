@@ -1,0 +1,36 @@
+// `eamos verify`: compile, read back every drone's mission file as `eamos run` does, and
+// let src/verify fly every explored path in the simulator and check it.
+#include <iostream>
+
+#include "cli/commands.h"
+#include "deploy/mission_file.h"
+#include "verify/verify.h"
+
+namespace eamos::cli {
+
+int cmd_verify(const CommonOptions& o, const VerifyCommandOptions& v) {
+  graph::Compilation c;
+  if (!compile_and_report(o, c)) return 1;
+  std::string hash = deploy::mission_hash(c);
+  std::vector<dex::Mission> missions(c.drone_count());
+  for (int d = 0; d < c.drone_count(); ++d) {
+    std::vector<std::string> errors;
+    if (!deploy::read_mission(deploy::mission_text(c, d, hash), c.drone_name(d) + "/mission.json", missions[d],
+                              errors)) {
+      for (const std::string& e : errors) std::cerr << e << "\n";
+      return 1;
+    }
+  }
+  verify::VerifyOptions options;
+  options.max_paths = v.paths;
+  options.jitter = v.jitter;
+  options.time_limit_s = v.time_limit;
+  verify::VerifyReport report = verify::verify(c, missions, options);
+  if (!v.plot.empty() && !write_output(v.plot, verify::plot_first_path(c, missions, options))) return 1;
+  std::cerr.flush();
+  std::cout << (v.json ? verify::json_report(c, report) : verify::format_report(c, report));
+  std::cout.flush();
+  return report.error.empty() && report.violations.empty() ? 0 : 1;
+}
+
+}  // namespace eamos::cli

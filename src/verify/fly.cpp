@@ -1,0 +1,233 @@
+// One flight of the mission on virtual time, with an observer that records every action
+// start and condition evaluation and decides the conditions the path forces.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "sim/sim_drone.h"
+#include "verify/flight.h"
+
+namespace eamos::verify {
+
+std::string num(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", std::abs(v) < 5e-7 ? 0.0 : v);
+  return text;
+}
+std::string seconds(double t) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f s", t);
+  return text;
+}
+std::string point(double x, double y, double z) {
+  auto r = [](double v) { return num(std::round(v * 100) / 100); };
+  return "(" + r(x) + ", " + r(y) + ", " + r(z) + ")";
+}
+
+namespace {
+
+void collect_reads(const dex::Expr& e, std::vector<const dex::Expr*>& out) {
+  if (e.kind == dex::Expr::Kind::property) out.push_back(&e);
+  for (const dex::Expr& a : e.args) collect_reads(a, out);
+}
+void collect_numbers(const dex::Expr& e, std::vector<double>& out) {
+  if (e.kind == dex::Expr::Kind::number) out.push_back(e.number);
+  for (const dex::Expr& a : e.args) collect_numbers(a, out);
+}
+
+/// A sensor read of a condition whose value the fleet lets range over [low, high].
+struct RangedRead {
+  int drone;
+  std::string sensor;
+  fleet::SensorRange range;
+};
+
+/// Values worth trying for a sensor over its range: both ends, every number the condition
+/// compares with (and just either side of it), and a grid between. For the comparisons a
+/// mission writes (a sensor against constants) this finds every outcome the range allows.
+std::vector<double> candidates(const fleet::SensorRange& r, const std::vector<double>& numbers) {
+  std::vector<double> v = {r.low, r.high};
+  for (int i = 1; i < 16; ++i) v.push_back(r.low + (r.high - r.low) * i / 16.0);
+  for (double n : numbers)
+    for (double c : {n, n - 1e-6 * std::max(1.0, std::abs(n)), n + 1e-6 * std::max(1.0, std::abs(n))})
+      if (c >= r.low && c <= r.high) v.push_back(c);
+  return v;
+}
+
+class Observer : public dex::RunObserver, public dex::TraceSink {
+ public:
+  Observer(const Setup& setup, const Assignment& forced, Flight& f) : setup_(setup), forced_(forced), f_(f) {}
+
+  void action_started(double t, int drone, const dex::Node& node, const mid::ActionRequest& request,
+                      const mid::DroneState& state) override {
+    ActionRun a;
+    a.drone = drone;
+    a.node = &node;
+    a.request = request;
+    a.state = state;
+    a.start = t;
+    const fleet::ActionSpec* spec = setup_.missions[drone].type.find_action(node.name);
+    a.motion = spec && spec->action_class == fleet::ActionClass::motion;
+    open_[{drone, node.meg}].push_back(f_.actions.size());
+    f_.actions.push_back(std::move(a));
+  }
+
+  bool condition(double t, int drone, const dex::Node& node, bool computed, const dex::PropertyReader& read) override {
+    ConditionSeen& seen = f_.conditions[{drone, node.meg}];
+    seen.node = &node;
+    seen.t = t;
+    seen.reads.clear();
+    std::vector<const dex::Expr*> reads;
+    collect_reads(node.condition, reads);
+    for (const dex::Expr* r : reads)
+      seen.reads.emplace_back(setup_.missions[drone].fleet[r->drone] + "." + r->property, read(r->drone, r->property));
+    bool value = decide(drone, node, computed, read);
+    seen.value = value;
+    return value;
+  }
+
+  void record(const dex::TraceEvent& e) override {
+    f_.events.push_back(e);
+    if (e.event == "failsafe" && f_.abandoned_at < 0) f_.abandoned_at = e.t;
+    if (e.event != "end") return;
+    int drone = drone_index(e.drone);
+    // Each end closes the oldest open run of that node on that drone (instances end in order).
+    for (auto& [key, open] : open_) {
+      if (key.first != drone || open.empty()) continue;
+      ActionRun& a = f_.actions[open.front()];
+      if (a.node->line != e.line || a.node->col != e.col || a.node->text != e.text) continue;
+      a.end = e.t;
+      a.outcome = e.outcome;
+      open.erase(open.begin());
+      return;
+    }
+  }
+
+ private:
+  int drone_index(const std::string& name) const {
+    const auto& names = setup_.missions[0].fleet;
+    return static_cast<int>(std::find(names.begin(), names.end(), name) - names.begin());
+  }
+
+  std::vector<RangedRead> ranged_reads(const dex::Node& node) const {
+    std::vector<const dex::Expr*> reads;
+    collect_reads(node.condition, reads);
+    std::vector<RangedRead> out;
+    for (const dex::Expr* r : reads) {
+      if (r->drone < 0 || r->drone >= static_cast<int>(setup_.missions.size())) continue;
+      const fleet::SensorRange* range = setup_.c.fleet.sensor_range(setup_.missions[0].fleet[r->drone], r->property);
+      if (range) out.push_back({r->drone, r->property, *range});
+    }
+    return out;
+  }
+
+  /// Which outcomes the condition can take with its ranged sensors anywhere in their ranges
+  /// (the other values as read now): {can be false, can be true}.
+  std::pair<bool, bool> possible(const dex::Node& node, const std::vector<RangedRead>& ranged,
+                                 const dex::PropertyReader& read) const {
+    std::vector<double> numbers;
+    collect_numbers(node.condition, numbers);
+    std::pair<bool, bool> can{false, false};
+    // The first two ranged sensors are tried against each other; any further one takes the
+    // first one's candidate position (rare in missions; documented in docs/verify.md).
+    std::vector<std::vector<double>> values;
+    for (const RangedRead& r : ranged) values.push_back(candidates(r.range, numbers));
+    std::size_t n0 = values[0].size(), n1 = values.size() > 1 ? values[1].size() : 1;
+    for (std::size_t i = 0; i < n0; ++i)
+      for (std::size_t j = 0; j < n1; ++j) {
+        auto substituted = [&](int d, const std::string& p) {
+          for (std::size_t k = 0; k < ranged.size(); ++k)
+            if (ranged[k].drone == d && ranged[k].sensor == p) {
+              const std::vector<double>& vs = values[k];
+              std::size_t idx = k == 1 ? j : i;
+              return vs[std::min(idx, vs.size() - 1)];
+            }
+          return read(d, p);
+        };
+        (dex::evaluate(node.condition, substituted).boolean ? can.second : can.first) = true;
+        if (can.first && can.second) return can;
+      }
+    return can;
+  }
+
+  bool decide(int drone, const dex::Node& node, bool computed, const dex::PropertyReader& read) {
+    std::pair<int, int> key{drone, node.meg};
+    auto known = free_.find(key);
+    if (known == free_.end()) {
+      std::vector<RangedRead> ranged = ranged_reads(node);
+      bool is_free = false;
+      if (!ranged.empty()) {
+        auto [can_false, can_true] = possible(node, ranged, read);
+        is_free = can_false && can_true;
+      }
+      known = free_.emplace(key, is_free).first;
+    }
+    if (!known->second) return computed;
+    auto forced = forced_.find(key);
+    bool value = forced == forced_.end() ? computed : forced->second;
+    if (std::find(f_.decision_keys.begin(), f_.decision_keys.end(), key) == f_.decision_keys.end()) {
+      f_.decision_keys.push_back(key);
+      f_.decisions.push_back({setup_.missions[drone].fleet[drone], node.meg, node.line, node.col, node.text,
+                              value, forced != forced_.end() && value != computed});
+    }
+    return value;
+  }
+
+  const Setup& setup_;
+  const Assignment& forced_;
+  Flight& f_;
+  std::map<std::pair<int, int>, bool> free_;                    ///< condition → explored both ways
+  std::map<std::pair<int, int>, std::vector<std::size_t>> open_;  ///< (drone, meg) → running runs
+};
+
+/// Every drone flies in the built-in simulator, whatever adapter the fleet names: verify
+/// never touches a vehicle. A factor f makes every motion and payload action take f times
+/// as long (speeds / f, accelerations / f²).
+void register_simulator(mid::AdapterRegistry& adapters, std::map<std::string, double> factors) {
+  auto factory = [factors](const fleet::DroneSettings& s, const fleet::DroneType& t, mid::EventLoop& loop) {
+    fleet::DroneSettings settings = s;
+    double f = factors.count(s.name) ? factors.at(s.name) : 1.0;
+    settings.limits.max_speed_mps /= f;
+    settings.limits.max_climb_mps /= f;
+    settings.limits.max_descent_mps /= f;
+    settings.limits.max_accel_mps2 /= f * f;
+    sim::SimOptions options;
+    options.picture_s *= f;
+    options.sensor_read_s *= f;
+    mid::CreateResult r;
+    r.drone = std::make_unique<sim::SimDrone>(settings, t, loop, options);
+    return r;
+  };
+  adapters.register_adapter("sim", factory);
+  adapters.register_adapter("mavlink", factory);
+}
+
+}  // namespace
+
+Flight fly(const Setup& setup, const Assignment& forced, const std::vector<double>& factors) {
+  Flight f;
+  f.factors = factors;
+  std::map<std::string, double> by_name;
+  for (std::size_t d = 0; d < setup.missions.size(); ++d) by_name[setup.missions[d].settings.name] = factors[d];
+  mid::AdapterRegistry adapters;
+  register_simulator(adapters, by_name);
+  Observer observer(setup, forced, f);
+  dex::RunOptions options;
+  options.time_limit_s = setup.options.time_limit_s;
+  options.observer = &observer;
+  f.result = dex::run_in_process(setup.missions, adapters, &observer, options);
+  return f;
+}
+
+const ActionRun* running_at(const Flight& f, int drone, double t) {
+  const ActionRun* any = nullptr;
+  const ActionRun* motion = nullptr;
+  for (const ActionRun& a : f.actions) {
+    if (a.drone != drone || a.start > t || a.end < t) continue;
+    if (a.motion) motion = &a;
+    else any = &a;
+  }
+  return motion ? motion : any;
+}
+
+}  // namespace eamos::verify

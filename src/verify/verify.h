@@ -1,0 +1,79 @@
+#pragma once
+// `eamos verify`: flies a compiled mission in the built-in simulator on virtual time, once
+// per explored path, and checks every flight against the fleet's operating rules
+// (fleet::Safety, geofences, sensor ranges): separation, geofence, battery reserve, speed
+// and climb, occupied take-off and landing spots, the state at the end, waits that never
+// end and actions the vehicle refuses. Each violation points at the source line of the
+// action responsible and names the path (the condition outcomes) that leads to it.
+#include <string>
+#include <vector>
+
+#include "dex/mission.h"
+#include "graph/pipeline.h"
+
+namespace eamos::verify {
+
+struct VerifyOptions {
+  int max_paths = 64;         ///< runs at most; exploration stops there (incomplete)
+  bool jitter = false;        ///< also fly each path with every drone 10 % slower and faster
+  double time_limit_s = 3600; ///< a run still going then: "never ends"
+};
+
+/// One decision that made a path: condition `text` of `drone` (at line/col) went `value`.
+struct Decision {
+  std::string drone;
+  int meg = 0;  ///< the condition's MEG id
+  int line = 0, col = 0;
+  std::string text;
+  bool value = false;
+  bool forced = false;  ///< false: the value the simulated sensors gave
+};
+
+/// A source position with a message: where a violation points, and its notes.
+struct Located {
+  int line = 0, col = 0;
+  std::string message;
+};
+
+struct Violation {
+  std::string kind;  ///< separation | geofence | battery | speed | climb | descent |
+                     ///< occupied_home | airborne_at_end | armed_at_end | never_ends | action_failed
+  double t = 0.0;    ///< mission seconds
+  std::vector<std::string> drones;
+  Located at;                  ///< the action responsible: "what; how to fix"
+  std::vector<Located> notes;  ///< the other action involved, the values a wait last read
+  std::vector<Decision> path;  ///< the condition outcomes of the run that found it
+  std::string timing;          ///< "" nominal; else which drones flew slower or faster
+  int paths_seen = 1;          ///< explored paths on which it happened
+};
+
+struct VerifyReport {
+  std::vector<Violation> violations;  ///< in source order
+  int paths = 0;                      ///< runs flown
+  int free_conditions = 0;            ///< conditions explored both ways
+  bool complete = false;              ///< every combination of outcomes was flown
+  std::string error;                  ///< setup problem (nothing was flown)
+};
+
+/// Verifies `c` (a complete compilation) with `missions`, the drones' mission files as
+/// read back from the deployed format (index order = fleet order).
+VerifyReport verify(const graph::Compilation& c, const std::vector<dex::Mission>& missions,
+                    const VerifyOptions& options = {});
+
+/// GCC-style text: one `file:line:col: error:` per violation with its notes, then a
+/// summary line (paths flown, complete or not).
+std::string format_report(const graph::Compilation& c, const VerifyReport& r);
+/// The same as JSON for tools.
+std::string json_report(const graph::Compilation& c, const VerifyReport& r);
+
+}  // namespace eamos::verify
+
+namespace eamos::verify {
+
+/// The picture of the first path (every condition as the simulated sensors read it, nominal
+/// timing) as `eamos run --plot` draws it, with each violation on that path as a red mark
+/// where and when it happened.
+std::string plot_first_path(const graph::Compilation& c, const std::vector<dex::Mission>& missions,
+                            const VerifyOptions& options);
+
+}  // namespace eamos::verify

@@ -1,0 +1,160 @@
+// `eamos verify` end to end, through the real binary. One mission per rule under
+// tests/verify/missions/: NAME.eamos (with NAME.fleet.yaml and NAME.args when present) next
+// to NAME.expected, the exact text `eamos verify` prints in that folder. Each NAME has a
+// twin NAME_fixed that keeps the mission's intent and verifies clean (exit 0).
+// Regenerate after an intended change with EAMOS_UPDATE_GOLDEN=1 and review the diff.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "support/run_eamos.h"
+
+namespace eamos {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kMissions = fs::path(EAMOS_TEST_DATA) / "missions";
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::vector<std::string> cases() {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(kMissions))
+    if (e.path().extension() == ".eamos") names.push_back(e.path().stem().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::string arguments(const std::string& name) {
+  std::string args = name + ".eamos";
+  if (fs::exists(kMissions / (name + ".fleet.yaml"))) args += " --fleet " + name + ".fleet.yaml";
+  if (fs::exists(kMissions / (name + ".args"))) {
+    std::string extra = read_file(kMissions / (name + ".args"));
+    extra.erase(std::remove(extra.begin(), extra.end(), '\n'), extra.end());
+    args += " " + extra;
+  }
+  return args;
+}
+
+bool is_fixed_twin(const std::string& name) { return name.size() > 6 && name.substr(name.size() - 6) == "_fixed"; }
+
+class VerifyMission : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(VerifyMission, EamosVerifyPrintsExpectedOutput) {
+  std::string name = GetParam();
+  eamos_test::Output run = eamos_test::run_eamos("verify " + arguments(name), {}, kMissions.string());
+  ASSERT_NE(run.status, -1) << name << ": eamos did not exit normally (a signal?)\n" << run.out;
+  bool has_error = run.out.find(": error: ") != std::string::npos;
+  EXPECT_EQ(run.status, has_error ? 1 : 0) << name << ":\n" << run.out;
+  // Every rule's mission breaks it; every twin keeps to all of them.
+  EXPECT_EQ(has_error, !is_fixed_twin(name)) << name << ":\n" << run.out;
+  fs::path expected = kMissions / (name + ".expected");
+  if (std::getenv("EAMOS_UPDATE_GOLDEN")) {
+    std::ofstream(expected, std::ios::binary) << run.out;
+    return;
+  }
+  EXPECT_EQ(read_file(expected), run.out) << "for " << name;
+}
+
+TEST(VerifyMissions, EveryRuleMissionHasAFixedTwin) {
+  for (const std::string& name : cases())
+    if (!is_fixed_twin(name)) EXPECT_TRUE(fs::exists(kMissions / (name + "_fixed.eamos"))) << name;
+}
+
+INSTANTIATE_TEST_SUITE_P(Files, VerifyMission, ::testing::ValuesIn(cases()),
+                         [](const auto& info) { return info.param; });
+
+TEST(VerifyJson, ReportsEachViolationWithItsKindLineAndPath) {
+  eamos_test::Output run =
+      eamos_test::run_eamos("verify --json branch.eamos --fleet branch.fleet.yaml", {}, kMissions.string());
+  EXPECT_EQ(run.status, 1);
+  nlohmann::json j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["paths"], 2);
+  EXPECT_TRUE(j["complete"]);
+  ASSERT_EQ(j["violations"].size(), 1u);
+  const auto& v = j["violations"][0];
+  EXPECT_EQ(v["kind"], "separation");
+  EXPECT_EQ(v["line"], 14);
+  ASSERT_EQ(v["path"].size(), 1u);
+  EXPECT_EQ(v["path"][0]["value"], false);
+  EXPECT_EQ(v["path"][0]["forced"], true);
+}
+
+TEST(VerifyPlot, MarksEachViolationOfTheFirstPathInRed) {
+  fs::path svg = fs::temp_directory_path() / ("verify_plot_" + std::to_string(::getpid()) + ".svg");
+  eamos_test::Output run = eamos_test::run_eamos(
+      "verify occupied_home.eamos --fleet occupied_home.fleet.yaml --plot " + svg.string(), {}, kMissions.string());
+  EXPECT_EQ(run.status, 1) << run.out;
+  std::string picture = read_file(svg);
+  fs::remove(svg);
+  std::size_t rings = 0;
+  for (std::size_t at = 0; (at = picture.find("<circle data-violation=\"occupied_home\"", at)) != std::string::npos; ++at)
+    ++rings;
+  EXPECT_EQ(rings, 3u) << "one ring per violation on the map";
+  EXPECT_NE(picture.find("<line data-violation=\"occupied_home\""), std::string::npos);
+}
+
+TEST(VerifyPaths, StopsAtTheBoundAndSaysTheExplorationIsIncomplete) {
+  eamos_test::Output run =
+      eamos_test::run_eamos("verify --paths 1 branch.eamos --fleet branch.fleet.yaml", {}, kMissions.string());
+  EXPECT_EQ(run.status, 0) << run.out;  // the one path flown (east) is clean
+  EXPECT_NE(run.out.find("on 1 path(s) flown; exploration incomplete"), std::string::npos) << run.out;
+}
+
+TEST(VerifyInput, AMissionWithErrorsIsNotFlown) {
+  eamos_test::Output run = eamos_test::run_eamos("verify missing_block.eamos", {}, (fs::path(EAMOS_TEST_DATA) / "bad").string());
+  EXPECT_EQ(run.status, 1);
+  EXPECT_NE(run.out.find("missing_block.eamos:4:15: error: "), std::string::npos) << run.out;
+  EXPECT_EQ(run.out.find("path(s) flown"), std::string::npos) << run.out;
+}
+
+// The shipped examples: each verifies with exactly the findings examples/*.expected records
+// (docs/verify.md explains each one).
+class VerifyExample : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(VerifyExample, MatchesItsRecordedFindings) {
+  std::string args = GetParam();
+  fs::path examples = fs::path(EAMOS_SOURCE_DIR) / "examples";
+  std::string golden;
+  for (char ch : args) golden += std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
+  eamos_test::Output run = eamos_test::run_eamos("verify -q " + args, {}, examples.string());
+  ASSERT_NE(run.status, -1) << run.out;
+  bool has_error = run.out.find(": error: ") != std::string::npos;
+  EXPECT_EQ(run.status, has_error ? 1 : 0) << run.out;
+  fs::path expected = fs::path(EAMOS_TEST_DATA) / "examples" / (golden + ".expected");
+  if (std::getenv("EAMOS_UPDATE_GOLDEN")) {
+    std::ofstream(expected, std::ios::binary) << run.out;
+    return;
+  }
+  EXPECT_EQ(read_file(expected), run.out) << "for " << args;
+}
+
+INSTANTIATE_TEST_SUITE_P(Examples, VerifyExample,
+                         ::testing::Values("listing2.eamos", "listing2.eamos --fleet listing2-left.yaml",
+                                           "listing2.eamos --fleet listing2-right.yaml",
+                                           "listing2.eamos --fleet listing2-range.yaml --jitter", "patrol.eamos",
+                                           "patrol.eamos --jitter", "relay.eamos", "relay.eamos --jitter",
+                                           "survey.eamos", "survey.eamos --jitter"),
+                         [](const auto& info) {
+                           std::string n = info.param;
+                           for (char& ch : n)
+                             if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+                           return n;
+                         });
+
+}  // namespace
+}  // namespace eamos
