@@ -4,6 +4,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "deploy/mission_file.h"
 #include "deploy/synthesize.h"
 #include "graph/export.h"
 #include "graph/pipeline.h"
@@ -41,6 +42,20 @@ bool compile_and_report(const CommonOptions& o, graph::Compilation& c, graph::Ke
   return ok;
 }
 
+
+bool load_compiled_missions(const graph::Compilation& c, std::vector<dex::Mission>& missions) {
+  std::string hash = deploy::mission_hash(c);
+  missions.assign(c.drone_count(), dex::Mission{});
+  for (int d = 0; d < c.drone_count(); ++d) {
+    std::vector<std::string> errors;
+    if (!deploy::read_mission(deploy::mission_text(c, d, hash), c.drone_name(d) + "/mission.json", missions[d],
+                              errors)) {
+      for (const std::string& e : errors) std::cerr << e << "\n";
+      return false;
+    }
+  }
+  return true;
+}
 
 bool write_output(const std::string& path, const std::string& text) {
   if (path.empty() || path == "-") {

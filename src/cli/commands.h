@@ -64,6 +64,10 @@ int cmd_gen_stress(long long nodes, int drones, unsigned seed, const std::string
 /// Compiles and prints every diagnostic; true when the graphs are usable.
 bool compile_and_report(const CommonOptions& o, graph::Compilation& c,
                         graph::Keep keep = graph::Keep::all_graphs);
+/// Every drone's mission as `eamos compile` would write it, read back through the one
+/// validating reader, so a run or a verification exercises the deployed format; false
+/// (errors printed) when the reader refuses one.
+bool load_compiled_missions(const graph::Compilation& c, std::vector<dex::Mission>& missions);
 
 /// Renders DOT to SVG with Graphviz `dot`; returns false with `error` set on failure.
 bool render_svg(const std::string& dot, std::string& svg, std::string& error);

@@ -40,18 +40,8 @@ nlohmann::ordered_json summary_json(const dex::RunResult& r) {
 int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   graph::Compilation c;
   if (!compile_and_report(o, c)) return 1;
-  // The DEX loads the same mission files `eamos compile` writes, so a run exercises the
-  // deployed format, not a shortcut.
-  std::string hash = deploy::mission_hash(c);
-  std::vector<dex::Mission> missions(c.drone_count());
-  for (int d = 0; d < c.drone_count(); ++d) {
-    std::vector<std::string> errors;
-    if (!deploy::read_mission(deploy::mission_text(c, d, hash), c.drone_name(d) + "/mission.json", missions[d],
-                              errors)) {
-      for (const std::string& e : errors) std::cerr << e << "\n";
-      return 1;
-    }
-  }
+  std::vector<dex::Mission> missions;
+  if (!load_compiled_missions(c, missions)) return 1;
   // From here on drones may fly: Ctrl-C or SIGTERM lands them instead of killing the process
   // under them. First, before an adapter starts a thread that would inherit the old mask.
   dex::RunInterrupt interrupt;

@@ -11,16 +11,8 @@ namespace eamos::cli {
 int cmd_verify(const CommonOptions& o, const VerifyCommandOptions& v) {
   graph::Compilation c;
   if (!compile_and_report(o, c)) return 1;
-  std::string hash = deploy::mission_hash(c);
-  std::vector<dex::Mission> missions(c.drone_count());
-  for (int d = 0; d < c.drone_count(); ++d) {
-    std::vector<std::string> errors;
-    if (!deploy::read_mission(deploy::mission_text(c, d, hash), c.drone_name(d) + "/mission.json", missions[d],
-                              errors)) {
-      for (const std::string& e : errors) std::cerr << e << "\n";
-      return 1;
-    }
-  }
+  std::vector<dex::Mission> missions;
+  if (!load_compiled_missions(c, missions)) return 1;
   verify::VerifyOptions options;
   options.max_paths = v.paths;
   options.jitter = v.jitter;
