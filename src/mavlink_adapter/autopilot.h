@@ -32,6 +32,9 @@ struct Autopilot {
   /// Where a cancelled DO_ORBIT goes at once: the autopilot's hold (PX4: AUTO.LOITER), so the
   /// vehicle stops circling before the setpoint stream has earned the setpoint mode.
   uint32_t hold_mode;
+  /// The mode switched to before arming: ArduCopter cannot arm in LAND or RTL (its GUIDED can,
+  /// with a position), PX4 not in AUTO.LAND or AUTO.RTL (its AUTO.LOITER can).
+  uint32_t arm_mode;
 };
 
 /// The row for a HEARTBEAT.autopilot value; nullptr for autopilots we do not fly.
