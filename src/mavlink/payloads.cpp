@@ -321,7 +321,10 @@ Message pack(const Statustext& m) {
 std::optional<Statustext> unpack_statustext(const Message& m) {
   if (m.id != msg::STATUSTEXT) return std::nullopt;
   FieldReader r(def_of(m.id), m);
-  return Statustext{r.get<uint8_t>("severity"), printable(r.get_chars("text")), r.get<uint16_t>("id"),
+  // PX4 ends a text with a newline: trailing control characters and blanks are no text.
+  std::string text = r.get_chars("text");
+  while (!text.empty() && static_cast<unsigned char>(text.back()) <= 0x20) text.pop_back();
+  return Statustext{r.get<uint8_t>("severity"), printable(text), r.get<uint16_t>("id"),
                     r.get<uint8_t>("chunk_seq")};
 }
 

@@ -111,7 +111,8 @@ struct BatteryStatus {
 /// longer than 50 characters arrive in chunks sharing an id (chunk_seq counts up).
 struct Statustext {
   uint8_t severity = 6;  ///< MAV_SEVERITY: 0 emergency … 3 error, 4 warning, 6 info, 7 debug
-  std::string text;      ///< up to 50 characters; not NUL-terminated on the wire when full
+  std::string text;      ///< up to 50 characters; not NUL-terminated on the wire when full;
+                         ///< read: printable ASCII only, trailing newline and blanks dropped
   uint16_t id = 0;       ///< 0: a message of one chunk
   uint8_t chunk_seq = 0;
 };

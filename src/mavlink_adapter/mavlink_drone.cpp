@@ -110,7 +110,8 @@ void MavlinkDrone::start_system(ActionId id, const mid::ActionRequest& r) {
 }
 
 void MavlinkDrone::arm(ActionId id, std::function<void()> armed) {
-  if (vehicle_.custom_mode == autopilot_->arm_mode) return send_arm(id, std::move(armed));
+  // Until a HEARTBEAT is folded in, the mode is unknown: switch rather than be refused.
+  if (vehicle_.heard && can_arm_in(*autopilot_, vehicle_.custom_mode)) return send_arm(id, std::move(armed));
   auto p = set_mode_params(*autopilot_, autopilot_->arm_mode);
   send_mode_command(command(ml::cmd::DO_SET_MODE, {p[0], p[1], p[2]}),
                     [this, id, armed = std::move(armed)](const CommandResult& result) mutable {

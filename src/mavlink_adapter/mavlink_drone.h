@@ -110,8 +110,9 @@ class MavlinkDrone final : public mid::Drone {
   void start_payload(mid::ActionId id, const mid::ActionRequest& r);
   void start_motion(mid::ActionId id, const mid::ActionRequest& r);
   void start_takeoff(mid::ActionId id, double altitude);
-  /// Arms, first switching to a mode where arming is allowed (ArduPilot cannot arm in LAND,
-  /// PX4 not in AUTO.LAND or AUTO.RTL); `armed` runs once the autopilot accepted.
+  /// Arms, first switching to a mode where arming is allowed when the vehicle is in one where
+  /// it is not (ArduPilot cannot arm in LAND, where a landing leaves it); `armed` runs once
+  /// the autopilot accepted.
   void arm(mid::ActionId id, std::function<void()> armed);
   void send_arm(mid::ActionId id, std::function<void()> armed);
   double timeout_for(const mid::ActionRequest& r) const;
@@ -189,6 +190,7 @@ class MavlinkDrone final : public mid::Drone {
     std::string text;
   };
   std::deque<Text> texts_;  ///< the autopilot's recent STATUSTEXTs, newest last
+  std::map<uint16_t, std::string> chunks_;  ///< STATUSTEXT id -> the chunks so far
   /// The mission armed the vehicle and it has not taken off since: an autopilot's auto-disarm
   /// in this state is survived by arming again before the Takeoff.
   bool armed_waiting_ = false;

@@ -60,6 +60,8 @@ std::map<std::string, float> read_params(FirstHeartbeat& first, std::unique_lock
 }
 
 constexpr std::size_t kTextsKept = 32;
+constexpr std::size_t kMaxTextLength = 50 * 8;  ///< longest text assembled from chunks
+constexpr std::size_t kMaxChunkedTexts = 4;     ///< texts being assembled at once
 constexpr uint8_t kSeverityWarning = 4;  ///< MAV_SEVERITY_WARNING: refusals explain at or above it
 
 const char* severity_name(uint8_t s) {
@@ -168,9 +170,19 @@ void MavlinkDrone::on_frame(const ml::Frame& frame) {
 }
 
 void MavlinkDrone::on_statustext(const ml::Statustext& t) {
-  texts_.push_back({loop_.now(), t.severity, t.text});
+  std::string text = t.text;
+  if (t.id != 0) {
+    // A text longer than 50 characters comes in chunks of one id; a chunk shorter than 50
+    // is the last. Bounded: a sender that never ends a text cannot grow this without limit.
+    std::string& pending = chunks_[t.id];
+    pending += t.text;
+    if (t.text.size() >= 50 && pending.size() < kMaxTextLength && chunks_.size() <= kMaxChunkedTexts) return;
+    text = pending;
+    chunks_.erase(t.id);
+  }
+  texts_.push_back({loop_.now(), t.severity, text});
   if (texts_.size() > kTextsKept) texts_.pop_front();
-  note(std::string(autopilot_->name) + " " + severity_name(t.severity) + ": " + t.text);
+  note(std::string(autopilot_->name) + " " + severity_name(t.severity) + ": " + text);
 }
 
 std::string MavlinkDrone::autopilot_says(double since) const {

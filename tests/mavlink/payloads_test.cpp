@@ -236,6 +236,13 @@ TEST(RoundTrip, StatustextOfFiftyCharactersAndForeignBytesIsReadSafely) {
 namespace eamos::mavlink {
 namespace {
 
+// PX4 sends "Armed by external command\n": the newline is no part of the text.
+TEST(RoundTrip, StatustextDropsATrailingNewline) {
+  auto out = unpack_statustext(through_the_wire(pack(Statustext{6, "Armed by external command\n", 0, 0})));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->text, "Armed by external command");
+}
+
 TEST(RoundTrip, ParamRequestReadKeepsTargetNameAndIndex) {
   auto out = unpack_param_request_read(through_the_wire(pack(ParamRequestRead{3, 1, "WPNAV_SPEED_UP", -1})));
   ASSERT_TRUE(out);
