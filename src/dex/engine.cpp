@@ -37,7 +37,19 @@ Engine::Engine(const Mission& mission, mid::Drone& drone, mid::EventLoop& loop, 
     state_[i].exec_pending = m_.nodes[i].exec_in;
     state_[i].back_pending = m_.nodes[i].back_in;
   }
+  if (hooks_.trace) {
+    drone_.set_message_sink([this](const std::string& text) {
+      TraceEvent e;
+      e.t = loop_.now();
+      e.drone = drone_.name();
+      e.event = "vehicle";
+      e.text = text;
+      hooks_.trace->record(e);
+    });
+  }
 }
+
+Engine::~Engine() { drone_.set_message_sink(nullptr); }
 
 void Engine::start() {
   for (std::size_t i = 0; i < m_.nodes.size(); ++i) {

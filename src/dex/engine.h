@@ -51,6 +51,9 @@ inline constexpr int kMaxInstantIterations = 10000;
 class Engine {
  public:
   Engine(const Mission& mission, mid::Drone& drone, mid::EventLoop& loop, EngineHooks hooks);
+  ~Engine();
+  Engine(const Engine&) = delete;
+  Engine& operator=(const Engine&) = delete;
 
   /// Starts the drone's init clone, if it holds one (mission start).
   void start();

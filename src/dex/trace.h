@@ -9,7 +9,7 @@ namespace eamos::dex {
 struct TraceEvent {
   double t = 0.0;           ///< mission seconds
   std::string drone;
-  std::string event;        ///< start | end | condition | sensor | failsafe | error
+  std::string event;        ///< start | end | condition | sensor | failsafe | error | vehicle (its own words)
   std::string name;         ///< action or control structure
   int line = 0;
   std::string text;         ///< "Drone1.Takeoff(3)", "Drone1.Sensor1() >= 100"

@@ -38,7 +38,9 @@ void LiveLog::record(const TraceEvent& e) {
   if (e.reading) out_ << "  = " << *e.reading;
   if (!e.reason.empty()) out_ << "  (" << e.reason << ")";
   if (e.line > 0) out_ << "   line " << e.line;
-  out_ << '\n';
+  // Live: a line is out when it happened, also through a pipe (`eamos run | tee`, a test
+  // that acts on a line), not when a buffer fills.
+  out_ << '\n' << std::flush;
 }
 
 }  // namespace eamos::dex

@@ -47,6 +47,15 @@ std::vector<MessageDef> build_table() {
                     ext(T::u32, "onboard_control_sensors_present_extended"),
                     ext(T::u32, "onboard_control_sensors_enabled_extended"),
                     ext(T::u32, "onboard_control_sensors_health_extended")}));
+  t.push_back(make(msg::PARAM_REQUEST_READ, "PARAM_REQUEST_READ",
+                   {{T::u8, "target_system"}, {T::u8, "target_component"},
+                    {T::char_, "param_id", 16}, {T::i16, "param_index"}}));
+  t.push_back(make(msg::PARAM_VALUE, "PARAM_VALUE",
+                   {{T::char_, "param_id", 16}, {T::f32, "param_value"}, {T::u8, "param_type"},
+                    {T::u16, "param_count"}, {T::u16, "param_index"}}));
+  t.push_back(make(msg::PARAM_SET, "PARAM_SET",
+                   {{T::u8, "target_system"}, {T::u8, "target_component"},
+                    {T::char_, "param_id", 16}, {T::f32, "param_value"}, {T::u8, "param_type"}}));
   t.push_back(make(msg::LOCAL_POSITION_NED, "LOCAL_POSITION_NED",
                    {{T::u32, "time_boot_ms"}, {T::f32, "x"}, {T::f32, "y"}, {T::f32, "z"},
                     {T::f32, "vx"}, {T::f32, "vy"}, {T::f32, "vz"}}));

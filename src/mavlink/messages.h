@@ -15,6 +15,9 @@ namespace eamos::mavlink {
 namespace msg {
 inline constexpr uint32_t HEARTBEAT = 0;
 inline constexpr uint32_t SYS_STATUS = 1;
+inline constexpr uint32_t PARAM_REQUEST_READ = 20;
+inline constexpr uint32_t PARAM_VALUE = 22;
+inline constexpr uint32_t PARAM_SET = 23;
 inline constexpr uint32_t LOCAL_POSITION_NED = 32;
 inline constexpr uint32_t GLOBAL_POSITION_INT = 33;
 inline constexpr uint32_t COMMAND_INT = 75;

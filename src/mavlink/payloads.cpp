@@ -11,6 +11,14 @@ const MessageDef& def_of(uint32_t id) { return *find_message(id); }
 
 std::string param_name(int i) { return "param" + std::to_string(i + 1); }
 
+// Text from the vehicle goes into logs, traces and JSON: anything but printable ASCII (a
+// hostile or broken sender's bytes, invalid UTF-8) becomes '?'.
+std::string printable(std::string text) {
+  for (char& c : text)
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) c = '?';
+  return text;
+}
+
 }  // namespace
 
 Message pack(const Heartbeat& m) {
@@ -30,6 +38,58 @@ std::optional<Heartbeat> unpack_heartbeat(const Message& m) {
   return Heartbeat{r.get<uint8_t>("type"), r.get<uint8_t>("autopilot"),
                    r.get<uint8_t>("base_mode"), r.get<uint32_t>("custom_mode"),
                    r.get<uint8_t>("system_status"), r.get<uint8_t>("mavlink_version")};
+}
+
+Message pack(const ParamRequestRead& m) {
+  FieldWriter w(def_of(msg::PARAM_REQUEST_READ));
+  w.set("target_system", m.target_system);
+  w.set("target_component", m.target_component);
+  w.set_chars("param_id", m.param_id);
+  w.set("param_index", m.param_index);
+  return w.take();
+}
+
+std::optional<ParamRequestRead> unpack_param_request_read(const Message& m) {
+  if (m.id != msg::PARAM_REQUEST_READ) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  return ParamRequestRead{r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component"),
+                          printable(r.get_chars("param_id")), r.get<int16_t>("param_index")};
+}
+
+Message pack(const ParamValue& m) {
+  FieldWriter w(def_of(msg::PARAM_VALUE));
+  w.set_chars("param_id", m.param_id);
+  w.set("param_value", m.param_value);
+  w.set("param_type", m.param_type);
+  w.set("param_count", m.param_count);
+  w.set("param_index", m.param_index);
+  return w.take();
+}
+
+std::optional<ParamValue> unpack_param_value(const Message& m) {
+  if (m.id != msg::PARAM_VALUE) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  return ParamValue{printable(r.get_chars("param_id")), r.get<float>("param_value"),
+                    r.get<uint8_t>("param_type"), r.get<uint16_t>("param_count"),
+                    r.get<uint16_t>("param_index")};
+}
+
+Message pack(const ParamSet& m) {
+  FieldWriter w(def_of(msg::PARAM_SET));
+  w.set("target_system", m.target_system);
+  w.set("target_component", m.target_component);
+  w.set_chars("param_id", m.param_id);
+  w.set("param_value", m.param_value);
+  w.set("param_type", m.param_type);
+  return w.take();
+}
+
+std::optional<ParamSet> unpack_param_set(const Message& m) {
+  if (m.id != msg::PARAM_SET) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  return ParamSet{r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component"),
+                  printable(r.get_chars("param_id")), r.get<float>("param_value"),
+                  r.get<uint8_t>("param_type")};
 }
 
 Message pack(const SysStatus& m) {
@@ -261,12 +321,11 @@ Message pack(const Statustext& m) {
 std::optional<Statustext> unpack_statustext(const Message& m) {
   if (m.id != msg::STATUSTEXT) return std::nullopt;
   FieldReader r(def_of(m.id), m);
-  // The text goes into logs, traces and JSON: anything but printable ASCII (a hostile or
-  // broken sender's bytes, invalid UTF-8) becomes '?'.
+  // PX4 ends a text with a newline: trailing control characters and blanks are no text.
   std::string text = r.get_chars("text");
-  for (char& c : text)
-    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) c = '?';
-  return Statustext{r.get<uint8_t>("severity"), text, r.get<uint16_t>("id"), r.get<uint8_t>("chunk_seq")};
+  while (!text.empty() && static_cast<unsigned char>(text.back()) <= 0x20) text.pop_back();
+  return Statustext{r.get<uint8_t>("severity"), printable(text), r.get<uint16_t>("id"),
+                    r.get<uint8_t>("chunk_seq")};
 }
 
 }  // namespace eamos::mavlink

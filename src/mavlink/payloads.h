@@ -111,12 +111,49 @@ struct BatteryStatus {
 /// longer than 50 characters arrive in chunks sharing an id (chunk_seq counts up).
 struct Statustext {
   uint8_t severity = 6;  ///< MAV_SEVERITY: 0 emergency … 3 error, 4 warning, 6 info, 7 debug
-  std::string text;      ///< up to 50 characters; not NUL-terminated on the wire when full
+  std::string text;      ///< up to 50 characters; not NUL-terminated on the wire when full;
+                         ///< read: printable ASCII only, trailing newline and blanks dropped
   uint16_t id = 0;       ///< 0: a message of one chunk
   uint8_t chunk_seq = 0;
 };
 
+/// A parameter by name (param_index -1) or by index. Names are up to 16 characters.
+struct ParamRequestRead {
+  uint8_t target_system = 0;
+  uint8_t target_component = 0;
+  std::string param_id;
+  int16_t param_index = -1;  ///< -1: look the parameter up by param_id
+};
+
+/// MAV_PARAM_TYPE: the autopilot's type of a parameter. param_value is a float field for every
+/// type: ArduPilot converts an integer parameter to a float, PX4 copies its bytes (MAVLink's
+/// "bytewise" encoding), so an integer is read by the sender's convention.
+namespace param_type {
+inline constexpr uint8_t UINT8 = 1, INT8 = 2, UINT16 = 3, INT16 = 4, UINT32 = 5, INT32 = 6, REAL32 = 9;
+}
+
+/// One parameter's value, the autopilot's answer to PARAM_REQUEST_READ or PARAM_SET.
+struct ParamValue {
+  std::string param_id;
+  float param_value = 0;
+  uint8_t param_type = param_type::REAL32;
+  uint16_t param_count = 0;
+  uint16_t param_index = 0;
+};
+
+/// Sets a parameter; the autopilot answers with PARAM_VALUE (the value it took).
+struct ParamSet {
+  uint8_t target_system = 0;
+  uint8_t target_component = 0;
+  std::string param_id;
+  float param_value = 0;
+  uint8_t param_type = param_type::REAL32;
+};
+
 Message pack(const Heartbeat& m);
+Message pack(const ParamRequestRead& m);
+Message pack(const ParamValue& m);
+Message pack(const ParamSet& m);
 Message pack(const SysStatus& m);
 Message pack(const LocalPositionNed& m);
 Message pack(const GlobalPositionInt& m);
@@ -129,6 +166,10 @@ Message pack(const BatteryStatus& m);
 Message pack(const Statustext& m);
 
 std::optional<Heartbeat> unpack_heartbeat(const Message& m);
+std::optional<ParamRequestRead> unpack_param_request_read(const Message& m);
+/// The name keeps only printable ASCII (anything else becomes '?'): it goes into messages.
+std::optional<ParamValue> unpack_param_value(const Message& m);
+std::optional<ParamSet> unpack_param_set(const Message& m);
 std::optional<SysStatus> unpack_sys_status(const Message& m);
 std::optional<LocalPositionNed> unpack_local_position_ned(const Message& m);
 std::optional<GlobalPositionInt> unpack_global_position_int(const Message& m);

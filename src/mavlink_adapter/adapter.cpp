@@ -26,6 +26,8 @@ void register_adapter(mid::AdapterRegistry& registry, MavlinkOptions options) {
         scaled.link_timeout_s *= options.speed;
         scaled.commands.ack_timeout_s *= options.speed;
         scaled.commands.in_progress_s *= options.speed;
+        scaled.mode_confirm_s *= options.speed;
+        scaled.statustext_wait_s *= options.speed;
         auto drone = std::make_unique<MavlinkDrone>(settings, type, loop, scaled);
         if (std::string error = drone->connect(*url.endpoint); !error.empty()) return failed(error);
         return {mid::CreateStatus::success, std::move(drone), ""};

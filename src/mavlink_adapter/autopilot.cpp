@@ -9,15 +9,19 @@ namespace {
 // ArduCopter mode numbers (ArduPilot's Copter/mode.h).
 constexpr uint32_t kCopterGuided = 4;
 constexpr uint32_t kCopterLoiter = 5;
+constexpr uint32_t kCopterRtl = 6;
+constexpr uint32_t kCopterLand = 9;
 
 const Autopilot kPx4{"PX4", mavlink::autopilot::PX4, px4::OFFBOARD, "OFFBOARD",
                      /*stream_before_switch=*/true, /*takeoff_in_setpoint_mode=*/false,
                      /*takeoff_altitude_amsl=*/true, /*main_sub_modes=*/true,
-                     /*do_orbit=*/true, px4::ORBIT, px4::LOITER};
+                     /*do_orbit=*/true, px4::ORBIT, px4::LOITER,
+                     /*arm_mode=*/px4::LOITER, px4::LAND, px4::RTL};
 const Autopilot kArduPilot{"ArduPilot", mavlink::autopilot::ARDUPILOTMEGA, kCopterGuided, "GUIDED",
                            /*stream_before_switch=*/false, /*takeoff_in_setpoint_mode=*/true,
                            /*takeoff_altitude_amsl=*/false, /*main_sub_modes=*/false,
-                           /*do_orbit=*/false, 0, kCopterLoiter};
+                           /*do_orbit=*/false, 0, kCopterLoiter,
+                           /*arm_mode=*/kCopterGuided, kCopterLand, kCopterRtl};
 
 }  // namespace
 
@@ -25,6 +29,10 @@ const Autopilot* autopilot_for(uint8_t mav_autopilot) {
   for (const Autopilot* a : {&kPx4, &kArduPilot})
     if (a->mav_autopilot == mav_autopilot) return a;
   return nullptr;
+}
+
+bool can_arm_in(const Autopilot& a, uint32_t custom_mode) {
+  return custom_mode != a.land_mode && custom_mode != a.rtl_mode;
 }
 
 std::array<float, 3> set_mode_params(const Autopilot& a, uint32_t custom_mode) {

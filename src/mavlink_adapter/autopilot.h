@@ -32,7 +32,16 @@ struct Autopilot {
   /// Where a cancelled DO_ORBIT goes at once: the autopilot's hold (PX4: AUTO.LOITER), so the
   /// vehicle stops circling before the setpoint stream has earned the setpoint mode.
   uint32_t hold_mode;
+  /// The mode switched to before arming from a mode that cannot arm (`land_mode`,
+  /// `rtl_mode`: where a landing leaves the vehicle): ArduCopter cannot arm in LAND or RTL
+  /// ("Arm: LAND mode not armable"), its GUIDED can with a position; PX4's AUTO.LOITER can.
+  uint32_t arm_mode;
+  uint32_t land_mode;
+  uint32_t rtl_mode;
 };
+
+/// False for the modes the autopilot refuses to arm in.
+bool can_arm_in(const Autopilot& a, uint32_t custom_mode);
 
 /// The row for a HEARTBEAT.autopilot value; nullptr for autopilots we do not fly.
 const Autopilot* autopilot_for(uint8_t mav_autopilot);

@@ -58,8 +58,8 @@ void CommandSender::on_ack(const ml::CommandAck& ack) {
     });
     return;
   }
-  if (ack.result == ml::result::ACCEPTED) finish(ack.command, {true, ""});
-  else finish(ack.command, {false, ml::command_name(ack.command) + ": " + ml::result_text(ack.result)});
+  if (ack.result == ml::result::ACCEPTED) finish(ack.command, {true, "", true});
+  else finish(ack.command, {false, ml::command_name(ack.command) + ": " + ml::result_text(ack.result), true});
 }
 
 void CommandSender::finish(uint16_t id, CommandResult result) {

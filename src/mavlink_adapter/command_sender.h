@@ -24,6 +24,7 @@ struct CommandOptions {
 struct CommandResult {
   bool accepted = false;
   std::string error;  ///< "" when accepted; else the command and the MAV_RESULT (or no ACK) in words
+  bool answered = false;  ///< the vehicle sent a final COMMAND_ACK (accepted or not)
 };
 using CommandDone = std::function<void(const CommandResult&)>;
 

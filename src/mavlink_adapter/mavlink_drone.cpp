@@ -57,7 +57,7 @@ ActionId MavlinkDrone::start(const mid::ActionRequest& request, mid::EndCallback
   if (std::string why = refusal(request, *check.spec); !why.empty())
     return tracker_.refuse(request, std::move(on_end), why);
 
-  double timeout = mid::action_timeout(request, reference(), settings_);
+  double timeout = timeout_for(request);
   fleet::ActionClass cls = check.spec->action_class;
   if (cls == fleet::ActionClass::motion) clear_action_timer(tracker_.motion());  // preempted
   ActionId id = tracker_.begin(request, cls, std::move(on_end), timeout);
@@ -74,21 +74,62 @@ std::string MavlinkDrone::refusal(const mid::ActionRequest& r, const fleet::Acti
   // autopilot knows (arming checks, its own limits) it judges, and its MAV_RESULT becomes the
   // reason. Takeoff while disarmed is refused here too: PX4 may accept the takeoff mode while
   // disarmed and take off by itself once something arms it later.
-  mid::VehicleFacts v{vehicle_.armed, vehicle_.landed(), reference(), ""};
+  // A vehicle the autopilot disarmed while it waited for its Takeoff is armed again by it.
+  bool armed = vehicle_.armed || (r.name == "Takeoff" && armed_waiting_ && vehicle_.landed());
+  mid::VehicleFacts v{armed, vehicle_.landed(), reference(), ""};
   if (tracker_.motion() != mid::kNoAction) v.running_motion = tracker_.request(tracker_.motion())->name;
   if (r.name == "Disarm") v.position = position();
   return mid::uniform_refusal(r, spec, v, settings_);
 }
 
+// Deadlines from the slower of the fleet's and the autopilot's limits (autopilot_params.h);
+// a landing descends at the autopilot's landing speed.
+double MavlinkDrone::timeout_for(const mid::ActionRequest& r) const {
+  fleet::DroneSettings timing = settings_;
+  timing.limits = limits_.motion;
+  if (r.name == "Land" || r.name == "ReturnHome") timing.limits.max_descent_mps = limits_.land_mps;
+  return mid::action_timeout(r, reference(), timing);
+}
+
 void MavlinkDrone::start_system(ActionId id, const mid::ActionRequest& r) {
-  bool arm = r.name == "Arm";
-  commands_.send(command(ml::cmd::COMPONENT_ARM_DISARM, {arm ? 1.0f : 0.0f}),
-                 [this, id, arm](const CommandResult& result) {
+  if (r.name == "Arm") {
+    return arm(id, [this, id] {
+      armed_waiting_ = true;
+      tracker_.end(id, Outcome::succeeded);
+    });
+  }
+  disarm_commanded_ = true;
+  commands_.send(command(ml::cmd::COMPONENT_ARM_DISARM, {0.0f}), [this, id](const CommandResult& result) {
+    if (!tracker_.running(id)) return;
+    if (!result.accepted) return end_refused(id, result);
+    armed_waiting_ = false;
+    vehicle_.armed = false;  // the next HEARTBEAT confirms it
+    publish();
+    tracker_.end(id, Outcome::succeeded);
+  });
+}
+
+void MavlinkDrone::arm(ActionId id, std::function<void()> armed) {
+  // Until a HEARTBEAT is folded in, the mode is unknown: switch rather than be refused.
+  if (vehicle_.heard && can_arm_in(*autopilot_, vehicle_.custom_mode)) return send_arm(id, std::move(armed));
+  auto p = set_mode_params(*autopilot_, autopilot_->arm_mode);
+  send_mode_command(command(ml::cmd::DO_SET_MODE, {p[0], p[1], p[2]}),
+                    [this, id, armed = std::move(armed)](const CommandResult& result) mutable {
+                      if (!tracker_.running(id)) return;
+                      if (!result.accepted) return end_refused(id, result);
+                      send_arm(id, std::move(armed));
+                    });
+}
+
+void MavlinkDrone::send_arm(ActionId id, std::function<void()> armed) {
+  disarm_commanded_ = false;
+  commands_.send(command(ml::cmd::COMPONENT_ARM_DISARM, {1.0f}),
+                 [this, id, armed = std::move(armed)](const CommandResult& result) {
                    if (!tracker_.running(id)) return;
                    if (!result.accepted) return end_refused(id, result);
-                   vehicle_.armed = arm;  // the next HEARTBEAT confirms it
+                   vehicle_.armed = true;  // the next HEARTBEAT (10 Hz) confirms it
                    publish();
-                   tracker_.end(id, Outcome::succeeded);
+                   armed();
                  });
 }
 
@@ -154,6 +195,14 @@ void MavlinkDrone::start_motion(ActionId id, const mid::ActionRequest& r) {
 }
 
 void MavlinkDrone::start_takeoff(ActionId id, double altitude) {
+  if (!vehicle_.armed && vehicle_.landed()) {
+    // The autopilot disarmed it while it waited (refusal() let only that case through).
+    note("arming again for " + tracker_.request(id)->name + " after the autopilot's auto-disarm");
+    return arm(id, [this, id, altitude] {
+      if (motion_owner_ == id) start_takeoff(id, altitude);
+    });
+  }
+  armed_waiting_ = false;
   const Vec3 here = position();
   goal_.emplace(Vec3{here.x, here.y, ground_z() + altitude}, options_.tolerance);
   until_ = Until::reached;
@@ -209,7 +258,18 @@ void MavlinkDrone::end_refused(ActionId id, const CommandResult& result) {
     motion_owner_ = mid::kNoAction;
     goal_.reset();
   }
-  tracker_.end(id, Outcome::failed, std::string("refused by ") + autopilot_->name + ": " + result.error);
+  std::string reason = std::string("refused by ") + autopilot_->name + ": " + result.error;
+  if (!result.answered) {
+    tracker_.end(id, Outcome::failed, reason);
+    return;
+  }
+  // The autopilot's reason ("Arm: LAND mode not armable") comes as STATUSTEXT, which
+  // ArduPilot queues and sends after the COMMAND_ACK: wait a moment for it.
+  double since = tracker_.started_at(id);
+  action_timers_[id] = loop_.after(options_.statustext_wait_s, [this, id, reason, since] {
+    action_timers_.erase(id);
+    if (tracker_.running(id)) tracker_.end(id, Outcome::failed, reason + autopilot_says(since));
+  });
 }
 
 // --- stopping ------------------------------------------------------------------------------
@@ -267,6 +327,8 @@ void MavlinkDrone::failsafe(fleet::Failsafe what) {
   }
   if (vehicle_.landed()) {
     streaming_ = false;
+    armed_waiting_ = false;
+    disarm_commanded_ = true;
     if (vehicle_.armed) commands_.send(command(ml::cmd::COMPONENT_ARM_DISARM, {0.0f}), nullptr);
     return;
   }

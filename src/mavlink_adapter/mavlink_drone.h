@@ -16,6 +16,8 @@
 // Every frame arrives on the link's thread and is posted to the event loop, so all state
 // here is touched by the loop's thread only. No HEARTBEAT for `link_timeout_s` = link lost:
 // the running actions end `failed` and new ones are refused until heartbeats return.
+#include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -23,6 +25,7 @@
 
 #include "mavlink/link.h"
 #include "mavlink_adapter/autopilot.h"
+#include "mavlink_adapter/autopilot_params.h"
 #include "mavlink_adapter/command_sender.h"
 #include "mavlink_adapter/telemetry.h"
 #include "mid/action_tracker.h"
@@ -45,6 +48,18 @@ struct MavlinkOptions {
   double setpoint_hz = 10.0;       ///< setpoint stream rate (PX4 needs > 2 Hz in OFFBOARD)
   int setpoints_before_switch = 5; ///< PX4: setpoints sent before asking for OFFBOARD
   double position_hz = 10.0;       ///< LOCAL_POSITION_NED rate asked for
+  /// HEARTBEAT rate asked for: the armed flag travels only there, and a disarm (the
+  /// autopilot's auto-disarm on the ground) must be seen within 100 ms.
+  double heartbeat_hz = 10.0;
+  /// Wall seconds at connect to read the autopilot's speed parameters (PARAM_REQUEST_READ,
+  /// resent every half second); what has not come by then keeps the fleet's limit.
+  double param_timeout_s = 3.0;
+  /// After an accepted mode switch, how long a HEARTBEAT in another mode still counts as sent
+  /// before the switch took effect (seconds; scaled like the link's budgets).
+  double mode_confirm_s = 3.0;
+  /// ArduPilot queues the STATUSTEXT that explains a refusal and sends it after the
+  /// COMMAND_ACK: a refused action waits this long for it (seconds; scaled).
+  double statustext_wait_s = 0.5;
   mid::Tolerance tolerance;        ///< when a goal counts as reached: this close ...
   double settled_mps = 0.3;        ///< ... and no faster than this (stopped, not passing by)
 };
@@ -67,6 +82,11 @@ class MavlinkDrone final : public mid::Drone {
   mid::SubscriptionId subscribe(mid::StateCallback fn) override;
   void unsubscribe(mid::SubscriptionId id) override { broker_.unsubscribe(id); }
   void failsafe(fleet::Failsafe what) override;
+  void set_message_sink(std::function<void(const std::string&)> sink) override { message_sink_ = std::move(sink); }
+
+  /// The limits deadlines are derived from: the slower of the fleet's and the autopilot's
+  /// (known after connect()), and what to warn about at start.
+  const FlightLimits& flight_limits() const { return limits_; }
 
   /// The autopilot row chosen from the first HEARTBEAT; nullptr before connect().
   const Autopilot* autopilot() const { return autopilot_; }
@@ -90,12 +110,25 @@ class MavlinkDrone final : public mid::Drone {
   void start_payload(mid::ActionId id, const mid::ActionRequest& r);
   void start_motion(mid::ActionId id, const mid::ActionRequest& r);
   void start_takeoff(mid::ActionId id, double altitude);
+  /// Arms, first switching to a mode where arming is allowed when the vehicle is in one where
+  /// it is not (ArduPilot cannot arm in LAND, where a landing leaves it); `armed` runs once
+  /// the autopilot accepted.
+  void arm(mid::ActionId id, std::function<void()> armed);
+  void send_arm(mid::ActionId id, std::function<void()> armed);
+  double timeout_for(const mid::ActionRequest& r) const;
   void command_motion(mid::ActionId id, uint16_t cmd, std::array<float, 7> params = {});
   void end_refused(mid::ActionId id, const CommandResult& result);
   void stop_action(mid::ActionId id);
   void clear_action_timer(mid::ActionId id);
   void hold_here();
   void fail_all(const std::string& reason);
+
+  // the vehicle's own words (mavlink_drone_link.cpp)
+  void on_statustext(const mavlink::Statustext& t);
+  /// "; ArduPilot says: …": its warnings and errors since `since` (mission s), or "".
+  std::string autopilot_says(double since) const;
+  void note(const std::string& text);  ///< to the trace (message sink)
+  void on_armed_changed();
 
   // link, telemetry, setpoints (mavlink_drone_link.cpp)
   void on_frame(const mavlink::Frame& frame);
@@ -149,6 +182,19 @@ class MavlinkDrone final : public mid::Drone {
   bool telemetry_requested_ = false;
   std::string failsafe_reason_;  ///< "" = none; else why new actions are refused
   int pictures_ = 0;
+  FlightLimits limits_;
+  std::function<void(const std::string&)> message_sink_;
+  struct Text {
+    double t;
+    uint8_t severity;
+    std::string text;
+  };
+  std::deque<Text> texts_;  ///< the autopilot's recent STATUSTEXTs, newest last
+  std::map<uint16_t, std::string> chunks_;  ///< STATUSTEXT id -> the chunks so far
+  /// The mission armed the vehicle and it has not taken off since: an autopilot's auto-disarm
+  /// in this state is survived by arming again before the Takeoff.
+  bool armed_waiting_ = false;
+  bool disarm_commanded_ = false;  ///< a disarm now is ours (Disarm, failsafe), not the autopilot's
 
   // the motion the adapter flies for an action
   mid::ActionId motion_owner_ = mid::kNoAction;
@@ -165,7 +211,7 @@ class MavlinkDrone final : public mid::Drone {
   /// HEARTBEAT in another mode is one sent before the switch took effect (PX4 acknowledges
   /// DO_SET_MODE a cycle before its mode changes), not somebody taking over.
   bool mode_confirmed_ = false;
-  int heartbeats_unconfirmed_ = 0;  ///< HEARTBEATs since acceptance without the setpoint mode
+  double mode_granted_at_ = 0.0;  ///< loop time the setpoint mode was last granted
   fleet::Vec3 setpoint_;          ///< mission frame
   Orbit orbit_;  ///< active: our setpoints fly it; commanded: the autopilot does
   int setpoints_sent_ = 0;

@@ -5,6 +5,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <mutex>
 
 #include "mavlink/enums.h"
@@ -22,14 +23,51 @@ namespace {
 
 constexpr uint8_t kLastMavResult = 9;  ///< MAV_RESULT_UNSUPPORTED_MAV_FRAME
 
-/// The first autopilot HEARTBEAT, handed from the link's thread to connect().
+/// The first autopilot HEARTBEAT and the parameters read at connect, handed from the link's
+/// thread to connect().
 struct FirstHeartbeat {
   std::mutex mutex;
   std::condition_variable cv;
   bool heard = false;
   uint8_t sysid = 0;
   uint8_t autopilot = 0;
+  std::map<std::string, float> params;  ///< PARAM_VALUE of the autopilot, by name
 };
+
+/// Reads `params` by name, asking again every half second for those missing, for at most
+/// `timeout_s` wall seconds; blocking like the wait for the HEARTBEAT (`lock` holds
+/// `first`'s mutex). What did not come is missing from the result.
+std::map<std::string, float> read_params(FirstHeartbeat& first, std::unique_lock<std::mutex>& lock,
+                                         const std::vector<LimitParam>& params, double timeout_s,
+                                         const std::function<void(const char*)>& request) {
+  auto all_read = [&] {
+    for (const LimitParam& p : params)
+      if (!first.params.contains(p.name)) return false;
+    return true;
+  };
+  using clock = std::chrono::steady_clock;
+  auto deadline = clock::now() + std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(timeout_s));
+  while (!all_read() && clock::now() < deadline) {
+    std::vector<const char*> missing;
+    for (const LimitParam& p : params)
+      if (!first.params.contains(p.name)) missing.push_back(p.name);
+    lock.unlock();  // the link's thread fills `first` meanwhile
+    for (const char* name : missing) request(name);
+    lock.lock();
+    first.cv.wait_until(lock, std::min(deadline, clock::now() + std::chrono::milliseconds(500)), all_read);
+  }
+  return first.params;
+}
+
+constexpr std::size_t kTextsKept = 32;
+constexpr std::size_t kMaxTextLength = 50 * 8;  ///< longest text assembled from chunks
+constexpr std::size_t kMaxChunkedTexts = 4;     ///< texts being assembled at once
+constexpr uint8_t kSeverityWarning = 4;  ///< MAV_SEVERITY_WARNING: refusals explain at or above it
+
+const char* severity_name(uint8_t s) {
+  static const char* names[] = {"emergency", "alert", "critical", "error", "warning", "notice", "info", "debug"};
+  return s < 8 ? names[s] : "unknown";
+}
 
 }  // namespace
 
@@ -40,6 +78,12 @@ std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
   mid::EventLoop* loop = &loop_;
   // Runs on the link's thread: it may only note the first heartbeat and post the frame.
   auto handler = [this, first, wanted, alive, loop](ml::Frame frame) {
+    if (auto pv = ml::unpack_param_value(frame.message); pv && frame.compid == ml::comp::AUTOPILOT1) {
+      std::lock_guard lock(first->mutex);
+      if (first->heard && frame.sysid == first->sysid) first->params[pv->param_id] = pv->param_value;
+      first->cv.notify_all();
+      return;
+    }
     if (auto hb = ml::unpack_heartbeat(frame.message);
         hb && hb->autopilot != ml::autopilot::INVALID && (wanted == 0 || frame.sysid == wanted)) {
       std::lock_guard lock(first->mutex);
@@ -77,13 +121,23 @@ std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
     return "system " + std::to_string(sysid_) + " on " + endpoint.url + " reports MAV_AUTOPILOT " +
            std::to_string(first->autopilot) + "; the mavlink adapter flies PX4 (12) and ArduPilot (3)";
   }
-  lock.unlock();
   link_->follow_only(sysid_);  // from now on only the vehicle's frames move a udp:// link
   encoder_ = {sysid_, ml::comp::ONBOARD_COMPUTER, 0};
+  // Before the mission starts, so that its first deadline already knows how fast the
+  // autopilot flies.
+  std::map<std::string, float> values = read_params(*first, lock, limit_params(*autopilot_), options_.param_timeout_s,
+                                                    [this](const char* name) {
+                                                      send(ml::pack(ml::ParamRequestRead{sysid_, ml::comp::AUTOPILOT1, name, -1}));
+                                                    });
+  lock.unlock();
+  limits_ = combine_limits(*autopilot_, settings_.limits, values);
+  for (const std::string& w : limits_.warnings) std::cerr << "eamos: warning: " << settings_.name << ": " << w << "\n";
   send_heartbeat();
   link_watchdog();
   return "";
 }
+
+
 
 // --- frames --------------------------------------------------------------------------------
 
@@ -101,8 +155,11 @@ void MavlinkDrone::on_frame(const ml::Frame& frame) {
   }
   if (auto hb = ml::unpack_heartbeat(frame.message); hb && hb->autopilot == ml::autopilot::INVALID)
     return;  // a camera, gimbal or companion of the same system: not the autopilot
+  if (auto t = ml::unpack_statustext(frame.message); t && frame.compid == ml::comp::AUTOPILOT1)
+    return on_statustext(*t);
   Changes c = apply_telemetry(vehicle_, frame);
   if (c.rejected) return note_rejected(c.rejected);
+  if (c.armed) on_armed_changed();
   if (c.heartbeat) on_heartbeat();
   if (c.landed && vehicle_.landed()) {
     streaming_ = false;  // on the ground: nothing to hold
@@ -110,6 +167,48 @@ void MavlinkDrone::on_frame(const ml::Frame& frame) {
   }
   if (c.position || c.landed) check_goal();
   if (c.position || c.armed || c.landed) publish();
+}
+
+void MavlinkDrone::on_statustext(const ml::Statustext& t) {
+  std::string text = t.text;
+  if (t.id != 0) {
+    // A text longer than 50 characters comes in chunks of one id; a chunk shorter than 50
+    // is the last. Bounded: a sender that never ends a text cannot grow this without limit.
+    std::string& pending = chunks_[t.id];
+    pending += t.text;
+    if (t.text.size() >= 50 && pending.size() < kMaxTextLength && chunks_.size() <= kMaxChunkedTexts) return;
+    text = pending;
+    chunks_.erase(t.id);
+  }
+  texts_.push_back({loop_.now(), t.severity, text});
+  if (texts_.size() > kTextsKept) texts_.pop_front();
+  note(std::string(autopilot_->name) + " " + severity_name(t.severity) + ": " + text);
+}
+
+std::string MavlinkDrone::autopilot_says(double since) const {
+  std::string said;
+  for (const Text& t : texts_) {
+    if (t.t < since || t.severity > kSeverityWarning) continue;
+    if (said.find(t.text) != std::string::npos) continue;  // the same text repeated
+    said += (said.empty() ? "" : "; ") + t.text;
+  }
+  return said.empty() ? "" : std::string("; ") + autopilot_->name + " says: " + said;
+}
+
+void MavlinkDrone::note(const std::string& text) {
+  if (message_sink_) message_sink_(text);
+}
+
+// A disarm the mission did not ask for. On the ground after the mission's Arm it is the
+// autopilot's auto-disarm (ArduPilot DISARM_DELAY, PX4 COM_DISARM_PRFLT): the next Takeoff
+// arms again. The mission sees the drone disarmed meanwhile, as it is.
+void MavlinkDrone::on_armed_changed() {
+  if (vehicle_.armed || disarm_commanded_) return;
+  if (armed_waiting_ && vehicle_.landed())
+    note(std::string(autopilot_->name) + " disarmed the vehicle on the ground by itself (auto-disarm); "
+         "eamos arms it again before its Takeoff");
+  else if (!vehicle_.landed())
+    note(std::string(autopilot_->name) + " reports the vehicle disarmed in the air");
 }
 
 void MavlinkDrone::note_rejected(const char* what) {
@@ -130,8 +229,8 @@ void MavlinkDrone::on_heartbeat() {
     mode_confirmed_ = true;
     return;
   }
-  // Three HEARTBEATs (about 3 s) without the mode we were granted: it never took effect.
-  if (!mode_confirmed_ && ++heartbeats_unconfirmed_ < 3) return;
+  // mode_confirm_s (about 3 s) without the mode we were granted: it never took effect.
+  if (!mode_confirmed_ && loop_.now() - mode_granted_at_ < options_.mode_confirm_s) return;
   // Someone else (a pilot's switch, the autopilot's own failsafe) took the vehicle out of
   // the setpoint mode: give way instead of switching back.
   streaming_ = false;
@@ -169,7 +268,7 @@ void MavlinkDrone::lose_link() {
 void MavlinkDrone::request_telemetry() {
   telemetry_requested_ = true;
   struct Rate { uint32_t id; double hz; };
-  for (Rate r : {Rate{ml::msg::LOCAL_POSITION_NED, options_.position_hz},
+  for (Rate r : {Rate{ml::msg::HEARTBEAT, options_.heartbeat_hz}, Rate{ml::msg::LOCAL_POSITION_NED, options_.position_hz},
                  Rate{ml::msg::EXTENDED_SYS_STATE, 2.0}, Rate{ml::msg::GLOBAL_POSITION_INT, 2.0},
                  Rate{ml::msg::SYS_STATUS, 1.0}, Rate{ml::msg::BATTERY_STATUS, 1.0}}) {
     // An autopilot that refuses a rate still streams its defaults: nothing to do about it.
@@ -267,7 +366,7 @@ void MavlinkDrone::switch_to_setpoint_mode() {
     if (r.accepted) {
       in_control_ = true;
       mode_confirmed_ = false;
-      heartbeats_unconfirmed_ = 0;
+      mode_granted_at_ = loop_.now();
       return;
     }
     streaming_ = false;

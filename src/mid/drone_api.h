@@ -98,6 +98,11 @@ class Drone {
   /// The mission failed: cancel every running action and land where the drone is, return
   /// home and land, or hover. After it the drone refuses new actions.
   virtual void failsafe(fleet::Failsafe what) = 0;
+
+  /// Where the vehicle's own messages go (an autopilot's STATUSTEXT, what the adapter did
+  /// about the vehicle on its own, such as re-arming after an auto-disarm): the DEX puts each
+  /// in the trace. Called on the loop's thread; an empty function stops them. Default: none.
+  virtual void set_message_sink(std::function<void(const std::string&)>) {}
 };
 
 }  // namespace eamos::mid

@@ -92,6 +92,29 @@ void SimVehicle::on_frame(const ml::Frame& frame) {
     return on_command(*c);
   }
   if (auto sp = ml::unpack_set_position_target_local_ned(frame.message)) return on_setpoint(*sp);
+  if (auto r = ml::unpack_param_request_read(frame.message)) return on_param_request(*r);
+}
+
+// The speed parameters the real autopilot has, valued as the simulator flies (its default
+// limits: 10 m/s across, 3 up, 2 down); a name it does not know gets no answer, like on the
+// real ones.
+void SimVehicle::on_param_request(const ml::ParamRequestRead& r) {
+  if ((r.target_system != options_.sysid && r.target_system != 0) || r.param_index != -1) return;
+  const fleet::Limits l;
+  bool px4 = dialect_.mav_autopilot == ml::autopilot::PX4;
+  const std::map<std::string, double> params =
+      px4 ? std::map<std::string, double>{{"MPC_XY_CRUISE", l.max_speed_mps}, {"MPC_Z_VEL_MAX_UP", l.max_climb_mps},
+                                          {"MPC_TKO_SPEED", l.max_climb_mps}, {"MPC_Z_VEL_MAX_DN", l.max_descent_mps},
+                                          {"MPC_LAND_SPEED", l.max_descent_mps}}
+          : std::map<std::string, double>{{"WPNAV_SPEED", 100 * l.max_speed_mps},
+                                          {"WPNAV_SPEED_UP", 100 * l.max_climb_mps},
+                                          {"WPNAV_SPEED_DN", 100 * l.max_descent_mps},
+                                          {"LAND_SPEED", 100 * l.max_descent_mps}, {"LAND_SPEED_HIGH", 0}};
+  auto it = params.find(r.param_id);
+  if (it == params.end()) return;
+  int index = static_cast<int>(std::distance(params.begin(), it));
+  send(ml::pack(ml::ParamValue{it->first, static_cast<float>(it->second), ml::param_type::REAL32,
+                               static_cast<uint16_t>(params.size()), static_cast<uint16_t>(index)}));
 }
 
 void SimVehicle::on_command(const ml::CommandLong& c) {

@@ -15,7 +15,9 @@
 //    back to AUTO.LOITER (PX4's offboard loss failsafe, COM_OF_LOSS_T);
 //  - telemetry (LOCAL_POSITION_NED, EXTENDED_SYS_STATE, SYS_STATUS, BATTERY_STATUS,
 //    GLOBAL_POSITION_INT) at 1 Hz each, or the rate SET_MESSAGE_INTERVAL asks for;
-//  - disarms 2 s after touching down (PX4's COM_DISARM_LAND).
+//  - disarms 2 s after touching down (PX4's COM_DISARM_LAND);
+//  - PARAM_REQUEST_READ of the autopilot's speed parameters answered with PARAM_VALUE, valued
+//    as the simulator flies.
 // Its local NED origin is its home; it runs on its own event loop in real time.
 #include <map>
 #include <memory>
@@ -86,6 +88,7 @@ class SimVehicle {
  private:
   void on_frame(const mavlink::Frame& frame);
   void on_command(const mavlink::CommandLong& c);
+  void on_param_request(const mavlink::ParamRequestRead& r);
   uint8_t execute(const mavlink::CommandLong& c);  ///< the MAV_RESULT to acknowledge with,
                                                   ///< or kAckLater
   uint8_t set_mode(Mode mode);

@@ -232,3 +232,54 @@ TEST(RoundTrip, StatustextOfFiftyCharactersAndForeignBytesIsReadSafely) {
 
 }  // namespace
 }  // namespace eamos::mavlink
+
+namespace eamos::mavlink {
+namespace {
+
+// PX4 sends "Armed by external command\n": the newline is no part of the text.
+TEST(RoundTrip, StatustextDropsATrailingNewline) {
+  auto out = unpack_statustext(through_the_wire(pack(Statustext{6, "Armed by external command\n", 0, 0})));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->text, "Armed by external command");
+}
+
+TEST(RoundTrip, ParamRequestReadKeepsTargetNameAndIndex) {
+  auto out = unpack_param_request_read(through_the_wire(pack(ParamRequestRead{3, 1, "WPNAV_SPEED_UP", -1})));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->target_system, 3);
+  EXPECT_EQ(out->target_component, 1);
+  EXPECT_EQ(out->param_id, "WPNAV_SPEED_UP");
+  EXPECT_EQ(out->param_index, -1);
+}
+
+// A name of exactly 16 characters has no NUL on the wire.
+TEST(RoundTrip, ParamValueOfASixteenCharacterNameKeepsEveryField) {
+  ParamValue in{"MPC_Z_VEL_MAX_DN", 1.25f, param_type::REAL32, 1234, 567};
+  ASSERT_EQ(in.param_id.size(), 16u);
+  auto out = unpack_param_value(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->param_id, "MPC_Z_VEL_MAX_DN");
+  EXPECT_EQ(out->param_value, 1.25f);
+  EXPECT_EQ(out->param_type, param_type::REAL32);
+  EXPECT_EQ(out->param_count, 1234);
+  EXPECT_EQ(out->param_index, 567);
+}
+
+TEST(RoundTrip, ParamValueNameWithForeignBytesArrivesAsQuestionMarks) {
+  auto out = unpack_param_value(through_the_wire(pack(ParamValue{"LAND\x01SPEED\xff", 50, param_type::REAL32, 1, 0})));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->param_id, "LAND?SPEED?");
+}
+
+TEST(RoundTrip, ParamSetKeepsTargetNameValueAndType) {
+  auto out = unpack_param_set(through_the_wire(pack(ParamSet{2, 1, "DISARM_DELAY", 0, param_type::INT8})));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->target_system, 2);
+  EXPECT_EQ(out->param_id, "DISARM_DELAY");
+  EXPECT_EQ(out->param_value, 0.0f);
+  EXPECT_EQ(out->param_type, param_type::INT8);
+  EXPECT_FALSE(unpack_param_set(pack(ParamValue{})));
+}
+
+}  // namespace
+}  // namespace eamos::mavlink

@@ -116,7 +116,7 @@ TEST(MavlinkOrbit, DoOrbitRefusedByPx4FailsWithTheResultInWordsAndKeepsHolding) 
   VehicleThread vehicle(25364, 1, kSpeed);
   Flight f(25364);
   Orbiting o;
-  take_off_and_orbit(f, o, 2.0, 2000.0);  // beyond PX4's largest orbit (MC_ORBIT_RAD_MAX)
+  take_off_and_orbit(f, o, 4.0, 2000.0);  // beyond PX4's largest orbit (MC_ORBIT_RAD_MAX)
   ASSERT_TRUE(o.end);
   EXPECT_EQ(o.end->outcome, mid::Outcome::failed);
   EXPECT_EQ(o.end->reason,

@@ -1,0 +1,100 @@
+#include "mavlink_adapter/autopilot_params.h"
+
+#include <cmath>
+#include <cstdio>
+#include <optional>
+
+namespace eamos::mavlink_adapter {
+
+namespace {
+
+// ArduCopter (its parameter docs): waypoint speeds in cm/s; LAND_SPEED is the last 10 m
+// (LAND_ALT_LOW) of a landing, LAND_SPEED_HIGH above it (0: WPNAV_SPEED_DN). The whole
+// descent is counted at the slower one: a deadline must not be too short.
+const std::vector<LimitParam> kArduPilot = {
+    {"WPNAV_SPEED", LimitKind::speed, 0.01},     {"WPNAV_SPEED_UP", LimitKind::climb, 0.01},
+    {"WPNAV_SPEED_DN", LimitKind::descent, 0.01}, {"LAND_SPEED", LimitKind::land, 0.01},
+    {"LAND_SPEED_HIGH", LimitKind::land, 0.01},
+};
+// PX4 (multicopter position control): m/s. A takeoff climbs at MPC_TKO_SPEED, a landing
+// ends at MPC_LAND_SPEED.
+const std::vector<LimitParam> kPx4 = {
+    {"MPC_XY_CRUISE", LimitKind::speed, 1.0},    {"MPC_Z_VEL_MAX_UP", LimitKind::climb, 1.0},
+    {"MPC_TKO_SPEED", LimitKind::climb, 1.0},    {"MPC_Z_VEL_MAX_DN", LimitKind::descent, 1.0},
+    {"MPC_LAND_SPEED", LimitKind::land, 1.0},
+};
+
+const char* fleet_key(LimitKind k) {
+  switch (k) {
+    case LimitKind::speed: return "max_speed";
+    case LimitKind::climb: return "max_climb";
+    case LimitKind::descent:
+    case LimitKind::land: return "max_descent";
+  }
+  return "";
+}
+
+std::string number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+// The slowest value the autopilot gave for `kind`, and which parameter said it.
+struct Slowest {
+  std::optional<double> mps;
+  std::string param;
+};
+
+Slowest slowest(const std::vector<LimitParam>& params, LimitKind kind,
+                const std::map<std::string, float>& values) {
+  Slowest s;
+  for (const LimitParam& p : params) {
+    if (p.kind != kind) continue;
+    auto it = values.find(p.name);
+    // 0 means "use another parameter" (LAND_SPEED_HIGH); NaN or a negative value is no limit
+    // an autopilot flies by: the fleet's limit stands.
+    if (it == values.end() || !std::isfinite(it->second) || it->second <= 0) continue;
+    double mps = it->second * p.to_mps;
+    if (!s.mps || mps < *s.mps) s = {mps, p.name};
+  }
+  return s;
+}
+
+}  // namespace
+
+std::vector<LimitParam> limit_params(const Autopilot& a) {
+  return a.mav_autopilot == mavlink::autopilot::PX4 ? kPx4 : kArduPilot;
+}
+
+FlightLimits combine_limits(const Autopilot& a, const fleet::Limits& fleet,
+                            const std::map<std::string, float>& values) {
+  const std::vector<LimitParam> params = limit_params(a);
+  FlightLimits out;
+  out.motion = fleet;
+  out.land_mps = fleet.max_descent_mps;
+  struct Slot { LimitKind kind; double& value; };
+  for (Slot slot : {Slot{LimitKind::speed, out.motion.max_speed_mps}, Slot{LimitKind::climb, out.motion.max_climb_mps},
+                    Slot{LimitKind::descent, out.motion.max_descent_mps}, Slot{LimitKind::land, out.land_mps}}) {
+    Slowest s = slowest(params, slot.kind, values);
+    if (!s.mps) {
+      std::string names;
+      for (const LimitParam& p : params)
+        if (p.kind == slot.kind) names += std::string(names.empty() ? "" : " or ") + p.name;
+      out.warnings.push_back(std::string(a.name) + " did not tell " + names + "; deadlines use the fleet's " +
+                             fleet_key(slot.kind) + " " + number(slot.value) + " m/s");
+      continue;
+    }
+    out.summary += std::string(out.summary.empty() ? "" : ", ") + s.param + " " + number(*s.mps) + " m/s";
+    // Landing is always slower than a fleet's descent on some autopilot: not worth a warning.
+    if (slot.value > *s.mps && slot.kind != LimitKind::land)
+      out.warnings.push_back("the fleet's " + std::string(fleet_key(slot.kind)) + " " + number(slot.value) +
+                             " m/s is above " + a.name + "'s " + s.param + " " + number(*s.mps) +
+                             " m/s: the vehicle flies at most " + number(*s.mps) + " m/s, deadlines use it");
+    slot.value = std::min(slot.value, *s.mps);
+  }
+  out.land_mps = std::min(out.land_mps, out.motion.max_descent_mps);
+  return out;
+}
+
+}  // namespace eamos::mavlink_adapter
