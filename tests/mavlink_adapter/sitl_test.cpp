@@ -122,6 +122,16 @@ std::vector<std::string> three_hops_of(int d) {
           n + ".Land() succeeded", n + ".Disarm() succeeded"};
 }
 
+// The smallest mission every autopilot must carry, in one eamos process: each of three
+// drones arms, climbs, hops east and lands at the same time, and every action succeeds.
+TEST_P(Sitl, ThreeDronesArmTakeOffFlyAndLandInOneProcess) {
+  auto sitl = start_fleet(kHomes);
+  if (HasFailure()) return;
+  Flight f = fly(mission_path("three_hops.eamos"), fleet_file(*sitl, kHomes), dir_);
+  ASSERT_EQ(f.run.status, 0) << f.run.out;
+  for (int d = 1; d <= 3; ++d) EXPECT_EQ(f.actions["Drone" + std::to_string(d)], three_hops_of(d)) << f.run.out;
+}
+
 // A first mission, then a second on the same autopilots without restarting them: Drone2
 // arms where the first landing left it (ArduPilot: in LAND, where it cannot arm) and waits
 // on the ground longer than the autopilot's auto-disarm before its takeoff.

@@ -251,11 +251,9 @@ void on_probe_frame(Readiness& r, uint8_t sysid, const ml::Frame& f) {
   if (f.sysid != sysid || f.compid != 1) return;
   std::lock_guard lock(r.mutex);
   if (ml::unpack_heartbeat(f.message)) r.heartbeat = true;
-  if (auto s = ml::unpack_sys_status(f.message)) {
-    // An autopilot that does not report the pre-arm bit at all is judged by the rest.
-    bool reported = (s->sensors_present & kPrearmCheck) != 0;
-    r.prearm_ok = !reported || (s->sensors_health & kPrearmCheck) != 0;
-  }
+  // PX4 reports the pre-arm bit only in `health` (not in `present`), and only once its
+  // health checks pass; ArduPilot sets it in both. So the health bit alone decides.
+  if (auto s = ml::unpack_sys_status(f.message)) r.prearm_ok = (s->sensors_health & kPrearmCheck) != 0;
   if (auto g = ml::unpack_global_position_int(f.message)) r.position = g->lat != 0 || g->lon != 0;
   if (auto t = ml::unpack_statustext(f.message))
     if (t->text.find("is using GPS") != std::string::npos) r.ekf_uses_gps = true;
