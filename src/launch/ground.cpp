@@ -151,7 +151,11 @@ int Ground::run() {
   // Logged on the ground's own thread: the listener that dropped the sample only posts.
   h.dropped = [this](const std::string& line) { inbox_.deliver([this, line] { err_ << "ground: " << line << "\n"; }); };
   h.limits.drones = static_cast<int>(drones_.size());
-  node_ = transport::DdsNode::open(o_.dds, std::move(h), error);
+  transport::DdsOptions dds = o_.dds;
+  dds.mission_hash = hash_;
+  dds.self = transport::kGroundParticipant;
+  if (!o_.insecure) dds.security_folder = o_.dir + "/ground-station/security";
+  node_ = transport::DdsNode::open(dds, std::move(h), error);
   if (!node_) {
     err_ << "eamos launch: error: " << error << "\n";
     return 1;
@@ -223,6 +227,7 @@ bool Ground::start_processes() {
     argv.insert(argv.end(), {"--time-limit", number});
     std::snprintf(number, sizeof number, "%.17g", o_.barrier_timeout_s + 5.0);
     argv.insert(argv.end(), {"--start-timeout", number});
+    if (o_.insecure) argv.push_back("--insecure");
     d.log = d.folder + "/dex.log";
     std::remove(d.log.c_str());
     std::string error;
