@@ -433,6 +433,8 @@ void Ground::check_pending_finished() {
 }
 
 void Ground::on_status(const StatusSample& s) {
+  // Statuses of waiting DEXes (run 0) say nothing the barrier needs: READY does.
+  if (stage_ != Stage::running) return;
   if (!ours(s.mission_hash) || s.run_id != r_.run_id || s.drone < 0 || s.drone >= static_cast<int>(drones_.size()))
     return;
   // Bound to the process START named: a second process with that drone's credentials

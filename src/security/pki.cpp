@@ -30,6 +30,12 @@ std::string ssl_error(const std::string& what) {
   return out;
 }
 
+/// Sets `error` to OpenSSL's account of `what` failing; returns false.
+bool failed(std::string& error, const std::string& what) {
+  error = ssl_error(what);
+  return false;
+}
+
 std::string bio_text(BIO* b) {
   char* data = nullptr;
   long n = BIO_get_mem_data(b, &data);
@@ -91,7 +97,7 @@ Cert new_cert(EVP_PKEY* key, const std::string& subject, const Validity& v) {
 
 bool make_ca(const std::string& subject, const Validity& v, Credential& out, std::string& error) {
   out.key = new_key();
-  if (!out.key) return error = ssl_error("cannot make a key for " + subject), false;
+  if (!out.key) return failed(error, "cannot make a key for " + subject);
   out.cert = new_cert(out.key.get(), subject, v);
   X509* c = out.cert.get();
   // digitalSignature too: the permissions CA signs the governance and permissions
@@ -101,21 +107,21 @@ bool make_ca(const std::string& subject, const Validity& v, Credential& out, std
             add_extension(c, c, NID_key_usage, "critical,keyCertSign,cRLSign,digitalSignature") &&
             add_extension(c, c, NID_subject_key_identifier, "hash") &&
             X509_sign(c, out.key.get(), EVP_sha256()) > 0;
-  if (!ok) return error = ssl_error("cannot make the certificate of " + subject), false;
+  if (!ok) return failed(error, "cannot make the certificate of " + subject);
   return true;
 }
 
 bool make_identity(const Credential& ca, const std::string& subject, const Validity& v, Credential& out,
                    std::string& error) {
   out.key = new_key();
-  if (!out.key) return error = ssl_error("cannot make a key for " + subject), false;
+  if (!out.key) return failed(error, "cannot make a key for " + subject);
   out.cert = new_cert(out.key.get(), subject, v);
   X509* c = out.cert.get();
   bool ok = c && X509_set_issuer_name(c, X509_get_subject_name(ca.cert.get())) &&
             add_extension(c, ca.cert.get(), NID_basic_constraints, "critical,CA:FALSE") &&
             add_extension(c, ca.cert.get(), NID_key_usage, "critical,digitalSignature,keyAgreement") &&
             X509_sign(c, ca.key.get(), EVP_sha256()) > 0;
-  if (!ok) return error = ssl_error("cannot make the certificate of " + subject), false;
+  if (!ok) return failed(error, "cannot make the certificate of " + subject);
   return true;
 }
 
@@ -137,10 +143,10 @@ bool read_credential(const std::string& cert_text, const std::string& key_text, 
   Bio k(BIO_new_mem_buf(key_text.data(), static_cast<int>(key_text.size())));
   out.cert.reset(PEM_read_bio_X509(c.get(), nullptr, nullptr, nullptr));
   out.key.reset(PEM_read_bio_PrivateKey(k.get(), nullptr, nullptr, nullptr));
-  if (!out.cert) return error = ssl_error("not a PEM certificate"), false;
-  if (!out.key) return error = ssl_error("not an unencrypted PEM private key"), false;
+  if (!out.cert) return failed(error, "not a PEM certificate");
+  if (!out.key) return failed(error, "not an unencrypted PEM private key");
   if (X509_check_private_key(out.cert.get(), out.key.get()) != 1)
-    return error = ssl_error("the private key is not the certificate's"), false;
+    return failed(error, "the private key is not the certificate's");
   return true;
 }
 
@@ -150,19 +156,14 @@ bool smime_sign(const Credential& signer, const std::string& text, std::string& 
   const int flags = PKCS7_DETACHED | PKCS7_TEXT | PKCS7_STREAM;
   Bio in(BIO_new_mem_buf(text.data(), static_cast<int>(text.size())));
   PKCS7* p7 = PKCS7_sign(signer.cert.get(), signer.key.get(), nullptr, in.get(), flags);
-  if (!p7) return error = ssl_error("cannot sign"), false;
+  if (!p7) return failed(error, "cannot sign");
   Bio b(BIO_new(BIO_s_mem()));
   bool ok = SMIME_write_PKCS7(b.get(), p7, in.get(), flags) == 1;
   PKCS7_free(p7);
-  if (!ok) return error = ssl_error("cannot write the S/MIME document"), false;
+  if (!ok) return failed(error, "cannot write the S/MIME document");
   out = bio_text(b.get());
   return true;
 }
 
-std::string subject_of(const X509* cert) {
-  Bio b(BIO_new(BIO_s_mem()));
-  X509_NAME_print_ex(b.get(), X509_get_subject_name(cert), 0, XN_FLAG_RFC2253);
-  return bio_text(b.get());
-}
 
 }  // namespace eamos::security

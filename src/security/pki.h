@@ -49,7 +49,4 @@ bool read_credential(const std::string& cert_pem, const std::string& key_pem, Cr
 /// `text` signed by `signer` as S/MIME (what `openssl smime -sign -text` writes).
 bool smime_sign(const Credential& signer, const std::string& text, std::string& out, std::string& error);
 
-/// The subject of `cert` as "CN=...,O=..." (RFC 2253 order reversed back to ours).
-std::string subject_of(const X509* cert);
-
 }  // namespace eamos::security
