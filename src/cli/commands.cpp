@@ -8,6 +8,7 @@
 #include "deploy/synthesize.h"
 #include "graph/export.h"
 #include "graph/pipeline.h"
+#include "security/mission_keys.h"
 #include "stress/generator.h"
 
 namespace eamos::cli {
@@ -90,7 +91,32 @@ int cmd_check(const CommonOptions& o, bool list_capabilities) {
   return 0;
 }
 
-int cmd_compile(const CommonOptions& o, const std::string& out_dir) {
+void warn_insecure(const char* command) {
+  std::cerr << "eamos " << command << ": WARNING: --insecure: DDS Security is OFF. Anyone who can reach this "
+               "network can read the mission and command, stop or crash every drone in it. Use it only for "
+               "experiments, never with aircraft that can hurt anyone.\n";
+}
+
+bool write_security(const graph::Compilation& c, const std::string& dir, const SecurityOptions& security) {
+  std::vector<std::string> drones;
+  for (int d = 0; d < c.drone_count(); ++d) drones.push_back(c.drone_name(d));
+  if (security.insecure) {
+    security::remove_mission_keys(dir, drones);
+    return true;
+  }
+  security::MissionKeysRequest r{dir, deploy::mission_hash(c), drones, security.keys_dir, security.valid_days};
+  std::vector<std::string> notes;
+  std::string error;
+  if (!security::write_mission_keys(r, notes, error)) {
+    std::cerr << "eamos: error: cannot make the mission's DDS Security credentials: " << error << "\n";
+    return false;
+  }
+  for (const std::string& n : notes) std::cout << n << "\n";
+  return true;
+}
+
+int cmd_compile(const CommonOptions& o, const std::string& out_dir, const SecurityOptions& security) {
+  if (security.insecure) warn_insecure("compile");
   graph::Compilation c;
   if (!compile_and_report(o, c, graph::Keep::deployment_graphs)) return 1;
   Diagnostics diags;
@@ -98,6 +124,7 @@ int cmd_compile(const CommonOptions& o, const std::string& out_dir) {
     std::cerr << diags.format();
     return 1;
   }
+  if (!write_security(c, out_dir, security)) return 1;
   std::cout << "compiled " << o.mission << " → " << out_dir << "/ (" << c.drone_count()
             << " drones, " << c.meg.nodes.size() << " MEG nodes)\n";
   return 0;

@@ -18,8 +18,20 @@ struct CommonOptions {
   bool quiet = false;         ///< no warnings
 };
 
+/// How a compiled mission's DDS Security credentials are made (docs/security.md).
+struct SecurityOptions {
+  std::string keys_dir;   ///< the CAs to sign with (made there when absent); "" = fresh ones
+  bool insecure = false;  ///< no credentials at all: anyone on the network can command the drones
+  int valid_days = 30;    ///< how long the credentials are valid
+};
+
 int cmd_check(const CommonOptions& o, bool list_capabilities);
-int cmd_compile(const CommonOptions& o, const std::string& out_dir);
+int cmd_compile(const CommonOptions& o, const std::string& out_dir, const SecurityOptions& security);
+/// Writes (or, insecure, removes) the credentials of the deployment in `dir`; false with
+/// the error printed.
+bool write_security(const graph::Compilation& c, const std::string& dir, const SecurityOptions& security);
+/// The warning every insecure command prints first.
+void warn_insecure(const char* command);
 int cmd_graph(const CommonOptions& o, const std::string& kind, const std::string& drone,
               const std::string& format, const std::string& output);
 int cmd_stats(const CommonOptions& o, const std::string& output);
@@ -48,7 +60,8 @@ int cmd_verify(const CommonOptions& o, const VerifyCommandOptions& v);
 int cmd_dex(const launch::DexProcessOptions& options);
 int cmd_launch(const launch::LaunchOptions& options, const RunCommandOptions& r);
 /// `eamos run --distributed`: compiles into options.dir (a temporary folder when ""), then launches.
-int cmd_run_distributed(const CommonOptions& o, const RunCommandOptions& r, launch::LaunchOptions options);
+int cmd_run_distributed(const CommonOptions& o, const RunCommandOptions& r, launch::LaunchOptions options,
+                        const SecurityOptions& security);
 struct SimVehicleCommandOptions {
   int udp_port = 14540;     ///< sends to udpout://127.0.0.1:PORT, like PX4 SITL instance 0
   std::string connection;   ///< any link URL instead of --udp; "" = use udp_port

@@ -16,6 +16,7 @@
 namespace eamos::cli {
 
 int cmd_dex(const launch::DexProcessOptions& options) {
+  if (options.insecure) warn_insecure("dex");
   mid::AdapterRegistry adapters;
   sim::register_adapter(adapters);
   // A DEX process always runs on wall time (scaled by its --speed).
@@ -24,6 +25,7 @@ int cmd_dex(const launch::DexProcessOptions& options) {
 }
 
 int cmd_launch(const launch::LaunchOptions& options, const RunCommandOptions& r) {
+  if (options.insecure) warn_insecure("launch");
   dex::LiveLog live(std::cout);
   launch::LaunchResult result;
   int status = launch::launch(options, r.log ? &live : nullptr, result, std::cout, std::cerr);
@@ -40,7 +42,9 @@ int cmd_launch(const launch::LaunchOptions& options, const RunCommandOptions& r)
   return result.run.completed ? status : 1;
 }
 
-int cmd_run_distributed(const CommonOptions& o, const RunCommandOptions& r, launch::LaunchOptions options) {
+int cmd_run_distributed(const CommonOptions& o, const RunCommandOptions& r, launch::LaunchOptions options,
+                        const SecurityOptions& security) {
+  if (security.insecure) warn_insecure("run --distributed");
   graph::Compilation c;
   if (!compile_and_report(o, c)) return 1;
   std::string dir = options.dir;
@@ -57,8 +61,10 @@ int cmd_run_distributed(const CommonOptions& o, const RunCommandOptions& r, laun
     std::cerr << diags.format();
     return 1;
   }
+  if (!write_security(c, dir, security)) return 1;
   std::cout << "deployment in " << dir << "\n";
   options.dir = dir;
+  options.insecure = security.insecure;
   return cmd_launch(options, r);
 }
 

@@ -37,6 +37,16 @@ void add_report(CLI::App* cmd, eamos::cli::RunCommandOptions& r) {
   cmd->add_option("--plot", r.plot, "Draw the run (tracks and action timeline) as SVG to this file");
 }
 
+void add_security(CLI::App* cmd, eamos::cli::SecurityOptions& s) {
+  cmd->add_option("--keys", s.keys_dir,
+                  "Folder with the identity and permissions CAs that sign the mission's DDS Security credentials "
+                  "(made there when it has none; default: fresh CAs per compilation, their keys thrown away)");
+  cmd->add_option("--valid-days", s.valid_days, "Days the mission's credentials are valid")
+      ->default_val(30)->check(CLI::Range(1, 3650));
+  cmd->add_flag("--insecure", s.insecure,
+                "No DDS Security: anyone on the network can command the drones (experiments only)");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -56,6 +66,8 @@ int main(int argc, char** argv) {
   add_common(compile, o);
   std::string out_dir;
   compile->add_option("-o,--output", out_dir, "Output folder")->required();
+  eamos::cli::SecurityOptions security;
+  add_security(compile, security);
 
   auto* graph = app.add_subcommand("graph", "Write the AMT, MEG or a drone's MDG as DOT, JSON or SVG");
   add_common(graph, o);
@@ -99,6 +111,7 @@ int main(int argc, char** argv) {
   run->add_option("--barrier-timeout", launch_opts.barrier_timeout_s, "With --distributed: seconds to wait for every DEX to be ready")
       ->check(CLI::PositiveNumber);
   add_dds(run, launch_opts.dds);
+  add_security(run, security);
 
   auto* launch = app.add_subcommand("launch", "Run a deployment folder as one DEX process per drone over Cyclone DDS, with a ground process that starts them together and collects their traces");
   launch->add_option("deployment", launch_opts.dir, "Deployment folder written by `eamos compile -o`")
@@ -114,6 +127,8 @@ int main(int argc, char** argv) {
   launch->add_option("--drones", launch_opts.local, "Start only these drones here; the others run their DEX elsewhere")
       ->delimiter(',');
   add_dds(launch, launch_opts.dds);
+  launch->add_flag("--insecure", launch_opts.insecure,
+                   "Fly without DDS Security, even when the deployment has credentials (experiments only)");
 
   auto* dexcmd = app.add_subcommand("dex", "Run one drone's DEX from its deployment folder (the deployment package's entry point)");
   eamos::launch::DexProcessOptions dex_opts;
@@ -127,6 +142,8 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   dexcmd->add_option("--trace", dex_opts.trace_file, "Also write this drone's trace as JSON Lines to this file");
   add_dds(dexcmd, dex_opts.dds);
+  dexcmd->add_flag("--insecure", dex_opts.insecure,
+                   "Fly without DDS Security, even when the folder has credentials (experiments only)");
 
   auto* gen = app.add_subcommand("gen-stress", "Generate a large valid mission for scaling tests");
   long long nodes = 5000;
@@ -166,13 +183,13 @@ int main(int argc, char** argv) {
 
   try {
     if (*check) return eamos::cli::cmd_check(o, list_caps);
-    if (*compile) return eamos::cli::cmd_compile(o, out_dir);
+    if (*compile) return eamos::cli::cmd_compile(o, out_dir, security);
     if (*graph) return eamos::cli::cmd_graph(o, kind, drone, format, graph_out);
     if (*stats) return eamos::cli::cmd_stats(o, stats_out);
     if (*run && distributed) {
       launch_opts.speed = run_opts.speed > 0 ? run_opts.speed : 1.0;
       launch_opts.time_limit_s = run_opts.time_limit;
-      return eamos::cli::cmd_run_distributed(o, run_opts, launch_opts);
+      return eamos::cli::cmd_run_distributed(o, run_opts, launch_opts, security);
     }
     if (*run) return eamos::cli::cmd_run(o, run_opts);
     if (*verify) return eamos::cli::cmd_verify(o, verify_opts);

@@ -85,7 +85,12 @@ int DexProcess::run(const mid::AdapterRegistry& adapters) {
     inbox_.deliver([this, line] { err_ << "eamos dex: " << name() << ": " << line << "\n"; });
   };
   h.limits.drones = static_cast<int>(mission_.fleet.size());
-  node_ = transport::DdsNode::open(o_.dds, std::move(h), error);
+  // This drone's partition, and its own credentials (only its key is in its folder).
+  transport::DdsOptions dds = o_.dds;
+  dds.mission_hash = mission_.hash;
+  dds.self = mission_.self;
+  if (!o_.insecure) dds.security_folder = o_.folder + "/security";
+  node_ = transport::DdsNode::open(dds, std::move(h), error);
   if (!node_) {
     err_ << "eamos dex: error: " << error << "\n";
     return 1;

@@ -25,6 +25,8 @@ struct DexProcessOptions {
   double settle_s = 0.15;
   std::string trace_file;         ///< the drone's own JSONL trace; "" = none
   bool log = true;                ///< live log on `out`
+  /// Without DDS Security even when the folder holds credentials (docs/security.md).
+  bool insecure = false;
 };
 
 /// Runs the process; returns its exit status: 0 when the mission completed, 1 otherwise

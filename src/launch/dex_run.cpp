@@ -23,6 +23,7 @@ void DexProcess::tick() {
   }
   publish_status();
   check_finished();
+  check_pending_finished();
   double every = tick_s() * o_.speed;
   loop_->after(every, [this] { tick(); });
 }
@@ -48,7 +49,14 @@ void DexProcess::note_foreign(const std::string& hash) {
 
 void DexProcess::on_trigger(const TriggerSample& s) {
   if (!ours(s.message.mission_hash, s.run_id) || s.to != mission_.self) return;
-  ++received_;
+  std::string why;
+  if (!trigger_allowed(s, why)) return reject(s.message.from, "trigger", why);
+  // Reliable delivery never repeats a sample: a second one with the same number is a replay.
+  if (!seen_triggers_.insert({s.message.from, s.seq}).second)
+    return reject(s.message.from, "trigger", "sequence number " + std::to_string(s.seq) + " was already received");
+  // Only what was accepted is counted: a dropped sample counted as received would leave
+  // Σsent ≠ Σreceived and the mission waiting for ever.
+  if (s.message.kind == dex::Message::Kind::ended) ++received_;
   if (phase_ == Phase::running) engine_->receive(s.message);
   publish_status();
 }
@@ -74,20 +82,21 @@ void DexProcess::on_lifecycle(const LifecycleSample& s) {
   if (s.kind == LifecycleKind::ready || s.kind == LifecycleKind::start) return;
   if (!ours(s.mission_hash, s.run_id)) return;
   if (s.kind == LifecycleKind::abort) {
-    // The sender's number came over the network: an unknown one still aborts (safe), by number.
-    bool known = s.drone >= 0 && s.drone < static_cast<int>(mission_.fleet.size());
-    std::string who = s.drone == transport::kGround ? "the ground"
-                      : known                       ? mission_.fleet[s.drone]
-                                                    : "drone #" + std::to_string(s.drone);
-    abandon("aborted by " + who + ": " + s.reason, s.failure, false);
+    std::string why;
+    if (!abort_allowed(s, why)) return reject(s.drone, "abort", why);
+    abandon("aborted by " + who(s.drone) + ": " + s.reason, s.failure, false);
   } else if (s.kind == LifecycleKind::finished && phase_ == Phase::running) {
-    complete();
+    on_finished(s);
   }
 }
 
 void DexProcess::on_status(const StatusSample& s) {
   if (s.mission_hash != mission_.hash) return note_foreign(s.mission_hash);
   if (s.run_id != start_.run_id || s.drone == mission_.self) return;
+  // Bound to the process START named for that drone: another process with the drone's
+  // credentials (a restarted DEX, a copy) does not speak for it.
+  if (s.drone >= static_cast<int>(start_.nonces.size()) || start_.nonces[s.drone] != s.nonce)
+    return reject(s.drone, "status", "it comes from another process than the one this run was started with");
   statuses_[s.drone] = s;
   ++status_changes_;
 }

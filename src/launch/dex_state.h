@@ -85,6 +85,15 @@ class DexProcess {
   void on_lifecycle(const LifecycleSample& s);
   void on_status(const StatusSample& s);
   void on_lost(const std::string& hash, int drone, std::uint64_t nonce);
+  // --- checks of what arrives, even from an authenticated peer (dex_checks.cpp) ---
+  bool trigger_allowed(const TriggerSample& s, std::string& why) const;
+  bool abort_allowed(const LifecycleSample& s, std::string& why) const;
+  bool finish_agreed(int lead, std::string& why) const;
+  void on_finished(const LifecycleSample& s);
+  void check_pending_finished();
+  /// Logs once per sender and kind of fault that a sample was ignored.
+  void reject(int sender, const std::string& what, const std::string& why);
+  std::string who(int drone) const;
   void tick();
   void publish_status(bool force = false);
   void check_finished();
@@ -136,6 +145,10 @@ class DexProcess {
   std::set<std::string> foreign_;
   std::set<std::uint64_t> stale_runs_;
   double failsafe_since_ = 0.0;
+  std::set<std::pair<int, std::uint64_t>> seen_triggers_;  ///< (sender, seq) of every accepted trigger
+  std::set<std::string> rejected_;                        ///< what was logged as ignored
+  std::optional<LifecycleSample> pending_finished_;       ///< a FINISHED this DEX does not agree with (yet)
+  double pending_since_ = 0.0;                            ///< wall time it came
 
   // Last, so it goes first: its listener threads use everything above.
   std::unique_ptr<transport::DdsNode> node_;

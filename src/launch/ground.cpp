@@ -36,6 +36,7 @@ struct DroneEntry {
   std::optional<StatusSample> final_status;
   std::vector<dex::Sample> track;
   std::optional<mid::DroneState> last_state;  ///< newest telemetry of this run
+  std::optional<StatusSample> status;         ///< newest status of this run, from the process START named
   bool lost = false;                          ///< its DEX lost liveliness during the run
   std::string log;
   double started_at = 0.0;  ///< wall time its DEX process was started
@@ -88,6 +89,10 @@ class Ground {
   void send_start();
   void fail_barrier(const std::string& why);
   void on_lifecycle(const LifecycleSample& s);
+  void on_run_lifecycle(const LifecycleSample& s);
+  bool finish_agreed(int lead, std::string& why) const;
+  void check_pending_finished();
+  void reject(int sender, const std::string& what, const std::string& why);
   void on_status(const StatusSample& s);
   void on_trace(TraceSample s);
   void on_telemetry(const TelemetrySample& s);
@@ -112,6 +117,8 @@ class Ground {
   std::optional<double> finish_at_;
   std::optional<LifecycleSample> abort_;
   std::optional<LifecycleSample> finished_;
+  std::optional<LifecycleSample> pending_finished_;  ///< not agreed with (yet): see on_run_lifecycle
+  std::set<std::string> rejected_;
   std::string error_;
   std::set<std::string> foreign_;
   std::vector<std::uint64_t> start_nonces_;
@@ -151,7 +158,11 @@ int Ground::run() {
   // Logged on the ground's own thread: the listener that dropped the sample only posts.
   h.dropped = [this](const std::string& line) { inbox_.deliver([this, line] { err_ << "ground: " << line << "\n"; }); };
   h.limits.drones = static_cast<int>(drones_.size());
-  node_ = transport::DdsNode::open(o_.dds, std::move(h), error);
+  transport::DdsOptions dds = o_.dds;
+  dds.mission_hash = hash_;
+  dds.self = transport::kGroundParticipant;
+  if (!o_.insecure) dds.security_folder = o_.dir + "/ground-station/security";
+  node_ = transport::DdsNode::open(dds, std::move(h), error);
   if (!node_) {
     err_ << "eamos launch: error: " << error << "\n";
     return 1;
@@ -225,6 +236,7 @@ bool Ground::start_processes() {
     argv.insert(argv.end(), {"--time-limit", number});
     std::snprintf(number, sizeof number, "%.17g", o_.barrier_timeout_s + 5.0);
     argv.insert(argv.end(), {"--start-timeout", number});
+    if (o_.insecure) argv.push_back("--insecure");
     d.log = d.folder + "/dex.log";
     std::remove(d.log.c_str());
     std::string error;
@@ -366,14 +378,77 @@ void Ground::on_lifecycle(const LifecycleSample& s) {
     return;
   }
   if (s.run_id != r_.run_id || stage_ != Stage::running) return;
-  if (s.kind == LifecycleKind::abort && !abort_) abort_ = s;
-  if (s.kind == LifecycleKind::finished) finished_ = s;
+  on_run_lifecycle(s);
+}
+
+void Ground::reject(int sender, const std::string& what, const std::string& why) {
+  std::string name = sender >= 0 && sender < static_cast<int>(drones_.size()) ? drones_[sender].name : "the ground";
+  if (rejected_.insert(std::to_string(sender) + " " + what + " " + why).second)
+    err_ << "ground: ignored a " << what << " sample from " << name << ": " << why << "\n";
+}
+
+void Ground::on_run_lifecycle(const LifecycleSample& s) {
+  if (s.kind == LifecycleKind::abort && !abort_) {
+    if (s.failure && std::none_of(drones_.begin(), drones_.end(),
+                                  [&](const DroneEntry& d) { return d.name == s.failure->drone; }))
+      return reject(s.drone, "abort", "the failed drone it names is not in the mission");
+    if (!(s.t >= 0.0)) return reject(s.drone, "abort", "its mission time is negative");
+    abort_ = s;
+  }
+  // FINISHED only from the lead, and only when the statuses say what the lead saw; it may
+  // come before the last statuses do, so it waits for them (check_pending_finished).
+  if (s.kind == LifecycleKind::finished && !finished_) {
+    if (s.drone == transport::kGround) return reject(s.drone, "finished", "only the lead drone ends a mission");
+    pending_finished_ = s;
+    check_pending_finished();
+  }
+}
+
+bool Ground::finish_agreed(int lead, std::string& why) const {
+  const std::optional<StatusSample>& ls = drones_[lead].status;
+  if (!ls || !ls->end_reached) {
+    why = "its sender has not reached the mission's end";
+    return false;
+  }
+  std::uint64_t sent = 0, received = 0;
+  for (const DroneEntry& d : drones_) {
+    if (!d.status || d.status->busy) {
+      why = d.name + " is still busy";
+      return false;
+    }
+    sent += d.status->sent;
+    received += d.status->received;
+  }
+  if (sent != received) {
+    why = "triggers are still in flight";
+    return false;
+  }
+  return true;
+}
+
+void Ground::check_pending_finished() {
+  if (!pending_finished_ || finished_) return;
+  std::string why;
+  if (finish_agreed(pending_finished_->drone, why)) {
+    finished_ = pending_finished_;
+    pending_finished_.reset();
+  } else if (all_done()) {
+    reject(pending_finished_->drone, "finished", why);
+  }
 }
 
 void Ground::on_status(const StatusSample& s) {
+  // Statuses of waiting DEXes (run 0) say nothing the barrier needs: READY does.
+  if (stage_ != Stage::running) return;
   if (!ours(s.mission_hash) || s.run_id != r_.run_id || s.drone < 0 || s.drone >= static_cast<int>(drones_.size()))
     return;
+  // Bound to the process START named: a second process with that drone's credentials
+  // (restarted, copied) does not speak for it.
+  if (static_cast<int>(start_nonces_.size()) <= s.drone || start_nonces_[s.drone] != s.nonce)
+    return reject(s.drone, "status", "it comes from another process than the one this run was started with");
+  drones_[s.drone].status = s;
   if (s.phase == Phase::completed || s.phase == Phase::failed) drones_[s.drone].final_status = s;
+  check_pending_finished();
 }
 
 void Ground::on_trace(TraceSample s) {

@@ -23,6 +23,8 @@ struct LaunchOptions {
   double start_delay_s = 0.5;       ///< wall seconds between START and mission time 0
   std::vector<std::string> local;   ///< drones to start here; empty = all of them
   std::string exe;                  ///< the eamos program for DEX processes ("" = this one)
+  /// Without DDS Security, for the ground and every DEX it starts (docs/security.md).
+  bool insecure = false;
 };
 
 struct LaunchResult {

@@ -8,7 +8,9 @@
 #include <atomic>
 #include <cstdio>
 #include <fstream>
+#include <filesystem>
 #include <sstream>
+#include <vector>
 
 #include "loopback_config.h"
 #include "transport/wire_convert.h"
@@ -60,8 +62,8 @@ void log_dropped(const char* topic, const char* what) noexcept {
 
 /// Takes every sample the reader holds. Each is checked as it is converted (from_wire):
 /// one that breaks a rule is dropped and reported to `node`, never handed on.
-template <typename Wire, typename Sample, typename Fn>
-void take_all(dds_entity_t reader, const char* topic, DdsNode& node, Fn&& fn,
+template <typename Wire, typename Sample, typename Claimed, typename Fn>
+void take_all(dds_entity_t reader, const char* topic, DdsNode& node, Claimed&& claimed, Fn&& fn,
               std::function<void(std::uint64_t)> on_info = {}) {
   constexpr int kBatch = 64;
   void* samples[kBatch];
@@ -80,6 +82,9 @@ void take_all(dds_entity_t reader, const char* topic, DdsNode& node, Fn&& fn,
           node.dropped(topic, why);
           continue;
         }
+        // Who wrote it, not who it says it is: with DDS Security the writer's partition is
+        // the identity that authenticated it.
+        if (!node.sent_by(topic, claimed(s), node.sender_of(reader, infos[i].publication_handle))) continue;
         if (on_info) on_info(infos[i].publication_handle);
         fn(std::move(s));
       } catch (const std::exception& e) {
@@ -126,9 +131,41 @@ void on_liveliness(dds_entity_t, const dds_liveliness_changed_status_t s, void* 
             [&] { static_cast<DdsNode*>(arg)->liveliness_changed(s.last_publication_handle); });
 }
 
-}  // namespace
+/// The <Security> element: the three plugins Debian's libddsc0debian ships, and this
+/// participant's credentials (file: URIs, absolute, as Cyclone resolves them itself).
+bool security_config(const std::string& folder, std::string& xml, std::string& error) {
+  std::error_code ec;
+  std::string dir = std::filesystem::absolute(folder, ec).string();
+  std::vector<std::string> uri;
+  std::string missing;
+  for (const char* f : kSecurityFiles) {
+    std::string path = dir + "/" + f;
+    if (!std::filesystem::is_regular_file(path, ec)) missing += (missing.empty() ? "" : ", ") + std::string(f);
+    uri.push_back("file:" + path);
+  }
+  if (!missing.empty()) {
+    error = "DDS Security credentials missing in " + dir + ": " + missing +
+            "; compile the mission again (`eamos compile` writes them), or pass --insecure to fly without "
+            "DDS Security";
+    return false;
+  }
+  const std::string lib = EAMOS_DDS_SECURITY_PLUGIN_DIR;
+  xml = "<CycloneDDS><Domain Id=\"any\"><Security>"
+        "<Authentication><Library path=\"" + lib + "/libdds_security_auth.so\" initFunction=\"init_authentication\" "
+        "finalizeFunction=\"finalize_authentication\"/>"
+        "<IdentityCA>" + uri[0] + "</IdentityCA><IdentityCertificate>" + uri[1] + "</IdentityCertificate>"
+        "<PrivateKey>" + uri[2] + "</PrivateKey></Authentication>"
+        "<AccessControl><Library path=\"" + lib + "/libdds_security_ac.so\" initFunction=\"init_access_control\" "
+        "finalizeFunction=\"finalize_access_control\"/>"
+        "<PermissionsCA>" + uri[3] + "</PermissionsCA><Governance>" + uri[4] + "</Governance>"
+        "<Permissions>" + uri[5] + "</Permissions></AccessControl>"
+        "<Cryptographic><Library path=\"" + lib + "/libdds_security_crypto.so\" initFunction=\"init_crypto\" "
+        "finalizeFunction=\"finalize_crypto\"/></Cryptographic>"
+        "</Security></Domain></CycloneDDS>";
+  return true;
+}
 
-bool dds_config(const DdsOptions& options, std::string& xml, std::string& error) {
+bool base_config(const DdsOptions& options, std::string& xml, std::string& error) {
   if (!options.config_file.empty()) {
     std::ifstream in(options.config_file);
     if (!in) {
@@ -148,6 +185,19 @@ bool dds_config(const DdsOptions& options, std::string& xml, std::string& error)
   xml = "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface " + attr + "=\"" +
         options.interface + "\"/></Interfaces></General><Discovery><ParticipantIndex>auto</ParticipantIndex>"
         "<MaxAutoParticipantIndex>100</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>";
+  return true;
+}
+
+}  // namespace
+
+bool dds_config(const DdsOptions& options, std::string& xml, std::string& error) {
+  if (!base_config(options, xml, error)) return false;
+  if (options.security_folder.empty()) return true;
+  // Cyclone DDS merges configuration fragments given one after the other: the user's file
+  // (or ours) stays as it is, the security settings come second.
+  std::string security;
+  if (!security_config(options.security_folder, security, error)) return false;
+  xml += security;
   return true;
 }
 
@@ -178,9 +228,48 @@ bool DdsNode::create(const DdsOptions& options, std::string& error) {
   domain_ = domain > 0 ? domain : 0;
   participant_ = dds_create_participant(options.domain, nullptr, nullptr);
   if (participant_ < 0) {
-    error = "cannot join DDS domain " + std::to_string(options.domain) + ": " + retcode(participant_);
+    error = "cannot join DDS domain " + std::to_string(options.domain) + ": " + retcode(participant_) +
+            (options.security_folder.empty() ? "" : " (DDS Security refused the credentials in " +
+                                                        options.security_folder + "; see Cyclone's log above)");
     return false;
   }
+  mission_hash_ = options.mission_hash;
+  if (!create_endpoints(options, error)) return false;
+  return true;
+}
+
+namespace {
+
+/// A publisher or subscriber in `partitions` (none: the default partition).
+dds_entity_t grouping(dds_entity_t participant, bool publisher, const std::vector<std::string>& partitions) {
+  dds_qos_t* q = dds_create_qos();
+  std::vector<const char*> names;
+  for (const std::string& p : partitions) names.push_back(p.c_str());
+  if (!names.empty()) dds_qset_partition(q, static_cast<uint32_t>(names.size()), names.data());
+  dds_entity_t e = publisher ? dds_create_publisher(participant, q, nullptr) : dds_create_subscriber(participant, q, nullptr);
+  dds_delete_qos(q);
+  return e;
+}
+
+}  // namespace
+
+bool DdsNode::create_endpoints(const DdsOptions& options, std::string& error) {
+  // Each participant writes in its own partition and reads the whole mission's: DDS
+  // Security's permissions allow a drone to write only in its own (docs/security.md).
+  std::vector<std::string> write_in, read_in;
+  if (!mission_hash_.empty()) {
+    write_in.push_back(partition_of(mission_hash_, options.self));
+    read_in.push_back(partition_of(mission_hash_, kGroundParticipant));
+    for (int d = 0; d < handlers_.limits.drones; ++d) read_in.push_back(partition_of(mission_hash_, d));
+  }
+  dds_entity_t publisher = grouping(participant_, true, write_in);
+  dds_entity_t subscriber = grouping(participant_, false, read_in);
+  if (publisher < 0 || subscriber < 0) {
+    error = "cannot create the DDS publisher and subscriber: " + retcode(publisher < 0 ? publisher : subscriber);
+    return false;
+  }
+  // The ground writes only lifecycle samples (its permissions allow nothing else).
+  const bool ground = !mission_hash_.empty() && options.self == kGroundParticipant;
 
   struct TopicSpec {
     const char* name;
@@ -209,7 +298,8 @@ bool DdsNode::create(const DdsOptions& options, std::string& error) {
     dds_copy_qos(wqos, qos);
     if (spec.writer == &w_status_)
       dds_qset_liveliness(wqos, DDS_LIVELINESS_MANUAL_BY_TOPIC, DDS_SECS(1) * options.lease_s);
-    *spec.writer = dds_create_writer(participant_, topic, wqos, nullptr);
+    bool write = !ground || spec.writer == &w_lifecycle_;
+    *spec.writer = write ? dds_create_writer(publisher, topic, wqos, nullptr) : 0;
     dds_delete_qos(wqos);
     dds_listener_t* listener = dds_create_listener(this);
     dds_lset_data_available(listener, spec.on_data);
@@ -217,11 +307,14 @@ bool DdsNode::create(const DdsOptions& options, std::string& error) {
     dds_qset_ignorelocal(qos, DDS_IGNORELOCAL_PARTICIPANT);
     // Only the ground reads traces: a DEX does not take every other drone's events.
     bool wanted = spec.reader != &r_trace_ || handlers_.trace != nullptr;
-    *spec.reader = wanted ? dds_create_reader(participant_, topic, qos, listener) : 0;
+    *spec.reader = wanted ? dds_create_reader(subscriber, topic, qos, listener) : 0;
     dds_delete_listener(listener);
     dds_delete_qos(qos);
     if (*spec.writer < 0 || *spec.reader < 0) {
-      error = std::string("cannot create DDS endpoints of ") + spec.name;
+      error = std::string("cannot create DDS endpoints of ") + spec.name + ": " +
+              retcode(*spec.writer < 0 ? *spec.writer : *spec.reader) +
+              (options.security_folder.empty() ? "" : " (do the permissions in " + options.security_folder +
+                                                          " belong to this drone and mission?)");
       return false;
     }
   }
@@ -260,7 +353,9 @@ bool DdsNode::write(const TraceSample& s) {
   return dds_write(w_trace_, &w) == DDS_RETCODE_OK;
 }
 
-void DdsNode::assert_alive() { dds_assert_liveliness(w_status_); }
+void DdsNode::assert_alive() {
+  if (w_status_ > 0) dds_assert_liveliness(w_status_);
+}
 
 bool DdsNode::flush(double timeout_s) {
   // One deadline for all writers: a reader of a killed process stays matched until its
@@ -268,6 +363,7 @@ bool DdsNode::flush(double timeout_s) {
   dds_time_t deadline = dds_time() + static_cast<dds_duration_t>(timeout_s * 1e9);
   bool ok = true;
   for (int w : {w_trace_, w_status_, w_lifecycle_, w_trigger_}) {
+    if (w <= 0) continue;
     dds_duration_t left = std::max<dds_duration_t>(0, deadline - dds_time());
     ok = dds_wait_for_acks(w, left) == DDS_RETCODE_OK && ok;
   }
@@ -275,19 +371,23 @@ bool DdsNode::flush(double timeout_s) {
 }
 
 void DdsNode::take_triggers(int reader) {
-  take_all<eamos_wire_Trigger, TriggerSample>(reader, "trigger", *this, [this](TriggerSample s) {
+  take_all<eamos_wire_Trigger, TriggerSample>(
+      reader, "trigger", *this, [](const TriggerSample& s) { return s.message.from; }, [this](TriggerSample s) {
     if (handlers_.trigger) handlers_.trigger(std::move(s));
   });
 }
 
 void DdsNode::take_telemetry(int reader) {
-  take_all<eamos_wire_Telemetry, TelemetrySample>(reader, "telemetry", *this, [this](TelemetrySample s) {
+  take_all<eamos_wire_Telemetry, TelemetrySample>(
+      reader, "telemetry", *this, [](const TelemetrySample& s) { return s.telemetry.from; },
+      [this](TelemetrySample s) {
     if (handlers_.telemetry) handlers_.telemetry(std::move(s));
   });
 }
 
 void DdsNode::take_lifecycle(int reader) {
-  take_all<eamos_wire_Lifecycle, LifecycleSample>(reader, "lifecycle", *this, [this](LifecycleSample s) {
+  take_all<eamos_wire_Lifecycle, LifecycleSample>(
+      reader, "lifecycle", *this, [](const LifecycleSample& s) { return s.drone; }, [this](LifecycleSample s) {
     if (handlers_.lifecycle) handlers_.lifecycle(std::move(s));
   });
 }
@@ -295,7 +395,7 @@ void DdsNode::take_lifecycle(int reader) {
 void DdsNode::take_status(int reader) {
   std::uint64_t handle = 0;
   take_all<eamos_wire_Status, StatusSample>(
-      reader, "status", *this,
+      reader, "status", *this, [](const StatusSample& s) { return s.drone; },
       [this, &handle](StatusSample s) {
         {
           std::lock_guard<std::mutex> lock(writers_mutex_);
@@ -307,7 +407,8 @@ void DdsNode::take_status(int reader) {
 }
 
 void DdsNode::take_trace(int reader) {
-  take_all<eamos_wire_TraceRecord, TraceSample>(reader, "trace", *this, [this](TraceSample s) {
+  take_all<eamos_wire_TraceRecord, TraceSample>(
+      reader, "trace", *this, [](const TraceSample& s) { return s.drone; }, [this](TraceSample s) {
     if (handlers_.trace) handlers_.trace(std::move(s));
   });
 }
@@ -320,6 +421,40 @@ void DdsNode::dropped(const char* topic, const std::string& why) {
                      " dropped so far)";
   if (handlers_.dropped) handlers_.dropped(line);
   else std::cerr << "eamos: " << line << "\n";
+}
+
+int DdsNode::sender_of(int reader, std::uint64_t publication_handle) {
+  if (mission_hash_.empty()) return kUnknownSender;
+  {
+    std::lock_guard<std::mutex> lock(senders_mutex_);
+    auto it = senders_.find(publication_handle);
+    if (it != senders_.end()) return it->second;
+  }
+  int sender = kUnknownSender;
+  dds_builtintopic_endpoint_t* w = dds_get_matched_publication_data(reader, publication_handle);
+  if (w) {
+    uint32_t n = 0;
+    char** names = nullptr;
+    // One partition, of this mission: a writer in several could pose as several senders.
+    if (dds_qget_partition(w->qos, &n, &names) && n == 1)
+      sender = participant_of(mission_hash_, handlers_.limits.drones, names[0]);
+    for (uint32_t i = 0; i < n; ++i) dds_free(names[i]);
+    dds_free(names);
+    dds_builtintopic_free_endpoint(w);
+  }
+  std::lock_guard<std::mutex> lock(senders_mutex_);
+  senders_[publication_handle] = sender;
+  return sender;
+}
+
+bool DdsNode::sent_by(const char* topic, int claimed, int sender) {
+  if (mission_hash_.empty() || claimed == sender) return true;
+  auto who = [](int d) {
+    return d == kGroundParticipant ? std::string("the ground") : d == kUnknownSender ? std::string("no participant of this mission") : "drone " + std::to_string(d);
+  };
+  dropped(topic, "it says it is from " + who(claimed) + " but was written by " + who(sender) +
+                     " (the partition its writer is in)");
+  return false;
 }
 
 void DdsNode::liveliness_changed(std::uint64_t publication_handle) {

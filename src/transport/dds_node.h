@@ -18,6 +18,7 @@
 #include <mutex>
 #include <string>
 
+#include "transport/partitions.h"
 #include "transport/samples.h"
 
 namespace eamos::transport {
@@ -29,7 +30,21 @@ struct DdsOptions {
   std::string interface;
   std::string config_file;  ///< a Cyclone DDS XML file of the user's, used as is
   double lease_s = 2.0;     ///< status writer liveliness lease: how soon a lost drone is noticed
+  /// The mission this participant belongs to and who it is in it (a drone index, or
+  /// kGroundParticipant): the partition it writes in, and the mission's partitions it
+  /// reads (partitions.h). "" (a node on its own, in tests): the default partition, and
+  /// samples are not bound to their writers.
+  std::string mission_hash;
+  int self = kGroundParticipant;
+  /// This participant's DDS Security credentials (written by `eamos compile`, see
+  /// docs/security.md): identity_ca.pem, permissions_ca.pem, governance.p7s, identity.pem,
+  /// identity_key.pem and permissions.p7s. "": no DDS Security (`--insecure`).
+  std::string security_folder;
 };
+
+/// The files of a security folder, in the order the Cyclone DDS configuration names them.
+inline constexpr const char* kSecurityFiles[] = {"identity_ca.pem",   "identity.pem",   "identity_key.pem",
+                                                 "permissions_ca.pem", "governance.p7s", "permissions.p7s"};
 
 struct DdsHandlers {
   std::function<void(TriggerSample)> trigger;
@@ -78,6 +93,13 @@ class DdsNode {
   void take_status(int reader);
   void take_trace(int reader);
   void liveliness_changed(std::uint64_t publication_handle);
+  /// Whose partition the writer `publication_handle` of `reader` writes in: a drone index,
+  /// kGroundParticipant or kUnknownSender. With DDS Security, the identity that
+  /// authenticated it (its permissions allow no other partition).
+  int sender_of(int reader, std::uint64_t publication_handle);
+  /// False (and the sample dropped, logged) when a sample claiming to come from `claimed`
+  /// was written by someone else. Always true for a node without a mission hash.
+  bool sent_by(const char* topic, int claimed, int sender);
   /// Checks for received samples, and where a dropped one is reported.
   const WireLimits& wire_limits() const { return handlers_.limits; }
   void dropped(const char* topic, const std::string& why);
@@ -87,6 +109,7 @@ class DdsNode {
  private:
   DdsNode() = default;
   bool create(const DdsOptions& options, std::string& error);
+  bool create_endpoints(const DdsOptions& options, std::string& error);
 
   DdsHandlers handlers_;
   std::string config_;
@@ -101,13 +124,17 @@ class DdsNode {
   };
   std::mutex writers_mutex_;  ///< per status writer: whose it is, for liveliness reports
   std::map<std::uint64_t, Writer> status_writers_;
+  std::string mission_hash_;  ///< "" = samples are not bound to their writers
+  std::mutex senders_mutex_;  ///< per remote writer: whose partition it writes in
+  std::map<std::uint64_t, int> senders_;
   std::atomic<std::uint64_t> dropped_{0};
 };
 
 /// Notes: a second node in one process joins the domain the first created, and the first
 /// one's destruction ends the domain for both: tests destroy them in reverse order.
 
-/// The Cyclone DDS XML for `options` (loopback, an interface, or the user's file).
+/// The Cyclone DDS XML for `options` (loopback, an interface, or the user's file), with
+/// the DDS Security plugins and `options.security_folder`'s credentials when it is set.
 bool dds_config(const DdsOptions& options, std::string& xml, std::string& error);
 
 }  // namespace eamos::transport

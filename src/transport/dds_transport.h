@@ -1,7 +1,11 @@
 #pragma once
 // The DEX's Transport (dex/bridge.h) over DDS: OutBridge writes triggers and telemetry as
 // samples tagged with the mission hash and run id; it counts what it sent, which the
-// status uses to tell when nothing is in flight.
+// status uses to tell when nothing is in flight. Every sample has its own sequence number
+// (receivers drop duplicates by it); only `ended` triggers are counted as sent: a cancel
+// goes to every drone, also those whose mission does not hold the flipped condition, so a
+// receiver cannot tell a real one it has no use for from a forged one, and a cancel only
+// ever stops work, never starts any, so the lead need not wait for one in flight.
 #include <cstdint>
 
 #include "dex/bridge.h"
@@ -13,7 +17,8 @@ class DdsTransport : public dex::Transport {
  public:
   DdsTransport(DdsNode& node, std::uint64_t run_id) : node_(node), run_id_(run_id) {}
   void send(int to, const dex::Message& m) override {
-    TriggerSample s{run_id_, to, ++sent_, m};
+    TriggerSample s{run_id_, to, ++seq_, m};
+    if (m.kind == dex::Message::Kind::ended) ++sent_;
     if (!node_.write(s)) ++write_errors_;
   }
   void publish(std::shared_ptr<const dex::Telemetry> t) override {
@@ -25,6 +30,7 @@ class DdsTransport : public dex::Transport {
  private:
   DdsNode& node_;
   std::uint64_t run_id_;
+  std::uint64_t seq_ = 0;
   std::uint64_t sent_ = 0;
   std::uint64_t write_errors_ = 0;
 };

@@ -220,5 +220,50 @@ TEST(DdsNode, DropsAndLogsASampleFromADroneOutsideTheFleetAndDeliversTheNext) {
   writer.reset();
 }
 
+TEST(DdsNode, DropsASampleWhoseSenderIsNotTheDroneWhosePartitionItsWriterIsIn) {
+  // Drone1's participant (partition "eamos.h.0") writes a status claiming to be Drone2's:
+  // with DDS Security that partition is Drone1's identity, so the claim is a lie.
+  std::string error;
+  DdsOptions options;
+  options.domain = 159;
+  options.mission_hash = "h";
+  Received got;
+  std::vector<std::string> dropped;
+  DdsHandlers h = record_into(got);
+  h.limits.drones = 3;
+  h.dropped = [&](const std::string& line) {
+    std::lock_guard<std::mutex> lock(got.mutex);
+    dropped.push_back(line);
+  };
+  auto ground = DdsNode::open(options, std::move(h), error);  // the ground: first, owns the domain
+  ASSERT_TRUE(ground) << error;
+  options.self = 0;
+  Received ignored;
+  DdsHandlers dh = record_into(ignored);
+  dh.limits.drones = 3;
+  auto drone1 = DdsNode::open(options, std::move(dh), error);
+  ASSERT_TRUE(drone1) << error;
+  StatusSample forged;
+  forged.mission_hash = "h";
+  forged.drone = 1;
+  forged.nonce = 7;
+  ASSERT_TRUE(drone1->write(forged));
+  StatusSample own = forged;
+  own.drone = 0;  // another instance, after the forged one from the same writer
+  ASSERT_TRUE(drone1->write(own));
+  ASSERT_TRUE(got.wait([&] { return !got.status.empty(); }));
+  {
+    // Not held while the nodes go: their listeners (liveliness lost) take it too.
+    std::lock_guard<std::mutex> lock(got.mutex);
+    ASSERT_EQ(got.status.size(), 1u);
+    EXPECT_EQ(got.status[0].drone, 0);
+    ASSERT_EQ(dropped.size(), 1u);
+    EXPECT_EQ(dropped[0], "dropped a status sample: it says it is from drone 1 but was written by drone 0 (the "
+                          "partition its writer is in) (1 dropped so far)");
+  }
+  drone1.reset();
+  ground.reset();
+}
+
 }  // namespace
 }  // namespace eamos::transport
