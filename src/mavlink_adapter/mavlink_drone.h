@@ -122,6 +122,8 @@ class MavlinkDrone final : public mid::Drone {
   void clear_action_timer(mid::ActionId id);
   void hold_here();
   void fail_all(const std::string& reason);
+  /// Ends the motion the adapter flies (if any) `failed`, dropping its goal and orbit.
+  void fail_motion(const std::string& reason);
 
   // the vehicle's own words (mavlink_drone_link.cpp)
   void on_statustext(const mavlink::Statustext& t);

@@ -235,14 +235,17 @@ void MavlinkDrone::on_heartbeat() {
   // the setpoint mode: give way instead of switching back.
   streaming_ = false;
   in_control_ = false;
+  fail_motion(std::string("the vehicle left ") + autopilot_->setpoint_mode_name + " for " +
+              mode_name(*autopilot_, vehicle_.custom_mode));
+}
+
+void MavlinkDrone::fail_motion(const std::string& reason) {
   if (motion_owner_ == mid::kNoAction) return;
   ActionId id = motion_owner_;
   motion_owner_ = mid::kNoAction;
   goal_.reset();
   orbit_ = {};
-  tracker_.end(id, Outcome::failed,
-               std::string("the vehicle left ") + autopilot_->setpoint_mode_name + " for " +
-                   mode_name(*autopilot_, vehicle_.custom_mode));
+  tracker_.end(id, Outcome::failed, reason);
 }
 
 void MavlinkDrone::link_watchdog() {
@@ -370,14 +373,8 @@ void MavlinkDrone::switch_to_setpoint_mode() {
       return;
     }
     streaming_ = false;
-    if (motion_owner_ == mid::kNoAction) return;
-    ActionId id = motion_owner_;
-    motion_owner_ = mid::kNoAction;
-    goal_.reset();
-    orbit_ = {};
-    tracker_.end(id, Outcome::failed,
-                 std::string("switch to ") + autopilot_->setpoint_mode_name + " refused by " +
-                     autopilot_->name + ": " + r.error);
+    fail_motion(std::string("switch to ") + autopilot_->setpoint_mode_name + " refused by " + autopilot_->name +
+                ": " + r.error);
   });
 }
 
