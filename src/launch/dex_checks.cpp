@@ -75,18 +75,9 @@ bool DexProcess::finish_agreed(int lead, std::string& why) const {
     why = "its sender has not reached the mission's end";
     return false;
   }
-  std::uint64_t sent = transport_->sent(), received = received_;
-  for (int d = 0; d < static_cast<int>(mission_.fleet.size()); ++d) {
-    if (d == mission_.self) continue;
-    auto s = statuses_.find(d);
-    if (s == statuses_.end() || s->second.busy) {
-      why = who(d) + " is still busy";
-      return false;
-    }
-    sent += s->second.sent;
-    received += s->second.received;
-  }
-  if (sent != received) {
+  FleetCounters c;
+  if (!others_idle(false, c, why)) return false;
+  if (c.sent != c.received) {
     why = "triggers are still in flight";
     return false;
   }

@@ -148,21 +148,15 @@ void DexProcess::check_finished() {
     quiet_ticks_ = 0;
     return;
   }
-  std::uint64_t sent = transport_->sent(), received = received_;
-  double idle_since = last_status_ ? last_status_->since : loop_->now();
-  for (int d = 0; d < static_cast<int>(mission_.fleet.size()); ++d) {
-    if (d == mission_.self) continue;
-    auto it = statuses_.find(d);
-    if (it == statuses_.end() || it->second.busy || it->second.phase != Phase::running) {
-      quiet_ticks_ = 0;
-      return;
-    }
-    sent += it->second.sent;
-    received += it->second.received;
-    idle_since = std::max(idle_since, it->second.since);
+  FleetCounters c;
+  std::string why;
+  if (!others_idle(true, c, why)) {
+    quiet_ticks_ = 0;
+    return;
   }
-  auto signature = std::make_tuple(sent, received, status_changes_);
-  if (sent != received || (quiet_ticks_ > 0 && signature != quiet_signature_)) {
+  double idle_since = std::max(last_status_ ? last_status_->since : loop_->now(), c.others_idle_since);
+  auto signature = std::make_tuple(c.sent, c.received, status_changes_);
+  if (c.sent != c.received || (quiet_ticks_ > 0 && signature != quiet_signature_)) {
     quiet_ticks_ = 0;
     return;
   }
@@ -174,6 +168,22 @@ void DexProcess::check_finished() {
   finished.t = idle_since;
   node_->write(finished);
   complete();
+}
+
+bool DexProcess::others_idle(bool running_only, FleetCounters& c, std::string& why) const {
+  c = FleetCounters{transport_->sent(), received_, 0.0};
+  for (int d = 0; d < static_cast<int>(mission_.fleet.size()); ++d) {
+    if (d == mission_.self) continue;
+    auto it = statuses_.find(d);
+    if (it == statuses_.end() || it->second.busy || (running_only && it->second.phase != Phase::running)) {
+      why = who(d) + " is still busy";
+      return false;
+    }
+    c.sent += it->second.sent;
+    c.received += it->second.received;
+    c.others_idle_since = std::max(c.others_idle_since, it->second.since);
+  }
+  return true;
 }
 
 void DexProcess::complete() {

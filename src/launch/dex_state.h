@@ -97,6 +97,16 @@ class DexProcess {
   void tick();
   void publish_status(bool force = false);
   void check_finished();
+  /// Trigger counters of the whole fleet (this drone's own and every other drone's newest
+  /// status), and the latest instant another drone went idle.
+  struct FleetCounters {
+    std::uint64_t sent = 0;
+    std::uint64_t received = 0;
+    double others_idle_since = 0.0;
+  };
+  /// False with `why` when another drone has no status yet or is busy (with `running_only`,
+  /// also when it has left the running phase); otherwise fills `c`.
+  bool others_idle(bool running_only, FleetCounters& c, std::string& why) const;
   void complete();
   void abandon(const std::string& reason, const std::optional<dex::Failure>& failure, bool broadcast);
   void wait_for_failsafe();
