@@ -85,7 +85,14 @@ std::string SitlFleet::skip_message(Autopilot autopilot) {
          "; .ci/run sets it when ../shared/sitl exists (docs/adapters.md, 'SITL tests')";
 }
 
-SitlFleet::SitlFleet(SitlOptions options) : options_(std::move(options)) {}
+SitlFleet::SitlFleet(SitlOptions options) : options_(std::move(options)) {
+  first_instance_ = options_.first_instance;
+  if (first_instance_ < 0) {
+    const char* env = std::getenv("EAMOS_SITL_FIRST_INSTANCE");
+    first_instance_ = env ? std::atoi(env) : 0;
+    if (first_instance_ < 0 || first_instance_ > 200) first_instance_ = 0;
+  }
+}
 
 SitlFleet::~SitlFleet() { stop(); }
 
@@ -105,13 +112,13 @@ std::vector<std::string> SitlFleet::command_line(int i, const std::string& bin) 
   geographic_home(options_.homes[i], lat, lon);
   if (options_.autopilot == Autopilot::ardupilot) {
     std::string parm = (fs::path(bin).parent_path() / "copter.parm").string();
-    return {bin, "-I", std::to_string(i), "--model", "+", "--speedup", fixed(options_.speedup, 2),
-            "--sysid", std::to_string(i + 1),
+    return {bin, "-I", std::to_string(instance_number(i)), "--model", "+", "--speedup", fixed(options_.speedup, 2),
+            "--sysid", std::to_string(sysid(i)),
             "--home", fixed(lat, 8) + "," + fixed(lon, 8) + "," + fixed(kOriginAlt, 1) + ",0",
             "--defaults", parm, "-w", "--serial0", "tcp:0"};
   }
   std::string etc = (fs::path(bin).parent_path().parent_path() / "etc").string();
-  return {instances_[i].dir + "/bin/px4", "-i", std::to_string(i), "-d", etc};
+  return {instances_[i].dir + "/bin/px4", "-i", std::to_string(instance_number(i)), "-d", etc};
 }
 
 // PX4's start-up script runs its modules as `px4-NAME` commands from PATH, links to the one
@@ -182,8 +189,8 @@ bool SitlFleet::start_one(int i, std::string& error) {
 }
 
 std::string SitlFleet::connection(int i) const {
-  if (options_.autopilot == Autopilot::ardupilot) return "tcp://127.0.0.1:" + std::to_string(5760 + 10 * i);
-  return "udp://:" + std::to_string(14540 + i);
+  if (options_.autopilot == Autopilot::ardupilot) return "tcp://127.0.0.1:" + std::to_string(5760 + 10 * instance_number(i));
+  return "udp://:" + std::to_string(14540 + instance_number(i));
 }
 
 std::string SitlFleet::log_tail(int i) const {
@@ -289,12 +296,12 @@ bool SitlFleet::wait_ready(double timeout_s, std::string& error) {
     state.push_back(std::make_unique<Readiness>());
     state.back()->need_ekf_text = options_.autopilot == Autopilot::ardupilot;
     Readiness* r = state.back().get();
-    uint8_t sysid = static_cast<uint8_t>(sysid_of(i));
+    uint8_t vehicle = static_cast<uint8_t>(sysid(i));
     // ArduPilot opens its TCP port a moment after it starts: try again until the deadline.
     ml::OpenResult opened;
     while (!opened.link && now_s() < deadline) {
       opened = ml::Link::open(*ml::parse_url(connection(i)).endpoint,
-                              [r, sysid](ml::Frame f) { on_probe_frame(*r, sysid, f); }, 0.2);
+                              [r, vehicle](ml::Frame f) { on_probe_frame(*r, vehicle, f); }, 0.2);
       if (!opened.link) usleep(100000);
     }
     if (!opened.link) {
@@ -314,7 +321,7 @@ bool SitlFleet::wait_ready(double timeout_s, std::string& error) {
         return false;
       }
       lock.unlock();
-      for (int k = 0; k < size(); ++k) ask_for_status(*links[k], encoder, static_cast<uint8_t>(sysid_of(k)));
+      for (int k = 0; k < size(); ++k) ask_for_status(*links[k], encoder, static_cast<uint8_t>(sysid(k)));
       lock.lock();
       r.changed.wait_for(lock, std::chrono::milliseconds(500), [&] { return r.ready(); });
     }

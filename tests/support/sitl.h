@@ -23,6 +23,10 @@ struct SitlOptions {
   Autopilot autopilot = Autopilot::ardupilot;
   std::vector<SitlHome> homes;  ///< one instance per home; instance i has system id i + 1
   double speedup = 1;           ///< simulation speed: ArduPilot --speedup, PX4_SIM_SPEED_FACTOR
+  /// The autopilot's instance number of instance 0: it picks the ports (ArduPilot TCP
+  /// 5760 + 10 n, PX4 UDP 14540 + n), so two fleets on one machine do not meet. Unset, it is
+  /// EAMOS_SITL_FIRST_INSTANCE or 0.
+  int first_instance = -1;
 };
 
 class SitlFleet {
@@ -50,8 +54,8 @@ class SitlFleet {
   int size() const { return static_cast<int>(instances_.size()); }
   /// The `connection:` URL that reaches instance i, as a fleet file writes it.
   std::string connection(int i) const;
-  int sysid(int i) const { return sysid_of(i); }
-  static int sysid_of(int i) { return i + 1; }
+  /// PX4 derives its system id from the instance number; ArduPilot is told the same one.
+  int sysid(int i) const { return instance_number(i) + 1; }
   /// The last lines the instance printed, for failure messages.
   std::string log_tail(int i) const;
 
@@ -61,10 +65,12 @@ class SitlFleet {
     std::string dir;
   };
   bool start_one(int i, std::string& error);
+  int instance_number(int i) const { return first_instance_ + i; }
   std::vector<std::string> command_line(int i, const std::string& binary) const;
   void prepare_px4_bin(const std::string& dir, const std::string& binary) const;
 
   SitlOptions options_;
+  int first_instance_ = 0;
   std::vector<Instance> instances_;
 };
 
