@@ -1,0 +1,90 @@
+// The monitor's page in a real browser (Debian's chromium, headless, driven by puppeteer-core
+// from browser/monitor_check.js) against the real `eamos` process: a replay of a trace the
+// test flies first, and a live run. Screenshots go to the build's tests/monitor/screenshots.
+#include <gtest/gtest.h>
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "support/eamos_process.h"
+#include "support/run_eamos.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+bool have_chromium() { return std::string(EAMOS_CHROMIUM).size() > 0 && access(EAMOS_CHROMIUM, X_OK) == 0; }
+
+// The URL the process printed ("... at http://127.0.0.1:PORT/"), "" when it printed none.
+std::string read_url(eamos_test::EamosProcess& p, const std::string& marker) {
+  if (!eamos_test::read_until(p, marker)) return "";
+  std::size_t at = p.seen.rfind("http://");
+  if (at == std::string::npos) return "";
+  std::size_t end = p.seen.find_first_of(" \n", at);
+  return p.seen.substr(at, end - at);
+}
+
+// Runs the browser script; its output, and whether every check passed.
+bool run_browser(const std::string& mode, const std::string& url, std::string& output) {
+  std::string cmd = "cd '" + std::string(EAMOS_BROWSER_DIR) + "' && '" + EAMOS_NODE + "' monitor_check.js " + mode +
+                    " '" + url + "' '" + EAMOS_SCREENSHOT_DIR + "' '" + EAMOS_CHROMIUM + "' 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return false;
+  char buf[4096];
+  while (fgets(buf, sizeof buf, p)) output += buf;
+  int status = pclose(p);
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
+void stop(eamos_test::EamosProcess& p, int& status) {
+  kill(p.pid, SIGTERM);
+  eamos_test::Exit e = eamos_test::wait_exit(p);
+  status = e.exited ? e.status : -1;
+}
+
+TEST(MonitorBrowser, ReplayOfListing2ShowsLanesTriggerAndNodeStates) {
+  if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
+  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-replay-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  std::string trace = (dir / "listing2.jsonl").string();
+  auto run = eamos_test::run_eamos("run examples/listing2.eamos -q --trace " + trace);
+  ASSERT_EQ(run.status, 0) << run.out;
+  // --mission: a trace written before traces carried their mission still gets its graphs.
+  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0", "--mission", "examples/listing2.eamos"});
+  ASSERT_GT(monitor.pid, 0);
+  std::string url = read_url(monitor, "replaying");
+  ASSERT_FALSE(url.empty()) << monitor.seen;
+  std::string output;
+  bool passed = run_browser("replay", url, output);
+  int status = -1;
+  stop(monitor, status);
+  EXPECT_TRUE(passed) << output;
+  EXPECT_EQ(status, 0) << monitor.seen;
+  EXPECT_TRUE(fs::exists(fs::path(EAMOS_SCREENSHOT_DIR) / "replay-listing2-t5.png"));
+  fs::remove_all(dir);
+}
+
+TEST(MonitorBrowser, LiveRunProgressesAndSurvivesReloadAndSecondPage) {
+  if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
+  // At 2× the 16.7 s mission flies for about 8 s of wall time: long enough to watch it move.
+  auto run = eamos_test::start_eamos({"run", "examples/listing2.eamos", "-q", "--speed", "2", "--monitor", "127.0.0.1:0"});
+  ASSERT_GT(run.pid, 0);
+  std::string url = read_url(run, "monitor at");
+  ASSERT_FALSE(url.empty()) << run.seen;
+  std::string output;
+  bool passed = run_browser("live", url, output);
+  // The page stays up after the end until the user stops it; the run's status is the mission's.
+  bool held = eamos_test::read_until(run, "until Ctrl-C");
+  int status = -1;
+  stop(run, status);
+  EXPECT_TRUE(passed) << output;
+  EXPECT_TRUE(held) << run.seen;
+  EXPECT_EQ(status, 0) << run.seen;
+  EXPECT_NE(run.seen.find("mission completed in 16.7 s"), std::string::npos) << run.seen;
+}
+
+}  // namespace
