@@ -250,8 +250,10 @@ function buildLanes() {
     lanes.appendChild(lane);
     d.track = track;
   }
+  const rows = barRows();
   D.bars.forEach((b, i) => {
     const d = D.drones[D.droneIndex.get(b.drone)];
+    const [row, count] = rows.get(b);
     const bar = el('div', 'bar', b.name);
     bar.dataset.index = String(i);
     bar.dataset.drone = b.drone;
@@ -264,6 +266,11 @@ function buildLanes() {
     bar.title = b.text + (b.outcome ? ' — ' + b.outcome : '') + (b.reason ? ' (' + b.reason + ')' : '') +
                 '  line ' + b.line;
     bar.addEventListener('click', () => select({ nodes: b.nodes, line: b.line, drone: b.drone, text: b.text, t: b.start }));
+    // Actions that overlap in one drone (a motion and a picture) share the lane in rows.
+    const h = Math.floor(28 / count);
+    bar.style.top = (2 + row * h) + 'px';
+    bar.style.height = (h - 1) + 'px';
+    if (count > 1) bar.style.fontSize = '9px';
     b.el = bar;
     d.track.appendChild(bar);
   });
@@ -280,12 +287,29 @@ function buildLanes() {
     // Marks of one lane take turns between two rows, so neighbours do not overlap.
     const row = (rowOf.get(c.drone) || 0);
     rowOf.set(c.drone, row + 1);
-    mark.style.top = (row % 2 === 0 ? 37 : 50) + 'px';
+    mark.style.top = (row % 2 === 0 ? 42 : 54) + 'px';
     mark.addEventListener('click', () => select({ nodes: c.nodes, line: c.line, drone: c.drone, text: c.text, t: c.t }));
     c.el = mark;
     d.track.appendChild(mark);
   });
   buildTriggers();
+}
+
+// Each bar's row in its lane (the first free one) and its lane's row count.
+function barRows() {
+  const free = new Map(), out = new Map();
+  for (const b of D.bars) {
+    if (!free.has(b.drone)) free.set(b.drone, []);
+    const ends = free.get(b.drone);
+    let row = ends.findIndex(e => e <= b.start + 1e-9);
+    if (row < 0) { row = ends.length; ends.push(0); }
+    ends[row] = b.end === null ? Infinity : b.end;
+    out.set(b, row);
+  }
+  const result = new Map();
+  for (const b of D.bars) result.set(b, [out.get(b), Math.min(3, free.get(b.drone).length)]);
+  for (const [b, [row, count]] of result) if (row >= count) result.set(b, [count - 1, count]);
+  return result;
 }
 
 function buildTriggers() {
@@ -353,7 +377,7 @@ function renderLanes() {
   svg.setAttribute('height', String(lanes.scrollHeight));
   for (const tr of D.triggerList || []) {
     const a = D.droneIndex.get(tr.from), b = D.droneIndex.get(tr.to);
-    const laneH = 64, y1 = a * laneH + 14, y2 = b * laneH + (b > a ? 4 : 22);
+    const laneH = 68, y1 = a * laneH + 14, y2 = b * laneH + (b > a ? 4 : 26);
     const x1 = xOf(tr.sent), x2 = xOf(tr.received);
     tr.el.setAttribute('d', `M${x1},${y1} C${x1 + 30},${y1} ${x2 - 30},${y2} ${x2},${y2}`);
     tr.el.classList.toggle('future', tr.received > now + 1e-9);
