@@ -7,8 +7,12 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <filesystem>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "support/eamos_process.h"
 #include "support/run_eamos.h"
@@ -65,6 +69,52 @@ TEST(MonitorBrowser, ReplayOfListing2ShowsLanesTriggerAndNodeStates) {
   EXPECT_TRUE(passed) << output;
   EXPECT_EQ(status, 0) << monitor.seen;
   EXPECT_TRUE(fs::exists(fs::path(EAMOS_SCREENSHOT_DIR) / "replay-listing2-t5.png"));
+  fs::remove_all(dir);
+}
+
+// A trace as schema v1 (docs/trace.md) has it: the header line with the mission's text, a
+// telemetry line per drone and sample, and message lines. Made from a real trace of Listing 2
+// with a hand-written header, a flight of Drone1 along x and one trigger message.
+std::string v1_trace(const std::string& real_trace) {
+  std::ifstream mission("examples/listing2.eamos");
+  std::string source((std::istreambuf_iterator<char>(mission)), {});
+  nlohmann::json header = {{"t", 0}, {"event", "header"}, {"schema", "eamos-trace"}, {"version", 1},
+                           {"mission", "listing2.eamos"}, {"mission_hash", "x"}, {"source", source}, {"fleet", ""},
+                           {"drones", {{{"name", "Drone1"}, {"index", 0}, {"type", "DroneType1"}, {"home", {0, 0, 0}}},
+                                       {{"name", "Drone2"}, {"index", 1}, {"type", "DroneType2"}, {"home", {0, 5, 0}}},
+                                       {{"name", "Drone3"}, {"index", 2}, {"type", "DroneType3"}, {"home", {0, 10, 0}}}}},
+                           {"telemetry_hz", 5}};
+  std::string out = header.dump() + "\n";
+  std::ifstream in(real_trace);
+  std::string line;
+  while (std::getline(in, line)) out += line + "\n";
+  for (double t : {0.0, 2.0, 3.0, 5.0})
+    out += nlohmann::json({{"t", t}, {"event", "telemetry"}, {"drone", "Drone1"}, {"x", t <= 2 ? 0.0 : -(t - 2) * 2},
+                           {"y", 0.0}, {"z", t > 0 ? 4.0 : 0.0}, {"heading", 0}, {"armed", true}, {"landed", false},
+                           {"battery", 99.0}, {"mode", "sim"}}).dump() + "\n";
+  out += nlohmann::json({{"t", 3.75}, {"event", "message"}, {"kind", "trigger"}, {"from", "Drone1"}, {"to", "Drone3"},
+                         {"node", 23}, {"sent", 3.7}, {"received", 3.75}}).dump() + "\n";
+  return out;
+}
+
+TEST(MonitorBrowser, ReplayOfASchemaV1TraceUsesItsHeaderTelemetryAndMessages) {
+  if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
+  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-v1-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  std::string real = (dir / "real.jsonl").string(), trace = (dir / "v1.jsonl").string();
+  auto run = eamos_test::run_eamos("run examples/listing2.eamos -q --trace " + real);
+  ASSERT_EQ(run.status, 0) << run.out;
+  std::ofstream(trace) << v1_trace(real);
+  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0"});
+  ASSERT_GT(monitor.pid, 0);
+  std::string url = read_url(monitor, "replaying");
+  ASSERT_FALSE(url.empty()) << monitor.seen;
+  std::string output;
+  bool passed = run_browser("v1", url, output);
+  int status = -1;
+  stop(monitor, status);
+  EXPECT_TRUE(passed) << output;
+  EXPECT_EQ(status, 0) << monitor.seen;
   fs::remove_all(dir);
 }
 

@@ -222,6 +222,7 @@ function renderControls() {
   $('mode').textContent = mode === 'live' ? '● live' : 'replay';
   $('outcome').dataset.outcome = D.outcome;
   $('outcome').textContent = D.outcome ? 'mission ' + D.outcome : '';
+  $('follow').parentElement.hidden = mode !== 'live';
   $('play').disabled = S.playing;
   $('pause').disabled = !S.playing;
 }

@@ -118,6 +118,27 @@ async function replay(browser) {
   await page.close();
 }
 
+// A schema v1 trace: the mission comes from its header, positions from its telemetry, the
+// arrows from its message events (tests/monitor/browser_test.cpp writes it).
+async function v1(browser) {
+  const page = await open(browser, '?t=4');
+  await page.waitForSelector('body[data-finished="true"]', { timeout: 15000, polling: 100 });
+  const s = await page.evaluate(snapshot);
+  check(Object.keys(s.nodes).length > 20, 'the graph comes from the header\'s mission: ' + Object.keys(s.nodes).length + ' nodes');
+  const note = await page.evaluate(() => document.getElementById('map-note').textContent);
+  check(note === '', 'the map has telemetry: "' + note + '"');
+  const d1 = await page.evaluate(() => {
+    const li = document.querySelector('#drone-list li[data-drone="Drone1"]');
+    return li ? Number(li.dataset.x) : NaN; });
+  check(Math.abs(d1 - -4) < 0.01, 'at 4 s Drone1 is at x = -4 (interpolated telemetry): ' + d1);
+  const t = s.triggers.filter(t => t.from === 'Drone1' && t.to === 'Drone3');
+  check(t.length === 1 && Math.abs(t[0].sent - 3.7) < 1e-6 && Math.abs(t[0].received - 3.75) < 1e-6,
+        'the Drone1 → Drone3 arrow is the message event (sent 3.7, received 3.75)');
+  const source = await page.evaluate(() => document.querySelectorAll('#source .src-line').length);
+  check(source > 90, 'the mission text is the header\'s: ' + source + ' lines');
+  await page.screenshot({ path: path.join(shots, 'replay-v1-header-t4.png'), fullPage: true });
+}
+
 async function live(browser) {
   const page = await open(browser, '');
   await page.waitForFunction(() => document.querySelectorAll('.lane').length === 3, { timeout: 15000, polling: 100 });
@@ -151,6 +172,7 @@ async function live(browser) {
   try {
     if (mode === 'replay') await replay(browser);
     else if (mode === 'live') await live(browser);
+    else if (mode === 'v1') await v1(browser);
     else failures.push('unknown mode ' + mode);
   } finally {
     await browser.close();
