@@ -2,6 +2,10 @@
 // untrusted, so every bad line is reported as file:line: error, all at once, exit 1.
 #include <gtest/gtest.h>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -10,6 +14,7 @@
 
 #include "monitor/server.h"
 #include "monitor/trace_file.h"
+#include "support/eamos_process.h"
 #include "support/run_eamos.h"
 
 namespace {
@@ -75,6 +80,80 @@ TEST(MonitorEndpoint, HostAndPortAreChecked) {
   EXPECT_NE(error.find("is not a port number"), std::string::npos);
   EXPECT_FALSE(eamos::monitor::parse_endpoint("host;rm:80", e, error));
   EXPECT_FALSE(eamos::monitor::parse_endpoint("", e, error));
+}
+
+// One raw HTTP/1.1 request to 127.0.0.1:port; the whole answer ("" when none).
+std::string http(int port, const std::string& request) {
+  int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  std::string answer;
+  if (connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0) {
+    (void)!write(fd, request.data(), request.size());
+    shutdown(fd, SHUT_WR);
+    char buf[4096];
+    ssize_t n;
+    while ((n = read(fd, buf, sizeof buf)) > 0) answer.append(buf, static_cast<std::size_t>(n));
+  }
+  close(fd);
+  return answer;
+}
+
+int port_of(const std::string& seen) {
+  std::size_t at = seen.find("http://127.0.0.1:");
+  return at == std::string::npos ? -1 : std::atoi(seen.c_str() + at + 17);
+}
+
+std::string get(int port, const std::string& path, const std::string& host) {
+  return http(port, "GET " + path + " HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n");
+}
+
+TEST(MonitorServer, ServesOnlyThePageAndRefusesEverythingThatWouldChangeSomething) {
+  std::string trace = write_temp("ok.jsonl", "{\"t\":0,\"drone\":\"Drone1\",\"event\":\"start\",\"name\":\"Arm\",\"line\":3}\n");
+  auto p = eamos_test::start_eamos({"monitor", trace, "--port", "0"});
+  ASSERT_TRUE(eamos_test::read_until(p, "replaying")) << p.seen;
+  int port = port_of(p.seen);
+  ASSERT_GT(port, 0) << p.seen;
+  std::string self = "127.0.0.1:" + std::to_string(port);
+  std::string page = get(port, "/", self);
+  EXPECT_EQ(page.rfind("HTTP/1.1 200", 0), 0u) << page;
+  EXPECT_NE(page.find("<title>eamos monitor</title>"), std::string::npos);
+  EXPECT_NE(page.find("Content-Security-Policy: default-src 'self'"), std::string::npos);
+  EXPECT_EQ(get(port, "/monitor.js", self).rfind("HTTP/1.1 200", 0), 0u);
+  EXPECT_EQ(http(port, "POST / HTTP/1.1\r\nHost: " + self + "\r\nContent-Length: 2\r\n\r\n{}").rfind("HTTP/1.1 405", 0), 0u);
+  EXPECT_EQ(http(port, "PUT /monitor.js HTTP/1.1\r\nHost: " + self + "\r\nContent-Length: 0\r\n\r\n").rfind("HTTP/1.1 405", 0), 0u);
+  EXPECT_EQ(get(port, "/../../etc/passwd", self).find("root:"), std::string::npos);
+  EXPECT_EQ(get(port, "/nothing", self).rfind("HTTP/1.1 404", 0), 0u);
+  // DNS rebinding: another name for this address is not served.
+  EXPECT_EQ(get(port, "/", "evil.example:" + std::to_string(port)).rfind("HTTP/1.1 403", 0), 0u);
+  // A WebSocket from another site's page is refused.
+  std::string upgrade = http(port, "GET /ws HTTP/1.1\r\nHost: " + self + "\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                                   "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n"
+                                   "Origin: http://evil.example\r\n\r\n");
+  EXPECT_EQ(upgrade.find("101 Switching Protocols"), std::string::npos) << upgrade;
+  kill(p.pid, SIGTERM);
+  eamos_test::Exit e = eamos_test::wait_exit(p);
+  EXPECT_TRUE(e.exited);
+  EXPECT_EQ(e.status, 0);
+  fs::remove(trace);
+}
+
+// The distributed run (one DEX process per drone over DDS) serves its ground's events the same way.
+TEST(MonitorRun, ADistributedRunIsServedLiveAndStaysUpUntilStopped) {
+  auto p = eamos_test::start_eamos({"run", "examples/listing2.eamos", "-q", "--distributed", "--insecure", "--speed", "4",
+                                    "--domain", "201", "--monitor", "127.0.0.1:0"});
+  ASSERT_TRUE(eamos_test::read_until(p, "monitor at")) << p.seen;
+  int port = port_of(p.seen);
+  ASSERT_GT(port, 0) << p.seen;
+  EXPECT_EQ(get(port, "/", "127.0.0.1:" + std::to_string(port)).rfind("HTTP/1.1 200", 0), 0u);
+  ASSERT_TRUE(eamos_test::read_until(p, "until Ctrl-C")) << p.seen;
+  EXPECT_NE(p.seen.find("mission completed"), std::string::npos) << p.seen;
+  kill(p.pid, SIGTERM);
+  eamos_test::Exit e = eamos_test::wait_exit(p);
+  EXPECT_TRUE(e.exited);
+  EXPECT_EQ(e.status, 0) << p.seen;
 }
 
 TEST(MonitorRun, ABadMonitorAddressStopsTheRunBeforeItFlies) {
