@@ -118,6 +118,27 @@ TEST(MonitorBrowser, ReplayOfASchemaV1TraceUsesItsHeaderTelemetryAndMessages) {
   fs::remove_all(dir);
 }
 
+TEST(MonitorBrowser, AThousandDroneReplayDrawsItsLanesOnACanvas) {
+  if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
+  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-scale-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  std::string mission = (dir / "fleet.eamos").string(), trace = (dir / "fleet.jsonl").string();
+  ASSERT_EQ(eamos_test::run_eamos("gen-stress --drones 1000 --nodes 20000 -o " + mission).status, 0);
+  auto run = eamos_test::run_eamos("run " + mission + " -q --trace " + trace + " > /dev/null");
+  ASSERT_EQ(run.status, 0) << run.out;
+  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0", "--mission", mission});
+  ASSERT_GT(monitor.pid, 0);
+  std::string url = read_url(monitor, "replaying");
+  ASSERT_FALSE(url.empty()) << monitor.seen;
+  std::string output;
+  bool passed = run_browser("scale", url, output);
+  int status = -1;
+  stop(monitor, status);
+  EXPECT_TRUE(passed) << output;
+  EXPECT_EQ(status, 0) << monitor.seen;
+  fs::remove_all(dir);
+}
+
 TEST(MonitorBrowser, LiveRunProgressesAndSurvivesReloadAndSecondPage) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
   // At 2× the 16.7 s mission flies for about 8 s of wall time: long enough to watch it move.

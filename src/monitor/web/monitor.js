@@ -404,9 +404,11 @@ function renderLanesCanvas() {
   g.clearRect(0, 0, w, canvas.height);
   const end = missionEnd(), now = S.clock;
   const colours = { succeeded: '#2e7d32', failed: '#c62828', preempted: '#ef6c00', cancelled: '#757575', running: '#1565c0' };
+  let drawn = 0;
   for (const b of D.bars) {
     const state = barState(b);
     if (state === 'future') continue;
+    drawn++;
     const row = D.droneIndex.get(b.drone);
     const stop = state === 'running' ? now : b.end;
     g.fillStyle = colours[state] || '#2e7d32';
@@ -415,6 +417,8 @@ function renderLanesCanvas() {
   }
   g.fillStyle = '#d50000';
   g.fillRect((now / end) * w, 0, 2, canvas.height);
+  canvas.dataset.drones = String(D.drones.length);
+  canvas.dataset.bars = String(drawn);
   $('playhead').style.height = '0px';
 }
 
@@ -646,6 +650,7 @@ function renderGraphStates() {
 function buildSource() {
   const pre = $('source');
   pre.textContent = '';
+  S.activeLines = new Set();
   const text = S.mission ? str(S.mission.source) : '';
   if (!text) { pre.textContent = 'the mission text is not in this trace'; return; }
   text.split('\n').forEach((line, i) => {
@@ -657,10 +662,14 @@ function buildSource() {
   });
 }
 
+// Only the rows whose state changed are touched: a generated mission has tens of thousands.
 function renderSourceActive() {
   const active = new Set();
   for (const b of D.bars) if (b.start <= S.clock + 1e-9 && (b.end === null || b.end > S.clock + 1e-9)) active.add(b.line);
-  for (const row of $('source').children) row.classList.toggle('active', active.has(Number(row.dataset.line)));
+  const rows = $('source').children, before = S.activeLines || new Set();
+  for (const line of before) if (!active.has(line) && rows[line - 1]) rows[line - 1].classList.remove('active');
+  for (const line of active) if (!before.has(line) && rows[line - 1]) rows[line - 1].classList.add('active');
+  S.activeLines = active;
 }
 
 function select(what) {

@@ -139,6 +139,26 @@ async function v1(browser) {
   await page.screenshot({ path: path.join(shots, 'replay-v1-header-t4.png'), fullPage: true });
 }
 
+// 1,000 drones: lanes on a canvas, no element per bar, and a change of the clock redrawn fast.
+async function scale(browser) {
+  const page = await open(browser, '?t=0');
+  await page.waitForSelector('body[data-finished="true"]', { timeout: 60000, polling: 200 });
+  const r = await page.evaluate(() => {
+    const start = performance.now();
+    for (let i = 1; i <= 10; i++) window.eamosMonitor.setClock(i * 4);
+    const perRender = (performance.now() - start) / 10;
+    const canvas = document.getElementById('lanes-canvas');
+    return { perRender, bars: document.querySelectorAll('.bar').length, canvasHidden: canvas.hidden,
+             drones: Number(canvas.dataset.drones), drawn: Number(canvas.dataset.bars),
+             elements: document.querySelectorAll('#timeline-panel *').length };
+  });
+  check(r.drones === 1000 && !r.canvasHidden && r.drawn > 1000, `1000 lanes on the canvas (${r.drawn} bars drawn)`);
+  check(r.bars === 0 && r.elements < 100, `no element per bar (${r.elements} elements in the timeline)`);
+  // Generous for two shared cores: a frame budget is 16 ms, a person notices a stall at about 0.5 s.
+  check(r.perRender < 500, `a clock change redraws in ${r.perRender.toFixed(1)} ms`);
+  await page.screenshot({ path: path.join(shots, 'replay-1000-drones.png') });
+}
+
 async function live(browser) {
   const page = await open(browser, '');
   await page.waitForFunction(() => document.querySelectorAll('.lane').length === 3, { timeout: 15000, polling: 100 });
@@ -173,6 +193,7 @@ async function live(browser) {
     if (mode === 'replay') await replay(browser);
     else if (mode === 'live') await live(browser);
     else if (mode === 'v1') await v1(browser);
+    else if (mode === 'scale') await scale(browser);
     else failures.push('unknown mode ' + mode);
   } finally {
     await browser.close();
