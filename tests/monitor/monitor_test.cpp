@@ -44,6 +44,15 @@ TEST(MonitorTrace, EveryBadLineIsReportedWithItsLineNumber) {
   fs::remove(path);
 }
 
+TEST(MonitorTrace, DeepNestingAndBinaryAreErrorsNotCrashes) {
+  std::string nasty = std::string(200000, '[') + "\n" + std::string("\xff\xfe\x00garbage\n", 12) +
+                      "{\"t\":1,\"event\":\"start\",\"drone\":\"\\ud800\"}\n";
+  std::istringstream in(nasty);
+  eamos::monitor::LoadedTrace t = eamos::monitor::read_trace("x.jsonl", in);
+  EXPECT_EQ(t.errors.size(), 3u);
+  EXPECT_TRUE(t.events.empty());
+}
+
 TEST(MonitorTrace, ACutOffLastLineIsAWarningNotAnError) {
   std::istringstream in("{\"t\":0,\"event\":\"start\",\"drone\":\"D\"}\n{\"t\":1,\"ev");
   eamos::monitor::LoadedTrace t = eamos::monitor::read_trace("x.jsonl", in);
