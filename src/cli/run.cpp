@@ -54,12 +54,14 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
     interrupt.request(std::string("interrupted (") + name + ")");
     hold.signal();
   });
-  monitor::MonitorServer server;
+  // Only a run with --monitor has a server at all: without it nothing of civetweb is touched.
+  std::unique_ptr<monitor::MonitorServer> server;
   std::unique_ptr<monitor::LiveSink> live_monitor;
   if (!r.monitor.empty()) {
-    if (!start_monitor(server, r.monitor, view)) return 1;
-    live_monitor = std::make_unique<monitor::LiveSink>(server);
-    std::cout << "eamos: monitor at " << server.url() << "\n" << std::flush;
+    server = std::make_unique<monitor::MonitorServer>();
+    if (!start_monitor(*server, r.monitor, view)) return 1;
+    live_monitor = std::make_unique<monitor::LiveSink>(*server);
+    std::cout << "eamos: monitor at " << server->url() << "\n" << std::flush;
   }
   mid::AdapterRegistry adapters;
   sim::register_adapter(adapters);
@@ -92,7 +94,7 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   }
   dex::RunResult result = dex::run_in_process(missions, adapters, &tee, options);
   if (!report_run(r, result, memory.events)) return 1;
-  if (live_monitor && !hold.was_interrupted()) hold_monitor(server, hold);
+  if (live_monitor && !hold.was_interrupted()) hold_monitor(*server, hold);
   return result.completed ? 0 : 1;
 }
 
