@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <iostream>
 #include <fstream>
 #include <iterator>
 #include <filesystem>
@@ -149,6 +150,7 @@ TEST(MonitorBrowser, LiveRunProgressesAndSurvivesReloadAndSecondPage) {
   ASSERT_FALSE(url.empty()) << run.seen;
   std::string output;
   bool passed = run_browser("live", url, output);
+  std::cout << output;  // what was checked, and the measured live latency
   // The page stays up after the end until the user stops it; the run's status is the mission's.
   bool held = eamos_test::read_until(run, "until Ctrl-C");
   int status = -1;

@@ -14,7 +14,7 @@ const DOM_LANES_MAX = 60;  // more drones: lanes on a canvas, no element per bar
 
 const S = {
   mission: null, live: false, finished: false, events: [], clock: 0, playing: false, speed: 1,
-  follow: true, selected: null, dirty: true, structureDirty: true, graphIndex: 0,
+  follow: true, selected: null, dirty: true, structureDirty: true, graphIndex: 0, arrivals: [],
 };
 let D = null;  // what the events say, rebuilt incrementally (see resetDerived)
 
@@ -705,6 +705,8 @@ function onMessage(text) {
     S.live = !!S.mission.live;
     S.finished = false;
     S.events = [];
+    S.batches = 0;
+    S.arrivals = [];
     resetDerived();
     $('mission-name').textContent = str(S.mission.mission);
     buildSource();
@@ -713,6 +715,12 @@ function onMessage(text) {
   } else if (m.type === 'events' && Array.isArray(m.events) && D) {
     for (const e of m.events) { S.events.push(e); ingest(e); }
     document.body.dataset.events = String(S.events.length);
+    // Wall arrival time against mission time, for the latency a live page sees (real-time runs).
+    const last = m.events[m.events.length - 1];
+    // The first batch is the history so far, not news.
+    S.batches = (S.batches || 0) + 1;
+    if (S.live && !S.finished && S.batches > 1 && last && typeof last.t === 'number')
+      S.arrivals.push([performance.now() / 1000, last.t]);
     // A page in a background tab gets no animation frames: keep its DOM current anyway.
     if (document.hidden) { if (S.live && !S.finished && S.follow) S.clock = missionEnd(); render(); }
   } else if (m.type === 'finished') {
@@ -763,6 +771,12 @@ window.eamosMonitor = {
   setClock: t => { S.playing = false; S.follow = false; $('follow').checked = false; setClock(t); render(); },
   clock: () => S.clock,
   nodeState: id => stateAt(id),
+  // Spread of (arrival wall time − mission time) over the live batches, seconds: in a
+  // real-time run, how much later than the earliest one an event reached the page.
+  latencySpread: () => {
+    const d = S.arrivals.map(([wall, t]) => wall - t);
+    return d.length ? Math.max(...d) - Math.min(...d) : null;
+  },
   triggers: () => (D.triggerList || []).map(t => ({ from: t.from, to: t.to, sent: t.sent, received: t.received, wait: t.received - t.waitFrom })),
 };
 
