@@ -156,10 +156,11 @@ int main(int argc, char** argv) {
       ->default_val(8080)->check(CLI::Range(0, 65535));
   monitor->add_option("--host", monitor_opts.host, "Address to serve at (0.0.0.0: every interface; default loopback only)")
       ->default_val("127.0.0.1");
-  monitor->add_option("--mission", monitor_opts.mission,
+  auto* monitor_mission = monitor->add_option("--mission", monitor_opts.mission,
                       "The mission, for a trace that does not carry it (an older trace): adds the graphs and the text")
       ->check(CLI::ExistingFile);
-  monitor->add_option("--fleet", monitor_opts.fleet, "The fleet file, with --mission")->check(CLI::ExistingFile);
+  monitor->add_option("--fleet", monitor_opts.fleet, "The fleet file, with --mission")
+      ->check(CLI::ExistingFile)->needs(monitor_mission);
 
   auto* gen = app.add_subcommand("gen-stress", "Generate a large valid mission for scaling tests");
   long long nodes = 5000;

@@ -165,6 +165,14 @@ TEST(MonitorRun, ADistributedRunIsServedLiveAndStaysUpUntilStopped) {
   EXPECT_EQ(e.status, 0) << p.seen;
 }
 
+TEST(MonitorRun, AFleetWithoutItsMissionIsAnError) {
+  std::string trace = write_temp("fleet.jsonl", "{\"t\":0,\"event\":\"start\",\"drone\":\"Drone1\"}\n");
+  auto r = eamos_test::run_eamos("monitor " + trace + " --fleet examples/listing2-right.yaml --port 0");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("--fleet requires --mission"), std::string::npos) << r.out;
+  fs::remove(trace);
+}
+
 TEST(MonitorRun, ABadMonitorAddressStopsTheRunBeforeItFlies) {
   auto r = eamos_test::run_eamos("run examples/listing2.eamos -q --monitor 99999");
   EXPECT_EQ(r.status, 1);
