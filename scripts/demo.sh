@@ -36,3 +36,6 @@ echo "demo: deployment in $OUT/deploy/, graphs in $OUT/graphs/, statistics in $O
 echo "      trace in $OUT/trace.jsonl, summary in $OUT/summary.json, picture of the run in $OUT/plot.svg,"
 echo "      the distributed run's trace in $OUT/distributed-trace.jsonl (DEX logs: $OUT/deploy/<drone>/dex.log)"
 ls "$OUT/deploy" "$OUT/graphs"
+echo
+echo "watch the run replay in the browser (docs/monitor.md): open the URL this prints"
+echo "  $EAMOS monitor $OUT/trace.jsonl --mission $MISSION --fleet examples/listing2-right.yaml"

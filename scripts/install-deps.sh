@@ -8,9 +8,11 @@ packages=(
   libfmt-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev nettle-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   graphviz
+  libcivetweb-dev
   cyclonedds-dev cyclonedds-tools libddsc0debian libssl-dev openssl
   clang libclang-rt-14-dev
   nodejs
+  chromium
 )
 
 missing=()

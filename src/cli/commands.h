@@ -1,12 +1,20 @@
 #pragma once
 // The `eamos` subcommands. Each returns the process exit status: 0 success, 1 when the
 // input had errors (all of them printed) or a file could not be read or written.
+#include <condition_variable>
+#include <mutex>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "dex/runner.h"
 #include "graph/pipeline.h"
 #include "launch/dex_process.h"
 #include "launch/ground.h"
+
+namespace eamos::monitor {
+class MonitorServer;
+}
 
 namespace eamos::cli {
 
@@ -43,6 +51,7 @@ struct RunCommandOptions {
   double speed = 0.0;     ///< > 0: real time scaled by this factor
   double time_limit = 3600.0;
   bool log = true;        ///< print the live log
+  std::string monitor;    ///< "[HOST:]PORT" to serve the run live in a browser; "" = none
 };
 int cmd_run(const CommonOptions& o, const RunCommandOptions& r);
 /// Writes the summary and plot of a finished run as `eamos run` does; false when a file
@@ -59,6 +68,9 @@ struct VerifyCommandOptions {
 int cmd_verify(const CommonOptions& o, const VerifyCommandOptions& v);
 int cmd_dex(const launch::DexProcessOptions& options);
 int cmd_launch(const launch::LaunchOptions& options, const RunCommandOptions& r);
+int launch_with_monitor(const launch::LaunchOptions& options, const RunCommandOptions& r);
+/// Writes the trace, summary and plot of a finished launch; the exit status.
+int report_launch(const RunCommandOptions& r, const launch::LaunchResult& result, int status);
 /// `eamos run --distributed`: compiles into options.dir (a temporary folder when ""), then launches.
 int cmd_run_distributed(const CommonOptions& o, const RunCommandOptions& r, launch::LaunchOptions options,
                         const SecurityOptions& security);
@@ -73,6 +85,33 @@ struct SimVehicleCommandOptions {
 };
 int cmd_sim_vehicle(const SimVehicleCommandOptions& o);
 int cmd_gen_stress(long long nodes, int drones, unsigned seed, const std::string& output);
+
+struct MonitorCommandOptions {
+  std::string trace;   ///< the JSONL trace to replay
+  std::string host = "127.0.0.1";
+  int port = 8080;     ///< 0: any free port
+  std::string mission; ///< the mission, for a trace without a header; "" = the trace's own
+  std::string fleet;
+};
+/// `eamos monitor`: serves the replay until SIGINT/SIGTERM; 1 when the trace has errors.
+int cmd_monitor(const MonitorCommandOptions& m);
+/// Waits, after a run with --monitor, until the user stops the process (Ctrl-C, SIGTERM).
+struct MonitorHold {
+  std::mutex mutex;
+  std::condition_variable signalled;
+  bool interrupted = false;
+  void signal();
+  bool was_interrupted();
+  void wait_for_signal();
+};
+/// After the run: the page shows the finished mission until the user stops the process.
+void hold_monitor(monitor::MonitorServer& server, MonitorHold& hold);
+/// The live page's mission; runs Graphviz, so call it before any thread starts.
+nlohmann::json live_view(const graph::Compilation& c, const std::string& mission, const std::string& fleet);
+/// The live page's mission for `eamos launch DIR`.
+nlohmann::json launch_view(const std::string& dir);
+/// Parses `at` ("[HOST:]PORT") and starts `server` there; false with the error printed.
+bool start_monitor(monitor::MonitorServer& server, const std::string& at, const nlohmann::json& view);
 
 /// Compiles and prints every diagnostic; true when the graphs are usable.
 bool compile_and_report(const CommonOptions& o, graph::Compilation& c,

@@ -5,12 +5,19 @@
 #include <fstream>
 #include <iostream>
 
+#include <signal.h>
+#include <unistd.h>
+
+#include <cerrno>
+
 #include "cli/commands.h"
 #include "deploy/synthesize.h"
 #include "dex/trace_writers.h"
 #include "launch/dex_process.h"
 #include "launch/ground.h"
 #include "mavlink_adapter/adapter.h"
+#include "monitor/live_sink.h"
+#include "monitor/server.h"
 #include "sim/sim_adapter.h"
 
 namespace eamos::cli {
@@ -26,9 +33,60 @@ int cmd_dex(const launch::DexProcessOptions& options) {
 
 int cmd_launch(const launch::LaunchOptions& options, const RunCommandOptions& r) {
   if (options.insecure) warn_insecure("launch");
+  if (!r.monitor.empty()) return launch_with_monitor(options, r);
   dex::LiveLog live(std::cout);
   launch::LaunchResult result;
   int status = launch::launch(options, r.log ? &live : nullptr, result, std::cout, std::cerr);
+  return report_launch(r, result, status);
+}
+
+namespace {
+
+int g_hold_pipe[2] = {-1, -1};
+void on_hold_signal(int) {
+  char c = 1;
+  (void)!write(g_hold_pipe[1], &c, 1);  // async-signal-safe; wakes the waiting read
+}
+
+// The ground handles SIGINT/SIGTERM itself while it flies, and its DEX children inherit the
+// signal mask, so no signal is blocked here: a handler wakes a pipe once the mission is over.
+void hold_after_launch(monitor::MonitorServer& server) {
+  if (pipe(g_hold_pipe) != 0) return;
+  struct sigaction action {};
+  action.sa_handler = on_hold_signal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+  server.finish();
+  std::cout << "eamos: the mission has ended; the monitor shows it at " << server.url() << " until Ctrl-C\n"
+            << std::flush;
+  char c;
+  while (read(g_hold_pipe[0], &c, 1) < 0 && errno == EINTR) {
+  }
+}
+
+}  // namespace
+
+// The ground's live events go to the log and to the page; after the end the page stays up.
+int launch_with_monitor(const launch::LaunchOptions& options, const RunCommandOptions& r) {
+  nlohmann::json view = launch_view(options.dir);
+  monitor::MonitorServer server;
+  if (!start_monitor(server, r.monitor, view)) return 1;
+  std::cout << "eamos: monitor at " << server.url() << "\n" << std::flush;
+  monitor::LiveSink page(server);
+  dex::LiveLog log(std::cout);
+  dex::TeeTrace tee;
+  if (r.log) tee.add(&log);
+  tee.add(&page);
+  launch::LaunchResult result;
+  int status = launch::launch(options, &tee, result, std::cout, std::cerr);
+  status = report_launch(r, result, status);
+  // Interrupted (Ctrl-C during the flight): the user wants out, not a page.
+  if (result.run.error.find("interrupted") == std::string::npos) hold_after_launch(server);
+  return status;
+}
+
+int report_launch(const RunCommandOptions& r, const launch::LaunchResult& result, int status) {
   if (!r.trace.empty()) {
     std::ofstream out(r.trace, std::ios::trunc);
     if (!out) {

@@ -35,6 +35,9 @@ void add_report(CLI::App* cmd, eamos::cli::RunCommandOptions& r) {
   cmd->add_option("--trace", r.trace, "Write the trace as JSON Lines to this file");
   cmd->add_option("--summary", r.summary, "Write the summary JSON to this file");
   cmd->add_option("--plot", r.plot, "Draw the run (tracks and action timeline) as SVG to this file");
+  cmd->add_option("--monitor", r.monitor,
+                  "Serve the running mission live in a browser at [HOST:]PORT (default host 127.0.0.1; "
+                  "port 0: any free one); the URL is printed, and the page stays up after the end until Ctrl-C");
 }
 
 void add_security(CLI::App* cmd, eamos::cli::SecurityOptions& s) {
@@ -145,6 +148,20 @@ int main(int argc, char** argv) {
   dexcmd->add_flag("--insecure", dex_opts.insecure,
                    "Fly without DDS Security, even when the folder has credentials (experiments only)");
 
+  auto* monitor = app.add_subcommand("monitor", "Replay a finished mission's trace in the browser (the URL is printed)");
+  eamos::cli::MonitorCommandOptions monitor_opts;
+  monitor->add_option("trace", monitor_opts.trace, "The trace (JSON Lines) `eamos run --trace` wrote")
+      ->required()->check(CLI::ExistingFile);
+  monitor->add_option("--port", monitor_opts.port, "Port to serve at (0: any free one)")
+      ->default_val(8080)->check(CLI::Range(0, 65535));
+  monitor->add_option("--host", monitor_opts.host, "Address to serve at (0.0.0.0: every interface; default loopback only)")
+      ->default_val("127.0.0.1");
+  auto* monitor_mission = monitor->add_option("--mission", monitor_opts.mission,
+                      "The mission, for a trace that does not carry it (an older trace): adds the graphs and the text")
+      ->check(CLI::ExistingFile);
+  monitor->add_option("--fleet", monitor_opts.fleet, "The fleet file, with --mission")
+      ->check(CLI::ExistingFile)->needs(monitor_mission);
+
   auto* gen = app.add_subcommand("gen-stress", "Generate a large valid mission for scaling tests");
   long long nodes = 5000;
   int drones = 20;
@@ -179,7 +196,7 @@ int main(int argc, char** argv) {
 
   // A flight's live log goes out line by line also into a pipe (`| tee log`): what a person
   // watches is now, not a buffer later, and a killed process loses at most half a line.
-  if (*run || *launch || *dexcmd || *simv) std::setvbuf(stdout, nullptr, _IOLBF, BUFSIZ);
+  if (*run || *launch || *dexcmd || *simv || *monitor) std::setvbuf(stdout, nullptr, _IOLBF, BUFSIZ);
 
   try {
     if (*check) return eamos::cli::cmd_check(o, list_caps);
@@ -196,6 +213,7 @@ int main(int argc, char** argv) {
     if (*launch) return eamos::cli::cmd_launch(launch_opts, launch_report);
     if (*dexcmd) return eamos::cli::cmd_dex(dex_opts);
     if (*simv) return eamos::cli::cmd_sim_vehicle(simv_opts);
+    if (*monitor) return eamos::cli::cmd_monitor(monitor_opts);
     if (*gen) return eamos::cli::cmd_gen_stress(nodes, drones, seed, gen_out);
   } catch (const std::exception& e) {
     std::cerr << "eamos: error: " << e.what() << "\n";

@@ -13,6 +13,8 @@
 #include "dex/trace_writers.h"
 #include "graph/pipeline.h"
 #include "mavlink_adapter/adapter.h"
+#include "monitor/live_sink.h"
+#include "monitor/server.h"
 #include "sim/sim_adapter.h"
 
 namespace eamos::cli {
@@ -42,12 +44,25 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   if (!compile_and_report(o, c)) return 1;
   std::vector<dex::Mission> missions;
   if (!load_compiled_missions(c, missions)) return 1;
+  nlohmann::json view;
+  if (!r.monitor.empty()) view = live_view(c, o.mission, o.fleet);
   // From here on drones may fly: Ctrl-C or SIGTERM lands them instead of killing the process
   // under them. First, before an adapter starts a thread that would inherit the old mask.
   dex::RunInterrupt interrupt;
-  SignalWatch signals([&interrupt](const char* name) {
+  MonitorHold hold;
+  SignalWatch signals([&interrupt, &hold](const char* name) {
     interrupt.request(std::string("interrupted (") + name + ")");
+    hold.signal();
   });
+  // Only a run with --monitor has a server at all: without it nothing of civetweb is touched.
+  std::unique_ptr<monitor::MonitorServer> server;
+  std::unique_ptr<monitor::LiveSink> live_monitor;
+  if (!r.monitor.empty()) {
+    server = std::make_unique<monitor::MonitorServer>();
+    if (!start_monitor(*server, r.monitor, view)) return 1;
+    live_monitor = std::make_unique<monitor::LiveSink>(*server);
+    std::cout << "eamos: monitor at " << server->url() << "\n" << std::flush;
+  }
   mid::AdapterRegistry adapters;
   sim::register_adapter(adapters);
   mavlink_adapter::register_adapter(adapters, {.real_time = r.realtime || r.speed > 0,
@@ -69,6 +84,7 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   }
   dex::MemoryTrace memory;  // the plot is drawn from the whole trace after the run
   if (!r.plot.empty()) tee.add(&memory);
+  if (live_monitor) tee.add(live_monitor.get());
   dex::RunOptions options;
   options.time_limit_s = r.time_limit;
   options.interrupt = &interrupt;
@@ -78,7 +94,15 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   }
   dex::RunResult result = dex::run_in_process(missions, adapters, &tee, options);
   if (!report_run(r, result, memory.events)) return 1;
+  if (live_monitor && !hold.was_interrupted()) hold_monitor(*server, hold);
   return result.completed ? 0 : 1;
+}
+
+void hold_monitor(monitor::MonitorServer& server, MonitorHold& hold) {
+  server.finish();
+  std::cout << "eamos: the mission has ended; the monitor shows it at " << server.url()
+            << " until Ctrl-C\n" << std::flush;
+  hold.wait_for_signal();
 }
 
 bool report_run(const RunCommandOptions& r, const dex::RunResult& result, const std::vector<dex::TraceEvent>& events) {

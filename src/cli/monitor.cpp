@@ -1,0 +1,171 @@
+// `eamos monitor TRACE.jsonl` (replay a finished mission in the browser) and the views
+// `eamos run --monitor` / `eamos launch --monitor` serve live (src/monitor).
+#include <condition_variable>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+
+#include "cli/commands.h"
+#include "cli/signal_watch.h"
+#include "deploy/mission_file.h"
+#include "monitor/mission_view.h"
+#include "monitor/server.h"
+#include "monitor/trace_file.h"
+
+namespace eamos::cli {
+
+namespace {
+
+monitor::SvgRenderer dot_renderer() {
+  return [](const std::string& dot, std::string& svg, std::string& error) { return render_svg(dot, svg, error); };
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "";
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// The trace's embedded mission (schema v1 header) compiled again, for the graphs.
+bool compile_header(const nlohmann::json& header, graph::Compilation& c, std::string& why) {
+  std::string name = header.value("mission", std::string("mission.eamos"));
+  std::string fleet_text = header.value("fleet", std::string());
+  Diagnostics diags;
+  fleet::Fleet fleet;
+  if (!fleet_text.empty())
+    fleet::parse_fleet(std::make_shared<SourceFile>(name + " (fleet in the trace)", fleet_text), fleet, diags);
+  auto source = std::make_shared<SourceFile>(name + " (in the trace)", header.value("source", std::string()));
+  if (graph::compile(source, fleet, diags, c) && !diags.has_errors()) return true;
+  why = "the mission in the trace does not compile here:\n" + diags.format();
+  return false;
+}
+
+// The page's mission for a replay: from --mission when given, else the trace's header.
+bool replay_view(const MonitorCommandOptions& m, const monitor::LoadedTrace& trace, nlohmann::json& view) {
+  monitor::ViewInput in;
+  graph::Compilation c;
+  std::string why, warnings;
+  if (!m.mission.empty()) {
+    CommonOptions o;
+    o.mission = m.mission;
+    o.fleet = m.fleet;
+    o.quiet = true;
+    if (!compile_and_report(o, c)) return false;
+    in.mission_name = m.mission;
+    in.fleet_text = m.fleet.empty() ? "" : read_text(m.fleet);
+  } else if (trace.header && trace.header->value("source", std::string()).size() > 0) {
+    in.mission_name = trace.header->value("mission", std::string());
+    in.fleet_text = trace.header->value("fleet", std::string());
+    if (!compile_header(*trace.header, c, why)) {
+      std::cerr << "eamos monitor: warning: " << why << "the page shows the lanes only\n";
+      view = monitor::bare_view(in, "the mission in the trace does not compile: lanes only");
+      return true;
+    }
+  } else {
+    in.mission_name = m.trace;
+    view = monitor::bare_view(in, "this trace names no mission (no header line): lanes only; "
+                                  "`eamos monitor TRACE --mission FILE.eamos` adds the graphs and the text");
+    return true;
+  }
+  view = monitor::mission_view(c, in, dot_renderer(), warnings);
+  if (!warnings.empty()) std::cerr << "eamos monitor: warning: " << warnings;
+  return true;
+}
+
+}  // namespace
+
+void MonitorHold::wait_for_signal() {
+  std::unique_lock<std::mutex> lock(mutex);
+  signalled.wait(lock, [this] { return interrupted; });
+}
+
+bool MonitorHold::was_interrupted() {
+  std::lock_guard<std::mutex> lock(mutex);
+  return interrupted;
+}
+
+void MonitorHold::signal() {
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    interrupted = true;
+  }
+  signalled.notify_all();
+}
+
+bool start_monitor(monitor::MonitorServer& server, const std::string& at, const nlohmann::json& view) {
+  monitor::Endpoint endpoint;
+  std::string error;
+  if (!monitor::parse_endpoint(at, endpoint, error)) {
+    std::cerr << "eamos: error: --monitor " << error << "\n";
+    return false;
+  }
+  server.set_mission(view.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+  if (!server.start(endpoint, error)) {
+    std::cerr << "eamos: error: " << error << "\n";
+    return false;
+  }
+  return true;
+}
+
+nlohmann::json live_view(const graph::Compilation& c, const std::string& mission, const std::string& fleet) {
+  monitor::ViewInput in;
+  in.mission_name = mission;
+  in.fleet_text = fleet.empty() ? "" : read_text(fleet);
+  in.live = true;
+  std::string warnings;
+  nlohmann::json view = monitor::mission_view(c, in, dot_renderer(), warnings);
+  if (!warnings.empty()) std::cerr << "eamos: warning: " << warnings;
+  return view;
+}
+
+// A deployment names its mission's source file and hash: when that file still compiles to
+// the same hash, the page shows its graphs and text; otherwise the lanes only.
+nlohmann::json launch_view(const std::string& dir) {
+  monitor::ViewInput in;
+  in.mission_name = dir;
+  in.live = true;
+  nlohmann::json manifest = nlohmann::json::parse(read_text(dir + "/manifest.json"), nullptr, false);
+  if (!manifest.is_object() || !manifest.contains("source") || !manifest["source"].is_string() ||
+      !manifest.contains("mission_hash") || !manifest["mission_hash"].is_string())
+    return monitor::bare_view(in, "the deployment names no mission source: lanes only");
+  std::string source = manifest["source"];
+  graph::Compilation c;
+  Diagnostics diags;
+  if (!graph::compile_file(source, "", diags, c) || deploy::mission_hash(c) != manifest["mission_hash"])
+    return monitor::bare_view(in, "'" + source + "' is not the deployed mission any more (or needs its fleet): lanes only");
+  in.mission_name = source;
+  std::string warnings;
+  nlohmann::json view = monitor::mission_view(c, in, dot_renderer(), warnings);
+  if (!warnings.empty()) std::cerr << "eamos: warning: " << warnings;
+  return view;
+}
+
+int cmd_monitor(const MonitorCommandOptions& m) {
+  MonitorHold hold;
+  SignalWatch signals([&hold](const char*) { hold.signal(); });
+  std::ifstream in(m.trace, std::ios::binary);
+  if (!in) {
+    std::cerr << "eamos: error: cannot read trace '" << m.trace << "'; give the file `eamos run --trace` wrote\n";
+    return 1;
+  }
+  monitor::LoadedTrace trace = monitor::read_trace(m.trace, in);
+  for (const auto& w : trace.warnings) std::cerr << w << "\n";
+  if (!trace.errors.empty()) {
+    for (const auto& e : trace.errors) std::cerr << e << "\n";
+    std::cerr << "eamos monitor: the trace has errors; nothing to replay\n";
+    return 1;
+  }
+  nlohmann::json view;
+  if (!replay_view(m, trace, view)) return 1;
+  monitor::MonitorServer server;
+  std::string at = m.host + ":" + std::to_string(m.port);
+  if (!start_monitor(server, at, view)) return 1;
+  for (auto& e : trace.events) server.append(std::move(e));
+  server.finish();
+  std::cout << "eamos monitor: replaying " << m.trace << " (" << trace.events.size() << " events) at "
+            << server.url() << "\nopen it in a browser; Ctrl-C stops\n" << std::flush;
+  hold.wait_for_signal();
+  return 0;
+}
+
+}  // namespace eamos::cli

@@ -1,0 +1,786 @@
+// The eamos monitor page: one clock for the map, the lanes, the graph and the mission text.
+// Everything comes from the server's WebSocket (/ws): first the mission, then the trace
+// events (the history so far, then each new one). The page sends nothing that matters: the
+// monitor cannot command a drone. Text from the trace is only ever set as textContent.
+'use strict';
+
+const PALETTE = ['#0072B2', '#D55E00', '#009E73', '#CC79A7', '#E69F00', '#56B4E9', '#F0E442', '#000000',
+                 '#7f3c8d', '#11a579', '#3969ac', '#f2b701', '#e73f74', '#80ba5a', '#e68310', '#008695'];
+const STATE_FILL = {
+  waiting: '#fff59d', running: '#90caf9', succeeded: '#a5d6a7', failed: '#ef9a9a', preempted: '#ffcc80',
+  cancelled: '#bdbdbd', released: '#b2ebf2', true: '#a5d6a7', false: '#cfd8dc', 'not-run': '#f5f5f5',
+};
+const DOM_LANES_MAX = 60;  // more drones: lanes on a canvas, no element per bar
+
+const S = {
+  mission: null, live: false, finished: false, events: [], clock: 0, playing: false, speed: 1,
+  follow: true, selected: null, dirty: true, structureDirty: true, graphIndex: 0, arrivals: [],
+};
+let D = null;  // what the events say, rebuilt incrementally (see resetDerived)
+
+function $(id) { return document.getElementById(id); }
+function el(tag, cls, text) {
+  const e = document.createElement(tag);
+  if (cls) e.className = cls;
+  if (text !== undefined) e.textContent = text;
+  return e;
+}
+function num(v, fallback) { return typeof v === 'number' && isFinite(v) ? v : fallback; }
+function str(v) { return typeof v === 'string' ? v : ''; }
+
+function resetDerived() {
+  D = {
+    drones: [], droneIndex: new Map(), bars: [], openBars: new Map(), conds: [], telemetry: new Map(),
+    messages: [], nodeHistory: new Map(), end: 0, outcome: '', failures: [], eventTimes: [],
+    nodeKey: new Map(), nodes: new Map(), lastIngested: 0,
+  };
+  const m = S.mission || {};
+  for (const d of Array.isArray(m.drones) ? m.drones : []) addDrone(str(d.name), d);
+  for (const n of Array.isArray(m.nodes) ? m.nodes : []) {
+    D.nodes.set(n.id, n);
+    const key = str(n.drone) + '|' + n.line + '|' + str(n.name);
+    if (!D.nodeKey.has(key)) D.nodeKey.set(key, []);
+    D.nodeKey.get(key).push(n.id);
+  }
+}
+
+function addDrone(name, info) {
+  if (!name || D.droneIndex.has(name)) return D.droneIndex.get(name);
+  const i = D.drones.length;
+  const home = info && Array.isArray(info.home) ? info.home.map(v => num(v, 0)) : null;
+  D.drones.push({ name, index: i, home, geofence: info ? info.geofence : null, colour: PALETTE[i % PALETTE.length] });
+  D.droneIndex.set(name, i);
+  S.structureDirty = true;
+  return i;
+}
+
+// The MEG nodes an event is about: its "node" field, else (older traces) drone + line + name.
+function nodesOf(e) {
+  if (Number.isInteger(e.node)) return [e.node];
+  return D.nodeKey.get(str(e.drone) + '|' + e.line + '|' + str(e.name)) || [];
+}
+
+function nodeState(e) {
+  if (e.event === 'start') return 'running';
+  if (e.event === 'end') return str(e.outcome) || 'succeeded';
+  if (e.event === 'condition') {
+    if (str(e.name).startsWith('Wait') && e.value === false) return 'waiting';
+    return e.value ? 'true' : 'false';
+  }
+  if (e.event === 'released' || e.event === 'cancelled') return e.event;
+  return null;
+}
+
+function ingest(e) {
+  if (!e || typeof e !== 'object' || typeof e.t !== 'number' || typeof e.event !== 'string') return;
+  const t = e.t;
+  D.end = Math.max(D.end, t);
+  D.eventTimes.push(t);
+  if (e.drone) addDrone(str(e.drone));
+  const key = str(e.drone) + '|' + str(e.name) + '|' + e.line + '|' + (e.node ?? '') + '|' + (e.instance ?? '');
+  if (e.event === 'start') {
+    const bar = { drone: str(e.drone), name: str(e.name), line: e.line | 0, text: str(e.text), start: t, end: null,
+                  outcome: '', reason: '', nodes: nodesOf(e) };
+    D.bars.push(bar);
+    if (!D.openBars.has(key)) D.openBars.set(key, []);
+    D.openBars.get(key).push(bar);
+    S.structureDirty = true;
+  } else if (e.event === 'end') {
+    const open = D.openBars.get(key);
+    const bar = open && open.length ? open.pop() : null;
+    if (bar) { bar.end = t; bar.outcome = str(e.outcome); bar.reason = str(e.reason); }
+    if (e.outcome === 'failed') D.failures.push(t);
+    S.structureDirty = true;
+  } else if (e.event === 'condition') {
+    D.conds.push({ drone: str(e.drone), name: str(e.name), line: e.line | 0, text: str(e.text), t, value: !!e.value,
+                   nodes: nodesOf(e) });
+    S.structureDirty = true;
+  } else if (e.event === 'telemetry') {
+    if (!D.telemetry.has(e.drone)) D.telemetry.set(e.drone, []);
+    D.telemetry.get(e.drone).push({ t, x: num(e.x, 0), y: num(e.y, 0), z: num(e.z, 0), battery: e.battery,
+                                    mode: str(e.mode), armed: e.armed, landed: e.landed });
+  } else if (e.event === 'message') {
+    D.messages.push({ kind: str(e.kind), from: str(e.from), to: str(e.to), node: e.node,
+                      sent: num(e.sent, t), received: num(e.received, t) });
+    S.structureDirty = true;
+  } else if (e.event === 'mission') {
+    D.outcome = str(e.outcome);
+    if (D.outcome === 'failed') D.failures.push(t);
+  } else if (e.event === 'failsafe' || e.event === 'error') {
+    D.failures.push(t);
+    S.structureDirty = true;
+  }
+  if (e.event !== 'telemetry' && e.event !== 'message') {
+    const state = nodeState(e);
+    if (state) for (const id of nodesOf(e)) {
+      if (!D.nodeHistory.has(id)) D.nodeHistory.set(id, []);
+      D.nodeHistory.get(id).push({ t, state, value: e.value });
+    }
+  }
+  S.dirty = true;
+}
+
+// ---- cross-drone triggers: the trace's message events, else the MEG's cross-drone arcs ----
+
+function laneEndBefore(drone, t) {
+  let last = 0;
+  for (const b of D.bars) if (b.drone === drone && b.end !== null && b.end <= t + 1e-9 && b.end > last) last = b.end;
+  return last;
+}
+
+// Whether a node's recorded state fires an arc of `branch` (an action's end fires every arc;
+// a condition's value fires the arcs of its outcome).
+function fires(h, branch) {
+  if (h.state === 'running' || h.state === 'waiting') return false;
+  if (h.state === 'true') return ['true', 'go', 'repeat', 'do', 'continue', ''].includes(branch);
+  if (h.state === 'false') return ['false', 'exit', 'skip', 'done', ''].includes(branch);
+  return !branch || branch === 'go';
+}
+
+function triggers() {
+  const out = [];
+  const fromMessages = D.messages.filter(m => m.kind === 'trigger' || m.kind === 'abort');
+  if (fromMessages.length) {
+    for (const m of fromMessages) {
+      if (!D.droneIndex.has(m.from) || !D.droneIndex.has(m.to) || m.from === m.to) continue;
+      out.push({ from: m.from, to: m.to, sent: m.sent, received: m.received, node: m.node, kind: m.kind,
+                 waitFrom: laneEndBefore(m.to, m.received) });
+    }
+    return out;
+  }
+  const arcs = S.mission && Array.isArray(S.mission.arcs) ? S.mission.arcs : [];
+  for (const a of arcs) {
+    if (a.kind !== 'exec') continue;
+    const from = D.nodes.get(a.from), to = D.nodes.get(a.to);
+    if (!from || !to || !from.drone || !to.drone || from.drone === to.drone) continue;
+    const fired = (D.nodeHistory.get(a.from) || []).filter(h => fires(h, a.branch));
+    const started = (D.nodeHistory.get(a.to) || []).filter(h => h.state !== 'waiting');
+    let next = 0;
+    fired.forEach((f, i) => {
+      // Each firing triggers the target's next run: the first one after it and before the next firing.
+      const until = i + 1 < fired.length ? fired[i + 1].t : Infinity;
+      while (next < started.length && started[next].t < f.t - 1e-9) next++;
+      if (next >= started.length || started[next].t > until + 1e-9) return;
+      const s = started[next++];
+      out.push({ from: from.drone, to: to.drone, sent: f.t, received: s.t, node: a.from, kind: 'trigger',
+                 waitFrom: laneEndBefore(to.drone, s.t) });
+    });
+  }
+  return out;
+}
+
+// ---- the clock ----
+
+function missionEnd() { return Math.max(D.end, 0.001); }
+
+function setClock(t) {
+  S.clock = Math.min(Math.max(0, num(t, 0)), missionEnd());
+  S.dirty = true;
+}
+
+function nextEventTime(after) {
+  for (const t of D.eventTimes) if (t > after + 1e-6) return t;
+  return null;
+}
+
+function tick(prev) {
+  return now => {
+    const dt = Math.min(0.25, (now - prev) / 1000);
+    if (S.playing) {
+      setClock(S.clock + dt * S.speed);
+      if (S.clock >= missionEnd() && (S.finished || !S.live)) S.playing = false;
+    }
+    if (S.live && !S.finished && S.follow) S.clock = missionEnd();
+    if (S.dirty) render();
+    requestAnimationFrame(tick(now));
+  };
+}
+
+// ---- drawing ----
+
+function render() {
+  S.dirty = false;
+  if (S.structureDirty) { buildLanes(); S.structureDirty = false; }
+  renderControls();
+  renderLanes();
+  renderMap();
+  renderDroneList();
+  renderGraphStates();
+  renderSourceActive();
+  document.body.dataset.clock = S.clock.toFixed(3);
+}
+
+function renderControls() {
+  const end = missionEnd();
+  const scrub = $('scrub');
+  scrub.max = String(end);
+  if (document.activeElement !== scrub) scrub.value = String(S.clock);
+  $('clock').textContent = S.clock.toFixed(2) + ' s / ' + end.toFixed(2) + ' s';
+  $('clock').dataset.t = S.clock.toFixed(3);
+  const mode = S.live && !S.finished ? 'live' : 'replay';
+  $('mode').dataset.mode = mode;
+  $('mode').textContent = mode === 'live' ? '● live' : 'replay';
+  $('outcome').dataset.outcome = D.outcome;
+  $('outcome').textContent = D.outcome ? 'mission ' + D.outcome : '';
+  $('follow').parentElement.hidden = mode !== 'live';
+  $('play').disabled = S.playing;
+  $('pause').disabled = !S.playing;
+}
+
+function trackWidth() {
+  const lanes = $('lanes');
+  return Math.max(200, (lanes.clientWidth || 800) - 84);
+}
+function xOf(t) { return 76 + (t / missionEnd()) * trackWidth(); }
+
+function buildLanes() {
+  const lanes = $('lanes');
+  lanes.textContent = '';
+  const useDom = D.drones.length <= DOM_LANES_MAX;
+  lanes.hidden = !useDom;
+  $('lanes-canvas').hidden = useDom;
+  lanes.dataset.drones = String(D.drones.length);
+  if (!useDom) return;
+  for (const d of D.drones) {
+    const lane = el('div', 'lane');
+    lane.dataset.drone = d.name;
+    lane.style.setProperty('--drone', d.colour);
+    lane.appendChild(el('div', 'lane-label', d.name));
+    const track = el('div', 'track');
+    lane.appendChild(track);
+    lanes.appendChild(lane);
+    d.track = track;
+  }
+  const rows = barRows();
+  D.bars.forEach((b, i) => {
+    const d = D.drones[D.droneIndex.get(b.drone)];
+    const [row, count] = rows.get(b);
+    const bar = el('div', 'bar', b.name);
+    bar.dataset.index = String(i);
+    bar.dataset.drone = b.drone;
+    bar.dataset.name = b.name;
+    bar.dataset.line = String(b.line);
+    bar.dataset.start = String(b.start);
+    bar.dataset.end = b.end === null ? '' : String(b.end);
+    bar.dataset.outcome = b.outcome;
+    bar.dataset.node = b.nodes.join(' ');
+    bar.title = b.text + (b.outcome ? ' — ' + b.outcome : '') + (b.reason ? ' (' + b.reason + ')' : '') +
+                '  line ' + b.line;
+    bar.addEventListener('click', () => select({ nodes: b.nodes, line: b.line, drone: b.drone, text: b.text, t: b.start }));
+    // Actions that overlap in one drone (a motion and a picture) share the lane in rows.
+    const h = Math.floor(28 / count);
+    bar.style.top = (2 + row * h) + 'px';
+    bar.style.height = (h - 1) + 'px';
+    if (count > 1) bar.style.fontSize = '9px';
+    b.el = bar;
+    d.track.appendChild(bar);
+  });
+  const rowOf = new Map();
+  D.conds.forEach(c => {
+    const d = D.drones[D.droneIndex.get(c.drone)];
+    const mark = el('div', 'cond', c.name + (c.value ? ' ✓' : ' ✗'));
+    mark.dataset.drone = c.drone;
+    mark.dataset.name = c.name;
+    mark.dataset.line = String(c.line);
+    mark.dataset.value = String(c.value);
+    mark.dataset.t = String(c.t);
+    mark.title = c.text + ' → ' + c.value + ' at ' + c.t.toFixed(2) + ' s';
+    // Marks of one lane take turns between two rows, so neighbours do not overlap.
+    const row = (rowOf.get(c.drone) || 0);
+    rowOf.set(c.drone, row + 1);
+    mark.style.top = (row % 2 === 0 ? 42 : 54) + 'px';
+    mark.addEventListener('click', () => select({ nodes: c.nodes, line: c.line, drone: c.drone, text: c.text, t: c.t }));
+    c.el = mark;
+    d.track.appendChild(mark);
+  });
+  buildTriggers();
+}
+
+// Each bar's row in its lane (the first free one) and its lane's row count.
+function barRows() {
+  const free = new Map(), out = new Map();
+  for (const b of D.bars) {
+    if (!free.has(b.drone)) free.set(b.drone, []);
+    const ends = free.get(b.drone);
+    let row = ends.findIndex(e => e <= b.start + 1e-9);
+    if (row < 0) { row = ends.length; ends.push(0); }
+    ends[row] = b.end === null ? Infinity : b.end;
+    out.set(b, row);
+  }
+  const result = new Map();
+  for (const b of D.bars) result.set(b, [out.get(b), Math.min(3, free.get(b.drone).length)]);
+  for (const [b, [row, count]] of result) if (row >= count) result.set(b, [count - 1, count]);
+  return result;
+}
+
+function buildTriggers() {
+  const svg = $('triggers');
+  svg.textContent = '';
+  const NS = 'http://www.w3.org/2000/svg';
+  const defs = document.createElementNS(NS, 'defs');
+  defs.innerHTML = '<marker id="arrow" viewBox="0 0 10 10" refX="9" refY="5" markerWidth="7" markerHeight="7" orient="auto">' +
+                   '<path d="M0,0 L10,5 L0,10 z" fill="#6a1b9a"/></marker>';
+  svg.appendChild(defs);
+  D.triggerList = triggers();
+  for (const tr of D.triggerList) {
+    const line = document.createElementNS(NS, 'path');
+    line.setAttribute('class', 'trigger' + (tr.kind === 'abort' ? ' abort' : ''));
+    line.setAttribute('marker-end', 'url(#arrow)');
+    line.dataset.from = tr.from;
+    line.dataset.to = tr.to;
+    line.dataset.node = String(tr.node ?? '');
+    line.dataset.sent = String(tr.sent);
+    line.dataset.received = String(tr.received);
+    line.dataset.wait = (tr.received - tr.waitFrom).toFixed(2);
+    const title = document.createElementNS(NS, 'title');
+    title.textContent = tr.to + ' waited ' + (tr.received - tr.waitFrom).toFixed(2) + ' s on ' + tr.from;
+    line.appendChild(title);
+    svg.appendChild(line);
+    tr.el = line;
+    const d = D.drones[D.droneIndex.get(tr.to)];
+    if (d && d.track && tr.received - tr.waitFrom > 0.01) {
+      const wait = el('div', 'wait', 'waits ' + (tr.received - tr.waitFrom).toFixed(2) + ' s on ' + tr.from);
+      wait.dataset.drone = tr.to;
+      wait.dataset.on = tr.from;
+      tr.waitEl = wait;
+      d.track.appendChild(wait);
+    }
+  }
+}
+
+function barState(b) {
+  if (b.start > S.clock + 1e-9) return 'future';
+  if (b.end === null || b.end > S.clock + 1e-9) return 'running';
+  return b.outcome || 'succeeded';
+}
+
+function renderLanes() {
+  if (D.drones.length > DOM_LANES_MAX) { renderLanesCanvas(); return; }
+  const w = trackWidth(), end = missionEnd(), px = t => (t / end) * w;
+  const now = S.clock;
+  for (const b of D.bars) {
+    if (!b.el) continue;
+    const state = barState(b);
+    const stop = b.end === null ? D.end : b.end;
+    const shown = state === 'running' ? Math.min(now, stop) : stop;
+    b.el.dataset.state = state;
+    b.el.style.left = px(b.start) + 'px';
+    b.el.style.width = Math.max(3, px((state === 'future' ? stop : shown) - b.start)) + 'px';
+  }
+  for (const c of D.conds) {
+    if (!c.el) continue;
+    c.el.style.left = px(c.t) + 'px';
+    c.el.classList.toggle('future', c.t > now + 1e-9);
+  }
+  const lanes = $('lanes');
+  const svg = $('triggers');
+  svg.setAttribute('width', String(lanes.scrollWidth));
+  svg.setAttribute('height', String(lanes.scrollHeight));
+  for (const tr of D.triggerList || []) {
+    const a = D.droneIndex.get(tr.from), b = D.droneIndex.get(tr.to);
+    const laneH = 68, y1 = a * laneH + 14, y2 = b * laneH + (b > a ? 4 : 26);
+    const x1 = xOf(tr.sent), x2 = xOf(tr.received);
+    tr.el.setAttribute('d', `M${x1},${y1} C${x1 + 30},${y1} ${x2 - 30},${y2} ${x2},${y2}`);
+    tr.el.classList.toggle('future', tr.received > now + 1e-9);
+    if (tr.waitEl) {
+      tr.waitEl.style.left = px(tr.waitFrom) + 'px';
+      tr.waitEl.style.width = Math.max(2, px(tr.received - tr.waitFrom)) + 'px';
+      tr.waitEl.classList.toggle('future', tr.waitFrom > now + 1e-9);
+    }
+  }
+  const head = $('playhead');
+  head.style.left = xOf(now) + 'px';
+  head.style.height = lanes.scrollHeight + 'px';
+}
+
+// Level of detail for large fleets: one pixel row group per drone, bars merged below a pixel.
+function renderLanesCanvas() {
+  const canvas = $('lanes-canvas');
+  const rowH = Math.max(2, Math.min(8, Math.floor(4000 / D.drones.length)));
+  const w = Math.max(400, $('lanes-scroll').clientWidth - 4);
+  canvas.width = w;
+  canvas.height = rowH * D.drones.length;
+  const g = canvas.getContext('2d');
+  g.clearRect(0, 0, w, canvas.height);
+  const end = missionEnd(), now = S.clock;
+  const colours = { succeeded: '#2e7d32', failed: '#c62828', preempted: '#ef6c00', cancelled: '#757575', running: '#1565c0' };
+  let drawn = 0;
+  for (const b of D.bars) {
+    const state = barState(b);
+    if (state === 'future') continue;
+    drawn++;
+    const row = D.droneIndex.get(b.drone);
+    const stop = state === 'running' ? now : b.end;
+    g.fillStyle = colours[state] || '#2e7d32';
+    const x = (b.start / end) * w;
+    g.fillRect(x, row * rowH, Math.max(1, ((stop - b.start) / end) * w), rowH - (rowH > 3 ? 1 : 0));
+  }
+  g.fillStyle = '#d50000';
+  g.fillRect((now / end) * w, 0, 2, canvas.height);
+  canvas.dataset.drones = String(D.drones.length);
+  canvas.dataset.bars = String(drawn);
+  $('playhead').style.height = '0px';
+}
+
+// ---- map ----
+
+function positionAt(drone, t) {
+  const samples = D.telemetry.get(drone.name);
+  if (!samples || !samples.length) return drone.home ? { x: drone.home[0], y: drone.home[1], z: drone.home[2], home: true } : null;
+  let lo = 0, hi = samples.length - 1;
+  if (t <= samples[0].t) return samples[0];
+  if (t >= samples[hi].t) return samples[hi];
+  while (hi - lo > 1) { const mid = (lo + hi) >> 1; if (samples[mid].t <= t) lo = mid; else hi = mid; }
+  const a = samples[lo], b = samples[hi], f = (t - a.t) / Math.max(1e-9, b.t - a.t);
+  return { x: a.x + (b.x - a.x) * f, y: a.y + (b.y - a.y) * f, z: a.z + (b.z - a.z) * f, battery: a.battery, mode: a.mode };
+}
+
+function worldBounds() {
+  let minX = Infinity, maxX = -Infinity, minY = Infinity, maxY = -Infinity, maxZ = 1;
+  const take = (x, y, z) => {
+    minX = Math.min(minX, x); maxX = Math.max(maxX, x); minY = Math.min(minY, y); maxY = Math.max(maxY, y);
+    maxZ = Math.max(maxZ, z || 0);
+  };
+  for (const d of D.drones) {
+    if (d.home) take(d.home[0], d.home[1], d.home[2]);
+    if (d.geofence && Array.isArray(d.geofence.polygon)) for (const p of d.geofence.polygon) take(num(p[0], 0), num(p[1], 0), 0);
+    for (const s of D.telemetry.get(d.name) || []) take(s.x, s.y, s.z);
+  }
+  if (!isFinite(minX)) { minX = -10; maxX = 10; minY = -10; maxY = 10; }
+  const pad = Math.max(2, 0.08 * Math.max(maxX - minX, maxY - minY));
+  return { minX: minX - pad, maxX: maxX + pad, minY: minY - pad, maxY: maxY + pad, maxZ: maxZ * 1.15 };
+}
+
+function renderMap() {
+  const canvas = $('map'), g = canvas.getContext('2d');
+  const W = canvas.width, H = canvas.height, B = worldBounds();
+  const scale = Math.min(W / (B.maxX - B.minX), H / (B.maxY - B.minY));
+  const X = x => (x - B.minX) * scale + (W - (B.maxX - B.minX) * scale) / 2;
+  const Y = y => H - ((y - B.minY) * scale + (H - (B.maxY - B.minY) * scale) / 2);
+  g.clearRect(0, 0, W, H);
+  drawGrid(g, W, H, B, X, Y);
+  const many = D.drones.length > 100;
+  const seenFences = new Set();
+  for (const d of D.drones) {
+    const f = d.geofence;
+    if (f && Array.isArray(f.polygon) && f.polygon.length > 2 && !seenFences.has(JSON.stringify(f.polygon))) {
+      seenFences.add(JSON.stringify(f.polygon));
+      g.strokeStyle = '#c62828'; g.setLineDash([6, 4]); g.beginPath();
+      f.polygon.forEach((p, i) => (i ? g.lineTo : g.moveTo).call(g, X(num(p[0], 0)), Y(num(p[1], 0))));
+      g.closePath(); g.stroke(); g.setLineDash([]);
+    }
+  }
+  for (const d of D.drones) {
+    const samples = D.telemetry.get(d.name) || [];
+    if (samples.length > 1) {
+      g.strokeStyle = d.colour; g.globalAlpha = 0.6; g.lineWidth = 1.5; g.beginPath();
+      const step = many ? Math.max(1, Math.floor(samples.length / 50)) : 1;
+      let first = true;
+      for (let i = 0; i < samples.length && samples[i].t <= S.clock; i += step) {
+        (first ? g.moveTo : g.lineTo).call(g, X(samples[i].x), Y(samples[i].y)); first = false;
+      }
+      const p = positionAt(d, S.clock);
+      if (p && !first) g.lineTo(X(p.x), Y(p.y));
+      g.stroke(); g.globalAlpha = 1;
+    }
+    if (d.home && !many) { g.strokeStyle = d.colour; g.strokeRect(X(d.home[0]) - 4, Y(d.home[1]) - 4, 8, 8); }
+    const p = positionAt(d, S.clock);
+    if (!p) continue;
+    g.fillStyle = d.colour;
+    g.beginPath(); g.arc(X(p.x), Y(p.y), many ? 2 : 5, 0, 2 * Math.PI); g.fill();
+    if (!many) { g.fillStyle = '#222'; g.font = '11px sans-serif'; g.fillText(d.name, X(p.x) + 7, Y(p.y) - 6); }
+  }
+  renderSide(B);
+  const hasTelemetry = D.telemetry.size > 0;
+  $('map-note').textContent = hasTelemetry ? '' : (D.drones.some(d => d.home) ?
+    'this trace has no telemetry: homes only' : 'this trace has no telemetry and names no homes');
+}
+
+function drawGrid(g, W, H, B, X, Y) {
+  const span = Math.max(B.maxX - B.minX, B.maxY - B.minY);
+  const step = Math.pow(10, Math.floor(Math.log10(span / 2)));
+  g.strokeStyle = '#eee'; g.fillStyle = '#aaa'; g.font = '10px sans-serif'; g.lineWidth = 1;
+  for (let x = Math.ceil(B.minX / step) * step; x <= B.maxX; x += step) {
+    g.beginPath(); g.moveTo(X(x), 0); g.lineTo(X(x), H); g.stroke(); g.fillText(String(+x.toFixed(2)), X(x) + 2, H - 2);
+  }
+  for (let y = Math.ceil(B.minY / step) * step; y <= B.maxY; y += step) {
+    g.beginPath(); g.moveTo(0, Y(y)); g.lineTo(W, Y(y)); g.stroke(); g.fillText(String(+y.toFixed(2)), 2, Y(y) - 2);
+  }
+}
+
+function renderSide(B) {
+  const canvas = $('side'), g = canvas.getContext('2d');
+  const W = canvas.width, H = canvas.height;
+  const X = x => ((x - B.minX) / (B.maxX - B.minX)) * W;
+  const Z = z => H - 10 - (z / B.maxZ) * (H - 20);
+  g.clearRect(0, 0, W, H);
+  g.strokeStyle = '#8d6e63'; g.beginPath(); g.moveTo(0, Z(0)); g.lineTo(W, Z(0)); g.stroke();
+  const fence = D.drones.map(d => d.geofence).find(f => f && typeof f.max_altitude === 'number');
+  if (fence) { g.strokeStyle = '#c62828'; g.setLineDash([6, 4]); g.beginPath(); g.moveTo(0, Z(fence.max_altitude));
+    g.lineTo(W, Z(fence.max_altitude)); g.stroke(); g.setLineDash([]); }
+  for (const d of D.drones) {
+    const p = positionAt(d, S.clock);
+    if (!p) continue;
+    g.fillStyle = d.colour;
+    g.beginPath(); g.arc(X(p.x), Z(p.z), D.drones.length > 100 ? 2 : 4, 0, 2 * Math.PI); g.fill();
+  }
+  g.fillStyle = '#888'; g.font = '10px sans-serif'; g.fillText(B.maxZ.toFixed(1) + ' m', 2, 10);
+}
+
+function currentAction(name) {
+  let last = null;
+  for (const b of D.bars) if (b.drone === name && b.start <= S.clock + 1e-9 && (b.end === null || b.end > S.clock + 1e-9)) last = b;
+  return last;
+}
+
+function renderDroneList() {
+  const list = $('drone-list');
+  if (D.drones.length > DOM_LANES_MAX) {
+    list.textContent = '';
+    list.appendChild(el('li', '', D.drones.length + ' drones (too many to list; hover the lanes)'));
+    return;
+  }
+  if (list.children.length !== D.drones.length) {
+    list.textContent = '';
+    for (const d of D.drones) {
+      const li = el('li');
+      li.dataset.drone = d.name;
+      const sw = el('span', 'swatch'); sw.style.background = d.colour;
+      li.appendChild(sw);
+      li.appendChild(el('span', 'text'));
+      list.appendChild(li);
+    }
+  }
+  D.drones.forEach((d, i) => {
+    const li = list.children[i];
+    const p = positionAt(d, S.clock), act = currentAction(d.name);
+    li.dataset.action = act ? act.name : '';
+    let text = d.name + '  ' + (act ? act.text || act.name : '—');
+    if (p) {
+      li.dataset.x = p.x.toFixed(2); li.dataset.y = p.y.toFixed(2); li.dataset.z = p.z.toFixed(2);
+      text += `  (${p.x.toFixed(1)}, ${p.y.toFixed(1)}, ${p.z.toFixed(1)})`;
+      if (typeof p.battery === 'number') text += `  ${p.battery.toFixed(0)} %`;
+    }
+    li.lastChild.textContent = text;
+  });
+}
+
+// ---- graphs ----
+
+function sanitiseSvg(text) {
+  const doc = new DOMParser().parseFromString(text, 'image/svg+xml');
+  const svg = doc.documentElement;
+  if (!svg || svg.nodeName !== 'svg') return null;
+  for (const bad of svg.querySelectorAll('script, foreignObject, iframe, a')) {
+    if (bad.nodeName === 'a') bad.replaceWith(...bad.childNodes); else bad.remove();
+  }
+  for (const e of svg.querySelectorAll('*')) {
+    for (const attr of [...e.attributes]) {
+      if (/^on/i.test(attr.name) || /href$/i.test(attr.name)) e.removeAttribute(attr.name);
+    }
+  }
+  return document.importNode(svg, true);
+}
+
+function buildGraphSelect() {
+  const select = $('graph-select');
+  select.textContent = '';
+  const graphs = S.mission && Array.isArray(S.mission.graphs) ? S.mission.graphs : [];
+  graphs.forEach((g, i) => { const o = el('option', '', str(g.name)); o.value = String(i); select.appendChild(o); });
+  select.hidden = graphs.length === 0;
+  $('graph-note').textContent = S.mission ? str(S.mission.graph_note) : '';
+  showGraph(Math.min(S.graphIndex, Math.max(0, graphs.length - 1)));
+}
+
+function showGraph(index) {
+  S.graphIndex = index;
+  const box = $('graph');
+  box.textContent = '';
+  const graphs = S.mission && Array.isArray(S.mission.graphs) ? S.mission.graphs : [];
+  const g = graphs[index];
+  if (!g) return;
+  $('graph-select').value = String(index);
+  const svg = sanitiseSvg(str(g.svg));
+  if (!svg) return;
+  svg.id = 'graph-svg';
+  // Graphviz sizes the picture in points; the viewBox keeps its layout at the panel's width.
+  svg.removeAttribute('width');
+  svg.removeAttribute('height');
+  box.dataset.graph = str(g.name);
+  for (const node of svg.querySelectorAll('g.node')) {
+    const title = node.querySelector('title');
+    const name = title ? title.textContent : '';
+    let id = null, holder = '';
+    if (/^n\d+$/.test(name)) id = Number(name.slice(1));
+    else if (/^m\d+$/.test(name) && Array.isArray(g.mdg_nodes)) {
+      const m = g.mdg_nodes[Number(name.slice(1))];
+      if (Array.isArray(m)) { id = m[0]; holder = str(m[1]); }
+    }
+    if (id === null) continue;
+    node.dataset.node = String(id);
+    if (holder) node.dataset.holder = holder;
+    node.addEventListener('click', () => {
+      const n = D.nodes.get(id);
+      select({ nodes: [id], line: n ? n.line : 0, drone: n ? n.drone : '', text: n ? n.label : '' });
+    });
+  }
+  box.appendChild(svg);
+  S.dirty = true;
+}
+
+function stateAt(id) {
+  const h = D.nodeHistory.get(id);
+  let state = null;
+  if (h) for (const s of h) { if (s.t <= S.clock + 1e-9) state = s.state; else break; }
+  if (state) return state;
+  return D.outcome && S.clock >= D.end - 1e-9 ? 'not-run' : 'waiting';
+}
+
+function renderGraphStates() {
+  for (const node of $('graph').querySelectorAll('g.node[data-node]')) {
+    const state = stateAt(Number(node.dataset.node));
+    if (node.dataset.state === state) continue;
+    node.dataset.state = state;
+    for (const shape of node.querySelectorAll('ellipse, polygon, path')) shape.setAttribute('fill', STATE_FILL[state] || '#fff');
+  }
+}
+
+// ---- mission text and selection ----
+
+function buildSource() {
+  const pre = $('source');
+  pre.textContent = '';
+  S.activeLines = new Set();
+  const text = S.mission ? str(S.mission.source) : '';
+  if (!text) { pre.textContent = 'the mission text is not in this trace'; return; }
+  text.split('\n').forEach((line, i) => {
+    const row = el('span', 'src-line');
+    row.dataset.line = String(i + 1);
+    row.appendChild(el('span', 'ln', String(i + 1)));
+    row.appendChild(document.createTextNode(line));
+    pre.appendChild(row);
+  });
+}
+
+// Only the rows whose state changed are touched: a generated mission has tens of thousands.
+function renderSourceActive() {
+  const active = new Set();
+  for (const b of D.bars) if (b.start <= S.clock + 1e-9 && (b.end === null || b.end > S.clock + 1e-9)) active.add(b.line);
+  const rows = $('source').children, before = S.activeLines || new Set();
+  for (const line of before) if (!active.has(line) && rows[line - 1]) rows[line - 1].classList.remove('active');
+  for (const line of active) if (!before.has(line) && rows[line - 1]) rows[line - 1].classList.add('active');
+  S.activeLines = active;
+}
+
+function select(what) {
+  S.selected = what;
+  const nodes = new Set(what.nodes || []);
+  const sameBar = b => (nodes.size ? b.nodes.some(n => nodes.has(n)) : b.line === what.line && b.drone === what.drone);
+  for (const b of D.bars) if (b.el) b.el.classList.toggle('selected', sameBar(b));
+  for (const c of D.conds) if (c.el) c.el.classList.toggle('selected', nodes.size ? c.nodes.some(n => nodes.has(n)) : c.line === what.line);
+  for (const g of $('graph').querySelectorAll('g.node')) g.classList.toggle('selected', nodes.has(Number(g.dataset.node)));
+  let lineRow = null;
+  for (const row of $('source').children) {
+    const on = Number(row.dataset.line) === what.line;
+    row.classList.toggle('selected', on);
+    if (on) lineRow = row;
+  }
+  if (lineRow) lineRow.scrollIntoView({ block: 'center' });
+  const g = $('graph').querySelector('g.node.selected');
+  if (g) g.scrollIntoView({ block: 'center', inline: 'center' });
+  $('selection').textContent = (what.text || '') + (what.line ? '  — line ' + what.line : '') +
+                               (nodes.size ? '  — MEG node ' + [...nodes].join(', ') : '');
+  $('selection').dataset.line = String(what.line || '');
+  $('selection').dataset.node = [...nodes].join(' ');
+}
+
+// ---- the connection ----
+
+function onMessage(text) {
+  let m;
+  try { m = JSON.parse(text); } catch (e) { return; }
+  if (!m || typeof m !== 'object') return;
+  if (m.type === 'mission') {
+    S.mission = m.mission && typeof m.mission === 'object' ? m.mission : {};
+    S.live = !!S.mission.live;
+    S.finished = false;
+    S.events = [];
+    S.batches = 0;
+    S.arrivals = [];
+    resetDerived();
+    $('mission-name').textContent = str(S.mission.mission);
+    buildSource();
+    buildGraphSelect();
+    S.structureDirty = true;
+  } else if (m.type === 'events' && Array.isArray(m.events) && D) {
+    for (const e of m.events) { S.events.push(e); ingest(e); }
+    document.body.dataset.events = String(S.events.length);
+    // Wall arrival time against mission time, for the latency a live page sees (real-time runs).
+    const last = m.events[m.events.length - 1];
+    // The first batch is the history so far, not news.
+    S.batches = (S.batches || 0) + 1;
+    if (S.live && !S.finished && S.batches > 1 && last && typeof last.t === 'number')
+      S.arrivals.push([performance.now() / 1000, last.t]);
+    // A page in a background tab gets no animation frames: keep its DOM current anyway.
+    if (document.hidden) { if (S.live && !S.finished && S.follow) S.clock = missionEnd(); render(); }
+  } else if (m.type === 'finished') {
+    const first = !S.finished;
+    S.finished = true;
+    document.body.dataset.finished = 'true';
+    const start = new URLSearchParams(location.search).get('t');
+    if (start !== null) { S.playing = false; setClock(Number(start)); }
+    else if (first && !S.live) { setClock(0); S.playing = true; }
+    S.dirty = true;
+  }
+}
+
+function connect() {
+  const ws = new WebSocket((location.protocol === 'https:' ? 'wss://' : 'ws://') + location.host + '/ws');
+  ws.onopen = () => { $('connection').dataset.state = 'open'; $('connection').textContent = ''; ws.send('hello'); };
+  ws.onmessage = ev => { if (typeof ev.data === 'string') onMessage(ev.data); };
+  ws.onclose = () => {
+    $('connection').dataset.state = 'closed';
+    $('connection').textContent = S.finished ? '' : 'disconnected; retrying…';
+    if (!S.finished) setTimeout(connect, 1000);
+  };
+}
+
+function wireControls() {
+  $('play').onclick = () => { if (S.clock >= missionEnd()) setClock(0); S.playing = true; S.follow = false; $('follow').checked = false; S.dirty = true; };
+  $('pause').onclick = () => { S.playing = false; S.dirty = true; };
+  $('speed').onchange = e => { S.speed = Number(e.target.value) || 1; };
+  $('scrub').oninput = e => { S.follow = false; $('follow').checked = false; setClock(Number(e.target.value)); };
+  $('next-event').onclick = () => { const t = nextEventTime(S.clock); if (t !== null) { S.follow = false; $('follow').checked = false; setClock(t); } };
+  $('next-failure').onclick = () => {
+    const t = D.failures.filter(f => f > S.clock + 1e-6).sort((a, b) => a - b)[0];
+    if (t !== undefined) { S.follow = false; $('follow').checked = false; S.playing = false; setClock(t); }
+  };
+  $('follow').onchange = e => { S.follow = e.target.checked; S.dirty = true; };
+  // A control's effect shows at once, not at the next animation frame.
+  for (const id of ['play', 'pause', 'scrub', 'next-event', 'next-failure', 'follow'])
+    $(id).addEventListener(id === 'scrub' ? 'input' : 'click', () => render());
+  $('graph-select').onchange = e => showGraph(Number(e.target.value));
+  window.addEventListener('resize', () => { S.dirty = true; });
+  document.addEventListener('keydown', e => {
+    if (e.key === ' ' && e.target === document.body) { e.preventDefault(); (S.playing ? $('pause') : $('play')).click(); }
+  });
+}
+
+// For the browser tests and for people at the console: read-only views of the page's state.
+window.eamosMonitor = {
+  setClock: t => { S.playing = false; S.follow = false; $('follow').checked = false; setClock(t); render(); },
+  clock: () => S.clock,
+  nodeState: id => stateAt(id),
+  // Spread of (arrival wall time − mission time) over the live batches, seconds: in a
+  // real-time run, how much later than the earliest one an event reached the page.
+  latencySpread: () => {
+    const d = S.arrivals.map(([wall, t]) => wall - t);
+    return d.length ? Math.max(...d) - Math.min(...d) : null;
+  },
+  triggers: () => (D.triggerList || []).map(t => ({ from: t.from, to: t.to, sent: t.sent, received: t.received, wait: t.received - t.waitFrom })),
+};
+
+resetDerived();
+wireControls();
+connect();
+requestAnimationFrame(tick(performance.now()));

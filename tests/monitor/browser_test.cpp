@@ -1,0 +1,164 @@
+// The monitor's page in a real browser (Debian's chromium, headless, driven by puppeteer-core
+// from browser/monitor_check.js) against the real `eamos` process: a replay of a trace the
+// test flies first, and a live run. Screenshots go to the build's tests/monitor/screenshots.
+#include <gtest/gtest.h>
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <iostream>
+#include <fstream>
+#include <iterator>
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "support/eamos_process.h"
+#include "support/run_eamos.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+bool have_chromium() { return std::string(EAMOS_CHROMIUM).size() > 0 && access(EAMOS_CHROMIUM, X_OK) == 0; }
+
+// The URL the process printed ("... at http://127.0.0.1:PORT/"), "" when it printed none.
+std::string read_url(eamos_test::EamosProcess& p, const std::string& marker) {
+  if (!eamos_test::read_until(p, marker)) return "";
+  std::size_t at = p.seen.rfind("http://");
+  if (at == std::string::npos) return "";
+  std::size_t end = p.seen.find_first_of(" \n", at);
+  return p.seen.substr(at, end - at);
+}
+
+// Runs the browser script; its output, and whether every check passed.
+bool run_browser(const std::string& mode, const std::string& url, std::string& output) {
+  std::string cmd = "cd '" + std::string(EAMOS_BROWSER_DIR) + "' && '" + EAMOS_NODE + "' monitor_check.js " + mode +
+                    " '" + url + "' '" + EAMOS_SCREENSHOT_DIR + "' '" + EAMOS_CHROMIUM + "' 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return false;
+  char buf[4096];
+  while (fgets(buf, sizeof buf, p)) output += buf;
+  int status = pclose(p);
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
+void stop(eamos_test::EamosProcess& p, int& status) {
+  kill(p.pid, SIGTERM);
+  eamos_test::Exit e = eamos_test::wait_exit(p);
+  status = e.exited ? e.status : -1;
+}
+
+TEST(MonitorBrowser, ReplayOfListing2ShowsLanesTriggerAndNodeStates) {
+  if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
+  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-replay-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  std::string trace = (dir / "listing2.jsonl").string();
+  auto run = eamos_test::run_eamos("run examples/listing2.eamos -q --trace " + trace);
+  ASSERT_EQ(run.status, 0) << run.out;
+  // --mission: a trace written before traces carried their mission still gets its graphs.
+  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0", "--mission", "examples/listing2.eamos"});
+  ASSERT_GT(monitor.pid, 0);
+  std::string url = read_url(monitor, "replaying");
+  ASSERT_FALSE(url.empty()) << monitor.seen;
+  std::string output;
+  bool passed = run_browser("replay", url, output);
+  int status = -1;
+  stop(monitor, status);
+  EXPECT_TRUE(passed) << output;
+  EXPECT_EQ(status, 0) << monitor.seen;
+  EXPECT_TRUE(fs::exists(fs::path(EAMOS_SCREENSHOT_DIR) / "replay-listing2-t5.png"));
+  fs::remove_all(dir);
+}
+
+// A trace as schema v1 (docs/trace.md) has it: the header line with the mission's text, a
+// telemetry line per drone and sample, and message lines. Made from a real trace of Listing 2
+// with a hand-written header, a flight of Drone1 along x and one trigger message.
+std::string v1_trace(const std::string& real_trace) {
+  std::ifstream mission("examples/listing2.eamos");
+  std::string source((std::istreambuf_iterator<char>(mission)), {});
+  nlohmann::json header = {{"t", 0}, {"event", "header"}, {"schema", "eamos-trace"}, {"version", 1},
+                           {"mission", "listing2.eamos"}, {"mission_hash", "x"}, {"source", source}, {"fleet", ""},
+                           {"drones", {{{"name", "Drone1"}, {"index", 0}, {"type", "DroneType1"}, {"home", {0, 0, 0}}},
+                                       {{"name", "Drone2"}, {"index", 1}, {"type", "DroneType2"}, {"home", {0, 5, 0}}},
+                                       {{"name", "Drone3"}, {"index", 2}, {"type", "DroneType3"}, {"home", {0, 10, 0}}}}},
+                           {"telemetry_hz", 5}};
+  std::string out = header.dump() + "\n";
+  std::ifstream in(real_trace);
+  std::string line;
+  while (std::getline(in, line)) out += line + "\n";
+  for (double t : {0.0, 2.0, 3.0, 5.0})
+    out += nlohmann::json({{"t", t}, {"event", "telemetry"}, {"drone", "Drone1"}, {"x", t <= 2 ? 0.0 : -(t - 2) * 2},
+                           {"y", 0.0}, {"z", t > 0 ? 4.0 : 0.0}, {"heading", 0}, {"armed", true}, {"landed", false},
+                           {"battery", 99.0}, {"mode", "sim"}}).dump() + "\n";
+  out += nlohmann::json({{"t", 3.75}, {"event", "message"}, {"kind", "trigger"}, {"from", "Drone1"}, {"to", "Drone3"},
+                         {"node", 23}, {"sent", 3.7}, {"received", 3.75}}).dump() + "\n";
+  return out;
+}
+
+TEST(MonitorBrowser, ReplayOfASchemaV1TraceUsesItsHeaderTelemetryAndMessages) {
+  if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
+  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-v1-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  std::string real = (dir / "real.jsonl").string(), trace = (dir / "v1.jsonl").string();
+  auto run = eamos_test::run_eamos("run examples/listing2.eamos -q --trace " + real);
+  ASSERT_EQ(run.status, 0) << run.out;
+  std::ofstream(trace) << v1_trace(real);
+  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0"});
+  ASSERT_GT(monitor.pid, 0);
+  std::string url = read_url(monitor, "replaying");
+  ASSERT_FALSE(url.empty()) << monitor.seen;
+  std::string output;
+  bool passed = run_browser("v1", url, output);
+  int status = -1;
+  stop(monitor, status);
+  EXPECT_TRUE(passed) << output;
+  EXPECT_EQ(status, 0) << monitor.seen;
+  fs::remove_all(dir);
+}
+
+TEST(MonitorBrowser, AThousandDroneReplayDrawsItsLanesOnACanvas) {
+  if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
+  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-scale-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  std::string mission = (dir / "fleet.eamos").string(), trace = (dir / "fleet.jsonl").string();
+  ASSERT_EQ(eamos_test::run_eamos("gen-stress --drones 1000 --nodes 20000 -o " + mission).status, 0);
+  auto run = eamos_test::run_eamos("run " + mission + " -q --trace " + trace + " > /dev/null");
+  ASSERT_EQ(run.status, 0) << run.out;
+  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0", "--mission", mission});
+  ASSERT_GT(monitor.pid, 0);
+  std::string url = read_url(monitor, "replaying");
+  ASSERT_FALSE(url.empty()) << monitor.seen;
+  std::string output;
+  bool passed = run_browser("scale", url, output);
+  int status = -1;
+  stop(monitor, status);
+  EXPECT_TRUE(passed) << output;
+  EXPECT_EQ(status, 0) << monitor.seen;
+  fs::remove_all(dir);
+}
+
+TEST(MonitorBrowser, LiveRunProgressesAndSurvivesReloadAndSecondPage) {
+  if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
+  // In real time the 16.7 s mission flies long enough for a browser to start on a loaded
+  // machine and watch it move (at 2x, a browser slow to start once saw only the end).
+  auto run = eamos_test::start_eamos({"run", "examples/listing2.eamos", "-q", "--realtime", "--monitor", "127.0.0.1:0"});
+  ASSERT_GT(run.pid, 0);
+  std::string url = read_url(run, "monitor at");
+  ASSERT_FALSE(url.empty()) << run.seen;
+  std::string output;
+  bool passed = run_browser("live", url, output);
+  std::cout << output;  // what was checked, and the measured live latency
+  // The page stays up after the end until the user stops it; the run's status is the mission's.
+  bool held = eamos_test::read_until(run, "until Ctrl-C");
+  int status = -1;
+  stop(run, status);
+  EXPECT_TRUE(passed) << output;
+  EXPECT_TRUE(held) << run.seen;
+  EXPECT_EQ(status, 0) << run.seen;
+  EXPECT_NE(run.seen.find("mission completed in 16.7 s"), std::string::npos) << run.seen;
+}
+
+}  // namespace

@@ -1,0 +1,183 @@
+// `eamos monitor` and `--monitor` with bad input, through the real process: a trace is
+// untrusted, so every bad line is reported as file:line: error, all at once, exit 1.
+#include <gtest/gtest.h>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "monitor/server.h"
+#include "monitor/trace_file.h"
+#include "support/eamos_process.h"
+#include "support/run_eamos.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string write_temp(const std::string& name, const std::string& text) {
+  fs::path p = fs::temp_directory_path() / (std::to_string(getpid()) + "-" + name);
+  std::ofstream(p) << text;
+  return p.string();
+}
+
+TEST(MonitorTrace, EveryBadLineIsReportedWithItsLineNumber) {
+  std::string path = write_temp("bad.jsonl",
+                                "{\"t\":0,\"drone\":\"Drone1\",\"event\":\"start\",\"name\":\"Arm\",\"line\":3}\n"
+                                "not json\n"
+                                "{\"t\":\"soon\",\"event\":\"end\"}\n"
+                                "[1,2]\n"
+                                "{\"t\":1,\"event\":\"end\",\"line\":-4}\n");
+  auto r = eamos_test::run_eamos("monitor " + path + " --port 0");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find(path + ":2: error: not valid JSON"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(path + ":3: error: \"t\""), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(path + ":4: error: a trace line must be a JSON object"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(path + ":5: error: \"line\" must be a whole number"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find(":1: error"), std::string::npos) << r.out;
+  fs::remove(path);
+}
+
+TEST(MonitorTrace, DeepNestingAndBinaryAreErrorsNotCrashes) {
+  std::string nasty = std::string(200000, '[') + "\n" + std::string("\xff\xfe\x00garbage\n", 12) +
+                      "{\"t\":1,\"event\":\"start\",\"drone\":\"\\ud800\"}\n";
+  std::istringstream in(nasty);
+  eamos::monitor::LoadedTrace t = eamos::monitor::read_trace("x.jsonl", in);
+  EXPECT_EQ(t.errors.size(), 3u);
+  EXPECT_TRUE(t.events.empty());
+}
+
+TEST(MonitorTrace, ACutOffLastLineIsAWarningNotAnError) {
+  std::istringstream in("{\"t\":0,\"event\":\"start\",\"drone\":\"D\"}\n{\"t\":1,\"ev");
+  eamos::monitor::LoadedTrace t = eamos::monitor::read_trace("x.jsonl", in);
+  EXPECT_TRUE(t.errors.empty());
+  ASSERT_EQ(t.warnings.size(), 1u);
+  EXPECT_NE(t.warnings[0].find("x.jsonl:2: warning: the last line is cut off"), std::string::npos);
+  EXPECT_EQ(t.events.size(), 1u);
+}
+
+TEST(MonitorTrace, AHeaderOfAnotherSchemaVersionIsRefused) {
+  std::istringstream in("{\"t\":0,\"event\":\"header\",\"schema\":\"eamos-trace\",\"version\":7}\n");
+  eamos::monitor::LoadedTrace t = eamos::monitor::read_trace("x.jsonl", in);
+  ASSERT_EQ(t.errors.size(), 1u);
+  EXPECT_NE(t.errors[0].find("version 7 is not supported"), std::string::npos) << t.errors[0];
+}
+
+TEST(MonitorTrace, UnknownEventsAndFieldsAreKept) {
+  std::istringstream in("{\"t\":0.5,\"event\":\"something-new\",\"future\":{\"a\":1}}\n");
+  eamos::monitor::LoadedTrace t = eamos::monitor::read_trace("x.jsonl", in);
+  EXPECT_TRUE(t.errors.empty());
+  ASSERT_EQ(t.events.size(), 1u);
+  EXPECT_NE(t.events[0].find("something-new"), std::string::npos);
+}
+
+TEST(MonitorEndpoint, HostAndPortAreChecked) {
+  eamos::monitor::Endpoint e;
+  std::string error;
+  EXPECT_TRUE(eamos::monitor::parse_endpoint("8080", e, error));
+  EXPECT_EQ(e.host, "127.0.0.1");
+  EXPECT_EQ(e.port, 8080);
+  EXPECT_TRUE(eamos::monitor::parse_endpoint("0.0.0.0:9000", e, error));
+  EXPECT_EQ(e.host, "0.0.0.0");
+  EXPECT_FALSE(eamos::monitor::parse_endpoint("70000", e, error));
+  EXPECT_NE(error.find("is not a port number"), std::string::npos);
+  EXPECT_FALSE(eamos::monitor::parse_endpoint("host;rm:80", e, error));
+  EXPECT_FALSE(eamos::monitor::parse_endpoint("", e, error));
+}
+
+// One raw HTTP/1.1 request to 127.0.0.1:port; the whole answer ("" when none).
+std::string http(int port, const std::string& request) {
+  int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  std::string answer;
+  if (connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0) {
+    (void)!write(fd, request.data(), request.size());
+    shutdown(fd, SHUT_WR);
+    char buf[4096];
+    ssize_t n;
+    while ((n = read(fd, buf, sizeof buf)) > 0) answer.append(buf, static_cast<std::size_t>(n));
+  }
+  close(fd);
+  return answer;
+}
+
+int port_of(const std::string& seen) {
+  std::size_t at = seen.find("http://127.0.0.1:");
+  return at == std::string::npos ? -1 : std::atoi(seen.c_str() + at + 17);
+}
+
+std::string get(int port, const std::string& path, const std::string& host) {
+  return http(port, "GET " + path + " HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n");
+}
+
+TEST(MonitorServer, ServesOnlyThePageAndRefusesEverythingThatWouldChangeSomething) {
+  std::string trace = write_temp("ok.jsonl", "{\"t\":0,\"drone\":\"Drone1\",\"event\":\"start\",\"name\":\"Arm\",\"line\":3}\n");
+  auto p = eamos_test::start_eamos({"monitor", trace, "--port", "0"});
+  ASSERT_TRUE(eamos_test::read_until(p, "replaying")) << p.seen;
+  int port = port_of(p.seen);
+  ASSERT_GT(port, 0) << p.seen;
+  std::string self = "127.0.0.1:" + std::to_string(port);
+  std::string page = get(port, "/", self);
+  EXPECT_EQ(page.rfind("HTTP/1.1 200", 0), 0u) << page;
+  EXPECT_NE(page.find("<title>eamos monitor</title>"), std::string::npos);
+  EXPECT_NE(page.find("Content-Security-Policy: default-src 'self'"), std::string::npos);
+  EXPECT_EQ(get(port, "/monitor.js", self).rfind("HTTP/1.1 200", 0), 0u);
+  EXPECT_EQ(http(port, "POST / HTTP/1.1\r\nHost: " + self + "\r\nContent-Length: 2\r\n\r\n{}").rfind("HTTP/1.1 405", 0), 0u);
+  EXPECT_EQ(http(port, "PUT /monitor.js HTTP/1.1\r\nHost: " + self + "\r\nContent-Length: 0\r\n\r\n").rfind("HTTP/1.1 405", 0), 0u);
+  EXPECT_EQ(get(port, "/../../etc/passwd", self).find("root:"), std::string::npos);
+  EXPECT_EQ(get(port, "/nothing", self).rfind("HTTP/1.1 404", 0), 0u);
+  // DNS rebinding: another name for this address is not served.
+  EXPECT_EQ(get(port, "/", "evil.example:" + std::to_string(port)).rfind("HTTP/1.1 403", 0), 0u);
+  // A WebSocket from another site's page is refused.
+  std::string upgrade = http(port, "GET /ws HTTP/1.1\r\nHost: " + self + "\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                                   "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n"
+                                   "Origin: http://evil.example\r\n\r\n");
+  EXPECT_EQ(upgrade.find("101 Switching Protocols"), std::string::npos) << upgrade;
+  kill(p.pid, SIGTERM);
+  eamos_test::Exit e = eamos_test::wait_exit(p);
+  EXPECT_TRUE(e.exited);
+  EXPECT_EQ(e.status, 0);
+  fs::remove(trace);
+}
+
+// The distributed run (one DEX process per drone over DDS) serves its ground's events the same way.
+TEST(MonitorRun, ADistributedRunIsServedLiveAndStaysUpUntilStopped) {
+  auto p = eamos_test::start_eamos({"run", "examples/listing2.eamos", "-q", "--distributed", "--insecure", "--speed", "4",
+                                    "--domain", "201", "--monitor", "127.0.0.1:0"});
+  ASSERT_TRUE(eamos_test::read_until(p, "monitor at")) << p.seen;
+  int port = port_of(p.seen);
+  ASSERT_GT(port, 0) << p.seen;
+  EXPECT_EQ(get(port, "/", "127.0.0.1:" + std::to_string(port)).rfind("HTTP/1.1 200", 0), 0u);
+  ASSERT_TRUE(eamos_test::read_until(p, "until Ctrl-C")) << p.seen;
+  EXPECT_NE(p.seen.find("mission completed"), std::string::npos) << p.seen;
+  kill(p.pid, SIGTERM);
+  eamos_test::Exit e = eamos_test::wait_exit(p);
+  EXPECT_TRUE(e.exited);
+  EXPECT_EQ(e.status, 0) << p.seen;
+}
+
+TEST(MonitorRun, AFleetWithoutItsMissionIsAnError) {
+  std::string trace = write_temp("fleet.jsonl", "{\"t\":0,\"event\":\"start\",\"drone\":\"Drone1\"}\n");
+  auto r = eamos_test::run_eamos("monitor " + trace + " --fleet examples/listing2-right.yaml --port 0");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("--fleet requires --mission"), std::string::npos) << r.out;
+  fs::remove(trace);
+}
+
+TEST(MonitorRun, ABadMonitorAddressStopsTheRunBeforeItFlies) {
+  auto r = eamos_test::run_eamos("run examples/listing2.eamos -q --monitor 99999");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("error: --monitor '99999' is not a port number"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("Drone1"), std::string::npos) << r.out;
+}
+
+}  // namespace
