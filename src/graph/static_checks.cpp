@@ -1,6 +1,7 @@
 #include "graph/static_checks.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -217,6 +218,8 @@ class LogicChecker {
     for (std::size_t k = 0; k < order_.size(); ++k)
       for (int s : succ[order_[k]])
         if (--waiting[s] == 0) order_.push_back(s);
+    position_.assign(n, 0);
+    for (std::size_t k = 0; k < order_.size(); ++k) position_[order_[k]] = static_cast<int>(k);
     return order_.size() == n;  // a cycle would be a builder bug: analyse nothing then
   }
 
@@ -280,6 +283,30 @@ class LogicChecker {
       if (k == fleet::ActionClass::motion) moving_[n.drone].push_back(n.id);
       if (k != fleet::ActionClass::payload) arming_[n.drone].push_back(n.id);
     }
+    auto by_position = [this](int a, int b) { return position_[a] < position_[b]; };
+    for (auto& v : moving_) std::sort(v.begin(), v.end(), by_position);
+    for (auto& v : arming_) std::sort(v.begin(), v.end(), by_position);
+  }
+
+  /// A cheap necessary test for `fact` knowing anything about `prop` of `drone` at `c`:
+  /// an action that comes before `c` in the graph's order cannot wait for `c`, so either no
+  /// relevant action comes before it, or the last that does is the Land (Disarm) it stands
+  /// after. It spares the pass over the graph for almost every condition of a large mission.
+  bool may_be_known(int drone, const std::string& prop, int c) const {
+    bool armed = prop == "Armed";
+    if (prop != "X" && prop != "Y" && prop != "Z" && prop != "Landed" && !armed) return false;
+    const std::vector<int>& relevant = armed ? arming_[drone] : moving_[drone];
+    auto it = std::lower_bound(relevant.begin(), relevant.end(), c,
+                               [this](int a, int node) { return position_[a] < position_[node]; });
+    if (it == relevant.begin()) return true;
+    return meg_.nodes[*std::prev(it)].name == (armed ? "Disarm" : "Land");
+  }
+
+  bool any_may_be_known(const Expr* e, int c) const {
+    if (!e) return false;
+    if (e->kind == ExprKind::property && e->drone_index >= 0 && may_be_known(e->drone_index, e->property, c))
+      return true;
+    return any_may_be_known(e->lhs.get(), c) || any_may_be_known(e->rhs.get(), c);
   }
 
   /// Nodes a Do may cancel: a wait among them can end by cancellation, never for ever.
@@ -296,11 +323,52 @@ class LogicChecker {
 
   // --- what a drone's property is known to be ---------------------------------------------
 
-  /// `prop` of `drone` while condition `c` is evaluated, given the actions that cannot have
-  /// started yet (`later`). A drone none of whose relevant actions can have started stands
-  /// where the mission started it; one whose last such action is a Land (or, for Armed, a
-  /// Disarm) that has ended before `c` stands where it landed.
-  Fact fact(int drone, const std::string& prop, int c, const std::vector<char>& later) {
+  /// How far a drone's relevant actions (motions, or those that can change Armed) can
+  /// have run by the time a condition is evaluated, given the actions that cannot have
+  /// started yet: none, or all up to a last one that every other has ended before.
+  struct Standing {
+    bool summarised = false;
+    int early = 0;   ///< relevant actions that may have started
+    int last = -1;   ///< the one of them last in the graph's order
+    bool settled = false;  ///< every other early action ends before `last` starts
+  };
+
+  /// What may have run by a condition: `later` marks the nodes that cannot have started.
+  /// Empty when nothing about positions or arming can be known (see may_be_known).
+  struct Knowledge {
+    std::vector<char> later;
+    std::vector<std::array<Standing, 2>> standing;  ///< per drone: [moving, arming]
+  };
+
+  Knowledge knowledge(std::vector<char> later) {
+    Knowledge k;
+    k.later = std::move(later);
+    k.standing.assign(in_.mission.drones.size(), {});
+    return k;
+  }
+
+  const Standing& standing(Knowledge& k, int drone, bool armed) {
+    Standing& st = k.standing[drone][armed ? 1 : 0];
+    if (st.summarised) return st;
+    st.summarised = true;
+    const std::vector<int>& relevant = armed ? arming_[drone] : moving_[drone];
+    for (int a : relevant)  // sorted by position: the last early one is the latest
+      if (!k.later[a]) {
+        ++st.early;
+        st.last = a;
+      }
+    if (st.early == 0 || meg_.nodes[st.last].name != (armed ? "Disarm" : "Land")) return st;
+    const std::vector<char>& first = before(st.last);
+    st.settled = std::all_of(relevant.begin(), relevant.end(),
+                             [&](int b) { return k.later[b] || b == st.last || first[b]; });
+    return st;
+  }
+
+  /// `prop` of `drone` while condition `c` is evaluated. A drone none of whose relevant
+  /// actions can have started stands where the mission started it; one whose last such
+  /// action is a Land (or, for Armed, a Disarm) that has ended before `c`, every other
+  /// having ended before that, stands where it landed.
+  Fact fact(int drone, const std::string& prop, int c, Knowledge& k) {
     const std::string& name = in_.mission.drones[drone].name;
     Fact f;
     if (prop.rfind("Sensor", 0) == 0) {
@@ -313,20 +381,11 @@ class LogicChecker {
     }
     bool armed = prop == "Armed";
     if (prop != "X" && prop != "Y" && prop != "Z" && prop != "Landed" && !armed) return f;  // Battery
-    const std::vector<int>& relevant = armed ? arming_[drone] : moving_[drone];
-    std::vector<int> early;
-    for (int a : relevant)
-      if (!later[a]) early.push_back(a);
-    if (early.empty()) return standing_at_start(drone, prop);
-    const char* settle = armed ? "Disarm" : "Land";
-    for (int a : early) {
-      if (meg_.nodes[a].name != settle || !before(c)[a]) continue;
-      const std::vector<char>& first = before(a);
-      bool last = std::all_of(early.begin(), early.end(), [&](int b) { return b == a || first[b]; });
-      if (!last) continue;
-      return armed ? disarmed(drone, a) : landed(drone, prop, a);
-    }
-    return f;
+    if (k.later.empty()) return f;  // the caller knows nothing can be known (may_be_known)
+    const Standing& st = standing(k, drone, armed);
+    if (st.early == 0) return standing_at_start(drone, prop);
+    if (!st.settled || !before(c)[st.last]) return f;
+    return armed ? disarmed(drone, st.last) : landed(drone, prop, st.last);
   }
 
   Fact standing_at_start(int drone, const std::string& prop) const {
@@ -382,7 +441,7 @@ class LogicChecker {
     return f;
   }
 
-  Abstract evaluate(const Expr& e, int c, const std::vector<char>& later, std::vector<std::string>& why) {
+  Abstract evaluate(const Expr& e, int c, Knowledge& later, std::vector<std::string>& why) {
     switch (e.kind) {
       case ExprKind::number: return interval(e.number, e.number);
       case ExprKind::boolean: return truth_of(e.boolean ? 1 : 0);
@@ -409,7 +468,7 @@ class LogicChecker {
   }
 
   /// The truth of condition `c` whenever it is evaluated, -1 when it may differ.
-  int truth(int c, const std::vector<char>& later, std::vector<std::string>& why) {
+  int truth(int c, Knowledge& later, std::vector<std::string>& why) {
     const MegNode& n = meg_.nodes[c];
     if (!n.condition) return -1;
     why.clear();
@@ -440,11 +499,14 @@ class LogicChecker {
     return role_name(role);
   }
 
+  /// The control statement at `loc`; the index is built on the first finding only.
   const lang::Statement* statement_at(SourceLocation loc) const {
-    for (const auto& f : in_.mission.functions)
-      for (const auto& s : f.body)
-        if (s.loc.line == loc.line && s.loc.col == loc.col && s.control != ControlKind::none) return &s;
-    return nullptr;
+    if (statements_.empty())
+      for (const auto& f : in_.mission.functions)
+        for (const auto& s : f.body)
+          if (s.control != ControlKind::none) statements_.emplace(key(s.loc), &s);
+    auto it = statements_.find(key(loc));
+    return it == statements_.end() ? nullptr : it->second;
   }
 
   void add(int c, Finding kind, Severity sev, std::string message, bool every_instance) {
@@ -461,21 +523,24 @@ class LogicChecker {
     const MegNode& n = meg_.nodes[c];
     ControlKind k = n.control;
     if (!n.condition || k == ControlKind::none) return;
-    if (!spend(2 * static_cast<long long>(meg_.nodes.size()))) return;
+    // Without a read that may be known, the condition is judged on literals and sensor
+    // ranges alone, and no pass over the graph is needed.
+    bool known = any_may_be_known(n.condition, c);
+    if (known && !spend(2 * static_cast<long long>(meg_.nodes.size()))) return;
     std::vector<std::string> why;
-    std::vector<char> later = after({c});
+    Knowledge later = knowledge(known ? after({c}) : std::vector<char>{});
     int t = truth(c, later, why);
     std::string name = lang::control_name(k);
-    std::string cond = cond_text(c);
+    auto cond = [&] { return cond_text(c); };  // built only for a finding
     if (is_wait(k)) {
       if (t == go_value(k)) {
         add(c, Finding::wait_never_waits, Severity::warning,
-            name + " never waits: " + cond + " is already " + value_name(t) + " whenever it is reached" +
+            name + " never waits: " + cond() + " is already " + value_name(t) + " whenever it is reached" +
                 because(why) + "; remove the wait, or wait for something that can change",
             true);
       } else if (t >= 0 && !cancellable_[c]) {
         add(c, Finding::wait_never_ends, Severity::error,
-            name + " can never end: " + cond + " is " + value_name(t) + " whenever it is reached and nothing can change it" +
+            name + " can never end: " + cond() + " is " + value_name(t) + " whenever it is reached and nothing can change it" +
                 because(why) + "; wait for something that happens before this point, or move the wait",
             false);
         singleton_blocked_.insert(c);
@@ -487,28 +552,27 @@ class LogicChecker {
       std::string taken = branch_name(c, t ? Role::then_ : Role::else_);
       std::string dead = branch_name(c, t ? Role::else_ : Role::then_);
       add(c, t ? Finding::branch_never_runs_else : Finding::branch_never_runs_then, Severity::warning,
-          "branch " + dead + " can never run: " + cond + " is " + value_name(t) + " whenever this If is reached" +
+          "branch " + dead + " can never run: " + cond() + " is " + value_name(t) + " whenever this If is reached" +
               because(why) + "; only " + taken + " runs: test something that can differ, or call " + taken +
               " directly",
           true);
       return;
     }
     if (is_repeat(k)) {
-      std::string body = branch_name(c, Role::repeat);
       if (t >= 0 && t != go_value(k)) {
         add(c, Finding::loop_body_never_runs, Severity::warning,
-            "loop body " + body + " can never run: " + cond + " is " + value_name(t) + " when " + name +
+            "loop body " + branch_name(c, Role::repeat) + " can never run: " + cond() + " is " + value_name(t) + " when " + name +
                 " is first reached" + because(why) + "; test something that can differ, or remove the loop",
             true);
         return;
       }
       if (k == ControlKind::RepeatFor || cancellable_[c]) return;  // RepeatFor stops at its count
-      std::vector<char> once_done = after({c}, {Branch::repeat});
+      Knowledge once_done = knowledge(known ? after({c}, {Branch::repeat}) : std::vector<char>{});
       int always = truth(c, once_done, why);
       if (always == go_value(k))
         add(c, Finding::loop_never_ends, Severity::error,
-            name + " can never end: " + cond + " stays " + value_name(always) +
-                " whatever its body " + body + " does" + because(why) +
+            name + " can never end: " + cond() + " stays " + value_name(always) +
+                " whatever its body " + branch_name(c, Role::repeat) + " does" + because(why) +
                 "; test something the loop or another drone changes, or use RepeatFor with a count",
             true);
       return;
@@ -517,16 +581,16 @@ class LogicChecker {
       if (t >= 0 && t != go_value(k)) {
         add(c, Finding::do_never_starts, Severity::warning,
             "neither " + branch_name(c, Role::do_) + " nor " + branch_name(c, Role::done) +
-                " can ever run: " + cond + " is " + value_name(t) + " whenever this " + name + " is reached" +
+                " can ever run: " + cond() + " is " + value_name(t) + " whenever this " + name + " is reached" +
                 because(why) + "; test something that can differ, or remove the " + name,
             true);
         return;
       }
-      std::vector<char> watched = after({c}, {Branch::do_, Branch::continue_});
+      Knowledge watched = knowledge(known ? after({c}, {Branch::do_, Branch::continue_}) : std::vector<char>{});
       int always = truth(c, watched, why);
       if (always == go_value(k))
         add(c, Finding::done_never_runs, Severity::warning,
-            "branch " + branch_name(c, Role::done) + " can never run: " + cond + " stays " +
+            "branch " + branch_name(c, Role::done) + " can never run: " + cond() + " stays " +
                 value_name(always) + " while " + name + " watches it" + because(why) +
                 "; test something that can change while " + branch_name(c, Role::do_) + " runs",
             true);
@@ -551,7 +615,7 @@ class LogicChecker {
     return meg_.nodes[w].drone;
   }
 
-  bool blocked(int w, const std::vector<char>& later) {
+  bool blocked(int w, Knowledge& later) {
     std::vector<std::string> why;
     int t = truth(w, later, why);
     return t >= 0 && t != go_value(meg_.nodes[w].control);
@@ -587,7 +651,7 @@ class LogicChecker {
         set.push_back(n.id);
     while (!set.empty()) {
       if (!spend(2 * static_cast<long long>(meg_.nodes.size()) * static_cast<long long>(1 + set.size() / 64))) return;
-      std::vector<char> later = after(set);
+      Knowledge later = knowledge(after(set));
       std::vector<int> kept;
       for (int w : set)
         if (blocked(w, later)) kept.push_back(w);
@@ -705,6 +769,8 @@ class LogicChecker {
   StaticCheckLimits limits_;
   std::vector<std::vector<Pred>> preds_;
   std::vector<int> order_;
+  std::vector<int> position_;  ///< index of each node in order_
+  mutable std::map<std::pair<int, int>, const lang::Statement*> statements_;
   std::map<int, std::vector<char>> before_;
   std::vector<std::vector<int>> moving_;
   std::vector<std::vector<int>> arming_;
