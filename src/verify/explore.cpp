@@ -70,6 +70,17 @@ void children(const Flight& f, const Assignment& forced, std::deque<Assignment>&
   }
 }
 
+FlownPath flown_path(const Setup& setup, const Assignment& forced, const Flight& f, int number, int violations) {
+  FlownPath p;
+  p.forced.assign(forced.begin(), forced.end());
+  p.factors = f.factors;
+  p.decisions = f.decisions;
+  p.timing = timing_text(setup, f.factors);
+  p.number = number;
+  p.violations = violations;
+  return p;
+}
+
 }  // namespace
 
 VerifyReport verify(const graph::Compilation& c, const std::vector<dex::Mission>& missions,
@@ -97,7 +108,10 @@ VerifyReport verify(const graph::Compilation& c, const std::vector<dex::Mission>
       Flight f = fly(setup, forced, factors);
       ++report.paths;
       free.insert(f.decision_keys.begin(), f.decision_keys.end());
-      for (Violation& v : check_flight(setup, f)) {
+      std::vector<Violation> found = check_flight(setup, f);
+      if (report.paths == 1 || static_cast<int>(found.size()) > report.worst.violations)
+        report.worst = flown_path(setup, forced, f, report.paths, static_cast<int>(found.size()));
+      for (Violation& v : found) {
         auto [it, added] = index.emplace(identity(v), report.violations.size());
         if (!added) {
           ++report.violations[it->second].paths_seen;
