@@ -62,6 +62,8 @@ struct VerifyReport {
   FlownPath worst;                    ///< the path with the most violations (first flown on ties)
   int paths = 0;                      ///< runs flown
   int free_conditions = 0;            ///< conditions explored both ways
+  int timing_conditions = 0;          ///< Ifs/Repeats/Dos that read a drone while it moved
+  int timing_both_ways = 0;           ///< of those, seen both ways across the timings flown
   bool complete = false;              ///< every combination of outcomes was flown
   std::string error;                  ///< setup problem (nothing was flown)
 };
