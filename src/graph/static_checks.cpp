@@ -519,82 +519,108 @@ class LogicChecker {
     }
   }
 
+  /// A condition's first verdict, shared by the rules of each kind of structure.
+  struct Verdict {
+    int c = -1;
+    ControlKind kind = ControlKind::none;
+    bool known = false;  ///< some read may be known: the pass over the graph was made
+    int truth = -1;
+    std::vector<std::string> why;
+  };
+
   void check_condition(int c) {
     const MegNode& n = meg_.nodes[c];
-    ControlKind k = n.control;
-    if (!n.condition || k == ControlKind::none) return;
+    if (!n.condition || n.control == ControlKind::none) return;
+    Verdict v;
+    v.c = c;
+    v.kind = n.control;
     // Without a read that may be known, the condition is judged on literals and sensor
     // ranges alone, and no pass over the graph is needed.
-    bool known = any_may_be_known(n.condition, c);
-    if (known && !spend(2 * static_cast<long long>(meg_.nodes.size()))) return;
-    std::vector<std::string> why;
-    Knowledge later = knowledge(known ? after({c}) : std::vector<char>{});
-    int t = truth(c, later, why);
-    std::string name = lang::control_name(k);
-    auto cond = [&] { return cond_text(c); };  // built only for a finding
-    if (is_wait(k)) {
-      if (t == go_value(k)) {
-        add(c, Finding::wait_never_waits, Severity::warning,
-            name + " never waits: " + cond() + " is already " + value_name(t) + " whenever it is reached" +
-                because(why) + "; remove the wait, or wait for something that can change",
-            true);
-      } else if (t >= 0 && !cancellable_[c]) {
-        add(c, Finding::wait_never_ends, Severity::error,
-            name + " can never end: " + cond() + " is " + value_name(t) + " whenever it is reached and nothing can change it" +
-                because(why) + "; wait for something that happens before this point, or move the wait",
-            false);
-        singleton_blocked_.insert(c);
-      }
-      return;
+    v.known = any_may_be_known(n.condition, c);
+    if (v.known && !spend(2 * static_cast<long long>(meg_.nodes.size()))) return;
+    Knowledge later = knowledge(v.known ? after({c}) : std::vector<char>{});
+    v.truth = truth(c, later, v.why);
+    if (is_wait(v.kind)) judge_wait(v);
+    else if (v.kind == ControlKind::If) judge_if(v);
+    else if (is_repeat(v.kind)) judge_repeat(v);
+    else if (is_do(v.kind)) judge_do(v);
+  }
+
+  void judge_wait(const Verdict& v) {
+    int c = v.c, t = v.truth;
+    std::string name = lang::control_name(v.kind);
+    if (t == go_value(v.kind)) {
+      add(c, Finding::wait_never_waits, Severity::warning,
+          name + " never waits: " + cond_text(c) + " is already " + value_name(t) + " whenever it is reached" +
+              because(v.why) + "; remove the wait, or wait for something that can change",
+          true);
+    } else if (t >= 0 && !cancellable_[c]) {
+      add(c, Finding::wait_never_ends, Severity::error,
+          name + " can never end: " + cond_text(c) + " is " + value_name(t) +
+              " whenever it is reached and nothing can change it" + because(v.why) +
+              "; wait for something that happens before this point, or move the wait",
+          false);
+      singleton_blocked_.insert(c);
     }
-    if (k == ControlKind::If) {
-      if (t < 0) return;
-      std::string taken = branch_name(c, t ? Role::then_ : Role::else_);
-      std::string dead = branch_name(c, t ? Role::else_ : Role::then_);
-      add(c, t ? Finding::branch_never_runs_else : Finding::branch_never_runs_then, Severity::warning,
-          "branch " + dead + " can never run: " + cond() + " is " + value_name(t) + " whenever this If is reached" +
-              because(why) + "; only " + taken + " runs: test something that can differ, or call " + taken +
-              " directly",
+  }
+
+  void judge_if(const Verdict& v) {
+    int c = v.c, t = v.truth;
+    if (t < 0) return;
+    std::string taken = branch_name(c, t ? Role::then_ : Role::else_);
+    std::string dead = branch_name(c, t ? Role::else_ : Role::then_);
+    add(c, t ? Finding::branch_never_runs_else : Finding::branch_never_runs_then, Severity::warning,
+        "branch " + dead + " can never run: " + cond_text(c) + " is " + value_name(t) + " whenever this If is reached" +
+            because(v.why) + "; only " + taken + " runs: test something that can differ, or call " + taken +
+            " directly",
+        true);
+  }
+
+  void judge_repeat(const Verdict& v) {
+    int c = v.c, t = v.truth;
+    std::string name = lang::control_name(v.kind);
+    if (t >= 0 && t != go_value(v.kind)) {
+      add(c, Finding::loop_body_never_runs, Severity::warning,
+          "loop body " + branch_name(c, Role::repeat) + " can never run: " + cond_text(c) + " is " + value_name(t) +
+              " when " + name + " is first reached" + because(v.why) +
+              "; test something that can differ, or remove the loop",
           true);
       return;
     }
-    if (is_repeat(k)) {
-      if (t >= 0 && t != go_value(k)) {
-        add(c, Finding::loop_body_never_runs, Severity::warning,
-            "loop body " + branch_name(c, Role::repeat) + " can never run: " + cond() + " is " + value_name(t) + " when " + name +
-                " is first reached" + because(why) + "; test something that can differ, or remove the loop",
-            true);
-        return;
-      }
-      if (k == ControlKind::RepeatFor || cancellable_[c]) return;  // RepeatFor stops at its count
-      Knowledge once_done = knowledge(known ? after({c}, {Branch::repeat}) : std::vector<char>{});
-      int always = truth(c, once_done, why);
-      if (always == go_value(k))
-        add(c, Finding::loop_never_ends, Severity::error,
-            name + " can never end: " + cond() + " stays " + value_name(always) +
-                " whatever its body " + branch_name(c, Role::repeat) + " does" + because(why) +
-                "; test something the loop or another drone changes, or use RepeatFor with a count",
-            true);
+    if (v.kind == ControlKind::RepeatFor || cancellable_[c]) return;  // RepeatFor stops at its count
+    // Every later evaluation follows a run of the body: its actions count as having run.
+    Knowledge once_done = knowledge(v.known ? after({c}, {Branch::repeat}) : std::vector<char>{});
+    std::vector<std::string> why;
+    int always = truth(c, once_done, why);
+    if (always == go_value(v.kind))
+      add(c, Finding::loop_never_ends, Severity::error,
+          name + " can never end: " + cond_text(c) + " stays " + value_name(always) + " whatever its body " +
+              branch_name(c, Role::repeat) + " does" + because(why) +
+              "; test something the loop or another drone changes, or use RepeatFor with a count",
+          false);
+  }
+
+  void judge_do(const Verdict& v) {
+    int c = v.c, t = v.truth;
+    std::string name = lang::control_name(v.kind);
+    if (t >= 0 && t != go_value(v.kind)) {
+      add(c, Finding::do_never_starts, Severity::warning,
+          "neither " + branch_name(c, Role::do_) + " nor " + branch_name(c, Role::done) + " can ever run: " +
+              cond_text(c) + " is " + value_name(t) + " whenever this " + name + " is reached" + because(v.why) +
+              "; test something that can differ, or remove the " + name,
+          true);
       return;
     }
-    if (is_do(k)) {
-      if (t >= 0 && t != go_value(k)) {
-        add(c, Finding::do_never_starts, Severity::warning,
-            "neither " + branch_name(c, Role::do_) + " nor " + branch_name(c, Role::done) +
-                " can ever run: " + cond() + " is " + value_name(t) + " whenever this " + name + " is reached" +
-                because(why) + "; test something that can differ, or remove the " + name,
-            true);
-        return;
-      }
-      Knowledge watched = knowledge(known ? after({c}, {Branch::do_, Branch::continue_}) : std::vector<char>{});
-      int always = truth(c, watched, why);
-      if (always == go_value(k))
-        add(c, Finding::done_never_runs, Severity::warning,
-            "branch " + branch_name(c, Role::done) + " can never run: " + cond() + " stays " +
-                value_name(always) + " while " + name + " watches it" + because(why) +
-                "; test something that can change while " + branch_name(c, Role::do_) + " runs",
-            true);
-    }
+    // While it watches, the do-branch (and, for Async, what follows) runs.
+    Knowledge watched = knowledge(v.known ? after({c}, {Branch::do_, Branch::continue_}) : std::vector<char>{});
+    std::vector<std::string> why;
+    int always = truth(c, watched, why);
+    if (always == go_value(v.kind))
+      add(c, Finding::done_never_runs, Severity::warning,
+          "branch " + branch_name(c, Role::done) + " can never run: " + cond_text(c) + " stays " +
+              value_name(always) + " while " + name + " watches it" + because(why) +
+              "; test something that can change while " + branch_name(c, Role::do_) + " runs",
+          true);
   }
 
   // --- deadlock -------------------------------------------------------------------------
