@@ -18,7 +18,7 @@ int cmd_verify(const CommonOptions& o, const VerifyCommandOptions& v) {
   options.jitter = v.jitter;
   options.time_limit_s = v.time_limit;
   verify::VerifyReport report = verify::verify(c, missions, options);
-  if (!v.plot.empty() && !write_output(v.plot, verify::plot_first_path(c, missions, options))) return 1;
+  if (!v.plot.empty() && !write_output(v.plot, verify::plot_worst_path(c, missions, options, report))) return 1;
   std::cerr.flush();
   std::cout << (v.json ? verify::json_report(c, report) : verify::format_report(c, report));
   std::cout.flush();

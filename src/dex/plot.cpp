@@ -387,13 +387,18 @@ void timeline_marks(std::ostream& out, const std::vector<PlotMark>& marks, doubl
 
 }  // namespace
 
-std::string plot_svg(const RunResult& run, const std::vector<TraceEvent>& events, const std::vector<PlotMark>& marks) {
+std::string plot_svg(const RunResult& run, const std::vector<TraceEvent>& events, const std::vector<PlotMark>& marks,
+                     const std::string& caption) {
   std::ostringstream body;
   double y = 20;
   std::string status = run.completed ? "completed in " + num(run.duration) + " s"
                                      : "failed" + (run.error.empty() ? std::string() : ": " + run.error);
   body << text(kLeft - 100, y, "Mission run — " + status, "font-size=\"15\" font-weight=\"bold\" fill=\"#222222\"");
   y += 26;
+  if (!caption.empty()) {
+    body << text(kLeft - 100, y - 6, caption, "class=\"caption\" font-size=\"12\" fill=\"#d62728\"");
+    y += 14;
+  }
   body << text(kLeft - 100, y, "Tracks seen from above", "font-size=\"13\" font-weight=\"bold\" fill=\"#444444\"");
   y += 12;
   MapFrame frame = map_frame(run, y);

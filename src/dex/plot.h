@@ -22,7 +22,8 @@ struct PlotMark {
   std::string label;        ///< "separation", ...
 };
 
+/// `caption`, when given, is a line under the title (which run of several this is).
 std::string plot_svg(const RunResult& run, const std::vector<TraceEvent>& events,
-                     const std::vector<PlotMark>& marks = {});
+                     const std::vector<PlotMark>& marks = {}, const std::string& caption = "");
 
 }  // namespace eamos::dex

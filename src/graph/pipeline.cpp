@@ -1,5 +1,6 @@
 #include "graph/pipeline.h"
 
+#include "graph/static_checks.h"
 #include "lang/parser.h"
 
 namespace eamos::graph {
@@ -16,6 +17,9 @@ bool compile(std::shared_ptr<SourceFile> source, const fleet::Fleet& fleet, Diag
                                                   out.mission.drones[d].type, d));
   out.amt = build_amt(out.mission);
   out.meg = build_meg(out.amt, out.mission);
+  // Like the checker's warnings, only on a mission without errors: the MEG needs one.
+  check_mission_logic({out.meg, out.mission, out.fleet, out.checked.drone_types, out.settings}, diags);
+  if (diags.has_errors()) return false;
   if (keep == Keep::deployment_graphs) out.amt = Amt{};
   out.mdgs = build_mdgs(out.meg);
   return true;

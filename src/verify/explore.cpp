@@ -4,6 +4,7 @@
 // path keeps the outcomes before it and flips it: a depth-first enumeration of the outcome
 // tree, flown breadth first so a small --paths still covers the early decisions.
 #include <algorithm>
+#include <cmath>
 #include <deque>
 #include <set>
 
@@ -33,17 +34,35 @@ std::vector<std::vector<double>> timings(int drones, bool jitter) {
   return out;
 }
 
+/// "Drone1, Drone3 10 % slower, Drone2 25 % faster": drones grouped by how their timing moved.
 std::string timing_text(const Setup& s, const std::vector<double>& factors) {
-  std::string slower, faster;
+  std::vector<std::pair<std::string, std::string>> groups;  // "10 % slower" → drones
   for (std::size_t d = 0; d < factors.size(); ++d) {
-    std::string& list = factors[d] > 1 ? slower : factors[d] < 1 ? faster : slower;
     if (factors[d] == 1.0) continue;
-    list += (list.empty() ? "" : ", ") + s.missions[d].settings.name;
+    int percent = static_cast<int>(std::lround(std::abs(factors[d] > 1 ? factors[d] - 1 : 1 - factors[d]) * 100));
+    std::string how = std::to_string(percent) + " % " + (factors[d] > 1 ? "slower" : "faster");
+    auto it = std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.first == how; });
+    if (it == groups.end()) it = groups.insert(groups.end(), {how, ""});
+    it->second += (it->second.empty() ? "" : ", ") + s.missions[d].settings.name;
   }
+  std::stable_sort(groups.begin(), groups.end(), [](const auto& a, const auto& b) {
+    return (a.first.find("slower") != std::string::npos) > (b.first.find("slower") != std::string::npos);
+  });
   std::string out;
-  if (!slower.empty()) out += slower + " 10 % slower";
-  if (!faster.empty()) out += (out.empty() ? "" : ", ") + faster + " 10 % faster";
+  for (const auto& [how, drones] : groups) out += (out.empty() ? "" : ", ") + drones + " " + how;
   return out;
+}
+
+/// Timings that move one drone against the rest: each drone a timing-dependent condition
+/// read while it moved, 25 % slower and 25 % faster (20 % shorter), the others nominal.
+void timing_variants(const Flight& f, std::vector<std::vector<double>>& variants) {
+  for (const auto& [key, seen] : f.timing_conditions)
+    for (int d : seen.second)
+      for (double factor : {1.25, 0.8}) {
+        std::vector<double> v(f.factors.size(), 1.0);
+        v[d] = factor;
+        if (std::find(variants.begin(), variants.end(), v) == variants.end()) variants.push_back(v);
+      }
 }
 
 std::string identity(const Violation& v) {
@@ -70,6 +89,17 @@ void children(const Flight& f, const Assignment& forced, std::deque<Assignment>&
   }
 }
 
+FlownPath flown_path(const Setup& setup, const Assignment& forced, const Flight& f, int number, int violations) {
+  FlownPath p;
+  p.forced.assign(forced.begin(), forced.end());
+  p.factors = f.factors;
+  p.decisions = f.decisions;
+  p.timing = timing_text(setup, f.factors);
+  p.number = number;
+  p.violations = violations;
+  return p;
+}
+
 }  // namespace
 
 VerifyReport verify(const graph::Compilation& c, const std::vector<dex::Mission>& missions,
@@ -85,19 +115,27 @@ VerifyReport verify(const graph::Compilation& c, const std::vector<dex::Mission>
   std::set<Assignment> seen{Assignment{}};
   std::set<std::pair<int, int>> free;
   std::map<std::string, std::size_t> index;
+  std::map<std::pair<int, int>, std::set<bool>> timing_outcomes;  // timing-dependent condition → seen
   bool stopped = false;
   while (!work.empty() && !stopped) {
     Assignment forced = work.front();
     work.pop_front();
-    for (const std::vector<double>& factors : variants) {
+    std::vector<std::vector<double>> timings_here = variants;  // grows with what the flights meet
+    for (std::size_t v = 0; v < timings_here.size(); ++v) {
       if (report.paths >= options.max_paths) {
         stopped = true;
         break;
       }
+      const std::vector<double> factors = timings_here[v];
       Flight f = fly(setup, forced, factors);
       ++report.paths;
       free.insert(f.decision_keys.begin(), f.decision_keys.end());
-      for (Violation& v : check_flight(setup, f)) {
+      for (const auto& [key, seen] : f.timing_conditions) timing_outcomes[key].insert(seen.first);
+      timing_variants(f, timings_here);
+      std::vector<Violation> found = check_flight(setup, f);
+      if (report.paths == 1 || static_cast<int>(found.size()) > report.worst.violations)
+        report.worst = flown_path(setup, forced, f, report.paths, static_cast<int>(found.size()));
+      for (Violation& v : found) {
         auto [it, added] = index.emplace(identity(v), report.violations.size());
         if (!added) {
           ++report.violations[it->second].paths_seen;
@@ -111,6 +149,11 @@ VerifyReport verify(const graph::Compilation& c, const std::vector<dex::Mission>
   }
   report.complete = !stopped && work.empty();
   report.free_conditions = static_cast<int>(free.size());
+  for (const auto& [key, outcomes] : timing_outcomes) {
+    if (free.count(key)) continue;
+    ++report.timing_conditions;
+    if (outcomes.size() == 2) ++report.timing_both_ways;
+  }
   std::stable_sort(report.violations.begin(), report.violations.end(), [](const Violation& a, const Violation& b) {
     if (a.at.line != b.at.line) return a.at.line < b.at.line;
     if (a.at.col != b.at.col) return a.at.col < b.at.col;

@@ -49,6 +49,9 @@ struct Flight {
   std::map<std::pair<int, int>, ConditionSeen> conditions;  ///< (drone, meg) → last seen
   std::vector<Decision> decisions;                     ///< free conditions, first evaluation each
   std::vector<std::pair<int, int>> decision_keys;      ///< (drone, meg) of each decision
+  /// Conditions whose first outcome may hinge on other drones' timing (an If, Repeat or Do
+  /// that read a drone while it was moving): (drone, meg) → {outcome, the moving drones read}.
+  std::map<std::pair<int, int>, std::pair<bool, std::vector<int>>> timing_conditions;
   std::vector<double> factors;                         ///< per drone: durations × factor
   double abandoned_at = -1.0;                          ///< first failsafe; -1 none
 };

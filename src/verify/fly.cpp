@@ -83,6 +83,7 @@ class Observer : public dex::RunObserver, public dex::TraceSink {
       seen.reads.emplace_back(setup_.missions[drone].fleet[r->drone] + "." + r->property, read(r->drone, r->property));
     bool value = decide(drone, node, computed, read);
     seen.value = value;
+    note_timing(t, drone, node, value, reads);
     return value;
   }
 
@@ -148,6 +149,27 @@ class Observer : public dex::RunObserver, public dex::TraceSink {
         if (can.first && can.second) return can;
       }
     return can;
+  }
+
+  /// An If, Repeat or Do whose first evaluation read a drone while it was moving: its
+  /// outcome may differ when that drone is slower or faster (explore.cpp flies both).
+  void note_timing(double t, int drone, const dex::Node& node, bool value, const std::vector<const dex::Expr*>& reads) {
+    using lang::ControlKind;
+    ControlKind k = node.control;
+    if (k == ControlKind::WaitUntil || k == ControlKind::WaitWhile || k == ControlKind::PauseUntil ||
+        k == ControlKind::PauseWhile || k == ControlKind::none)
+      return;  // a wait ends either way; timing moves only when
+    std::pair<int, int> key{drone, node.meg};
+    if (f_.timing_conditions.count(key) || (free_.count(key) && free_.at(key))) return;
+    std::vector<int> moving;
+    for (const dex::Expr* r : reads) {
+      if (r->drone < 0 || r->drone >= static_cast<int>(setup_.missions.size())) continue;
+      if (r->property.rfind("Sensor", 0) == 0 || r->property == "Battery") continue;
+      if (std::find(moving.begin(), moving.end(), r->drone) != moving.end()) continue;
+      const ActionRun* a = running_at(f_, r->drone, t);
+      if (a && a->motion) moving.push_back(r->drone);
+    }
+    if (!moving.empty()) f_.timing_conditions[key] = {value, moving};
   }
 
   bool decide(int drone, const dex::Node& node, bool computed, const dex::PropertyReader& read) {

@@ -42,7 +42,11 @@ std::string format_report(const graph::Compilation& c, const VerifyReport& r) {
   }
   out += std::to_string(r.violations.size()) + " violation(s) on " + std::to_string(r.paths) + " path(s) flown";
   out += r.complete ? "; exploration complete" : "; exploration incomplete (raise --paths to fly more)";
-  out += " (" + std::to_string(r.free_conditions) + " condition(s) explored both ways)\n";
+  out += " (" + std::to_string(r.free_conditions) + " condition(s) explored both ways";
+  if (r.timing_conditions > 0)
+    out += "; " + std::to_string(r.timing_conditions) + " on other drones' timing, " +
+           std::to_string(r.timing_both_ways) + " of them seen both ways";
+  out += ")\n";
   return out;
 }
 
@@ -52,6 +56,8 @@ std::string json_report(const graph::Compilation& c, const VerifyReport& r) {
   j["paths"] = r.paths;
   j["complete"] = r.complete;
   j["free_conditions"] = r.free_conditions;
+  j["timing_conditions"] = r.timing_conditions;
+  j["timing_both_ways"] = r.timing_both_ways;
   if (!r.error.empty()) j["error"] = r.error;
   j["violations"] = nlohmann::ordered_json::array();
   for (const Violation& v : r.violations) {

@@ -47,10 +47,23 @@ struct Violation {
   int paths_seen = 1;          ///< explored paths on which it happened
 };
 
+/// One flown path, as needed to fly it again: the outcomes it forced and its timing.
+struct FlownPath {
+  std::vector<std::pair<std::pair<int, int>, bool>> forced;  ///< (drone, condition MEG id) → outcome
+  std::vector<double> factors;     ///< per drone: durations × factor
+  std::vector<Decision> decisions; ///< the free conditions it met, as they went
+  std::string timing;              ///< "" nominal
+  int number = 0;                  ///< 1 for the first path flown
+  int violations = 0;              ///< broken rules on it (each counted once)
+};
+
 struct VerifyReport {
   std::vector<Violation> violations;  ///< in source order
+  FlownPath worst;                    ///< the path with the most violations (first flown on ties)
   int paths = 0;                      ///< runs flown
   int free_conditions = 0;            ///< conditions explored both ways
+  int timing_conditions = 0;          ///< Ifs/Repeats/Dos that read a drone while it moved
+  int timing_both_ways = 0;           ///< of those, seen both ways across the timings flown
   bool complete = false;              ///< every combination of outcomes was flown
   std::string error;                  ///< setup problem (nothing was flown)
 };
@@ -70,10 +83,11 @@ std::string json_report(const graph::Compilation& c, const VerifyReport& r);
 
 namespace eamos::verify {
 
-/// The picture of the first path (every condition as the simulated sensors read it, nominal
-/// timing) as `eamos run --plot` draws it, with each violation on that path as a red mark
-/// where and when it happened.
-std::string plot_first_path(const graph::Compilation& c, const std::vector<dex::Mission>& missions,
-                            const VerifyOptions& options);
+/// The picture of the worst path of `report` (the one with the most violations; the first
+/// path when none has any) as `eamos run --plot` draws it, with each violation on that path as
+/// a red mark where and when it happened, and a caption naming the path's combination of
+/// condition outcomes and its timing.
+std::string plot_worst_path(const graph::Compilation& c, const std::vector<dex::Mission>& missions,
+                            const VerifyOptions& options, const VerifyReport& report);
 
 }  // namespace eamos::verify

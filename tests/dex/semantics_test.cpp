@@ -262,7 +262,7 @@ int count_of(const Flight& f, const std::string& event, const std::string& text,
 
 TEST(Semantics, LoopThatTakesNoTimeFailsTheMissionAndRunsTheFailsafeInsteadOfSpinning) {
   Flight f = test::fly_missions(test::missions_of(
-      kOne + "func INIT() { A.Arm(); A.Takeoff(3); RepeatWhile(true, SEQ_r, SEQ_n) }\n"
+      kOne + "func INIT() { A.Arm(); A.Takeoff(3); RepeatWhile(A.Battery() > 1, SEQ_r, SEQ_n) }\n"
              "func SEQ_r() { A.TakePicture() }\nfunc SEQ_n() { A.Land() }\n",
       {}, test::without_action("A.TakePicture()")));
   EXPECT_FALSE(f.result.completed);

@@ -107,9 +107,9 @@ TEST(Meg, RepeatForCarriesItsIterationLimit) {
 TEST(Meg, PauseUntilAndPauseWhileContinueOnGoWithoutTerminal) {
   for (const char* kind : {"PauseUntil", "PauseWhile"}) {
     auto c = compile_text(mission(std::string("func INIT() { A.Arm(); ") + kind +
-                                  "(B.Armed()); A.Takeoff(3) }\n"));
+                                  "(B.Battery() > 50); A.Takeoff(3) }\n"));
     ASSERT_TRUE(c);
-    int cond = node(*c, std::string(kind) + " B.Armed()");
+    int cond = node(*c, std::string(kind) + " B.Battery() > 50");
     ASSERT_GE(cond, 0) << kind;
     EXPECT_EQ(c->meg.nodes[cond].drone, 1) << kind;  // B's property: B evaluates
     EXPECT_TRUE(has_arc(*c, node(*c, "A.Arm()"), cond)) << kind;

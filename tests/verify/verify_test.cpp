@@ -94,7 +94,7 @@ TEST(VerifyJson, ReportsEachViolationWithItsKindLineAndPath) {
   EXPECT_EQ(v["path"][0]["forced"], true);
 }
 
-TEST(VerifyPlot, MarksEachViolationOfTheFirstPathInRed) {
+TEST(VerifyPlot, MarksEachViolationOfTheDrawnPathInRed) {
   fs::path svg = fs::temp_directory_path() / ("verify_plot_" + std::to_string(::getpid()) + ".svg");
   eamos_test::Output run = eamos_test::run_eamos(
       "verify occupied_home.eamos --fleet occupied_home.fleet.yaml --plot " + svg.string(), {}, kMissions.string());
@@ -106,6 +106,22 @@ TEST(VerifyPlot, MarksEachViolationOfTheFirstPathInRed) {
     ++rings;
   EXPECT_EQ(rings, 3u) << "one ring per violation on the map";
   EXPECT_NE(picture.find("<line data-violation=\"occupied_home\""), std::string::npos);
+}
+
+// branch.eamos breaks a rule only when its If is forced the other way (the second path): the
+// picture shows that path, not the clean first one, and says which combination it is.
+TEST(VerifyPlot, DrawsThePathWithTheMostViolationsAndNamesItsCombination) {
+  fs::path svg = fs::temp_directory_path() / ("verify_worst_" + std::to_string(::getpid()) + ".svg");
+  eamos_test::Output run = eamos_test::run_eamos("verify branch.eamos --fleet branch.fleet.yaml --plot " + svg.string(),
+                                                 {}, kMissions.string());
+  EXPECT_EQ(run.status, 1) << run.out;
+  std::string picture = read_file(svg);
+  fs::remove(svg);
+  EXPECT_NE(picture.find("<circle data-violation=\"separation\""), std::string::npos);
+  EXPECT_NE(picture.find("Path 2 of 2 flown, 1 violation(s) (the path with the most): Drone1.Sensor1() &gt;= 100 "
+                         "(Drone1) false, forced"),
+            std::string::npos)
+      << picture.substr(0, 600);
 }
 
 TEST(VerifyPaths, StopsAtTheBoundAndSaysTheExplorationIsIncomplete) {
