@@ -305,7 +305,7 @@ TEST_F(Distributed, GroundEndsWhenADexStartedElsewhereIsLost) {
   bool killed = false;
   // A ground that waited for Drone2's final status would run into ctest's timeout (120 s).
   Output r = eamos("launch " + deploy.string() + " --drones Drone1,Drone3 --speed 5 --liveliness-timeout 1 " +
-                       "--domain 32 --summary " + (dir_ / "summary.json").string(),
+                       "--final-state-timeout 1 --domain 32 --summary " + (dir_ / "summary.json").string(),
                    [&](const std::string& line) {
                      if (!killed && line.find("Drone3.Takeoff(3)  succeeded") != std::string::npos) {
                        kill(remote, SIGKILL);
@@ -317,8 +317,9 @@ TEST_F(Distributed, GroundEndsWhenADexStartedElsewhereIsLost) {
   EXPECT_NE(r.out.find("Drone2 lost"), std::string::npos) << r.out;
   nlohmann::json summary = read_json(dir_ / "summary.json");
   EXPECT_EQ(summary["status"], "failed");
-  // Reported where it was last seen (airborne), not as a drone that landed at home.
-  EXPECT_FALSE(summary["drones"]["Drone2"]["landed"]) << summary.dump(2);
+  // Its final state is unknown; it was last seen airborne, not as a drone that landed at home.
+  EXPECT_EQ(summary["drones"]["Drone2"]["state"], "unknown") << summary.dump(2);
+  EXPECT_FALSE(summary["drones"]["Drone2"]["last_seen"]["landed"]) << summary.dump(2);
 }
 
 TEST_F(Distributed, FailedActionOnOneDroneFailsTheMissionOnEveryDrone) {
