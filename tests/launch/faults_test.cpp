@@ -9,10 +9,13 @@
 #include <sys/types.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <condition_variable>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <mutex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -21,6 +24,7 @@
 
 #include "support/eamos_process.h"
 #include "support/run_eamos.h"
+#include "transport/dds_node.h"
 
 namespace {
 
@@ -239,6 +243,71 @@ TEST_F(Faults, SecondLaunchOfARunningDeploymentIsRefusedAndTheFirstCompletes) {
   EXPECT_EQ(second.out.find("starting run"), std::string::npos) << second.out;
   EXPECT_EQ(first.status, 0) << first.out;
   EXPECT_EQ(read_json(dir_ / "summary.json")["status"], "completed");
+}
+
+// The DEX on a drone (started on its own: any launch may start it) that already flies a
+// run answers another START naming it with REFUSED, which that launch prints and fails on.
+// The second ground here is a participant of the test's own (--insecure, posing as the
+// ground), so that it sends START however fast the real grounds' barrier check would be.
+TEST_F(Faults, RunningDexRefusesTheStartOfAnotherLaunch) {
+  using namespace eamos::transport;
+  Output c = eamos_test::run_eamos("compile -q --insecure " + test_mission("long_hover.eamos") + " -o " +
+                                   (dir_ / "deploy").string());
+  ASSERT_EQ(c.status, 0) << c.out;
+  fs::path deploy = dir_ / "deploy";
+  std::string hash = read_json(deploy / "manifest.json")["mission_hash"];
+  std::mutex mutex;
+  std::condition_variable cv;
+  std::uint64_t wing_nonce = 0;
+  std::optional<LifecycleSample> refused;
+  DdsOptions o;
+  o.domain = 164;
+  o.mission_hash = hash;
+  DdsHandlers h;
+  h.limits.drones = 2;
+  h.dropped = [](const std::string&) {};
+  h.lifecycle = [&](LifecycleSample s) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (s.kind == LifecycleKind::ready && s.drone == 1) wing_nonce = s.nonce;
+    if (s.kind == LifecycleKind::refused && s.run_id == 12345) refused = s;
+    cv.notify_all();
+  };
+  std::string error;
+  std::unique_ptr<DdsNode> second_ground = DdsNode::open(o, std::move(h), error);
+  ASSERT_NE(second_ground, nullptr) << error;
+
+  eamos_test::EamosProcess wing = eamos_test::start_eamos(
+      {"dex", (deploy / "Wing").string(), "--insecure", "--speed", "5", "--domain", "164", "--start-timeout", "60"});
+  ASSERT_GT(wing.pid, 0);
+  int airborne = 0;
+  bool answered = false;
+  std::string seen;
+  Output r = eamos_test::run_eamos(
+      "launch " + deploy.string() + " --insecure --drones Lead --speed 5 --domain 164",
+      [&](const std::string& line) {
+        seen += line;
+        if (line.find(".Takeoff(5)  succeeded") == std::string::npos || ++airborne != 2) return;
+        std::unique_lock<std::mutex> lock(mutex);
+        ASSERT_NE(wing_nonce, 0u) << seen;
+        LifecycleSample start{hash, kGround, LifecycleKind::start, 12345};
+        start.launch_id = 777;
+        start.speed = 5;
+        start.start_at_ns = 0;
+        start.nonces = {1, wing_nonce};
+        second_ground->write(start);
+        // The refusal is what this waits for; the bound only keeps a broken DEX from hanging the test.
+        answered = cv.wait_for(lock, std::chrono::seconds(20), [&] { return refused.has_value(); });
+        kill(parent_of(dex_pid(seen, "Lead")), SIGTERM);  // the first run ends, in its failsafe
+      });
+  eamos_test::wait_exit(wing);
+  ASSERT_TRUE(answered) << r.out << wing.seen;
+  EXPECT_EQ(refused->drone, 1);
+  EXPECT_EQ(refused->launch_id, 777u);
+  EXPECT_NE(refused->reason.find("Wing's DEX is already running run"), std::string::npos) << refused->reason;
+  EXPECT_NE(wing.seen.find("Wing: refused run 12345 of another launch"), std::string::npos) << wing.seen;
+  // The first run did not take the second START: it ended on the SIGTERM, landed.
+  EXPECT_NE(r.out.find("interrupted (SIGTERM)"), std::string::npos) << r.out;
+  second_ground.reset();
 }
 
 }  // namespace
