@@ -11,6 +11,7 @@ packages=(
   cyclonedds-dev cyclonedds-tools libddsc0debian libssl-dev openssl
   clang libclang-rt-14-dev
   nodejs
+  iproute2  # ip netns and veth pairs for tests/launch/netns_test.cpp
 )
 
 missing=()
