@@ -264,7 +264,7 @@ bool DexProcess::begin() {
       return false;
     }
   }
-  transport_ = std::make_unique<transport::DdsTransport>(*node_, start_.run_id, *loop_);
+  transport_ = std::make_unique<transport::DdsTransport>(*node_, start_.run_id);
   dds_trace_ = std::make_unique<DdsTraceSink>(*node_, *loop_, mission_.hash, start_.run_id, mission_.self);
   tee_.add(dds_trace_.get());
   if (o_.log) {

@@ -6,26 +6,18 @@
 // goes to every drone, also those whose mission does not hold the flipped condition, so a
 // receiver cannot tell a real one it has no use for from a forged one, and a cancel only
 // ever stops work, never starts any, so the lead need not wait for one in flight.
-#include <chrono>
 #include <cstdint>
 
 #include "dex/bridge.h"
-#include "mid/event_loop.h"
 #include "transport/dds_node.h"
 
 namespace eamos::transport {
 
 class DdsTransport : public dex::Transport {
  public:
-  DdsTransport(DdsNode& node, std::uint64_t run_id, const mid::EventLoop& loop)
-      : node_(node), run_id_(run_id), loop_(loop) {}
+  DdsTransport(DdsNode& node, std::uint64_t run_id) : node_(node), run_id_(run_id) {}
   void send(int to, const dex::Message& m) override {
     TriggerSample s{run_id_, to, ++seq_, m};
-    // When it left, in mission and wall time: the receiver traces the message's latency.
-    s.sent_t = loop_.now();
-    s.sent_unix_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                         std::chrono::system_clock::now().time_since_epoch())
-                         .count();
     if (m.kind == dex::Message::Kind::ended) ++sent_;
     if (!node_.write(s)) ++write_errors_;
   }
@@ -38,7 +30,6 @@ class DdsTransport : public dex::Transport {
  private:
   DdsNode& node_;
   std::uint64_t run_id_;
-  const mid::EventLoop& loop_;
   std::uint64_t seq_ = 0;
   std::uint64_t sent_ = 0;
   std::uint64_t write_errors_ = 0;

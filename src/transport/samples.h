@@ -20,8 +20,6 @@ struct TriggerSample {
   int to = 0;
   std::uint64_t seq = 0;  ///< per sender, from 1
   dex::Message message;   ///< carries the mission hash and the sender
-  double sent_t = 0.0;             ///< the sender's mission time at the write
-  std::int64_t sent_unix_ns = 0;   ///< the sender's wall clock at the write
 };
 
 struct TelemetrySample {

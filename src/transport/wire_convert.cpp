@@ -159,8 +159,6 @@ eamos_wire_Trigger to_wire(const TriggerSample& s) {
   w.scope = m.scope;
   w.epoch = m.epoch;
   w.body_epoch = m.body_epoch;
-  w.sent_t = s.sent_t;
-  w.sent_unix_ns = s.sent_unix_ns;
   return w;
 }
 
@@ -188,9 +186,6 @@ bool from_wire(const eamos_wire_Trigger& w, const WireLimits& limits, TriggerSam
   m.epoch = w.epoch;
   check.at_least("body_epoch", w.body_epoch, 0);
   m.body_epoch = w.body_epoch;
-  check.finite("sent_t", w.sent_t);
-  s.sent_t = w.sent_t;
-  s.sent_unix_ns = w.sent_unix_ns;
   return check.ok();
 }
 
