@@ -13,6 +13,7 @@ packages=(
   clang libclang-rt-14-dev
   nodejs
   chromium
+  iproute2  # ip netns and veth pairs for tests/launch/netns_test.cpp
 )
 
 missing=()

@@ -113,6 +113,9 @@ int main(int argc, char** argv) {
   run->add_option("--deploy-dir", launch_opts.dir, "With --distributed: where to write the deployment (default: a temporary folder)");
   run->add_option("--barrier-timeout", launch_opts.barrier_timeout_s, "With --distributed: seconds to wait for every DEX to be ready")
       ->check(CLI::PositiveNumber);
+  run->add_option("--final-state-timeout", launch_opts.final_state_timeout_s,
+                  "With --distributed: seconds to wait for a lost drone to report its final state (then: unknown)")
+      ->check(CLI::NonNegativeNumber);
   add_dds(run, launch_opts.dds);
   add_security(run, security);
 
@@ -129,6 +132,12 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   launch->add_option("--drones", launch_opts.local, "Start only these drones here; the others run their DEX elsewhere")
       ->delimiter(',');
+  launch->add_flag("--remote-only", launch_opts.remote_only,
+                   "Start no DEX here: every drone's DEX runs elsewhere (`eamos dex` on the drone)")
+      ->excludes("--drones");
+  launch->add_option("--final-state-timeout", launch_opts.final_state_timeout_s,
+                     "Seconds to wait for a lost drone to come back and report its final state (then: unknown)")
+      ->check(CLI::NonNegativeNumber);
   add_dds(launch, launch_opts.dds);
   launch->add_flag("--insecure", launch_opts.insecure,
                    "Fly without DDS Security, even when the deployment has credentials (experiments only)");
@@ -144,6 +153,8 @@ int main(int argc, char** argv) {
   dexcmd->add_option("--start-timeout", dex_opts.start_timeout_s, "Give up when no start came within this many seconds (default: wait)")
       ->check(CLI::NonNegativeNumber);
   dexcmd->add_option("--trace", dex_opts.trace_file, "Also write this drone's trace as JSON Lines to this file");
+  dexcmd->add_option("--launch-id", dex_opts.launch_id,
+                     "Take a start only from the `eamos launch` with this id (set by the launch that starts the DEX)");
   add_dds(dexcmd, dex_opts.dds);
   dexcmd->add_flag("--insecure", dex_opts.insecure,
                    "Fly without DDS Security, even when the folder has credentials (experiments only)");

@@ -29,10 +29,16 @@ nlohmann::ordered_json summary_json(const dex::RunResult& r) {
   if (r.failure) j["failure"] = {{"drone", r.failure->drone}, {"action", r.failure->action},
                                  {"line", r.failure->line}, {"reason", r.failure->reason}};
   nlohmann::ordered_json drones = nlohmann::ordered_json::object();
-  for (const auto& d : r.drones)
-    drones[d.name] = {{"x", d.state.x}, {"y", d.state.y}, {"z", d.state.z}, {"armed", d.state.armed},
-                      {"landed", d.state.landed}, {"battery", d.state.battery},
-                      {"pictures", d.state.pictures}};
+  for (const auto& d : r.drones) {
+    nlohmann::ordered_json state = {{"x", d.state.x}, {"y", d.state.y}, {"z", d.state.z}, {"armed", d.state.armed},
+                                    {"landed", d.state.landed}, {"battery", d.state.battery},
+                                    {"pictures", d.state.pictures}};
+    // Not known is not "armed at 10 m": the last state seen is kept apart from the answer.
+    if (d.final)
+      drones[d.name] = state;
+    else
+      drones[d.name] = {{"state", "unknown"}, {"last_seen", state}};
+  }
   j["drones"] = drones;
   return j;
 }

@@ -70,8 +70,11 @@ void record_sample(std::vector<Sample>& track, const mid::DroneState& s);
 
 struct DroneSummary {
   std::string name;
-  mid::DroneState state;       ///< at the end of the run
+  mid::DroneState state;       ///< at the end of the run (or as last seen, when not final)
   std::vector<Sample> track;   ///< from the state before start, one sample per change
+  /// False when the drone's final state is not known (a distributed run lost contact with
+  /// it, or its DEX died): `state` is then only what was last seen.
+  bool final = true;
 };
 
 struct RunResult {

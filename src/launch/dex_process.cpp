@@ -76,7 +76,10 @@ int DexProcess::run(const mid::AdapterRegistry& adapters) {
     on_lifecycle_waiting(s);
     inbox_.deliver([this, s = std::move(s)] { on_lifecycle(s); });
   };
-  h.status = [this](StatusSample s) { inbox_.deliver([this, s = std::move(s)] { on_status(s); }); };
+  h.status = [this](StatusSample s) {
+    on_status_waiting(s);
+    inbox_.deliver([this, s = std::move(s)] { on_status(s); });
+  };
   h.lost = [this](const std::string& hash, int drone, std::uint64_t nonce) {
     inbox_.deliver([this, hash, drone, nonce] { on_lost(hash, drone, nonce); });
   };
@@ -116,8 +119,35 @@ void DexProcess::on_lifecycle_waiting(const LifecycleSample& s) {
   if (s.mission_hash != mission_.hash) return;
   std::lock_guard<std::mutex> lock(wait_mutex_);
   if (s.kind == LifecycleKind::start) starts_.push_back(s);
-  if (s.kind == LifecycleKind::abort) aborts_.emplace(s.run_id, s.reason);
+  // The barrier ABORT of another launch (one that refused to run beside this one) is not
+  // this DEX's: it waits for its own launch.
+  bool other_launch = s.run_id == 0 && o_.launch_id != 0 && s.launch_id != o_.launch_id;
+  if (s.kind == LifecycleKind::abort && !other_launch) aborts_.emplace(s.run_id, s.reason);
   wait_cv_.notify_all();
+}
+
+void DexProcess::on_status_waiting(const StatusSample& s) {
+  if (s.mission_hash != mission_.hash || s.drone != mission_.self || s.nonce == nonce_ || s.run_id == 0) return;
+  if (s.phase != Phase::running && s.phase != Phase::failsafe) return;
+  std::lock_guard<std::mutex> lock(wait_mutex_);
+  if (flown_elsewhere_.empty())
+    flown_elsewhere_ = "another DEX of " + name() + " is " + (s.phase == Phase::running ? "flying" : "landing") +
+                       " run " + std::to_string(s.run_id) + " of this mission; a second launch of a running " +
+                       "deployment is refused (stop the first one, or wait for it to end)";
+  wait_cv_.notify_all();
+}
+
+std::string DexProcess::flown_elsewhere() {
+  std::lock_guard<std::mutex> lock(wait_mutex_);
+  return flown_elsewhere_;
+}
+
+void DexProcess::refuse(const LifecycleSample& start, const std::string& why) {
+  LifecycleSample refused{mission_.hash, mission_.self, LifecycleKind::refused, start.run_id};
+  refused.launch_id = start.launch_id;
+  refused.nonce = nonce_;
+  refused.reason = why;
+  node_->write(refused);
 }
 
 bool DexProcess::wait_for_start() {
@@ -147,9 +177,15 @@ bool DexProcess::wait_for_start() {
       return false;
     }
     if (!ready_sent) {
+      // Every other drone, not only those whose telemetry this mission reads: a sample
+      // from each shows the channel to it is up (with DDS Security, its handshake done). A
+      // handshake that failed (it times out under heavy loss and Cyclone does not retry
+      // it) would otherwise leave a trigger to that drone undelivered and the mission
+      // waiting for ever, with no liveliness ever lost: such a DEX stays unready and the
+      // ground's barrier refuses to start.
       std::map<int, TelemetrySample> seen = inbox_.latest();
       bool all = true;
-      for (int d : mission_.reads)
+      for (int d = 0; d < static_cast<int>(mission_.fleet.size()); ++d)
         if (d != mission_.self && !seen.count(d)) all = false;
       if (all) {
         LifecycleSample ready;
@@ -157,6 +193,7 @@ bool DexProcess::wait_for_start() {
         ready.drone = mission_.self;
         ready.kind = LifecycleKind::ready;
         ready.nonce = nonce_;
+        ready.launch_id = o_.launch_id;
         node_->write(ready);
         ready_sent = true;
         out_ << name() << ": ready\n" << std::flush;
@@ -164,7 +201,14 @@ bool DexProcess::wait_for_start() {
     }
     for (const LifecycleSample& s : starts) {
       bool mine = s.drone == transport::kGround && static_cast<int>(s.nonces.size()) > mission_.self &&
-                  s.nonces[mission_.self] == nonce_;
+                  s.nonces[mission_.self] == nonce_ && (o_.launch_id == 0 || s.launch_id == o_.launch_id);
+      std::string elsewhere = mine ? flown_elsewhere() : "";
+      if (!elsewhere.empty()) {
+        err_ << "eamos dex: error: " << name() << ": refusing run " << s.run_id << ": " << elsewhere << "\n";
+        refuse(s, elsewhere);
+        node_->flush(1.0);
+        return false;
+      }
       if (mine) {
         if (s.speed != o_.speed) {
           err_ << "eamos dex: error: " << name() << ": the ground started run " << s.run_id << " at speed "
@@ -198,6 +242,14 @@ bool DexProcess::begin() {
   double lease = o_.dds.lease_s;
   while (unix_ns() < start_.start_at_ns) {
     node_->assert_alive();
+    // Another DEX of this drone that was discovered only after the START came.
+    std::string elsewhere = flown_elsewhere();
+    if (!elsewhere.empty()) {
+      error_ = "refusing run " + std::to_string(start_.run_id) + ": " + elsewhere;
+      err_ << "eamos dex: error: " << name() << ": " << error_ << "\n";
+      refuse(start_, elsewhere);
+      return false;
+    }
     double left = (start_.start_at_ns - unix_ns()) / 1e9;
     std::this_thread::sleep_for(std::chrono::duration<double>(std::min(left, lease / 4)));
   }
@@ -248,6 +300,10 @@ bool DexProcess::begin() {
     engine_->properties_changed(mission_.self);
     transport_->publish(std::make_shared<const dex::Telemetry>(dex::Telemetry{mission_.hash, mission_.self, s}));
   });
+  // A loop that could not run for longer than the lease (the process was stopped, the
+  // machine starved it) has been given up by the others and must not replay what fell due
+  // meanwhile, every overdue action at once with back-dated times: it abandons first.
+  loop_->on_stall(o_.dds.lease_s, [this](double stalled_s) { on_stall(stalled_s); });
   loop_->at(o_.time_limit_s, [this] {
     if (phase_ != Phase::running) return;
     abandon("mission did not complete within " + std::to_string(o_.time_limit_s) +

@@ -6,6 +6,7 @@
 // other DEXes directly. No node is central during the mission: a failure anywhere is
 // broadcast as ABORT and every drone runs its failsafe; the lead drone (holder of the end
 // node) declares the mission finished once every drone is idle and nothing is in flight.
+#include <cstdint>
 #include <iosfwd>
 #include <string>
 
@@ -24,6 +25,9 @@ struct DexProcessOptions {
   /// the mission finished: covers status samples still on their way.
   double settle_s = 0.15;
   std::string trace_file;         ///< the drone's own JSONL trace; "" = none
+  /// The `eamos launch` that started this DEX: its READY says so and it takes a START only
+  /// from that launch. 0: started on its own; any launch may start it (once).
+  std::uint64_t launch_id = 0;
   bool log = true;                ///< live log on `out`
   /// Without DDS Security even when the folder holds credentials (docs/security.md).
   bool insecure = false;

@@ -79,7 +79,8 @@ void DexProcess::on_telemetry(const TelemetrySample& s) {
 }
 
 void DexProcess::on_lifecycle(const LifecycleSample& s) {
-  if (s.kind == LifecycleKind::ready || s.kind == LifecycleKind::start) return;
+  if (s.kind == LifecycleKind::start) return on_other_start(s);
+  if (s.kind == LifecycleKind::ready || s.kind == LifecycleKind::refused) return;
   if (!ours(s.mission_hash, s.run_id)) return;
   if (s.kind == LifecycleKind::abort) {
     std::string why;
@@ -88,6 +89,19 @@ void DexProcess::on_lifecycle(const LifecycleSample& s) {
   } else if (s.kind == LifecycleKind::finished && phase_ == Phase::running) {
     on_finished(s);
   }
+}
+
+void DexProcess::on_other_start(const LifecycleSample& s) {
+  // A second ground that took this process's READY (a DEX started on its own, which any
+  // launch may start) must hear that it runs a run already, and fail its own.
+  bool names_us = s.mission_hash == mission_.hash && s.drone == transport::kGround && s.run_id != start_.run_id &&
+                  static_cast<int>(s.nonces.size()) > mission_.self && s.nonces[mission_.self] == nonce_;
+  if (!names_us) return;
+  std::string why = name() + "'s DEX is already running run " + std::to_string(start_.run_id) +
+                    " of this mission; a second launch of a running deployment is refused";
+  err_ << name() << ": refused run " << s.run_id << " of another launch: it already runs run " << start_.run_id
+       << "\n";
+  refuse(s, why);
 }
 
 void DexProcess::on_status(const StatusSample& s) {
@@ -194,7 +208,7 @@ void DexProcess::complete() {
 
 void DexProcess::abandon(const std::string& reason, const std::optional<dex::Failure>& failure, bool broadcast) {
   if (phase_ != Phase::running) return;
-  phase_ = Phase::failed;
+  phase_ = Phase::failsafe;  // failed once the failsafe has ended (wait_for_failsafe)
   error_ = reason;
   // Safety first, words second: this drone's failsafe, then the ABORT that starts everyone
   // else's (a DDS write may block), and only then the log and the trace.
@@ -213,6 +227,15 @@ void DexProcess::abandon(const std::string& reason, const std::optional<dex::Fai
   wait_for_failsafe();
 }
 
+void DexProcess::on_stall(double stalled_s) {
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "'s DEX stalled for %.2f s, longer than the liveliness lease (%g s); abandoning instead of "
+                "running what fell due meanwhile",
+                stalled_s, o_.dds.lease_s);
+  abandon(name() + text, std::nullopt, true);
+}
+
 void DexProcess::on_internal_error(const std::string& what) {
   err_ << name() << ": internal error: " << what << "\n";
   abandon("internal error in the DEX of " + name() + ": " + what, std::nullopt, true);
@@ -225,6 +248,8 @@ void DexProcess::wait_for_failsafe() {
   bool done = s.landed || mission_.settings.failsafe == fleet::Failsafe::hover ||
               loop_->now() - failsafe_since_ > 600.0;
   if (done) {
+    // Its final state: the ground reports this one, not the one at the abort.
+    phase_ = Phase::failed;
     publish_status(true);
     loop_->stop();
     return;

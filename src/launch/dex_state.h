@@ -77,12 +77,21 @@ class DexProcess {
   // --- before the start (main thread) ---
   bool wait_for_start();
   void on_lifecycle_waiting(const LifecycleSample& s);
+  /// Notes (DDS thread) a status of this drone from another process in a run: another DEX
+  /// flies this drone, and a START naming this process must be refused.
+  void on_status_waiting(const StatusSample& s);
+  /// "" or why this process must not start (another DEX flies its drone); wait_mutex_.
+  std::string flown_elsewhere();
+  /// Answers `start` (which names this process) with REFUSED, saying `why`.
+  void refuse(const LifecycleSample& start, const std::string& why);
   // --- the mission (loop thread) ---
   bool begin();
   void on_trigger(const TriggerSample& s);
   void on_telemetry(const TelemetrySample& s);
   void seed_telemetry(const TelemetrySample& s);
   void on_lifecycle(const LifecycleSample& s);
+  /// A START of another run: refused when it names this process (it runs one already).
+  void on_other_start(const LifecycleSample& s);
   void on_status(const StatusSample& s);
   void on_lost(const std::string& hash, int drone, std::uint64_t nonce);
   // --- checks of what arrives, even from an authenticated peer (dex_checks.cpp) ---
@@ -111,6 +120,8 @@ class DexProcess {
   void abandon(const std::string& reason, const std::optional<dex::Failure>& failure, bool broadcast);
   void wait_for_failsafe();
   void on_internal_error(const std::string& what);
+  /// The loop found itself `stalled_s` wall seconds behind (EventLoop::on_stall).
+  void on_stall(double stalled_s);
   void finish_loop();
   bool ours(const std::string& hash, std::uint64_t run);
   void note_foreign(const std::string& hash);
@@ -133,6 +144,7 @@ class DexProcess {
   std::condition_variable wait_cv_;
   std::vector<LifecycleSample> starts_;
   std::map<std::uint64_t, std::string> aborts_;  ///< run id → reason, of ABORTs seen (0: the ground's barrier)
+  std::string flown_elsewhere_;                  ///< see on_status_waiting
 
   // The run (loop thread only).
   LifecycleSample start_;

@@ -37,7 +37,9 @@ struct DroneEntry {
   std::vector<dex::Sample> track;
   std::optional<mid::DroneState> last_state;  ///< newest telemetry of this run
   std::optional<StatusSample> status;         ///< newest status of this run, from the process START named
+  std::string refused;                        ///< why its DEX refused the start, if it did
   bool lost = false;                          ///< its DEX lost liveliness during the run
+  double lost_at = 0.0;                       ///< wall time it was lost
   std::string log;
   double started_at = 0.0;  ///< wall time its DEX process was started
 };
@@ -93,10 +95,16 @@ class Ground {
   bool finish_agreed(int lead, std::string& why) const;
   void check_pending_finished();
   void reject(int sender, const std::string& what, const std::string& why);
+  void on_refused(const LifecycleSample& s);
+  void refuse_second_launch(const StatusSample& s);
   void on_status(const StatusSample& s);
   void on_trace(TraceSample s);
   void on_telemetry(const TelemetrySample& s);
   bool ours(const std::string& hash);
+  /// The run's mission time now, from the start instant the ground chose (0 before it).
+  double mission_time() const {
+    return start_at_ns_ > 0 ? std::max(0.0, (unix_ns() - start_at_ns_) / 1e9 * o_.speed) : 0.0;
+  }
   bool all_done();
   void on_lost(const std::string& hash, int drone, std::uint64_t nonce);
   void interrupt();
@@ -122,6 +130,10 @@ class Ground {
   std::string error_;
   std::set<std::string> foreign_;
   std::vector<std::uint64_t> start_nonces_;
+  std::int64_t start_at_ns_ = 0;  ///< Unix time of mission time 0 of the run
+  /// This launch: its DEXes' READYs and its START carry it, so that a second launch of the
+  /// same deployment does not take the first one's READYs (or the reverse).
+  std::uint64_t launch_id_ = 0;
   bool interrupted_ = false;
 
   // Last, so it goes first: its listener threads post through inbox_ to loop_.
@@ -131,7 +143,13 @@ class Ground {
 volatile std::sig_atomic_t g_signal = 0;
 void on_signal(int signal) { g_signal = signal; }
 
+std::uint64_t random_id() {
+  std::random_device rd;
+  return ((static_cast<std::uint64_t>(rd()) << 32) | rd()) | 1;
+}
+
 int Ground::run() {
+  launch_id_ = random_id();
   std::string error;
   if (!read_manifest(o_.dir, hash_, drones_, error)) {
     err_ << "eamos launch: error: " << error << "\n";
@@ -145,7 +163,8 @@ int Ground::run() {
       return 1;
     }
   for (auto& d : drones_)
-    d.local = o_.local.empty() || std::find(o_.local.begin(), o_.local.end(), d.name) != o_.local.end();
+    d.local = !o_.remote_only &&
+              (o_.local.empty() || std::find(o_.local.begin(), o_.local.end(), d.name) != o_.local.end());
 
   transport::DdsHandlers h;
   h.lifecycle = [this](LifecycleSample s) { inbox_.deliver([this, s] { on_lifecycle(s); }); };
@@ -195,7 +214,7 @@ int Ground::run() {
   if (abort_) {
     run.failure = abort_->failure;
     run.error = abort_->reason;
-    run.duration = abort_->t;
+    run.duration = abort_->t;  // the mission time of the abort, not of the last landing
   } else if (finished_) {
     run.duration = finished_->t;
   }
@@ -205,10 +224,20 @@ int Ground::run() {
   if (live_) live_->record(end);
   r_.events.push_back(end);
   for (auto& d : drones_) {
-    // A drone without a final status (its DEX died) is reported as last seen.
-    mid::DroneState state = d.final_status ? d.final_status->state : d.last_state.value_or(mid::DroneState{});
-    run.drones.push_back({d.name, state, d.track});
+    // A drone without a final status (lost and not back, its DEX died) is reported as
+    // unknown, with what was last seen of it.
+    mid::DroneState seen = d.status ? d.status->state : mid::DroneState{};
+    mid::DroneState state = d.final_status ? d.final_status->state : d.last_state.value_or(seen);
+    // Before a start nothing moved: what the waiting DEXes published is where they are.
+    bool final = d.final_status.has_value() || r_.run_id == 0;
+    run.drones.push_back({d.name, state, d.track, final});
     if (d.final_status) run.activations += d.final_status->activations;
+    if (!final)
+      err_ << "ground: " << d.name << "'s final state is unknown: "
+           << (!d.refused.empty() ? "its DEX refused this run"
+               : d.lost            ? "no contact since it was lost"
+                                   : "its DEX ended without reporting it")
+           << "\n";
   }
   int status = run.completed ? 0 : 1;
   for (auto& d : drones_)
@@ -237,6 +266,7 @@ bool Ground::start_processes() {
     std::snprintf(number, sizeof number, "%.17g", o_.barrier_timeout_s + 5.0);
     argv.insert(argv.end(), {"--start-timeout", number});
     if (o_.insecure) argv.push_back("--insecure");
+    argv.insert(argv.end(), {"--launch-id", std::to_string(launch_id_)});
     d.log = d.folder + "/dex.log";
     std::remove(d.log.c_str());
     std::string error;
@@ -255,8 +285,12 @@ bool Ground::start_processes() {
 void Ground::tick() {
   // The next tick first: should anything below throw, the ground still ticks and ends.
   loop_.after(0.05, [this] { tick(); });
-  for (auto& d : drones_)
-    if (d.local) poll(d.child);
+  for (auto& d : drones_) {
+    if (!d.local || d.child.exit_status) continue;
+    poll(d.child);
+    if (d.child.exit_status)
+      out_ << "ground: the DEX of " << d.name << " exited with status " << *d.child.exit_status << "\n" << std::flush;
+  }
   if (g_signal != 0 && stage_ != Stage::done) {
     // A second time: stop the DEXes now (a DEX takes SIGTERM as "abandon the mission",
     // which it already does), leaving each drone in the failsafe it was commanded.
@@ -293,9 +327,12 @@ void Ground::tick() {
 }
 
 bool Ground::all_done() {
+  // Every drone's final state, after its failsafe: a drone that was lost may come back (a
+  // network cut that ended) and report it; one that does not within the bound is unknown.
   for (auto& d : drones_) {
     if (d.local && !d.child.exit_status) return false;
-    if (!d.local && !d.final_status && !d.lost) return false;
+    bool gave_up = (d.lost && wall_s() > d.lost_at + o_.final_state_timeout_s) || !d.refused.empty();
+    if (!d.local && !d.final_status && !gave_up) return false;
   }
   return true;
 }
@@ -304,7 +341,9 @@ void Ground::on_lost(const std::string& hash, int drone, std::uint64_t nonce) {
   if (hash != hash_ || drone < 0 || drone >= static_cast<int>(drones_.size()) || stage_ != Stage::running) return;
   DroneEntry& d = drones_[drone];
   if (d.final_status || static_cast<int>(start_nonces_.size()) <= drone || start_nonces_[drone] != nonce) return;
-  d.lost = true;  // it will send nothing more: do not wait for its final status
+  if (d.lost) return;
+  d.lost = true;  // wait for its final status only so long (all_done)
+  d.lost_at = wall_s();
   err_ << "ground: " << d.name << " lost its liveliness\n";
 }
 
@@ -315,22 +354,24 @@ void Ground::interrupt() {
   if (stage_ == Stage::barrier) return fail_barrier(why);
   LifecycleSample abort{hash_, transport::kGround, LifecycleKind::abort, r_.run_id};
   abort.reason = why;
+  abort.t = mission_time();
   node_->write(abort);  // first: the drones' failsafe must not wait for a terminal
   if (!abort_) abort_ = abort;
   err_ << "ground: " << why << "; aborting the run: every drone runs its failsafe\n";
 }
 
 void Ground::send_start() {
-  std::random_device rd;
   LifecycleSample start;
   start.mission_hash = hash_;
   start.drone = transport::kGround;
   start.kind = LifecycleKind::start;
-  start.run_id = ((static_cast<std::uint64_t>(rd()) << 32) | rd()) | 1;
+  start.run_id = random_id();
+  start.launch_id = launch_id_;
   start.start_at_ns = unix_ns() + static_cast<std::int64_t>(o_.start_delay_s * 1e9);
   start.speed = o_.speed;
   for (auto& d : drones_) start.nonces.push_back(*d.ready_nonce);
   start_nonces_ = start.nonces;
+  start_at_ns_ = start.start_at_ns;
   node_->write(start);
   r_.run_id = start.run_id;
   stage_ = Stage::running;
@@ -344,6 +385,7 @@ void Ground::fail_barrier(const std::string& why) {
   // DEXes started elsewhere wait for a start; tell them there will be none (run 0).
   LifecycleSample abort{hash_, transport::kGround, LifecycleKind::abort, 0};
   abort.reason = why;
+  abort.launch_id = launch_id_;  // the DEXes of another launch keep waiting for theirs
   node_->write(abort);
   node_->flush(1.0);
   stop_all(SIGTERM);
@@ -368,6 +410,7 @@ void Ground::on_lifecycle(const LifecycleSample& s) {
   if (!ours(s.mission_hash)) return;
   if (s.kind == LifecycleKind::ready) {
     if (stage_ != Stage::barrier || s.drone < 0 || s.drone >= static_cast<int>(drones_.size())) return;
+    if (s.launch_id != 0 && s.launch_id != launch_id_) return;  // another launch's DEX
     DroneEntry& d = drones_[s.drone];
     if (!d.ready_nonce) {
       out_ << "ground: " << d.name << " ready";
@@ -378,7 +421,34 @@ void Ground::on_lifecycle(const LifecycleSample& s) {
     return;
   }
   if (s.run_id != r_.run_id || stage_ != Stage::running) return;
+  if (s.kind == LifecycleKind::refused) return on_refused(s);
   on_run_lifecycle(s);
+}
+
+void Ground::on_refused(const LifecycleSample& s) {
+  if (s.launch_id != launch_id_ || s.drone < 0 || s.drone >= static_cast<int>(drones_.size())) return;
+  DroneEntry& d = drones_[s.drone];
+  if (!d.refused.empty() || start_nonces_[s.drone] != s.nonce) return;
+  d.refused = s.reason.empty() ? "no reason given" : s.reason;
+  // Nothing of this run may fly beside the run that DEX flies: every DEX of it lands.
+  LifecycleSample abort{hash_, transport::kGround, LifecycleKind::abort, r_.run_id};
+  abort.reason = "the DEX of " + d.name + " refused the start: " + d.refused;
+  abort.t = mission_time();
+  node_->write(abort);
+  if (!abort_) abort_ = abort;
+  error_ = abort.reason;
+  err_ << "eamos launch: error: " << abort.reason << "\n";
+}
+
+void Ground::refuse_second_launch(const StatusSample& s) {
+  // A status of this mission in a run while this launch waits at its barrier: a DEX of
+  // another launch flies (or lands) this deployment now. Starting a second copy would put
+  // two DEXes on one drone.
+  if (s.run_id == 0 || (s.phase != Phase::running && s.phase != Phase::failsafe)) return;
+  if (s.drone < 0 || s.drone >= static_cast<int>(drones_.size())) return;
+  fail_barrier("this deployment is already running: the DEX of " + drones_[s.drone].name + " is " +
+               (s.phase == Phase::running ? "flying" : "landing") + " run " + std::to_string(s.run_id) +
+               "; a second launch of a running deployment is refused (stop the first one, or wait for it to end)");
 }
 
 void Ground::reject(int sender, const std::string& what, const std::string& why) {
@@ -439,6 +509,7 @@ void Ground::check_pending_finished() {
 
 void Ground::on_status(const StatusSample& s) {
   // Statuses of waiting DEXes (run 0) say nothing the barrier needs: READY does.
+  if (stage_ == Stage::barrier && s.mission_hash == hash_) return refuse_second_launch(s);
   if (stage_ != Stage::running) return;
   if (!ours(s.mission_hash) || s.run_id != r_.run_id || s.drone < 0 || s.drone >= static_cast<int>(drones_.size()))
     return;

@@ -21,8 +21,12 @@ struct LaunchOptions {
   double barrier_timeout_s = 30.0;  ///< wall seconds to wait for every READY
   double time_limit_s = 3600.0;     ///< mission seconds, passed to every DEX
   double start_delay_s = 0.5;       ///< wall seconds between START and mission time 0
-  std::vector<std::string> local;   ///< drones to start here; empty = all of them
+  std::vector<std::string> local;   ///< drones to start here; empty = all of them (unless remote_only)
+  bool remote_only = false;         ///< start none here: every DEX runs elsewhere (on its drone)
   std::string exe;                  ///< the eamos program for DEX processes ("" = this one)
+  /// Wall seconds the ground waits, after a drone was lost, for it to come back and report
+  /// its final state (a network cut that ends); after that its state is reported unknown.
+  double final_state_timeout_s = 10.0;
   /// Without DDS Security, for the ground and every DEX it starts (docs/security.md).
   bool insecure = false;
 };

@@ -49,8 +49,7 @@ TimerId EventLoop::after(double dt, std::function<void()> fn) {
 
 TimerId EventLoop::defer(std::function<void()> fn) {
   double t = now_;
-  if (options_.mode == ClockMode::real_time && running_)
-    t = std::max(now_, mission_anchor_ + (options_.wall->now_s() - wall_anchor_) * options_.speed);
+  if (options_.mode == ClockMode::real_time && running_) t = std::max(now_, wall_mission_time());
   return at(t, std::move(fn));
 }
 
@@ -89,19 +88,38 @@ std::size_t EventLoop::run(double limit, bool bounded) {
     }
     Entry next = queue_.top();
     if (!wait_for(next.time)) continue;
+    if (real && stalled_before(next.time)) continue;  // the handler may have cancelled it
     queue_.pop();
     auto it = callbacks_.find(next.seq);
     if (it == callbacks_.end()) continue;
     // Take the callback out first: it may schedule or cancel timers, rehashing the map.
     std::function<void()> fn = std::move(it->second);
     callbacks_.erase(it);
-    now_ = next.time;
+    now_ = std::max(now_, next.time);  // after a stall, overdue callbacks run at its end
     run_callback(fn);
     ++ran;
     ++events_run_;
   }
   running_ = false;
   return ran;
+}
+
+double EventLoop::wall_mission_time() const {
+  return mission_anchor_ + (options_.wall->now_s() - wall_anchor_) * options_.speed;
+}
+
+bool EventLoop::stalled_before(double t) {
+  if (!on_stall_) return false;
+  double wall_now = options_.wall->now_s();
+  double due = wall_anchor_ + (t - mission_anchor_) / options_.speed;
+  double late = wall_now - std::max(due, caught_up_wall_);
+  caught_up_wall_ = wall_now;
+  if (!(late > stall_after_s_)) return false;
+  now_ = std::max(now_, wall_mission_time());
+  std::function<void()> fn = [this, late] { on_stall_(late); };
+  run_callback(fn);
+  ++events_run_;
+  return true;
 }
 
 void EventLoop::run_callback(std::function<void()>& fn) noexcept {
@@ -142,8 +160,7 @@ void EventLoop::take_posted() {
   }
   if (taken.empty()) return;
   double t = now_;
-  if (options_.mode == ClockMode::real_time)
-    t = std::max(now_, mission_anchor_ + (options_.wall->now_s() - wall_anchor_) * options_.speed);
+  if (options_.mode == ClockMode::real_time) t = std::max(now_, wall_mission_time());
   for (auto& fn : taken) at(t, std::move(fn));
 }
 
@@ -151,6 +168,7 @@ void EventLoop::start_wall_anchor() {
   // Anchor at the start of every run, so time spent outside the loop (compiling, loading)
   // is not "caught up" by running the first events late.
   if (options_.mode != ClockMode::real_time) return;
+  caught_up_wall_ = options_.wall->now_s();
   if (wall_origin_) {
     wall_anchor_ = *wall_origin_;
     mission_anchor_ = 0.0;

@@ -96,6 +96,18 @@ class EventLoop {
   /// a handler the message goes to standard error. A handler that throws is logged too.
   void on_callback_error(std::function<void(const std::string& what)> handler) { on_error_ = std::move(handler); }
 
+  /// Real time only: when the loop finds its next callback due more than `after_s` wall
+  /// seconds ago although the loop was already running then (the process was stopped with
+  /// SIGSTOP, swapped out, or starved), `handler` runs first, at the mission time the wall
+  /// clock shows now (not back-dated), with how many wall seconds the loop stalled. Only
+  /// then do the overdue callbacks run (at that mission time, in their order), so the
+  /// handler can cancel what must not happen late (a DEX halts its mission). What was due
+  /// before run() began is a catch-up (a late start), not a stall.
+  void on_stall(double after_s, std::function<void(double stalled_s)> handler) {
+    stall_after_s_ = after_s;
+    on_stall_ = std::move(handler);
+  }
+
   /// Callbacks run since construction (a cost measure: idle drones must not add to it).
   std::uint64_t events_run() const { return events_run_; }
 
@@ -116,6 +128,11 @@ class EventLoop {
   /// Moves posted callbacks into the queue at the current mission time.
   void take_posted();
   void run_callback(std::function<void()>& fn) noexcept;
+  /// Real time: true (and on_stall's handler run) when the callback due at `t` is late by
+  /// more than the stall bound.
+  bool stalled_before(double t);
+  /// Real time: the mission time the wall clock shows now.
+  double wall_mission_time() const;
   void report_error(const std::string& what) noexcept;
 
   ClockOptions options_;
@@ -134,6 +151,12 @@ class EventLoop {
   std::optional<double> wall_origin_;
   double wall_anchor_ = 0.0;     ///< real time: wall time at which mission time ...
   double mission_anchor_ = 0.0;  ///< ... was this
+  double stall_after_s_ = 0.0;
+  std::function<void(double)> on_stall_;
+  /// Real time: the wall time the loop last looked at a due callback (or began run()). A
+  /// callback is late by the wall time since then or since it was due, whichever is less:
+  /// a catch-up of many overdue callbacks in quick succession is not a stall.
+  double caught_up_wall_ = 0.0;
 };
 
 }  // namespace eamos::mid

@@ -27,7 +27,7 @@ struct TelemetrySample {
   dex::Telemetry telemetry;
 };
 
-enum class LifecycleKind { ready, start, abort, finished };
+enum class LifecycleKind { ready, start, abort, finished, refused };
 const char* lifecycle_name(LifecycleKind k);
 
 struct LifecycleSample {
@@ -36,15 +36,17 @@ struct LifecycleSample {
   LifecycleKind kind = LifecycleKind::ready;
   std::uint64_t run_id = 0;
   std::uint64_t nonce = 0;              ///< ready: the sending process, one per process start
+  std::uint64_t launch_id = 0;          ///< ready, start, refused: the launch (0: none)
   std::int64_t start_at_ns = 0;         ///< start: Unix time of mission time 0
   double speed = 1.0;                   ///< start: mission seconds per wall second
   double t = 0.0;                       ///< abort, finished: mission time
   std::vector<std::uint64_t> nonces;    ///< start: per drone, the process that was ready
-  std::string reason;                   ///< abort
+  std::string reason;                   ///< abort, refused
   std::optional<dex::Failure> failure;  ///< abort caused by a failed action
 };
 
-enum class Phase { waiting, running, completed, failed };
+/// failsafe: abandoned, the failsafe runs; failed: abandoned, the failsafe ended (final state).
+enum class Phase { waiting, running, completed, failed, failsafe };
 const char* phase_name(Phase p);
 
 struct StatusSample {

@@ -129,6 +129,7 @@ const char* lifecycle_name(LifecycleKind k) {
     case LifecycleKind::start: return "start";
     case LifecycleKind::abort: return "abort";
     case LifecycleKind::finished: return "finished";
+    case LifecycleKind::refused: return "refused";
   }
   return "?";
 }
@@ -139,6 +140,7 @@ const char* phase_name(Phase p) {
     case Phase::running: return "running";
     case Phase::completed: return "completed";
     case Phase::failed: return "failed";
+    case Phase::failsafe: return "failsafe";
   }
   return "?";
 }
@@ -226,6 +228,7 @@ eamos_wire_Lifecycle to_wire(const LifecycleSample& s) {
   w.kind = static_cast<eamos_wire_LifecycleKind>(s.kind);
   w.run_id = s.run_id;
   w.nonce = s.nonce;
+  w.launch_id = s.launch_id;
   w.start_at_ns = s.start_at_ns;
   w.speed = s.speed;
   w.t = s.t;
@@ -247,10 +250,11 @@ bool from_wire(const eamos_wire_Lifecycle& w, const WireLimits& limits, Lifecycl
   check.drone("drone", w.drone, true);
   s.drone = w.drone;
   uint32_t kind = raw_enum(w.kind);
-  check.one_of("kind", kind, 4);
+  check.one_of("kind", kind, 5);
   if (check.ok()) s.kind = static_cast<LifecycleKind>(kind);
   s.run_id = w.run_id;
   s.nonce = w.nonce;
+  s.launch_id = w.launch_id;
   s.start_at_ns = w.start_at_ns;
   check.finite("speed", w.speed);
   check.positive("speed", w.speed);
@@ -293,7 +297,7 @@ bool from_wire(const eamos_wire_Status& w, const WireLimits& limits, StatusSampl
   s.run_id = w.run_id;
   s.nonce = w.nonce;
   uint32_t phase = raw_enum(w.phase);
-  check.one_of("phase", phase, 4);
+  check.one_of("phase", phase, 5);
   if (check.ok()) s.phase = static_cast<Phase>(phase);
   s.busy = w.busy;
   s.end_reached = w.end_reached;

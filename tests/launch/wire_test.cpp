@@ -186,9 +186,9 @@ TEST(WireRules, RefusesUnknownEnumValues) {
   EXPECT_EQ(refusal<LifecycleSample>(lw), "kind 4294967293 is not a known value");
   StatusSample st;
   eamos_wire_Status sw = to_wire(st);
-  uint32_t four = 4;
-  std::memcpy(&sw.phase, &four, sizeof four);
-  EXPECT_EQ(refusal<StatusSample>(sw), "phase 4 is not a known value");
+  uint32_t five = 5;
+  std::memcpy(&sw.phase, &five, sizeof five);
+  EXPECT_EQ(refusal<StatusSample>(sw), "phase 5 is not a known value");
 }
 
 TEST(WireRules, RefusesTelemetryWithNaNOrInfinity) {

@@ -182,6 +182,59 @@ TEST(EventLoop, RealTimeDoesNotWaitForLateEvents) {
   EXPECT_EQ(wall.sleeps, (std::vector<double>{101.0}));
 }
 
+// A process stopped (SIGSTOP) for longer than the bound: the stall handler runs before any
+// overdue callback, at the mission time the wall clock shows (not back-dated), and what it
+// cancels never runs. Before on_stall the overdue timer ran 4.75 wall seconds late.
+TEST(EventLoop, StallLongerThanTheBoundRunsTheHandlerFirstAtTheMissionTimeOfItsEnd) {
+  FakeWall wall;
+  EventLoop loop({ClockMode::real_time, 2.0, &wall});
+  std::vector<std::string> order;
+  double stalled = 0.0, handler_at = -1.0;
+  TimerId overdue = kNoTimer;
+  loop.at(1.0, [&] { wall.t += 5.0; });  // the process stood still for 5 wall seconds here
+  overdue = loop.at(1.5, [&] { order.push_back("overdue action"); });
+  loop.at(1.6, [&] { order.push_back("at " + std::to_string(loop.now())); });
+  loop.on_stall(1.0, [&](double s) {
+    stalled = s;
+    handler_at = loop.now();
+    order.push_back("stall");
+    loop.cancel(overdue);
+  });
+  loop.run_until_idle();
+  // Mission 1.5 was due at wall 100.75; the loop looked again at 105.5.
+  EXPECT_DOUBLE_EQ(stalled, 4.75);
+  EXPECT_DOUBLE_EQ(handler_at, 11.0);  // wall 105.5 is mission (105.5 - 100) * 2
+  // What was overdue and not cancelled runs after the handler, at its mission time.
+  EXPECT_EQ(order, (std::vector<std::string>{"stall", "at " + std::to_string(11.0)}));
+}
+
+TEST(EventLoop, StallShorterThanTheBoundIsNoStall) {
+  FakeWall wall;
+  EventLoop loop({ClockMode::real_time, 1.0, &wall});
+  bool stalled = false, ran = false;
+  loop.at(1.0, [&] { wall.t += 0.5; });
+  loop.at(1.2, [&] { ran = true; });
+  loop.on_stall(1.0, [&](double) { stalled = true; });
+  loop.run_until_idle();
+  EXPECT_FALSE(stalled);
+  EXPECT_TRUE(ran);
+}
+
+// A DEX whose START came late catches up from the agreed mission time 0: many callbacks
+// overdue at once, but the loop was not stalled while running.
+TEST(EventLoop, CatchingUpALateStartIsNoStall) {
+  FakeWall wall;
+  EventLoop loop({ClockMode::real_time, 1.0, &wall});
+  loop.set_wall_origin(95.0);  // mission time 0 was 5 wall seconds ago
+  bool stalled = false;
+  int ran = 0;
+  for (int i = 0; i < 10; ++i) loop.at(i * 0.5, [&] { ++ran; });
+  loop.on_stall(1.0, [&](double) { stalled = true; });
+  loop.run_until_idle();
+  EXPECT_FALSE(stalled);
+  EXPECT_EQ(ran, 10);
+}
+
 TEST(EventLoop, DeferredCallbackRunsAfterEverythingAlreadyDueOnVirtualTime) {
   EventLoop loop;
   std::vector<int> order;
