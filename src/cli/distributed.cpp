@@ -28,14 +28,17 @@ int cmd_launch(const launch::LaunchOptions& options, const RunCommandOptions& r)
   if (options.insecure) warn_insecure("launch");
   dex::LiveLog live(std::cout);
   launch::LaunchResult result;
-  int status = launch::launch(options, r.log ? &live : nullptr, result, std::cout, std::cerr);
+  launch::LaunchOptions with_rate = options;
+  with_rate.telemetry_hz = r.telemetry_hz;
+  int status = launch::launch(with_rate, r.log ? &live : nullptr, result, std::cout, std::cerr);
   if (!r.trace.empty()) {
     std::ofstream out(r.trace, std::ios::trunc);
     if (!out) {
       std::cerr << "eamos: error: cannot write trace '" << r.trace << "'\n";
       return 1;
     }
-    dex::JsonlTrace jsonl(out);
+    dex::JsonlTrace jsonl(out, result.fleet);
+    jsonl.write_header(result.header);
     for (const auto& e : result.events) jsonl.record(e);
   }
   if (!report_run(r, result.run, result.events)) return 1;

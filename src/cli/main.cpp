@@ -35,6 +35,9 @@ void add_report(CLI::App* cmd, eamos::cli::RunCommandOptions& r) {
   cmd->add_option("--trace", r.trace, "Write the trace as JSON Lines to this file");
   cmd->add_option("--summary", r.summary, "Write the summary JSON to this file");
   cmd->add_option("--plot", r.plot, "Draw the run (tracks and action timeline) as SVG to this file");
+  cmd->add_option("--telemetry-hz", r.telemetry_hz,
+                  "Telemetry samples per drone per mission second in the trace (0: none)")
+      ->default_val(5.0)->check(CLI::Range(0.0, 100.0));
 }
 
 void add_security(CLI::App* cmd, eamos::cli::SecurityOptions& s) {

@@ -8,6 +8,7 @@
 #include "cli/commands.h"
 #include "cli/signal_watch.h"
 #include "deploy/mission_file.h"
+#include "deploy/synthesize.h"
 #include "dex/plot.h"
 #include "dex/runner.h"
 #include "dex/trace_writers.h"
@@ -64,7 +65,8 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
       std::cerr << "eamos: error: cannot write trace '" << r.trace << "'\n";
       return 1;
     }
-    jsonl = std::make_unique<dex::JsonlTrace>(trace_file);
+    jsonl = std::make_unique<dex::JsonlTrace>(trace_file, missions[0].fleet);
+    jsonl->write_header(deploy::trace_header(c, missions[0].hash, r.telemetry_hz));
     tee.add(jsonl.get());
   }
   dex::MemoryTrace memory;  // the plot is drawn from the whole trace after the run
@@ -72,6 +74,7 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   dex::RunOptions options;
   options.time_limit_s = r.time_limit;
   options.interrupt = &interrupt;
+  options.telemetry_hz = r.telemetry_hz;
   if (r.realtime || r.speed > 0) {
     options.clock.mode = mid::ClockMode::real_time;
     options.clock.speed = r.speed > 0 ? r.speed : 1.0;

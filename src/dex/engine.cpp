@@ -90,6 +90,7 @@ void Engine::trace(const Node& n, const std::string& event, const std::string& o
   e.col = n.col;
   e.text = n.text;
   e.outcome = outcome;
+  e.node = n.meg;
   hooks_.trace->record(e);
 }
 
@@ -300,6 +301,7 @@ void Engine::trace_end(const Node& n, const mid::ActionEnd& e) {
   t.text = n.text;
   t.outcome = mid::outcome_name(e.outcome);
   t.reason = e.reason;
+  t.node = n.meg;
   hooks_.trace->record(t);
   if (e.value && e.outcome == mid::Outcome::succeeded) {
     t.event = "sensor";
@@ -329,6 +331,7 @@ bool Engine::condition_value(int node) {
     t.col = n.col;
     t.text = n.text;
     t.value = v;
+    t.node = n.meg;
     hooks_.trace->record(t);
   }
   return v;
@@ -427,6 +430,7 @@ void Engine::cancel_do_run(int node) {
   cancel_local(n.cancels);
   Message msg{Message::Kind::cancel, m_.hash, m_.self, n.meg, Branch::any};
   msg.body_epoch = epoch_[n.meg];
+  msg.sent = loop_.now();
   if (n.scope >= 0) {
     msg.scope = n.scope;
     msg.epoch = epoch_of(n.scope);
@@ -514,6 +518,7 @@ void Engine::end(int node, Branch branch, bool released_by_partner) {
     }
   }
   Message msg{Message::Kind::ended, m_.hash, m_.self, n.meg, branch};
+  msg.sent = loop_.now();
   if (n.scope >= 0) {
     msg.scope = n.scope;
     msg.epoch = epoch_of(n.scope);

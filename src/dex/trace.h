@@ -4,6 +4,8 @@
 #include <optional>
 #include <string>
 
+#include "mid/drone_api.h"
+
 namespace eamos::dex {
 
 struct TraceEvent {
@@ -18,6 +20,15 @@ struct TraceEvent {
   std::optional<double> reading;  ///< sensor
   std::string reason;       ///< end failed / preempted: why
   int col = 0;              ///< source column of `name` (0 when unknown); not in the JSONL trace
+  int node = -1;            ///< MEG node id of the node the event is about; -1 none
+  int instance = -1;        ///< a cloned sync point (init, fork, end): the drone holding the clone; -1 none
+  // event "message": a trigger or cancel that crossed from one drone to another.
+  std::string kind;         ///< trigger | cancel | finished | abort
+  int from = -1;            ///< sender (drone index; -1 the ground)
+  int to = -1;              ///< receiver (drone index; -1 every drone)
+  double sent = 0.0;        ///< the sender's mission time when it sent it (t: when it arrived)
+  // event "telemetry": the drone's state at t.
+  std::optional<mid::DroneState> state;
 };
 
 class TraceSink {
