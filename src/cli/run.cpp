@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
+#include "cli/progress.h"
 #include "cli/signal_watch.h"
 #include "deploy/mission_file.h"
 #include "deploy/synthesize.h"
@@ -56,7 +57,11 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
 
   dex::TeeTrace tee;
   dex::LiveLog live(std::cout);
-  if (r.log) tee.add(&live);
+  // On a terminal, a status line per drone redrawn in place; through a pipe, the log lines.
+  std::unique_ptr<ProgressDisplay> progress;
+  if (r.log && stdout_is_terminal()) progress = std::make_unique<ProgressDisplay>(std::cout, missions);
+  if (progress) tee.add(progress.get());
+  else if (r.log) tee.add(&live);
   std::ofstream trace_file;
   std::unique_ptr<dex::JsonlTrace> jsonl;
   if (!r.trace.empty()) {
@@ -80,6 +85,7 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
     options.clock.speed = r.speed > 0 ? r.speed : 1.0;
   }
   dex::RunResult result = dex::run_in_process(missions, adapters, &tee, options);
+  if (progress) progress->finish();
   if (!report_run(r, result, memory.events)) return 1;
   return result.completed ? 0 : 1;
 }

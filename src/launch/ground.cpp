@@ -77,15 +77,19 @@ std::string tail_of(const std::string& path, std::size_t lines) {
   return out;
 }
 
-/// Events the ground makes itself (telemetry samples, lifecycle messages) go straight to
-/// the merged trace: the live log does not show them.
+/// Events the ground makes itself (telemetry samples, lifecycle messages): into the merged
+/// trace, and to the live view (the plain log skips them, the terminal's status uses them).
 class Collect : public dex::TraceSink {
  public:
-  explicit Collect(std::vector<dex::TraceEvent>& events) : events_(events) {}
-  void record(const dex::TraceEvent& e) override { events_.push_back(e); }
+  Collect(std::vector<dex::TraceEvent>& events, dex::TraceSink* live) : events_(events), live_(live) {}
+  void record(const dex::TraceEvent& e) override {
+    events_.push_back(e);
+    if (live_) live_->record(e);
+  }
 
  private:
   std::vector<dex::TraceEvent>& events_;
+  dex::TraceSink* live_;
 };
 
 /// The trace header `eamos compile` wrote into the deployment (trace-header.json); from the
@@ -120,7 +124,7 @@ class Ground {
  public:
   Ground(const LaunchOptions& o, dex::TraceSink* live, LaunchResult& r, std::ostream& out, std::ostream& err)
       : o_(o), live_(live), r_(r), out_(out), err_(err), loop_(mid::ClockOptions{mid::ClockMode::real_time, 1.0}),
-        collect_(r.events), telemetry_(&collect_, o.telemetry_hz) {}
+        collect_(r.events, live), telemetry_(&collect_, o.telemetry_hz) {}
   int run();
 
  private:
