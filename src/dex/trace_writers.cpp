@@ -20,17 +20,19 @@ std::string JsonlTrace::drone_name(int index) const {
 namespace {
 /// Telemetry is for people and pictures: millimetres, a tenth of a degree and a hundredth
 /// of a percent are finer than any vehicle reports, and keep the trace small.
-double to_step(double v, double step) { return std::round(v / step) * step; }
+/// `v` to 1/`per_unit` (1000: millimetres); divided, not multiplied by the step, so that
+/// the double printed is the short decimal ("4.35", not "4.3500000000000005").
+double to_step(double v, double per_unit) { return std::round(v * per_unit) / per_unit; }
 
 void put_telemetry(nlohmann::ordered_json& j, const mid::DroneState& s) {
-  j["x"] = to_step(s.x, 1e-3);
-  j["y"] = to_step(s.y, 1e-3);
-  j["z"] = to_step(s.z, 1e-3);
-  if (std::isfinite(s.heading)) j["heading"] = to_step(s.heading, 0.1);
+  j["x"] = to_step(s.x, 1000);
+  j["y"] = to_step(s.y, 1000);
+  j["z"] = to_step(s.z, 1000);
+  if (std::isfinite(s.heading)) j["heading"] = to_step(s.heading, 10);
   else j["heading"] = nullptr;
   j["armed"] = s.armed;
   j["landed"] = s.landed;
-  j["battery"] = to_step(s.battery, 0.01);
+  j["battery"] = to_step(s.battery, 100);
   j["mode"] = s.mode;
 }
 }  // namespace
