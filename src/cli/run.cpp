@@ -79,7 +79,9 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   dex::RunOptions options;
   options.time_limit_s = r.time_limit;
   options.interrupt = &interrupt;
-  options.telemetry_hz = r.telemetry_hz;
+  // Samples cost a copy of every drone's state per tick: only when a trace file or the
+  // terminal's status lines (their clock) take them.
+  options.telemetry_hz = jsonl || progress ? r.telemetry_hz : 0.0;
   if (r.realtime || r.speed > 0) {
     options.clock.mode = mid::ClockMode::real_time;
     options.clock.speed = r.speed > 0 ? r.speed : 1.0;
