@@ -107,7 +107,7 @@ void ProgressDisplay::record(const dex::TraceEvent& e) {
     return;
   }
   // The first draw waits for the first action, so it shows the mission under way.
-  bool first = drawn_ == 0 && e.event != "telemetry";
+  bool first = drawn_ == 0 && e.event == "start";
   if (first || (drawn_ > 0 && std::chrono::steady_clock::now() - last_draw_ >= kRedrawEvery)) draw();
 }
 

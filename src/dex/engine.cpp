@@ -144,7 +144,7 @@ void Engine::drain() {
         // A released terminal ends without its branch; it releases its own partner only
         // when a condition released it (Do's skip), never back to the partner that did.
         s.exec_pending = n.exec_in;
-        end(d.node, Branch::any, d.from_terminal);
+        end(d.node, Branch::any, d.from_terminal, true);
         break;
       case ArcKind::stop: stop_watching(d.node); break;
     }
@@ -222,6 +222,7 @@ void Engine::activate(int node, bool by_back_arc) {
     case MegKind::fork:
     case MegKind::terminal: end(node, Branch::any); return;
     case MegKind::end:
+      trace_node(n, "ended", Branch::any);
       if (hooks_.on_end) hooks_.on_end();
       return;
     case MegKind::action: activate_action(node); return;
@@ -249,6 +250,7 @@ void Engine::activate_action(int node) {
 
 void Engine::activate_pause(int node) {
   const Node& n = m_.nodes[node];
+  trace_node(n, "started", Branch::any);  // a pause runs for a while, like an action
   ++active_;
   std::uint64_t id = ++next_instance_;
   mid::TimerId timer = loop_.after(n.seconds, [this, node, id] {
@@ -504,8 +506,26 @@ void Engine::cancel_local(const std::vector<int>& nodes) {
                queue_.end());
 }
 
-void Engine::end(int node, Branch branch, bool released_by_partner) {
+void Engine::trace_node(const Node& n, const char* outcome, Branch branch) {
+  if (!hooks_.trace || n.kind == MegKind::action) return;  // actions have start and end events
+  TraceEvent e;
+  e.t = loop_.now();
+  e.drone = m_.fleet[m_.self];
+  e.event = "node";
+  e.kind = graph::meg_kind_name(n.kind);
+  e.name = n.kind == MegKind::condition ? lang::control_name(n.control) : n.name;
+  e.line = n.line;
+  e.col = n.col;
+  e.outcome = outcome;
+  e.branch = branch == Branch::any ? "" : graph::branch_name(branch);
+  e.node = n.meg;
+  if (graph::is_sync_point(n.kind)) e.instance = m_.self;
+  hooks_.trace->record(e);
+}
+
+void Engine::end(int node, Branch branch, bool released_by_partner, bool released) {
   const Node& n = m_.nodes[node];
+  trace_node(n, released ? "released" : "ended", branch);
   std::vector<int> remote;
   for (int a : n.out) {
     const Arc& arc = m_.arcs[a];

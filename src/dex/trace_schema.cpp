@@ -100,6 +100,15 @@ void check_event(const json& j, const std::string& event, LineCheck& c, const st
     }
     if (event == "condition") c.boolean("value");
     if (event == "sensor") c.number("value");
+  } else if (event == "node") {
+    c.drone("drone", fleet);
+    c.one_of("kind", {"init", "fork", "terminal", "end", "pause", "condition"});
+    c.string("name");
+    c.integer("line", 0);
+    c.integer("node", 0);
+    c.optional_integer("instance", 0);
+    c.one_of("outcome", {"started", "ended", "released"});
+    c.optional_string("branch");
   } else if (event == "failsafe") {
     c.drone("drone", fleet);
     c.one_of("name", {"land", "return_home", "hover"});

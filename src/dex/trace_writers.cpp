@@ -67,6 +67,8 @@ void JsonlTrace::record(const TraceEvent& e) {
     if (e.value) j["value"] = *e.value;
     if (e.reading) j["value"] = *e.reading;
     if (!e.reason.empty()) j["reason"] = e.reason;
+    if (!e.kind.empty()) j["kind"] = e.kind;
+    if (!e.branch.empty()) j["branch"] = e.branch;
     if (e.node >= 0) j["node"] = e.node;
     if (e.instance >= 0) j["instance"] = e.instance;
   }
@@ -82,9 +84,9 @@ void JsonlTrace::write(const nlohmann::ordered_json& j) {
 }
 
 void LiveLog::record(const TraceEvent& e) {
-  // Samples and messages are for the trace file and the monitor; the log a person reads
+  // Samples, messages and the other nodes' ends are for the trace file and the monitor; the log a person reads
   // (and tests parse) stays what it always was.
-  if (e.event == "telemetry" || e.event == "message") return;
+  if (e.event == "telemetry" || e.event == "message" || e.event == "node") return;
   char head[64];
   std::snprintf(head, sizeof head, "%9.2f s  %-8s %-9s ", e.t, e.drone.c_str(), e.event.c_str());
   out_ << head << (e.text.empty() ? e.name : e.text);

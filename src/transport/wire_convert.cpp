@@ -334,6 +334,7 @@ eamos_wire_TraceRecord to_wire(const TraceSample& s) {
   w.node = e.node;
   w.instance = e.instance;
   w.kind = borrow(e.kind);
+  w.branch = borrow(e.branch);
   w.from = e.from;
   w.to = e.to;
   w.sent = e.sent;
@@ -369,6 +370,7 @@ bool from_wire(const eamos_wire_TraceRecord& w, const WireLimits& limits, TraceS
   check.at_least("instance", w.instance, -1);
   e.instance = w.instance;
   e.kind = check.text("kind", w.kind, kMaxWireName);
+  e.branch = check.text("branch", w.branch, kMaxWireName);
   if (e.event == "message") {
     check.drone("from", w.from);
     check.drone("to", w.to);
