@@ -81,14 +81,16 @@ TEST_F(TraceSchema, EveryExampleTraceKeepsTheSchemaEventByEvent) {
     ASSERT_GE(lines.size(), 3u) << name;
     EXPECT_EQ(lines.front()["source"], read_file(entry.path())) << name;
     EXPECT_EQ(lines.front()["telemetry_hz"], 5.0) << name;
-    int telemetry = 0, messages = 0, actions = 0;
+    int telemetry = 0, messages = 0, actions = 0, inits = 0;
     for (const nlohmann::json& e : lines) {
       telemetry += e["event"] == "telemetry";
       messages += e["event"] == "message";
       actions += e["event"] == "start" && e.contains("node");
+      inits += e["event"] == "node" && e["kind"] == "init" && e.contains("instance");  // one clone per drone
     }
     EXPECT_GT(telemetry, 0) << name;
     EXPECT_GT(actions, 0) << name;
+    EXPECT_GE(inits, 1) << name;
     if (lines.front()["drones"].size() > 1) EXPECT_GT(messages, 0) << name;
   }
   EXPECT_GE(examples, 4);
@@ -170,6 +172,14 @@ TEST(TraceCheck, RefusesBrokenTelemetryAndMessages) {
             "line 2: \"y\" is not a finite number\n"
             "line 2: \"heading\" is neither null nor degrees from 0 to 360\n"
             "line 3: received before it was sent\n");
+}
+
+TEST(TraceCheck, RefusesANodeEventOfAnUnknownKindOrOutcome) {
+  std::string node = R"({"t":1,"drone":"D1","event":"node","name":"PAR_x","line":3,"node":1,"kind":"knot","outcome":"ended"})";
+  std::string outcome = R"({"t":1,"drone":"D1","event":"node","name":"PAR_x","line":3,"node":1,"kind":"fork","outcome":"gone"})";
+  EXPECT_EQ(joined(errors_of(kHeader + "\n" + node + "\n" + outcome + "\n" + kEnd + "\n")),
+            "line 2: \"kind\" is \"knot\", not one of the schema's values\n"
+            "line 3: \"outcome\" is \"gone\", not one of the schema's values\n");
 }
 
 TEST(TraceCheck, RefusesEventsOutOfTimeOrder) {
