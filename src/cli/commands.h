@@ -52,6 +52,7 @@ struct RunCommandOptions {
   double time_limit = 3600.0;
   bool log = true;        ///< print the live log
   std::string monitor;    ///< "[HOST:]PORT" to serve the run live in a browser; "" = none
+  double telemetry_hz = 5.0;  ///< telemetry events per drone per mission second in the trace; 0 = none
 };
 int cmd_run(const CommonOptions& o, const RunCommandOptions& r);
 /// Writes the summary and plot of a finished run as `eamos run` does; false when a file

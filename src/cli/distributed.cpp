@@ -4,13 +4,18 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 
 #include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
 
+#include <nlohmann/json.hpp>
+
 #include "cli/commands.h"
+#include "cli/progress.h"
+#include "deploy/mission_file.h"
 #include "deploy/synthesize.h"
 #include "dex/trace_writers.h"
 #include "launch/dex_process.h"
@@ -31,12 +36,42 @@ int cmd_dex(const launch::DexProcessOptions& options) {
   return launch::run_dex_process(options, adapters, std::cout, std::cerr);
 }
 
+namespace {
+
+/// Every drone's mission of the deployment in `dir`, for the terminal's status lines; empty
+/// when one cannot be read (the ground reports that itself, and the plain log is shown).
+std::vector<dex::Mission> deployed_missions(const std::string& dir) {
+  std::vector<dex::Mission> missions;
+  std::ifstream in(dir + "/manifest.json");
+  nlohmann::json manifest = nlohmann::json::parse(in, nullptr, false);
+  if (!manifest.is_object() || !manifest.contains("drones") || !manifest["drones"].is_array()) return {};
+  for (const nlohmann::json& d : manifest["drones"]) {
+    if (!d.is_object() || !d.contains("folder") || !d["folder"].is_string()) return {};
+    dex::Mission m;
+    std::vector<std::string> defects;
+    if (!deploy::read_mission_file(dir + "/" + d["folder"].get<std::string>() + "/mission.json", m, defects)) return {};
+    missions.push_back(std::move(m));
+  }
+  return missions;
+}
+
+}  // namespace
+
 int cmd_launch(const launch::LaunchOptions& options, const RunCommandOptions& r) {
   if (options.insecure) warn_insecure("launch");
-  if (!r.monitor.empty()) return launch_with_monitor(options, r);
+  launch::LaunchOptions with_rate = options;
+  with_rate.telemetry_hz = r.telemetry_hz;
+  if (!r.monitor.empty()) return launch_with_monitor(with_rate, r);
   dex::LiveLog live(std::cout);
+  std::unique_ptr<ProgressDisplay> progress;
+  if (r.log && stdout_is_terminal()) {
+    std::vector<dex::Mission> missions = deployed_missions(options.dir);
+    if (!missions.empty()) progress = std::make_unique<ProgressDisplay>(std::cout, missions);
+  }
+  dex::TraceSink* shown = progress ? static_cast<dex::TraceSink*>(progress.get()) : &live;
   launch::LaunchResult result;
-  int status = launch::launch(options, r.log ? &live : nullptr, result, std::cout, std::cerr);
+  int status = launch::launch(with_rate, r.log ? shown : nullptr, result, std::cout, std::cerr);
+  if (progress) progress->finish();
   return report_launch(r, result, status);
 }
 
@@ -93,7 +128,8 @@ int report_launch(const RunCommandOptions& r, const launch::LaunchResult& result
       std::cerr << "eamos: error: cannot write trace '" << r.trace << "'\n";
       return 1;
     }
-    dex::JsonlTrace jsonl(out);
+    dex::JsonlTrace jsonl(out, result.fleet);
+    jsonl.write_header(result.header);
     for (const auto& e : result.events) jsonl.record(e);
   }
   if (!report_run(r, result.run, result.events)) return 1;

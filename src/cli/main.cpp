@@ -38,6 +38,9 @@ void add_report(CLI::App* cmd, eamos::cli::RunCommandOptions& r) {
   cmd->add_option("--monitor", r.monitor,
                   "Serve the running mission live in a browser at [HOST:]PORT (default host 127.0.0.1; "
                   "port 0: any free one); the URL is printed, and the page stays up after the end until Ctrl-C");
+  cmd->add_option("--telemetry-hz", r.telemetry_hz,
+                  "Telemetry samples per drone per mission second in the trace (0: none)")
+      ->default_val(5.0)->check(CLI::Range(0.0, 100.0));
 }
 
 void add_security(CLI::App* cmd, eamos::cli::SecurityOptions& s) {

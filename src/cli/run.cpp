@@ -6,8 +6,10 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
+#include "cli/progress.h"
 #include "cli/signal_watch.h"
 #include "deploy/mission_file.h"
+#include "deploy/synthesize.h"
 #include "dex/plot.h"
 #include "dex/runner.h"
 #include "dex/trace_writers.h"
@@ -76,7 +78,11 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
 
   dex::TeeTrace tee;
   dex::LiveLog live(std::cout);
-  if (r.log) tee.add(&live);
+  // On a terminal, a status line per drone redrawn in place; through a pipe, the log lines.
+  std::unique_ptr<ProgressDisplay> progress;
+  if (r.log && stdout_is_terminal()) progress = std::make_unique<ProgressDisplay>(std::cout, missions);
+  if (progress) tee.add(progress.get());
+  else if (r.log) tee.add(&live);
   std::ofstream trace_file;
   std::unique_ptr<dex::JsonlTrace> jsonl;
   if (!r.trace.empty()) {
@@ -85,7 +91,8 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
       std::cerr << "eamos: error: cannot write trace '" << r.trace << "'\n";
       return 1;
     }
-    jsonl = std::make_unique<dex::JsonlTrace>(trace_file);
+    jsonl = std::make_unique<dex::JsonlTrace>(trace_file, missions[0].fleet);
+    jsonl->write_header(deploy::trace_header(c, missions[0].hash, r.telemetry_hz));
     tee.add(jsonl.get());
   }
   dex::MemoryTrace memory;  // the plot is drawn from the whole trace after the run
@@ -94,11 +101,15 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   dex::RunOptions options;
   options.time_limit_s = r.time_limit;
   options.interrupt = &interrupt;
+  // Samples cost a copy of every drone's state per tick: only when a trace file or the
+  // terminal's status lines (their clock) take them.
+  options.telemetry_hz = jsonl || progress ? r.telemetry_hz : 0.0;
   if (r.realtime || r.speed > 0) {
     options.clock.mode = mid::ClockMode::real_time;
     options.clock.speed = r.speed > 0 ? r.speed : 1.0;
   }
   dex::RunResult result = dex::run_in_process(missions, adapters, &tee, options);
+  if (progress) progress->finish();
   if (!report_run(r, result, memory.events)) return 1;
   if (live_monitor && !hold.was_interrupted()) hold_monitor(*server, hold);
   return result.completed ? 0 : 1;

@@ -26,6 +26,36 @@ json manifest(const graph::Compilation& c, const std::string& hash) {
           {"drones", drones}};
 }
 
+nlohmann::ordered_json trace_header(const graph::Compilation& c, const std::string& hash, double telemetry_hz) {
+  nlohmann::ordered_json drones = nlohmann::ordered_json::array();
+  for (int d = 0; d < c.drone_count(); ++d) {
+    const fleet::DroneSettings& s = c.settings[d];
+    nlohmann::ordered_json reads = nlohmann::ordered_json::array();
+    if (d < static_cast<int>(c.mdgs.size()))
+      for (int r : c.mdgs[d].reads)
+        if (r != d) reads.push_back(c.drone_name(r));
+    drones.push_back({{"name", c.drone_name(d)},
+                      {"index", d},
+                      {"type", s.type},
+                      {"adapter", s.adapter},
+                      {"home", {s.home.x, s.home.y, s.home.z}},
+                      {"reads", reads}});
+  }
+  nlohmann::ordered_json h;
+  h["t"] = 0;
+  h["event"] = "header";
+  h["schema"] = "eamos-trace";
+  h["version"] = kTraceSchemaVersion;
+  h["eamos"] = EAMOS_VERSION;
+  h["mission"] = std::filesystem::path(c.source->path).filename().string();
+  h["mission_hash"] = hash;
+  h["source"] = c.source->text;
+  h["fleet"] = c.fleet.source ? c.fleet.source->text : "";
+  h["drones"] = drones;
+  h["telemetry_hz"] = telemetry_hz;
+  return h;
+}
+
 namespace {
 
 bool cannot_write(const std::filesystem::path& path, Diagnostics& diags) {
@@ -52,6 +82,9 @@ bool write_deployment(const graph::Compilation& c, const std::string& dir, Diagn
   }
   std::string hash = mission_hash(c);
   if (!write_text(fs::path(dir) / "manifest.json", manifest(c, hash).dump(2) + "\n", diags)) return false;
+  // Mission and fleet text may hold any byte: replaced, not thrown, as in the trace itself.
+  std::string header = trace_header(c, hash, 0).dump(2, ' ', false, json::error_handler_t::replace);
+  if (!write_text(fs::path(dir) / "trace-header.json", header + "\n", diags)) return false;
   for (int d = 0; d < c.drone_count(); ++d) {
     fs::path folder = fs::path(dir) / c.drone_name(d);
     fs::create_directories(folder, ec);

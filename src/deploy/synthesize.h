@@ -15,7 +15,16 @@ namespace eamos::deploy {
 /// The deployment manifest: hash, source and one entry per drone folder.
 nlohmann::json manifest(const graph::Compilation& c, const std::string& hash);
 
-/// Writes DIR/manifest.json and DIR/<drone>/mission.json for every drone. Returns false
+/// The version of the trace schema (docs/trace.md) this build writes.
+constexpr int kTraceSchemaVersion = 1;
+
+/// A trace's first line (docs/trace.md, "header"): the mission and fleet text embedded, so
+/// a trace replays without its files; every drone with its index, type, home and the drones
+/// whose telemetry it reads.
+nlohmann::ordered_json trace_header(const graph::Compilation& c, const std::string& hash, double telemetry_hz);
+
+/// Writes DIR/manifest.json, DIR/trace-header.json (the header `eamos launch` starts its
+/// trace with) and DIR/<drone>/mission.json for every drone. Returns false
 /// and reports to `diags` when a file cannot be written.
 bool write_deployment(const graph::Compilation& c, const std::string& dir, Diagnostics& diags);
 

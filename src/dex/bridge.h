@@ -28,6 +28,7 @@ struct Message {
   long long epoch = 0;
   /// Sent by a Repeat/Do condition (and with `cancel`): the run number of its own body.
   long long body_epoch = 0;
+  double sent = 0.0;  ///< the sender's mission time when it sent this: for the trace only
 };
 
 /// A drone's newest properties, published to every other drone: the argument data and

@@ -90,6 +90,7 @@ void Engine::trace(const Node& n, const std::string& event, const std::string& o
   e.col = n.col;
   e.text = n.text;
   e.outcome = outcome;
+  e.node = n.meg;
   hooks_.trace->record(e);
 }
 
@@ -143,7 +144,7 @@ void Engine::drain() {
         // A released terminal ends without its branch; it releases its own partner only
         // when a condition released it (Do's skip), never back to the partner that did.
         s.exec_pending = n.exec_in;
-        end(d.node, Branch::any, d.from_terminal);
+        end(d.node, Branch::any, d.from_terminal, true);
         break;
       case ArcKind::stop: stop_watching(d.node); break;
     }
@@ -221,6 +222,7 @@ void Engine::activate(int node, bool by_back_arc) {
     case MegKind::fork:
     case MegKind::terminal: end(node, Branch::any); return;
     case MegKind::end:
+      trace_node(n, "ended", Branch::any);
       if (hooks_.on_end) hooks_.on_end();
       return;
     case MegKind::action: activate_action(node); return;
@@ -248,6 +250,7 @@ void Engine::activate_action(int node) {
 
 void Engine::activate_pause(int node) {
   const Node& n = m_.nodes[node];
+  trace_node(n, "started", Branch::any);  // a pause runs for a while, like an action
   ++active_;
   std::uint64_t id = ++next_instance_;
   mid::TimerId timer = loop_.after(n.seconds, [this, node, id] {
@@ -300,6 +303,7 @@ void Engine::trace_end(const Node& n, const mid::ActionEnd& e) {
   t.text = n.text;
   t.outcome = mid::outcome_name(e.outcome);
   t.reason = e.reason;
+  t.node = n.meg;
   hooks_.trace->record(t);
   if (e.value && e.outcome == mid::Outcome::succeeded) {
     t.event = "sensor";
@@ -329,6 +333,7 @@ bool Engine::condition_value(int node) {
     t.col = n.col;
     t.text = n.text;
     t.value = v;
+    t.node = n.meg;
     hooks_.trace->record(t);
   }
   return v;
@@ -427,6 +432,7 @@ void Engine::cancel_do_run(int node) {
   cancel_local(n.cancels);
   Message msg{Message::Kind::cancel, m_.hash, m_.self, n.meg, Branch::any};
   msg.body_epoch = epoch_[n.meg];
+  msg.sent = loop_.now();
   if (n.scope >= 0) {
     msg.scope = n.scope;
     msg.epoch = epoch_of(n.scope);
@@ -500,8 +506,26 @@ void Engine::cancel_local(const std::vector<int>& nodes) {
                queue_.end());
 }
 
-void Engine::end(int node, Branch branch, bool released_by_partner) {
+void Engine::trace_node(const Node& n, const char* outcome, Branch branch) {
+  if (!hooks_.trace || n.kind == MegKind::action) return;  // actions have start and end events
+  TraceEvent e;
+  e.t = loop_.now();
+  e.drone = m_.fleet[m_.self];
+  e.event = "node";
+  e.kind = graph::meg_kind_name(n.kind);
+  e.name = n.kind == MegKind::condition ? lang::control_name(n.control) : n.name;
+  e.line = n.line;
+  e.col = n.col;
+  e.outcome = outcome;
+  e.branch = branch == Branch::any ? "" : graph::branch_name(branch);
+  e.node = n.meg;
+  if (graph::is_sync_point(n.kind)) e.instance = m_.self;
+  hooks_.trace->record(e);
+}
+
+void Engine::end(int node, Branch branch, bool released_by_partner, bool released) {
   const Node& n = m_.nodes[node];
+  trace_node(n, released ? "released" : "ended", branch);
   std::vector<int> remote;
   for (int a : n.out) {
     const Arc& arc = m_.arcs[a];
@@ -514,6 +538,7 @@ void Engine::end(int node, Branch branch, bool released_by_partner) {
     }
   }
   Message msg{Message::Kind::ended, m_.hash, m_.self, n.meg, branch};
+  msg.sent = loop_.now();
   if (n.scope >= 0) {
     msg.scope = n.scope;
     msg.epoch = epoch_of(n.scope);

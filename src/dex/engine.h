@@ -112,7 +112,10 @@ class Engine {
   bool take_instance(int node, std::uint64_t id);
   void cancel_do_run(int node);
   void activate_condition(int node, bool by_back_arc);
-  void end(int node, graph::Branch branch, bool released_by_partner = false);
+  /// `released`: a partner arc released it (it ends without its branch having run).
+  void end(int node, graph::Branch branch, bool released_by_partner = false, bool released = false);
+  /// The trace's "node" event of a node that is not an action (docs/trace.md).
+  void trace_node(const Node& n, const char* outcome, graph::Branch branch);
   void evaluate_watch(int node);
   void flip_do(int node);
   void cancel_local(const std::vector<int>& nodes);

@@ -11,9 +11,12 @@ namespace eamos::dex {
 
 /// Top panel: each drone's track in the x/y plane (equal scale, metres), grey on the
 /// ground, solid in the air, start labelled with the drone's name, a black square where
-/// it armed, a green diamond where it landed. Bottom panel: one row per drone over mission
+/// it armed, a green diamond where it landed, the failsafe's part dashed red. Middle panel:
+/// every drone's altitude over mission time. Bottom panel: one row per drone over mission
 /// time, a bar per action start (`data-action` attribute) from start to end, coloured by
-/// outcome, and a tick per condition decision. `events` is the run's trace.
+/// outcome; a labelled tick per condition decision (in lanes, never overlapping); each
+/// wait for another drone's trigger (class "wait": who, on whom, how long) with an arrow
+/// from the sender; each failsafe phase hatched red. `events` is the run's trace.
 /// A problem to show on the picture (`eamos verify`): a red ring at (x, y) on the map and a
 /// red line at mission time t across the timeline, both labelled.
 struct PlotMark {

@@ -16,8 +16,9 @@ namespace {
 class InProcessTransport : public Transport {
  public:
   InProcessTransport(mid::EventLoop& loop, std::vector<std::unique_ptr<Engine>>& engines,
-                     const std::vector<Mission>& missions, std::function<void()> on_delivered)
-      : loop_(loop), engines_(engines), readers_(missions.size()), on_delivered_(std::move(on_delivered)) {
+                     const std::vector<Mission>& missions, TraceSink* trace, std::function<void()> on_delivered)
+      : loop_(loop), engines_(engines), missions_(missions), trace_(trace), readers_(missions.size()),
+        on_delivered_(std::move(on_delivered)) {
     for (std::size_t to = 0; to < missions.size(); ++to)
       for (int d : missions[to].reads)
         if (d >= 0 && d < static_cast<int>(readers_.size())) readers_[d].push_back(static_cast<int>(to));
@@ -26,6 +27,7 @@ class InProcessTransport : public Transport {
     ++in_flight_;
     loop_.after(0.0, [this, to, m] {
       --in_flight_;
+      if (trace_) trace_->record(message_event(missions_[to], m, to, loop_.now()));
       engines_[to]->receive(m);
       on_delivered_();
     });
@@ -45,6 +47,8 @@ class InProcessTransport : public Transport {
  private:
   mid::EventLoop& loop_;
   std::vector<std::unique_ptr<Engine>>& engines_;
+  const std::vector<Mission>& missions_;
+  TraceSink* trace_;
   std::vector<std::vector<int>> readers_;  ///< per drone: the drones that read its telemetry
   std::function<void()> on_delivered_;
   int in_flight_ = 0;
@@ -55,7 +59,59 @@ void trace_mission_end(TraceSink* trace, const RunResult& r) {
   if (trace) trace->record(mission_end_event(r));
 }
 
+/// Samples every drone at slot `tick` of the telemetry rate, and so on until the loop stops.
+void sample_fleet(mid::EventLoop& loop, TelemetryRecorder& recorder,
+                  const std::vector<std::unique_ptr<mid::Drone>>& drones, long long tick) {
+  double t = tick * recorder.period();
+  for (const auto& d : drones) recorder.sample(d->name(), d->state(), t);
+  loop.at((tick + 1) * recorder.period(), [&loop, &recorder, &drones, tick] {
+    sample_fleet(loop, recorder, drones, tick + 1);
+  });
+}
+
 }  // namespace
+
+TraceEvent message_event(const Mission& receiver, const Message& m, int to, double received) {
+  TraceEvent e;
+  e.t = received;
+  e.event = "message";
+  e.kind = m.kind == Message::Kind::cancel ? "cancel" : "trigger";
+  e.from = m.from;
+  e.to = to;
+  e.node = m.meg;
+  int held = receiver.find(m.meg, m.from);
+  if (held >= 0 && graph::is_sync_point(receiver.nodes[held].kind)) e.instance = m.from;
+  e.sent = m.sent;
+  if (to >= 0 && to < static_cast<int>(receiver.fleet.size())) e.drone = receiver.fleet[to];
+  return e;
+}
+
+void TelemetryRecorder::sample(const std::string& name, const mid::DroneState& s, double t) {
+  if (!enabled()) return;
+  auto it = last_.find(name);
+  if (it != last_.end()) {
+    const mid::DroneState& l = it->second;
+    bool same_heading = l.heading == s.heading || (std::isnan(l.heading) && std::isnan(s.heading));
+    if (l.x == s.x && l.y == s.y && l.z == s.z && l.armed == s.armed && l.landed == s.landed &&
+        l.battery == s.battery && l.mode == s.mode && same_heading)
+      return;
+  }
+  last_[name] = s;
+  TraceEvent e;
+  e.t = t;
+  e.event = "telemetry";
+  e.drone = name;
+  e.state = s;
+  trace_->record(e);
+}
+
+bool TelemetryRecorder::due(const std::string& name, double t) {
+  if (!enabled()) return false;
+  double& next = next_[name];
+  if (t < next) return false;
+  next = (std::floor(t * hz_ + 1e-9) + 1) / hz_;
+  return true;
+}
 
 TraceEvent mission_end_event(const RunResult& r) {
   TraceEvent e;
@@ -156,7 +212,7 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
   // Checked whenever an engine settles idle and after every delivered message: the mission
   // completes at that instant, not at the next event that happens to come by.
   std::function<void()> check_done;
-  InProcessTransport transport(loop, engines, missions, [&] { check_done(); });
+  InProcessTransport transport(loop, engines, missions, trace, [&] { check_done(); });
   check_done = [&] {
     if (!end_reached || failed || result.completed || transport.in_flight() > 0) return;
     for (const auto& e : engines)
@@ -226,6 +282,8 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     });
   }
   if (options.interrupt) options.interrupt->attach(loop, stop_mission);
+  TelemetryRecorder telemetry(trace, options.telemetry_hz);
+  if (telemetry.enabled()) sample_fleet(loop, telemetry, drones, 0);
   for (auto& e : engines) e->start();
 
   // Endless motions (an Orbit nobody preempts) keep the loop busy: bound the run.

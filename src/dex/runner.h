@@ -4,6 +4,7 @@
 // transport. The mission completes when the end node ran and nothing is active on any
 // drone; the first failed action fails it, and every airborne drone runs its failsafe.
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -43,6 +44,7 @@ struct RunOptions {
   double time_limit_s = 3600.0;  ///< a mission still running then fails ("did not finish")
   RunInterrupt* interrupt = nullptr;
   RunObserver* observer = nullptr;  ///< `eamos verify` only (dex/observer.h)
+  double telemetry_hz = 0.0;  ///< telemetry events in the trace per mission second; 0 = none
 };
 
 /// One drone's position and phase at a moment its broker published a change of them.
@@ -90,6 +92,33 @@ struct RunResult {
 /// error), at the mission time the mission ended (RunResult::duration). Every runner, in
 /// process or distributed, writes it last.
 TraceEvent mission_end_event(const RunResult& r);
+
+/// The trace event of message `m` arriving at drone `to` (whose mission is `receiver`) at
+/// mission time `received`: its kind, both drones, the node and, for a cloned sync point,
+/// the instance (the sender, which holds that clone).
+TraceEvent message_event(const Mission& receiver, const Message& m, int to, double received);
+
+/// Writes each drone's telemetry to a trace at a fixed rate of mission time. A sample is
+/// written when anything in it changed since that drone's last one, so a fleet standing on
+/// the ground costs nothing and a hung mission does not fill the disk.
+class TelemetryRecorder {
+ public:
+  TelemetryRecorder(TraceSink* trace, double hz) : trace_(trace), hz_(hz) {}
+  bool enabled() const { return trace_ && hz_ > 0; }
+  double period() const { return 1.0 / hz_; }
+  /// The state of drone `name` at mission time `t` (t on the rate's grid, or, from a
+  /// sampled stream, the sample's own time).
+  void sample(const std::string& name, const mid::DroneState& s, double t);
+  /// For a stream of states (the ground's DDS telemetry): true when `t` reached the
+  /// drone's next slot of the rate, which it then moves on.
+  bool due(const std::string& name, double t);
+
+ private:
+  TraceSink* trace_;
+  double hz_;
+  std::map<std::string, mid::DroneState> last_;
+  std::map<std::string, double> next_;
+};
 
 /// Runs `missions` (one per drone, same hash, index order = fleet order). Setup problems
 /// (unknown adapter, mismatched hashes) come back as a failed result before anything runs.

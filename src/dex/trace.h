@@ -4,12 +4,14 @@
 #include <optional>
 #include <string>
 
+#include "mid/drone_api.h"
+
 namespace eamos::dex {
 
 struct TraceEvent {
   double t = 0.0;           ///< mission seconds
   std::string drone;
-  std::string event;        ///< start | end | condition | sensor | failsafe | error | vehicle (its own words)
+  std::string event;        ///< start | end | condition | sensor | node | failsafe | error | vehicle (its own words) | telemetry | message | mission
   std::string name;         ///< action or control structure
   int line = 0;
   std::string text;         ///< "Drone1.Takeoff(3)", "Drone1.Sensor1() >= 100"
@@ -18,6 +20,16 @@ struct TraceEvent {
   std::optional<double> reading;  ///< sensor
   std::string reason;       ///< end failed / preempted: why
   int col = 0;              ///< source column of `name` (0 when unknown); not in the JSONL trace
+  int node = -1;            ///< MEG node id of the node the event is about; -1 none
+  std::string branch;       ///< event "node": the branch a condition released (go, true, repeat, …)
+  int instance = -1;        ///< a cloned sync point (init, fork, end): the drone holding the clone; -1 none
+  // event "message": a trigger or cancel that crossed from one drone to another.
+  std::string kind;         ///< message: trigger | cancel | finished | abort; node: init | fork | terminal | end | pause | condition
+  int from = -1;            ///< sender (drone index; -1 the ground)
+  int to = -1;              ///< receiver (drone index; -1 every drone)
+  double sent = 0.0;        ///< the sender's mission time when it sent it (t: when it arrived)
+  // event "telemetry": the drone's state at t.
+  std::optional<mid::DroneState> state;
 };
 
 class TraceSink {

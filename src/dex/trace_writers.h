@@ -2,23 +2,33 @@
 // Where trace events go: a JSON Lines file (one event per line), the live log a person
 // reads while the mission runs, and a fan-out to both.
 #include <ostream>
+#include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "dex/trace.h"
 
 namespace eamos::dex {
 
-/// {"t":1.25,"drone":"Drone1","event":"start","name":"Takeoff","line":51,...} per line.
+/// {"t":1.25,"drone":"Drone1","event":"start","name":"Takeoff","line":51,...} per line, in
+/// the schema of docs/trace.md. `fleet` names the drones of message events' from/to.
 class JsonlTrace : public TraceSink {
  public:
-  explicit JsonlTrace(std::ostream& out) : out_(out) {}
+  explicit JsonlTrace(std::ostream& out, std::vector<std::string> fleet = {}) : out_(out), fleet_(std::move(fleet)) {}
   void record(const TraceEvent& e) override;
+  /// The trace's first line (deploy::trace_header makes it).
+  void write_header(const nlohmann::ordered_json& header);
 
  private:
+  void write(const nlohmann::ordered_json& j);
+  std::string drone_name(int index) const;
   std::ostream& out_;
+  std::vector<std::string> fleet_;
 };
 
-/// "   12.40 s  Drone1  end    Drone1.Takeoff(3)  succeeded   line 51"
+/// "   12.40 s  Drone1  end    Drone1.Takeoff(3)  succeeded   line 51"; telemetry and
+/// message events are not shown.
 class LiveLog : public TraceSink {
  public:
   explicit LiveLog(std::ostream& out) : out_(out) {}

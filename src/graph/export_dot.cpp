@@ -1,17 +1,15 @@
 #include <sstream>
 
 #include "graph/export.h"
+#include "graph/palette.h"
 
 namespace eamos::graph {
 
 namespace {
 
-// Colour-blind-safe palette (Okabe–Ito), one colour per drone, cycling.
-const char* drone_colour(int d) {
-  static const char* palette[] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7",
-                                  "#E69F00", "#56B4E9", "#F0E442", "#000000"};
-  return d < 0 ? "#555555" : palette[d % 8];
-}
+// Triggers and control messages that cross from one drone to another: what the DEXes say
+// over DDS, drawn apart from the arcs a drone follows on its own.
+const char* kCrossDrone = "#7A0177";
 
 std::string escape(const std::string& s) {
   std::string out;
@@ -19,6 +17,18 @@ std::string escape(const std::string& s) {
     if (c == '"' || c == '\\') out += '\\';
     out += c;
   }
+  return out;
+}
+
+std::string escape_html(const std::string& s) {
+  std::string out;
+  for (char c : s) switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
   return out;
 }
 
@@ -37,7 +47,7 @@ const char* meg_shape(MegKind k) {
     case MegKind::action: return "ellipse";
     case MegKind::fork: return "box";
     case MegKind::condition: return "diamond";
-    case MegKind::terminal: return "square";
+    case MegKind::terminal: return "box";
     case MegKind::pause: return "hexagon";
   }
   return "ellipse";
@@ -46,7 +56,9 @@ const char* meg_shape(MegKind k) {
 std::string arc_style(ArcKind kind, Branch branch, bool external) {
   std::string attrs;
   switch (kind) {
-    case ArcKind::exec: attrs = external ? "style=dashed" : "style=solid"; break;
+    case ArcKind::exec:
+      attrs = external ? std::string("style=dashed, penwidth=1.8, color=\"") + kCrossDrone + "\"" : "style=solid";
+      break;
     case ArcKind::back: attrs = "style=dotted, constraint=false"; break;
     case ArcKind::partner: attrs = "style=dashed, color=red, constraint=false"; break;
     case ArcKind::stop: attrs = "style=dashed, color=blue, constraint=false"; break;
@@ -67,9 +79,40 @@ void meg_node_line(std::ostringstream& out, const Compilation& c, const std::str
   int colour_drone = n.drone >= 0 ? n.drone : holder;
   out << "  " << id << " [shape=" << meg_shape(n.kind) << ", label=\"" << label
       << "\", color=\"" << drone_colour(colour_drone) << "\"";
-  if (external) out << ", style=dashed, fontcolor=\"#777777\"";
-  if (n.kind == MegKind::fork) out << ", style=\"" << (external ? "dashed," : "") << "rounded\"";
+  // One style list: external copies dashed, forks rounded, terminals (small grey-filled
+  // boxes, apart from forks and actions) filled.
+  std::string style = external ? "dashed" : "";
+  if (n.kind == MegKind::fork) style += std::string(style.empty() ? "" : ",") + "rounded";
+  if (n.kind == MegKind::terminal) style += std::string(style.empty() ? "" : ",") + "filled";
+  if (!style.empty()) out << ", style=\"" << style << "\"";
+  if (external) out << ", fontcolor=\"#777777\"";
+  if (n.kind == MegKind::terminal) out << ", fillcolor=\"#EEEEEE\", fontsize=9";
   out << "];\n";
+}
+
+/// A key to the picture, as one HTML-like table node beside the graph: node shapes, arc
+/// styles and (`drones`) the drones' colours.
+void legend(std::ostringstream& out, const Compilation& c) {
+  out << "  subgraph cluster_legend {\n    label=\"legend\"; fontname=\"Helvetica\"; fontsize=10; "
+         "color=\"#BBBBBB\";\n    legend [shape=plaintext, fontsize=9, label=<<table border=\"0\" "
+         "cellspacing=\"2\" cellpadding=\"1\">\n";
+  const char* rows[][2] = {{"ellipse", "action"},
+                           {"diamond", "condition (control structure)"},
+                           {"rounded box", "fork: start of a PAR block"},
+                           {"grey box", "terminal: end of a block"},
+                           {"double circle", "INIT / mission end"},
+                           {"hexagon", "PauseFor"},
+                           {"solid arrow", "trigger on the same drone"},
+                           {"dashed purple arrow", "trigger across drones (DDS)"},
+                           {"dotted arrow", "back arc: next iteration"},
+                           {"dashed red arrow", "release of the partner terminal"},
+                           {"dashed blue arrow", "stop watching"}};
+  for (const auto& r : rows)
+    out << "      <tr><td align=\"left\"><b>" << r[0] << "</b></td><td align=\"left\">" << r[1] << "</td></tr>\n";
+  for (int d = 0; d < c.drone_count(); ++d)
+    out << "      <tr><td align=\"left\"><font color=\"" << drone_colour(d) << "\"><b>&#9632; " << escape_html(c.drone_name(d))
+        << "</b></font></td><td align=\"left\">its nodes</td></tr>\n";
+  out << "    </table>>];\n  }\n";
 }
 
 }  // namespace
@@ -140,8 +183,14 @@ std::string meg_dot(const Compilation& c) {
   std::ostringstream out;
   out << "digraph MEG {\n  rankdir=TB;\n  node [fontname=\"Helvetica\", fontsize=10];\n";
   for (const MegNode& n : c.meg.nodes) meg_node_line(out, c, "n" + std::to_string(n.id), n, -1, false);
-  for (const MegArc& a : c.meg.arcs)
-    out << "  n" << a.from << " -> n" << a.to << " [" << arc_style(a.kind, a.branch, false) << "];\n";
+  for (const MegArc& a : c.meg.arcs) {
+    // Across drones: both ends held by drones, and not the same one (sync points are cloned
+    // onto each drone that needs them, so their arcs never cross).
+    int from = c.meg.nodes[a.from].drone, to = c.meg.nodes[a.to].drone;
+    bool cross = from >= 0 && to >= 0 && from != to;
+    out << "  n" << a.from << " -> n" << a.to << " [" << arc_style(a.kind, a.branch, cross) << "];\n";
+  }
+  legend(out, c);
   out << "}\n";
   return out.str();
 }
@@ -159,6 +208,7 @@ std::string mdg_dot(const Compilation& c, int drone) {
   for (const MdgArc& a : g.arcs)
     out << "  m" << a.from << " -> m" << a.to << " [" << arc_style(a.kind, a.branch, g.external(a))
         << "];\n";
+  legend(out, c);
   out << "}\n";
   return out.str();
 }

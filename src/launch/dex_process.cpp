@@ -274,7 +274,7 @@ bool DexProcess::begin() {
   if (!o_.trace_file.empty()) {
     trace_file_.open(o_.trace_file, std::ios::trunc);
     if (trace_file_) {
-      jsonl_ = std::make_unique<dex::JsonlTrace>(trace_file_);
+      jsonl_ = std::make_unique<dex::JsonlTrace>(trace_file_, mission_.fleet);
       tee_.add(jsonl_.get());
     } else {
       err_ << name() << ": cannot write trace '" << o_.trace_file << "'\n";

@@ -57,7 +57,10 @@ void DexProcess::on_trigger(const TriggerSample& s) {
   // Only what was accepted is counted: a dropped sample counted as received would leave
   // Σsent ≠ Σreceived and the mission waiting for ever.
   if (s.message.kind == dex::Message::Kind::ended) ++received_;
-  if (phase_ == Phase::running) engine_->receive(s.message);
+  if (phase_ == Phase::running) {
+    tee_.record(dex::message_event(mission_, s.message, mission_.self, loop_->now()));
+    engine_->receive(s.message);
+  }
   publish_status();
 }
 

@@ -79,13 +79,59 @@ std::string tail_of(const std::string& path, std::size_t lines) {
   return out;
 }
 
+/// Events the ground makes itself (telemetry samples, lifecycle messages): into the merged
+/// trace, and to the live view (the plain log skips them, the terminal's status uses them).
+class Collect : public dex::TraceSink {
+ public:
+  Collect(std::vector<dex::TraceEvent>& events, dex::TraceSink* live) : events_(events), live_(live) {}
+  void record(const dex::TraceEvent& e) override {
+    events_.push_back(e);
+    if (live_) live_->record(e);
+  }
+
+ private:
+  std::vector<dex::TraceEvent>& events_;
+  dex::TraceSink* live_;
+};
+
+/// The trace header `eamos compile` wrote into the deployment (trace-header.json); from the
+/// manifest alone (no mission or fleet text) when it is missing or not a header.
+nlohmann::ordered_json load_header(const std::string& dir, const std::string& hash,
+                                   const std::vector<DroneEntry>& drones, double telemetry_hz, std::ostream& err) {
+  std::ifstream in(dir + "/trace-header.json");
+  nlohmann::ordered_json h = nlohmann::ordered_json::parse(in, nullptr, false);
+  bool usable = in && h.is_object() && h.value("event", "") == "header" && h.value("mission_hash", "") == hash;
+  if (!usable) {
+    err << "ground: " << dir << "/trace-header.json is missing or not this mission's; the trace's header will "
+        << "not embed the mission and fleet text (compile the deployment again with this eamos)\n";
+    h = nlohmann::ordered_json::object();
+    h["t"] = 0;
+    h["event"] = "header";
+    h["schema"] = "eamos-trace";
+    h["version"] = 1;
+    h["mission"] = "";
+    h["mission_hash"] = hash;
+    h["source"] = "";
+    h["fleet"] = "";
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (std::size_t d = 0; d < drones.size(); ++d)
+      list.push_back({{"name", drones[d].name}, {"index", d}, {"type", ""}, {"home", {0.0, 0.0, 0.0}}});
+    h["drones"] = list;
+  }
+  h["telemetry_hz"] = telemetry_hz;
+  return h;
+}
+
 class Ground {
  public:
   Ground(const LaunchOptions& o, dex::TraceSink* live, LaunchResult& r, std::ostream& out, std::ostream& err)
-      : o_(o), live_(live), r_(r), out_(out), err_(err), loop_(mid::ClockOptions{mid::ClockMode::real_time, 1.0}) {}
+      : o_(o), live_(live), r_(r), out_(out), err_(err), loop_(mid::ClockOptions{mid::ClockMode::real_time, 1.0}),
+        collect_(r.events, live), telemetry_(&collect_, o.telemetry_hz) {}
   int run();
 
  private:
+  double mission_now() const { return (unix_ns() - start_at_ns_) / 1e9 * o_.speed; }
+  void record_lifecycle(const LifecycleSample& s);
   bool start_processes();
   void tick();
   void send_start();
@@ -135,6 +181,8 @@ class Ground {
   /// same deployment does not take the first one's READYs (or the reverse).
   std::uint64_t launch_id_ = 0;
   bool interrupted_ = false;
+  Collect collect_;
+  dex::TelemetryRecorder telemetry_;
 
   // Last, so it goes first: its listener threads post through inbox_ to loop_.
   std::unique_ptr<transport::DdsNode> node_;
@@ -162,6 +210,8 @@ int Ground::run() {
       err_ << "eamos launch: error: --drones names '" << n << "', which is not a drone of this mission\n";
       return 1;
     }
+  r_.header = load_header(o_.dir, hash_, drones_, o_.telemetry_hz, err_);
+  for (auto& d : drones_) r_.fleet.push_back(d.name);
   for (auto& d : drones_)
     d.local = !o_.remote_only &&
               (o_.local.empty() || std::find(o_.local.begin(), o_.local.end(), d.name) != o_.local.end());
@@ -356,7 +406,12 @@ void Ground::interrupt() {
   abort.reason = why;
   abort.t = mission_time();
   node_->write(abort);  // first: the drones' failsafe must not wait for a terminal
-  if (!abort_) abort_ = abort;
+  if (!abort_) {
+    abort_ = abort;
+    LifecycleSample heard = abort;
+    heard.t = mission_now();  // for the trace only: the report keeps what it always said
+    record_lifecycle(heard);
+  }
   err_ << "ground: " << why << "; aborting the run: every drone runs its failsafe\n";
 }
 
@@ -464,6 +519,7 @@ void Ground::on_run_lifecycle(const LifecycleSample& s) {
       return reject(s.drone, "abort", "the failed drone it names is not in the mission");
     if (!(s.t >= 0.0)) return reject(s.drone, "abort", "its mission time is negative");
     abort_ = s;
+    record_lifecycle(s);
   }
   // FINISHED only from the lead, and only when the statuses say what the lead saw; it may
   // come before the last statuses do, so it waits for them (check_pending_finished).
@@ -502,6 +558,7 @@ void Ground::check_pending_finished() {
   if (finish_agreed(pending_finished_->drone, why)) {
     finished_ = pending_finished_;
     pending_finished_.reset();
+    record_lifecycle(*finished_);
   } else if (all_done()) {
     reject(pending_finished_->drone, "finished", why);
   }
@@ -541,6 +598,22 @@ void Ground::on_telemetry(const TelemetrySample& s) {
   if (s.run_id != (stage_ == Stage::barrier ? 0 : r_.run_id)) return;
   dex::record_sample(drones_[t.from].track, t.state);
   drones_[t.from].last_state = t.state;
+  // The DEXes publish on every change (20 Hz while moving): the trace keeps telemetry_hz.
+  const std::string& name = drones_[t.from].name;
+  if (stage_ == Stage::running && telemetry_.due(name, t.state.t)) telemetry_.sample(name, t.state, t.state.t);
+}
+
+void Ground::record_lifecycle(const LifecycleSample& s) {
+  // The ground hears of it at its own estimate of mission time, never before it was sent.
+  dex::TraceEvent e;
+  e.event = "message";
+  e.kind = s.kind == LifecycleKind::abort ? "abort" : "finished";
+  e.from = s.drone;
+  e.to = -1;
+  e.sent = s.t;
+  e.t = std::max(s.t, mission_now());
+  e.reason = s.reason;
+  collect_.record(e);
 }
 
 }  // namespace

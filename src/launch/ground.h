@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "dex/runner.h"
 #include "dex/trace.h"
 #include "transport/dds_node.h"
@@ -29,11 +31,14 @@ struct LaunchOptions {
   double final_state_timeout_s = 10.0;
   /// Without DDS Security, for the ground and every DEX it starts (docs/security.md).
   bool insecure = false;
+  double telemetry_hz = 5.0;  ///< telemetry events per drone per mission second in the trace; 0 = none
 };
 
 struct LaunchResult {
   dex::RunResult run;                   ///< as `eamos run` reports it
   std::vector<dex::TraceEvent> events;  ///< every drone's events, by time
+  nlohmann::ordered_json header;        ///< the trace's first line (docs/trace.md)
+  std::vector<std::string> fleet;       ///< drone names by index
   std::uint64_t run_id = 0;
 };
 

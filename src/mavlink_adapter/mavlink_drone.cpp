@@ -395,6 +395,8 @@ mid::DroneState MavlinkDrone::state() const {
   s.landed = vehicle_.landed();
   for (int k = 1; k <= type_.sensors; ++k) s.sensors["Sensor" + std::to_string(k)] = sensor_value(k);
   s.pictures = pictures_;
+  if (vehicle_.heading_deg >= 0) s.heading = vehicle_.heading_deg;
+  if (autopilot_ && vehicle_.heard) s.mode = mode_name(*autopilot_, vehicle_.custom_mode);
   return s;
 }
 

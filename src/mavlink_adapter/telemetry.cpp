@@ -78,6 +78,8 @@ Changes apply_telemetry(VehicleState& v, const ml::Frame& frame) {
     v.have_altitude = true;
     v.amsl_m = g->alt / 1000.0;
     v.relative_alt_m = g->relative_alt / 1000.0;
+    // UINT16_MAX: the vehicle does not know; anything else beyond 359.99° is not a heading.
+    v.heading_deg = g->hdg < 36000 ? g->hdg / 100.0 : -1.0;
   }
   c.landed = v.landed() != was_landed;
   return c;

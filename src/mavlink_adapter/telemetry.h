@@ -5,6 +5,7 @@
 //   mission = home + (NED east, NED north, -NED down),
 // with `home` the drone's home from the fleet file.
 #include <cstdint>
+#include <limits>
 
 #include "fleet/fleet.h"
 #include "mavlink/frame.h"
@@ -24,6 +25,7 @@ struct VehicleState {
   bool have_altitude = false;     ///< a GLOBAL_POSITION_INT arrived
   double amsl_m = 0.0;            ///< altitude above mean sea level
   double relative_alt_m = 0.0;    ///< altitude above home
+  double heading_deg = -1.0;      ///< GLOBAL_POSITION_INT.hdg in degrees, -1 unknown
 
   /// On the ground: EXTENDED_SYS_STATE says so; without it, disarmed or within 0.3 m of
   /// the local origin's height.

@@ -15,6 +15,7 @@
 //  - Hover() and Orbit() have no end of their own: they run until preempted or cancelled.
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -58,6 +59,10 @@ struct DroneState {
   bool landed = true;
   std::map<std::string, double> sensors;  ///< "Sensor1" … "SensorN" of the drone's type
   int pictures = 0;      ///< TakePicture actions that succeeded
+  /// Degrees clockwise from north (0 ≤ heading < 360); NaN while the adapter does not know
+  /// it. Telemetry for people (trace, monitor): no mission property reads it.
+  double heading = std::numeric_limits<double>::quiet_NaN();
+  std::string mode;      ///< the vehicle's flight mode in its own words ("OFFBOARD", "go"); "" unknown
 };
 
 /// Identifies one started action of one drone; 0 (kNoAction) is never issued.

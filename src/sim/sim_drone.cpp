@@ -262,6 +262,11 @@ void SimDrone::step() {
     kin_.velocity.z = std::max(0.0, kin_.velocity.z);
   }
   if (landed_ && kin_.position.z > ground_z()) set_landed(false);
+  // The nose follows the horizontal velocity; a drone (nearly) standing keeps its heading.
+  if (std::hypot(kin_.velocity.x, kin_.velocity.y) > 0.1) {
+    double deg = std::atan2(kin_.velocity.x, kin_.velocity.y) * 180.0 / M_PI;
+    heading_ = deg < 0 ? deg + 360.0 : deg;
+  }
 
   ActionId owner = motion_owner_;
   if (event == StepEvent::arrived || event == StepEvent::touched_down) motion_owner_ = mid::kNoAction;
@@ -342,7 +347,17 @@ mid::DroneState SimDrone::state() const {
   s.landed = landed_;
   for (int k = 1; k <= type_.sensors; ++k) s.sensors["Sensor" + std::to_string(k)] = sensor_value(k);
   s.pictures = pictures_;
+  s.heading = heading_;
+  s.mode = mode_name();
   return s;
+}
+
+std::string SimDrone::mode_name() const {
+  // The simulator has no autopilot modes: its mode is what its motors do, and whether a
+  // failsafe took over.
+  static const char* const kinds[] = {"idle", "hold", "go", "land", "orbit"};
+  std::string kind = kinds[static_cast<int>(motion_.kind)];
+  return failsafe_reason_.empty() ? kind : "failsafe " + kind;
 }
 
 mid::SubscriptionId SimDrone::subscribe(mid::StateCallback fn) {

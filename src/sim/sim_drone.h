@@ -70,6 +70,7 @@ class SimDrone final : public mid::Drone {
   void post_publish();   ///< publish from the loop (for changes made inside API calls)
   void update_timers();  ///< steps while moving, idle telemetry while armed and still
   double sensor_value(int k) const;
+  std::string mode_name() const;
   double ground_z() const { return settings_.home.z; }
 
   fleet::DroneSettings settings_;
@@ -81,6 +82,7 @@ class SimDrone final : public mid::Drone {
   bool armed_ = false;
   bool landed_ = true;
   int pictures_ = 0;
+  double heading_ = 0.0;  ///< degrees from north; a drone starts facing north
   Battery battery_;
   std::string failsafe_reason_;  ///< "" = no failsafe; otherwise why new actions are refused
 

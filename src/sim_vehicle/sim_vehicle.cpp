@@ -349,6 +349,8 @@ ml::Message SimVehicle::telemetry(uint32_t id) const {
       g.lon = static_cast<int32_t>(std::lround(lon * 1e7));
       g.alt = static_cast<int32_t>(std::lround((options_.home_amsl_m + s.z) * 1000.0));
       g.relative_alt = static_cast<int32_t>(std::lround(s.z * 1000.0));
+      // As a real autopilot: cdeg from north, UINT16_MAX when the vehicle does not know.
+      if (std::isfinite(s.heading)) g.hdg = static_cast<uint16_t>(std::lround(s.heading * 100.0) % 36000);
       return ml::pack(g);
     }
   }

@@ -159,6 +159,7 @@ eamos_wire_Trigger to_wire(const TriggerSample& s) {
   w.scope = m.scope;
   w.epoch = m.epoch;
   w.body_epoch = m.body_epoch;
+  w.sent = m.sent;
   return w;
 }
 
@@ -186,6 +187,8 @@ bool from_wire(const eamos_wire_Trigger& w, const WireLimits& limits, TriggerSam
   m.epoch = w.epoch;
   check.at_least("body_epoch", w.body_epoch, 0);
   m.body_epoch = w.body_epoch;
+  check.finite("sent", w.sent);
+  m.sent = w.sent;
   return check.ok();
 }
 
@@ -199,6 +202,8 @@ void to_wire(const TelemetrySample& s, TelemetryOut& out) {
   w.from = t.from;
   w.run_id = s.run_id;
   state_to_wire(t.state, w.t, w.x, w.y, w.z, w.battery, w.armed, w.landed, w.pictures);
+  w.heading = std::isfinite(t.state.heading) ? t.state.heading : -1.0;
+  w.mode = borrow(t.state.mode);
   w.sensors._length = w.sensors._maximum = static_cast<uint32_t>(out.sensors.size());
   w.sensors._buffer = out.sensors.data();
   w.sensors._release = false;
@@ -212,6 +217,9 @@ bool from_wire(const eamos_wire_Telemetry& w, const WireLimits& limits, Telemetr
   check.drone("from", w.from);
   s.telemetry.from = w.from;
   s.telemetry.state = state_from_wire(w, check);
+  // Heading and mode are only shown to people: an unusable heading is "unknown", not a fault.
+  if (std::isfinite(w.heading) && w.heading >= 0 && w.heading < 360) s.telemetry.state.heading = w.heading;
+  s.telemetry.state.mode = check.text("mode", w.mode, kMaxWireName);
   check.count("sensors", w.sensors._length, kMaxWireSensors);
   for (uint32_t i = 0; check.ok() && i < w.sensors._length; ++i) {
     std::string name = check.text("sensor name", w.sensors._buffer[i].name, kMaxWireName);
@@ -327,6 +335,13 @@ eamos_wire_TraceRecord to_wire(const TraceSample& s) {
   w.has_reading = e.reading.has_value();
   w.reading = e.reading.value_or(0.0);
   w.reason = borrow(e.reason);
+  w.node = e.node;
+  w.instance = e.instance;
+  w.kind = borrow(e.kind);
+  w.branch = borrow(e.branch);
+  w.from = e.from;
+  w.to = e.to;
+  w.sent = e.sent;
   return w;
 }
 
@@ -354,6 +369,20 @@ bool from_wire(const eamos_wire_TraceRecord& w, const WireLimits& limits, TraceS
     e.reading = w.reading;
   }
   e.reason = check.text("reason", w.reason, kMaxWireText);
+  check.at_least("node", w.node, -1);
+  e.node = w.node;
+  check.at_least("instance", w.instance, -1);
+  e.instance = w.instance;
+  e.kind = check.text("kind", w.kind, kMaxWireName);
+  e.branch = check.text("branch", w.branch, kMaxWireName);
+  if (e.event == "message") {
+    check.drone("from", w.from);
+    check.drone("to", w.to);
+    check.finite("sent", w.sent);
+  }
+  e.from = w.from;
+  e.to = w.to;
+  e.sent = w.sent;
   return check.ok();
 }
 

@@ -21,6 +21,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "dex/trace_schema.h"
+
 #include "support/run_eamos.h"
 
 extern char** environ;
@@ -51,6 +53,25 @@ pid_t spawn_vehicle(int port, int sysid, const char* duration = "400", const cha
 std::string read_text(const fs::path& p) {
   std::ifstream in(p);
   return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+/// What breaks the trace schema (docs/trace.md), one line per fault; "" when nothing does.
+std::string schema_errors(const fs::path& trace) {
+  std::ifstream in(trace);
+  std::string all;
+  for (const std::string& e : eamos::dex::check_trace(in, {.strict = true})) all += e + "\n";
+  return all;
+}
+
+/// A telemetry sample with the autopilot's own mode and a heading from GLOBAL_POSITION_INT.
+bool has_mavlink_telemetry(const fs::path& trace) {
+  std::ifstream in(trace);
+  for (std::string line; std::getline(in, line);) {
+    auto e = nlohmann::json::parse(line);
+    if (e.value("event", "") == "telemetry" && e.value("mode", "") == "OFFBOARD" && e["heading"].is_number())
+      return true;
+  }
+  return false;
 }
 
 Sequences actions(const fs::path& trace) {
@@ -94,6 +115,8 @@ TEST(MavlinkListing2, ThreeSimVehiclesFlyTheSameActionsAsTheSimulator) {
   }
   ASSERT_EQ(status, 0) << out;
 
+  EXPECT_EQ(schema_errors(dir / "mavlink.jsonl"), "");
+  EXPECT_TRUE(has_mavlink_telemetry(dir / "mavlink.jsonl"));
   Sequences sim = actions(dir / "sim.jsonl");
   Sequences mav = actions(dir / "mavlink.jsonl");
   ASSERT_EQ(sim.size(), 3u);
@@ -126,6 +149,8 @@ TEST(MavlinkListing2, OneDexProcessPerDroneEachFlyingItsOwnVehicle) {
     waitpid(pid, nullptr, 0);
   }
   ASSERT_EQ(status, 0) << out;
+  EXPECT_EQ(schema_errors(dir / "mavlink.jsonl"), "");
+  EXPECT_TRUE(has_mavlink_telemetry(dir / "mavlink.jsonl"));
   Sequences sim = actions(dir / "sim.jsonl");
   Sequences mav = actions(dir / "mavlink.jsonl");
   for (const auto& [drone, seq] : sim) EXPECT_EQ(mav[drone], seq) << drone;
