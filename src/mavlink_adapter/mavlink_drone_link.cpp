@@ -235,17 +235,18 @@ void MavlinkDrone::on_heartbeat() {
   // the setpoint mode: give way instead of switching back.
   streaming_ = false;
   in_control_ = false;
-  fail_motion(std::string("the vehicle left ") + autopilot_->setpoint_mode_name + " for " +
-              mode_name(*autopilot_, vehicle_.custom_mode));
+  std::string mode = mode_name(*autopilot_, vehicle_.custom_mode);
+  fail_motion(mid::FailureReason::pilot_took_over,
+              std::string("the vehicle left ") + autopilot_->setpoint_mode_name + " for " + mode, "mode " + mode);
 }
 
-void MavlinkDrone::fail_motion(const std::string& reason) {
+void MavlinkDrone::fail_motion(mid::FailureReason why, const std::string& reason, const std::string& detail) {
   if (motion_owner_ == mid::kNoAction) return;
   ActionId id = motion_owner_;
   motion_owner_ = mid::kNoAction;
   goal_.reset();
   orbit_ = {};
-  tracker_.end(id, Outcome::failed, reason);
+  tracker_.fail(id, why, reason, detail);
 }
 
 void MavlinkDrone::link_watchdog() {
@@ -264,7 +265,7 @@ void MavlinkDrone::lose_link() {
   char text[128];
   std::snprintf(text, sizeof text, "link lost: no HEARTBEAT from system %d for %.1f s", sysid_,
                 options_.link_timeout_s);
-  fail_all(text);
+  fail_all(mid::FailureReason::link_lost, text);
   commands_.fail_all("link lost");
 }
 
@@ -373,8 +374,10 @@ void MavlinkDrone::switch_to_setpoint_mode() {
       return;
     }
     streaming_ = false;
-    fail_motion(std::string("switch to ") + autopilot_->setpoint_mode_name + " refused by " + autopilot_->name +
-                ": " + r.error);
+    fail_motion(r.answered ? mid::FailureReason::refused : mid::FailureReason::timed_out,
+                std::string("switch to ") + autopilot_->setpoint_mode_name + " refused by " + autopilot_->name +
+                    ": " + r.error,
+                r.error);
   });
 }
 

@@ -78,6 +78,8 @@ TEST(MavlinkFlight, ArmRefusedByTheAutopilotFailsWithItsResultInWords) {
   mid::ActionEnd e = f.fly("Arm");
   EXPECT_EQ(e.outcome, mid::Outcome::failed);
   EXPECT_EQ(e.reason, "refused by PX4: MAV_CMD_COMPONENT_ARM_DISARM: MAV_RESULT_DENIED (denied by the autopilot)");
+  EXPECT_EQ(e.failure, mid::FailureReason::refused);
+  EXPECT_EQ(e.detail, "MAV_CMD_COMPONENT_ARM_DISARM: MAV_RESULT_DENIED (denied by the autopilot)");
   EXPECT_FALSE(f.drone->state().armed);
 }
 
@@ -110,9 +112,11 @@ TEST(MavlinkFlight, LinkLossFailsTheRunningAction) {
   ASSERT_TRUE(end);
   EXPECT_EQ(end->outcome, mid::Outcome::failed);
   EXPECT_EQ(end->reason, "link lost: no HEARTBEAT from system 1 for 2.0 s");
+  EXPECT_EQ(end->failure, mid::FailureReason::link_lost);
   mid::ActionEnd refused = f.fly("Land");
   EXPECT_EQ(refused.outcome, mid::Outcome::failed);
   EXPECT_EQ(refused.reason, "link lost: no HEARTBEAT from system 1");
+  EXPECT_EQ(refused.failure, mid::FailureReason::link_lost);
 }
 
 TEST(MavlinkFlight, APilotsModeSwitchFailsTheMotionAndTheAdapterGivesWay) {
@@ -144,6 +148,8 @@ TEST(MavlinkFlight, APilotsModeSwitchFailsTheMotionAndTheAdapterGivesWay) {
   ASSERT_TRUE(end);
   EXPECT_EQ(end->outcome, mid::Outcome::failed);
   EXPECT_EQ(end->reason, "the vehicle left OFFBOARD for POSCTL");
+  EXPECT_EQ(end->failure, mid::FailureReason::pilot_took_over);
+  EXPECT_EQ(end->detail, "mode POSCTL");
   f.loop.run_until(f.loop.now() + 2.0);  // and it does not switch back
   vehicle.halt();
   EXPECT_EQ(vehicle.mode(), sim_vehicle::Mode::manual);
@@ -185,6 +191,7 @@ TEST(MavlinkFlight, FailsafeLandCancelsTheFlightLandsAndRefusesMore) {
   ASSERT_TRUE(end);
   EXPECT_EQ(end->outcome, mid::Outcome::cancelled);
   EXPECT_EQ(end->reason, "failsafe: land");
+  EXPECT_EQ(end->failure, mid::FailureReason::none);  // cancelled is no failure
   for (int i = 0; i < 100 && !f.drone->state().landed; ++i) f.loop.run_until(f.loop.now() + 0.5);
   EXPECT_TRUE(f.drone->state().landed);
   EXPECT_LT(f.drone->state().x, 29.0);  // landed where it was, not at the target
