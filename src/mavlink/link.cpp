@@ -223,6 +223,17 @@ bool same_address(const sockaddr_in& a, const sockaddr_in& b) {
 }  // namespace
 
 void Link::handle_bytes(std::span<const uint8_t> bytes, const sockaddr_in* from) {
+  if (from && locked_) {
+    bool vehicle;
+    {
+      std::lock_guard lock(mutex_);
+      vehicle = same_address(*from, peer_);
+    }
+    if (!vehicle) {  // not the vehicle's address: not even parsed
+      ++foreign_datagrams_;
+      return;
+    }
+  }
   if (from && !same_address(*from, last_from_)) {
     parser_.discard_partial();
     last_from_ = *from;
@@ -237,16 +248,19 @@ void Link::handle_bytes(std::span<const uint8_t> bytes, const sockaddr_in* from)
 }
 
 // Replies go where the vehicle is, as PX4's offboard link expects, and the vehicle is
-// where its valid frames come from: anybody can send a datagram to the port, but only
-// the vehicle's CRC-checked frames may move the link (a stray packet would otherwise turn
-// every command away from the aircraft).
+// where its first valid frame came from: anybody can send a datagram to the port, and
+// anybody can forge a CRC-checked frame with the vehicle's system id (the CRC is no
+// secret), so once the vehicle is known its address is kept. A vehicle that comes back on
+// another port (a SITL restarted on a new port) is a lost link, not a new peer.
 void Link::follow_sender(const std::vector<Frame>& frames, const sockaddr_in& from) {
+  if (locked_) return;  // only the vehicle's address gets here (handle_bytes)
   uint8_t wanted = follow_sysid_;
   for (const Frame& f : frames)
     if (wanted == 0 || f.sysid == wanted) {
       std::lock_guard lock(mutex_);
       peer_ = from;
       has_peer_ = true;
+      if (wanted != 0) locked_ = true;
       return;
     }
 }

@@ -43,10 +43,17 @@ class Link {
   const Endpoint& endpoint() const { return endpoint_; }
   /// Parser counters so far (garbage, bad CRCs), copied under the lock.
   ParserStats stats() const;
-  /// udp:// only: replies go to whoever last sent a valid frame (CRC-checked and parsed)
-  /// from system `sysid`; 0 (the default, before the vehicle is known): from any system.
-  /// A datagram of garbage, or a frame of another system, never redirects the link.
+  /// udp:// only. 0 (the default, before the vehicle is known): replies go to whoever last
+  /// sent a valid frame (CRC-checked and parsed) of any system. Else the first valid frame of
+  /// system `sysid` fixes the vehicle's address for good: from then on every datagram from
+  /// another address is dropped unread and counted (foreign_datagrams), so a forged frame
+  /// with the vehicle's system id from another port neither reaches the adapter nor turns
+  /// its commands away. A datagram of garbage never redirects the link.
   void follow_only(uint8_t sysid) { follow_sysid_ = sysid; }
+  /// udp://: datagrams dropped because they came from another address than the vehicle's.
+  uint64_t foreign_datagrams() const { return foreign_datagrams_; }
+  /// udp://: the vehicle's address is fixed (see follow_only).
+  bool locked() const { return locked_; }
 
  private:
   Link(Endpoint endpoint, int fd, int wake_read, int wake_write, FrameHandler on_frame);
@@ -69,6 +76,8 @@ class Link {
   sockaddr_in peer_{};          ///< the vehicle's last address (udp://) or the target (udpout://)
   bool has_peer_ = false;
   std::atomic<uint8_t> follow_sysid_{0};  ///< udp://: whose valid frames move peer_
+  std::atomic<bool> locked_{false};        ///< udp://: peer_ is the vehicle's, for good
+  std::atomic<uint64_t> foreign_datagrams_{0};
   sockaddr_in last_from_{};     ///< udp://: sender of the previous datagram (receive thread only)
   bool closed_ = false;         ///< TCP: the peer closed the connection; not yet reconnected
   ParserStats stats_;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 
 #include "mavlink/enums.h"
 #include "mid/requests.h"
@@ -37,6 +38,9 @@ MavlinkDrone::MavlinkDrone(fleet::DroneSettings settings, fleet::DroneType type,
       commands_(loop, [this](const ml::Message& m) { send(m); }, options.commands) {}
 
 MavlinkDrone::~MavlinkDrone() {
+  if (link_ && link_->foreign_datagrams() > 0)
+    std::cerr << "mavlink: " << settings_.name << ": " << link_->foreign_datagrams()
+              << " datagram(s) from other addresses than the vehicle's were ignored in all\n";
   link_.reset();  // joins the receive thread: nothing new gets posted
   for (mid::TimerId t : {stream_timer_, heartbeat_timer_, watchdog_timer_}) loop_.cancel(t);
 }

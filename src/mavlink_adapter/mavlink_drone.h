@@ -137,6 +137,9 @@ class MavlinkDrone final : public mid::AdapterDrone {
   void on_frame(const mavlink::Frame& frame);
   /// A frame of the vehicle refused for its values: counted and logged, never applied.
   void note_rejected(const char* what);
+  /// Datagrams the udp:// link dropped for coming from another address than the vehicle's:
+  /// logged (the first, then every thousandth) and the first one put in the trace.
+  void note_foreign();
   void on_heartbeat();
   void link_watchdog();
   void lose_link();
@@ -169,6 +172,7 @@ class MavlinkDrone final : public mid::AdapterDrone {
   const Autopilot* autopilot_ = nullptr;
   uint8_t sysid_ = 0;  ///< the vehicle's system id (0 until known)
   uint64_t rejected_frames_ = 0;  ///< frames of the vehicle refused for their values
+  uint64_t foreign_reported_ = 0; ///< link's foreign_datagrams() when last looked at
 
   /// Posted frames hold a weak pointer to this: a frame that reaches the loop after the
   /// drone is gone is dropped instead of touching freed memory.

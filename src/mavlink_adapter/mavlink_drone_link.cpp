@@ -219,7 +219,21 @@ void MavlinkDrone::note_rejected(const char* what) {
               << " (" << rejected_frames_ << " dropped so far)\n";
 }
 
+void MavlinkDrone::note_foreign() {
+  uint64_t n = link_ ? link_->foreign_datagrams() : 0;
+  if (n == foreign_reported_) return;
+  bool first = foreign_reported_ == 0;
+  bool thousandth = n / 1000 > foreign_reported_ / 1000;
+  foreign_reported_ = n;
+  if (!first && !thousandth) return;
+  std::string text = "ignored " + std::to_string(n) + " datagram(s) from other addresses than system " +
+                     std::to_string(sysid_) + "'s (not the vehicle: someone else is sending to this port)";
+  std::cerr << "mavlink: " << settings_.name << ": " << text << "\n";
+  if (first) note(text);
+}
+
 void MavlinkDrone::on_heartbeat() {
+  note_foreign();
   link_lost_ = false;
   link_watchdog();
   if (!telemetry_requested_) request_telemetry();

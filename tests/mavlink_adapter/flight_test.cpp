@@ -2,7 +2,9 @@
 // time sped up 4×: every test flies a few mission seconds. Each test has its own port.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
+#include <thread>
 
 #include "mavlink/enums.h"
 #include "mavlink/link.h"
@@ -153,6 +155,39 @@ TEST(MavlinkFlight, APilotsModeSwitchFailsTheMotionAndTheAdapterGivesWay) {
   f.loop.run_until(f.loop.now() + 2.0);  // and it does not switch back
   vehicle.halt();
   EXPECT_EQ(vehicle.mode(), sim_vehicle::Mode::manual);
+}
+
+TEST(MavlinkFlight, ForgedFramesWithTheVehiclesSystemIdFromAnotherPortAreIgnoredAndCounted) {
+  test::VehicleThread vehicle(25371, 1, kSpeed);
+  Flight f(25371);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  std::vector<std::string> messages;
+  f.drone->set_message_sink([&](const std::string& m) { messages.push_back(m); });
+  // An attacker on the adapter's port: DENIED for every arm command and HEARTBEATs, all with
+  // the vehicle's system id, while the mission arms and takes off.
+  auto forger = mavlink::Link::open(*mavlink::parse_url("udpout://127.0.0.1:25371").endpoint, [](mavlink::Frame) {});
+  ASSERT_TRUE(forger.link) << forger.error;
+  std::atomic<bool> stop{false};
+  std::thread attack([&] {
+    mavlink::Encoder forged{1, 1, 0};
+    while (!stop) {
+      forger.link->send(forged.encode(mavlink::pack(mavlink::CommandAck{mavlink::cmd::COMPONENT_ARM_DISARM, 2})));
+      forger.link->send(forged.encode(mavlink::pack(mavlink::Heartbeat{})));
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // a 50 Hz flood, not a wait
+    }
+  });
+  mid::ActionEnd arm = f.fly("Arm");
+  mid::ActionEnd takeoff = f.fly("Takeoff", {3});
+  stop = true;
+  attack.join();
+  EXPECT_EQ(arm.outcome, mid::Outcome::succeeded) << arm.reason;
+  EXPECT_EQ(takeoff.outcome, mid::Outcome::succeeded) << takeoff.reason;
+  auto* d = dynamic_cast<MavlinkDrone*>(f.drone.get());
+  ASSERT_NE(d, nullptr);
+  f.loop.run_until(f.loop.now() + 0.5);  // a HEARTBEAT or two: the adapter reports the count
+  ASSERT_FALSE(messages.empty());
+  EXPECT_NE(messages[0].find("ignored"), std::string::npos) << messages[0];
+  EXPECT_NE(messages[0].find("datagram(s) from other addresses than system 1's"), std::string::npos) << messages[0];
 }
 
 TEST(MavlinkFlight, OrbitRunsUntilCancelledThenHolds) {
