@@ -68,7 +68,8 @@ bool connect_within(int fd, const sockaddr_in& to, int timeout_ms, std::string& 
 
 }  // namespace
 
-OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame, double reconnect_s) {
+OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame, double reconnect_s,
+                      const std::optional<SigningKey>& verify, bool require_signed) {
   auto fail = [&](const std::string& why) {
     return OpenResult{nullptr, "connection '" + endpoint.url + "': " + why};
   };
@@ -106,6 +107,10 @@ OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame, double re
   }
   std::unique_ptr<Link> link(new Link(endpoint, fd, pipe_fds[0], pipe_fds[1], std::move(on_frame)));
   link->reconnect_ms_ = static_cast<int>(reconnect_s * 1000.0);
+  if (verify) {  // before the receive thread exists: no datagram is read without the key
+    link->parser_.verify_with(*verify);
+    link->parser_.require_signed(require_signed);
+  }
   if (endpoint.kind != LinkKind::udp_listen) {
     link->peer_ = addr;
     link->has_peer_ = true;
@@ -222,7 +227,25 @@ bool same_address(const sockaddr_in& a, const sockaddr_in& b) {
 }
 }  // namespace
 
+void Link::verify_with(SigningKey key, bool required) {
+  std::lock_guard lock(mutex_);
+  pending_key_ = key;
+  pending_required_ = required;
+}
+
+void Link::require_signed(bool required) {
+  std::lock_guard lock(mutex_);
+  pending_required_ = required;
+}
+
 void Link::handle_bytes(std::span<const uint8_t> bytes, const sockaddr_in* from) {
+  {
+    std::lock_guard lock(mutex_);
+    if (pending_key_) parser_.verify_with(*pending_key_);
+    if (pending_required_) parser_.require_signed(*pending_required_);
+    pending_key_.reset();
+    pending_required_.reset();
+  }
   if (from && locked_) {
     bool vehicle;
     {

@@ -20,6 +20,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 
@@ -34,6 +35,8 @@
 #include "mid/state_broker.h"
 
 namespace eamos::mavlink_adapter {
+
+struct FirstHeartbeat;  ///< mavlink_drone_link.cpp
 
 struct MavlinkOptions {
   bool real_time = false;          ///< the loop runs in real time: required (a real vehicle
@@ -125,6 +128,9 @@ class MavlinkDrone final : public mid::AdapterDrone {
   void fail_all(mid::FailureReason why, const std::string& reason);
   /// Ends the motion the adapter flies (if any) `failed`, dropping its goal and orbit.
   void fail_motion(mid::FailureReason why, const std::string& reason, const std::string& detail);
+
+  /// fleet `signing: {setup: true}`: gives the vehicle the key at connect (mavlink_drone_link.cpp).
+  std::string give_key(FirstHeartbeat& first, std::unique_lock<std::mutex>& lock, const mavlink::SigningKey& key);
 
   // the vehicle's own words (mavlink_drone_link.cpp)
   void on_statustext(const mavlink::Statustext& t);

@@ -151,6 +151,20 @@ TEST(MavlinkSigning, ParserWithAKeySurvivesNoiseAndCutFrames) {
   EXPECT_GT(good, 1000u);  // the whole frames behind noise and cut ones still come through
 }
 
+TEST(MavlinkSigning, SetupSigningHasCommonXmlsLayoutAndRoundTrips) {
+  const MessageDef* def = find_message(msg::SETUP_SIGNING);
+  ASSERT_NE(def, nullptr);
+  EXPECT_EQ(def->crc_extra, 71);  // common.xml's SETUP_SIGNING
+  EXPECT_EQ(def->length, 42);
+  SetupSigning s{7, 1, counting_key().bytes, 123456789012345ull};
+  auto back = unpack_setup_signing(pack(s));
+  ASSERT_TRUE(back);
+  EXPECT_EQ(back->target_system, 7);
+  EXPECT_EQ(back->target_component, 1);
+  EXPECT_EQ(back->secret_key, s.secret_key);
+  EXPECT_EQ(back->initial_timestamp, s.initial_timestamp);
+}
+
 TEST(MavlinkSigning, KeysAreSixtyFourHexDigitsAndNeverAllZero) {
   std::string error;
   auto key = parse_signing_key("000102030405060708090a0b0c0d0e0f101112131415161718191A1B1C1D1E1F\n", error);

@@ -190,6 +190,50 @@ TEST(MavlinkFlight, ForgedFramesWithTheVehiclesSystemIdFromAnotherPortAreIgnored
   EXPECT_NE(messages[0].find("datagram(s) from other addresses than system 1's"), std::string::npos) << messages[0];
 }
 
+const char* kTestKey = "0f1e2d3c4b5a69788796a5b4c3d2e1f000112233445566778899aabbccddeeff";
+
+TEST(MavlinkFlight, SigningSetupGivesTheVehicleTheKeyAndAnUnsignedGroundStationIsIgnored) {
+  test::VehicleThread vehicle(25372, 1, kSpeed);
+  Flight f(25372, {}, [](fleet::DroneSettings& s) {
+    s.signing_key = kTestKey;
+    s.signing_setup = true;
+  });
+  ASSERT_TRUE(f.drone) << f.created.message;
+  ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
+  ASSERT_EQ(f.fly("Takeoff", {3}).outcome, mid::Outcome::succeeded);
+  // A ground station without the key switches the vehicle to POSCTL (as in
+  // APilotsModeSwitchFailsTheMotionAndTheAdapterGivesWay): the signed vehicle drops it.
+  auto gcs = mavlink::Link::open(*mavlink::parse_url("udpout://127.0.0.1:" + std::to_string(vehicle.port())).endpoint,
+                                 [](mavlink::Frame) {});
+  ASSERT_TRUE(gcs.link) << gcs.error;
+  mavlink::CommandLong c;
+  c.target_system = 1;
+  c.target_component = 1;
+  c.command = mavlink::cmd::DO_SET_MODE;
+  c.param = {1, mavlink::px4::MAIN_POSCTL, 0};
+  std::optional<mid::ActionEnd> end;
+  f.drone->start({"FlyTo", {30, 0, 3}}, [&](const mid::ActionEnd& e) {
+    end = e;
+    f.loop.stop();
+  });
+  f.loop.run_until(f.loop.now() + 1.0);
+  for (int i = 0; i < 5; ++i) gcs.link->send(mavlink::Encoder{255, 190, static_cast<uint8_t>(i)}.encode(mavlink::pack(c)));
+  f.loop.run_until(f.loop.now() + 30.0);
+  ASSERT_TRUE(end);
+  EXPECT_EQ(end->outcome, mid::Outcome::succeeded) << end->reason;
+  EXPECT_NEAR(f.drone->state().x, 30.0, 0.5);
+  EXPECT_EQ(f.fly("Land").outcome, mid::Outcome::succeeded);
+}
+
+TEST(MavlinkFlight, WithAKeyButNoSetupAVehicleThatDoesNotSignNeverConnects) {
+  test::VehicleThread vehicle(25373, 1, kSpeed);  // has no key: its frames are unsigned
+  MavlinkOptions options;
+  options.connect_timeout_s = 1.0;
+  Flight f(25373, options, [](fleet::DroneSettings& s) { s.signing_key = kTestKey; });
+  EXPECT_EQ(f.created.status, mid::CreateStatus::adapter_failed);
+  EXPECT_NE(f.created.message.find("Signing is on for this drone"), std::string::npos) << f.created.message;
+}
+
 TEST(MavlinkFlight, OrbitRunsUntilCancelledThenHolds) {
   test::VehicleThread vehicle(25315, 1, kSpeed);
   Flight f(25315);
