@@ -28,8 +28,12 @@ nlohmann::ordered_json summary_json(const dex::RunResult& r) {
   j["status"] = r.completed ? "completed" : "failed";
   j["duration"] = r.duration;
   if (!r.error.empty()) j["error"] = r.error;
-  if (r.failure) j["failure"] = {{"drone", r.failure->drone}, {"action", r.failure->action},
-                                 {"line", r.failure->line}, {"reason", r.failure->reason}};
+  if (r.failure) {
+    j["failure"] = {{"drone", r.failure->drone}, {"action", r.failure->action},
+                    {"line", r.failure->line}, {"reason", r.failure->reason}};
+    if (r.failure->kind != mid::FailureReason::none) j["failure"]["kind"] = mid::failure_reason_name(r.failure->kind);
+    if (!r.failure->detail.empty()) j["failure"]["detail"] = r.failure->detail;
+  }
   nlohmann::ordered_json drones = nlohmann::ordered_json::object();
   for (const auto& d : r.drones) {
     nlohmann::ordered_json state = {{"x", d.state.x}, {"y", d.state.y}, {"z", d.state.z}, {"armed", d.state.armed},

@@ -33,8 +33,9 @@ int cmd_sim_vehicle(const SimVehicleCommandOptions& o) {
     std::cerr << "eamos: error: " << error << "\n";
     return 1;
   }
+  // The local port: where a second ground station (a test playing a pilot) reaches the vehicle.
   std::cout << "sim-vehicle: system " << o.sysid << " (" << options.dialect->name << "-like) on " << url
-            << std::endl;
+            << ", receiving on port " << vehicle.local_port() << std::endl;
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   // Short slices, so a signal is noticed within a quarter of a (mission) second.

@@ -355,6 +355,10 @@ class Reader {
     f_.string(*d, "adapter", "/drone", s.adapter);
     f_.string(*d, "connection", "/drone", s.connection, false, 4096);
     f_.integer(*d, "sysid", "/drone", s.sysid, 1, 255, false);
+    if (f_.string(*d, "signing_key", "/drone", s.signing_key, false, 64))
+      if (std::string why = fleet::signing_key_problem(s.signing_key); !why.empty() && !s.signing_key.empty())
+        d_.add("/drone/signing_key", why);
+    f_.boolean(*d, "signing_setup", "/drone", s.signing_setup, false);
     vec3(*d, "home", "/drone", s.home);
     f_.number(*d, "battery", "/drone", s.battery_percent, 0, 100);
     int failsafe = 0;

@@ -286,7 +286,7 @@ void Engine::on_action_end(int node, std::uint64_t instance, const mid::ActionEn
       drain();
       return;
     case mid::Outcome::failed:
-      if (hooks_.on_failure) hooks_.on_failure({m_.fleet[m_.self], n.name, n.line, e.reason});
+      if (hooks_.on_failure) hooks_.on_failure({m_.fleet[m_.self], n.name, n.line, e.reason, e.failure, e.detail});
       return;
   }
 }
@@ -304,6 +304,8 @@ void Engine::trace_end(const Node& n, const mid::ActionEnd& e) {
   t.outcome = mid::outcome_name(e.outcome);
   t.reason = e.reason;
   t.node = n.meg;
+  t.failure = mid::failure_reason_name(e.failure);
+  t.detail = e.detail;
   hooks_.trace->record(t);
   if (e.value && e.outcome == mid::Outcome::succeeded) {
     t.event = "sensor";

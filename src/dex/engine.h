@@ -30,6 +30,8 @@ struct Failure {
   std::string action;
   int line = 0;
   std::string reason;
+  mid::FailureReason kind = mid::FailureReason::none;  ///< none: not an action's failure
+  std::string detail;  ///< the vehicle's own words (MAV_RESULT, STATUSTEXT), or ""
 };
 
 struct EngineHooks {

@@ -19,6 +19,8 @@ struct TraceEvent {
   std::optional<bool> value;      ///< condition
   std::optional<double> reading;  ///< sensor
   std::string reason;       ///< end failed / preempted: why
+  std::string failure;      ///< end failed: the uniform kind (mid::failure_reason_name), else ""
+  std::string detail;       ///< end failed: the vehicle's own words (MAV_RESULT, STATUSTEXT), or ""
   int col = 0;              ///< source column of `name` (0 when unknown); not in the JSONL trace
   int node = -1;            ///< MEG node id of the node the event is about; -1 none
   std::string branch;       ///< event "node": the branch a condition released (go, true, repeat, …)

@@ -97,6 +97,9 @@ void check_event(const json& j, const std::string& event, LineCheck& c, const st
     if (event == "end") {
       c.one_of("outcome", kOutcomes);
       c.optional_string("reason");
+      if (j.contains("failure"))
+        c.one_of("failure", {"refused", "timed_out", "link_lost", "vehicle_fault", "pilot_took_over"});
+      c.optional_string("detail");
     }
     if (event == "condition") c.boolean("value");
     if (event == "sensor") c.number("value");

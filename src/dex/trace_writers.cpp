@@ -67,6 +67,8 @@ void JsonlTrace::record(const TraceEvent& e) {
     if (e.value) j["value"] = *e.value;
     if (e.reading) j["value"] = *e.reading;
     if (!e.reason.empty()) j["reason"] = e.reason;
+    if (!e.failure.empty()) j["failure"] = e.failure;
+    if (!e.detail.empty()) j["detail"] = e.detail;
     if (!e.kind.empty()) j["kind"] = e.kind;
     if (!e.branch.empty()) j["branch"] = e.branch;
     if (e.node >= 0) j["node"] = e.node;
@@ -91,6 +93,7 @@ void LiveLog::record(const TraceEvent& e) {
   std::snprintf(head, sizeof head, "%9.2f s  %-8s %-9s ", e.t, e.drone.c_str(), e.event.c_str());
   out_ << head << (e.text.empty() ? e.name : e.text);
   if (!e.outcome.empty()) out_ << "  " << e.outcome;
+  if (!e.failure.empty()) out_ << " [" << e.failure << "]";
   if (e.value) out_ << "  → " << (*e.value ? "true" : "false");
   if (e.reading) out_ << "  = " << *e.reading;
   if (!e.reason.empty()) out_ << "  (" << e.reason << ")";

@@ -2,8 +2,46 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include <sys/stat.h>
 
 namespace eamos::fleet {
+
+std::string signing_key_problem(const std::string& hex) {
+  if (hex.size() != 64) return "a signing key is 64 hexadecimal digits (32 bytes), got " + std::to_string(hex.size()) +
+                               " characters; make one with `openssl rand -hex 32`";
+  if (hex.find_first_not_of("0123456789abcdefABCDEF") != std::string::npos)
+    return "a signing key holds only hexadecimal digits (0-9, a-f); make one with `openssl rand -hex 32`";
+  if (hex.find_first_not_of('0') == std::string::npos)
+    return "an all-zero signing key means \"signing off\" to an autopilot; make one with `openssl rand -hex 32`";
+  return "";
+}
+
+std::string read_signing_key_file(const std::string& path, std::string& hex) {
+  struct stat st{};
+  if (stat(path.c_str(), &st) != 0) return "cannot read signing key file '" + path + "': " + std::strerror(errno);
+  if (!S_ISREG(st.st_mode)) return "signing key file '" + path + "' is not a regular file";
+  if ((st.st_mode & 077) != 0) {
+    char mode[8];
+    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
+    return "signing key file '" + path + "' may be read or written by others (mode " + mode +
+           "); whoever reads it can fly the vehicle: chmod 600 '" + path + "'";
+  }
+  std::ifstream in(path);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  if (!in && !in.eof()) return "cannot read signing key file '" + path + "'";
+  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back()))) text.pop_back();
+  if (std::string why = signing_key_problem(text); !why.empty()) return "signing key file '" + path + "': " + why;
+  hex = text;
+  return "";
+}
+
 
 const char* failsafe_name(Failsafe f) {
   switch (f) {

@@ -40,7 +40,18 @@ struct DroneSettings {
   int sysid = 0;                             ///< MAVLink system id; 0 = not set
   double battery_percent = 100.0;            ///< charge at mission start
   std::map<std::string, double> timeouts_s;  ///< per action name; overrides derived ones
+  /// MAVLink 2 signing (docs/fleet.md `signing:`): the link's secret key as 64 hex digits;
+  /// "" = frames unsigned. A secret: only the drone's own deployment folder holds it.
+  std::string signing_key;
+  bool signing_setup = false;  ///< send the key to the vehicle (SETUP_SIGNING) at connect
 };
+
+/// "" when `hex` is a usable signing key (64 hex digits, not all zero), else what is wrong.
+std::string signing_key_problem(const std::string& hex);
+/// Reads a signing key file (64 hex digits, a final newline allowed) into `hex`; "" on
+/// success, else what is wrong and how to fix it. A file that its group or others may read
+/// or write is refused: the key lets whoever holds it fly the vehicle.
+std::string read_signing_key_file(const std::string& path, std::string& hex);
 
 /// Where drones may fly (docs/fleet.md, `geofence:`): inside a polygon of the mission frame's
 /// x/y plane (none: anywhere) and between two altitudes (each optional). `eamos verify`

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <optional>
 
 #include "fleet/fleet.h"
@@ -20,7 +21,8 @@ const std::vector<std::string> kTypeKeys = {"adapter", "capabilities", "sensors"
 const std::vector<std::string> kDroneKeys = {"home",     "battery",  "sensors",
                                              "limits",   "failsafe", "adapter",
                                              "connection", "sysid",  "timeouts",
-                                             "geofence"};
+                                             "geofence", "signing"};
+const std::vector<std::string> kSigningKeys = {"key", "key_file", "setup"};
 const std::vector<std::string> kLimitKeys = {"max_speed", "max_climb", "max_descent",
                                              "max_accel", "max_altitude"};
 const std::vector<std::string> kSensorKeys = {"value", "gradient", "range"};
@@ -74,6 +76,7 @@ class FleetParser {
   void geofence(const YAML::Node& node, const std::string& where, std::optional<Geofence>& out);
   void polygon(const YAML::Node& node, const std::string& what, Geofence& out);
   void timeouts(const YAML::Node& node, const std::string& where, DroneSettings& settings);
+  void signing(const YAML::Node& node, const std::string& where, DroneSettings& settings);
   bool saturated() const { return r_.diags.saturated(); }
 
   YamlReader r_;
@@ -237,10 +240,45 @@ void FleetParser::drone(const std::string& name, const YAML::Node& node) {
       }
       if (key == "timeouts") timeouts(v, where, s);
       if (key == "geofence") geofence(v, where, o.geofence);
+      if (key == "signing") signing(v, where, s);
     }
   }
   out_.drones[name] = std::move(s);
   out_.overrides[name] = std::move(o);
+}
+
+void FleetParser::signing(const YAML::Node& node, const std::string& where, DroneSettings& settings) {
+  const std::string what = "signing of " + where;
+  if (!r_.map(node, what)) {
+    if (!node.IsNull()) return;
+    r_.error(node, what + " needs `key_file: PATH` (or `key: HEX`); make a key with `openssl rand -hex 32`");
+    return;
+  }
+  std::set<std::string> seen;
+  std::string key, file;
+  const YAML::Node* at = &node;
+  for (const auto& kv : node) {
+    std::string field = r_.field(kv.first, kSigningKeys, seen, what);
+    if (field == "key" && r_.text(kv.second, "key of " + what, key)) at = &kv.second;
+    if (field == "key_file" && r_.text(kv.second, "key_file of " + what, file)) at = &kv.second;
+    if (field == "setup" && !kv.second.IsScalar())
+      r_.error(kv.second, "setup of " + what + " must be true or false; got " + describe(kv.second));
+    else if (field == "setup" && !YAML::convert<bool>::decode(kv.second, settings.signing_setup))
+      r_.error(kv.second, "setup of " + what + " must be true or false; got " + describe(kv.second));
+  }
+  if (key.empty() == file.empty()) {
+    r_.error(node, what + " needs exactly one of `key_file: PATH` and `key: HEX`");
+    return;
+  }
+  if (!file.empty()) {
+    // Relative to the fleet file, like every path a fleet file names.
+    std::filesystem::path p(file);
+    if (p.is_relative() && r_.file && !r_.file->path.empty()) p = std::filesystem::path(r_.file->path).parent_path() / p;
+    if (std::string why = read_signing_key_file(p.string(), key); !why.empty()) return r_.error(*at, why);
+  } else if (std::string why = signing_key_problem(key); !why.empty()) {
+    return r_.error(*at, "key of " + what + ": " + why);
+  }
+  settings.signing_key = key;
 }
 
 void FleetParser::sensors(const YAML::Node& node, const std::string& where,

@@ -39,7 +39,8 @@ std::vector<uint8_t> encode_frame(const Message& message, uint8_t seq, uint8_t s
 
 std::vector<uint8_t> Encoder::encode(const Message& message) {
   // uint8_t arithmetic wraps 255 -> 0, as MAVLink's sequence number does.
-  return encode_frame(message, next_seq++, sysid, compid);
+  std::vector<uint8_t> frame = encode_frame(message, next_seq++, sysid, compid);
+  return signer ? signer->sign(std::move(frame)) : frame;
 }
 
 std::vector<Frame> Parser::feed(std::span<const uint8_t> bytes) {
@@ -88,11 +89,14 @@ Parser::Step Parser::try_frame(std::vector<Frame>& out) {
   }
   // The checksum holds, so this is a real frame: drop it whole if we cannot handle it.
   head_ += total;
-  if (incompat != 0) {
+  bool verified = false;
+  if (verifier_) {
+    if (!accept_signing(avail.subspan(0, total), verified)) return Step::consumed;
+  } else if (incompat != 0) {
     ++stats_.unsupported;
     return Step::consumed;
   }
-  Frame frame{avail[4], avail[5], avail[6], incompat, avail[3], len, sent, {id, {}}};
+  Frame frame{avail[4], avail[5], avail[6], incompat, avail[3], len, sent, {id, {}}, verified};
   auto payload = avail.subspan(kHeaderLength, len);
   frame.message.payload.assign(payload.begin(), payload.end());
   // Zero-fill what the sender truncated; ignore extension bytes newer than our table.
@@ -100,6 +104,14 @@ Parser::Step Parser::try_frame(std::vector<Frame>& out) {
   out.push_back(std::move(frame));
   ++stats_.frames;
   return Step::consumed;
+}
+
+bool Parser::accept_signing(std::span<const uint8_t> frame, bool& verified) {
+  SignatureVerdict v = verifier_->check(frame);
+  verified = v == SignatureVerdict::good;
+  if (verified || (v == SignatureVerdict::unsigned_frame && !require_signed_)) return true;
+  ++stats_.signing_dropped;
+  return false;
 }
 
 void Parser::discard_partial() {

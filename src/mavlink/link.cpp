@@ -68,7 +68,8 @@ bool connect_within(int fd, const sockaddr_in& to, int timeout_ms, std::string& 
 
 }  // namespace
 
-OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame, double reconnect_s) {
+OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame, double reconnect_s,
+                      const std::optional<SigningKey>& verify, bool require_signed) {
   auto fail = [&](const std::string& why) {
     return OpenResult{nullptr, "connection '" + endpoint.url + "': " + why};
   };
@@ -106,6 +107,10 @@ OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame, double re
   }
   std::unique_ptr<Link> link(new Link(endpoint, fd, pipe_fds[0], pipe_fds[1], std::move(on_frame)));
   link->reconnect_ms_ = static_cast<int>(reconnect_s * 1000.0);
+  if (verify) {  // before the receive thread exists: no datagram is read without the key
+    link->parser_.verify_with(*verify);
+    link->parser_.require_signed(require_signed);
+  }
   if (endpoint.kind != LinkKind::udp_listen) {
     link->peer_ = addr;
     link->has_peer_ = true;
@@ -222,7 +227,36 @@ bool same_address(const sockaddr_in& a, const sockaddr_in& b) {
 }
 }  // namespace
 
+void Link::verify_with(SigningKey key, bool required) {
+  std::lock_guard lock(mutex_);
+  pending_key_ = key;
+  pending_required_ = required;
+}
+
+void Link::require_signed(bool required) {
+  std::lock_guard lock(mutex_);
+  pending_required_ = required;
+}
+
 void Link::handle_bytes(std::span<const uint8_t> bytes, const sockaddr_in* from) {
+  {
+    std::lock_guard lock(mutex_);
+    if (pending_key_) parser_.verify_with(*pending_key_);
+    if (pending_required_) parser_.require_signed(*pending_required_);
+    pending_key_.reset();
+    pending_required_.reset();
+  }
+  if (from && locked_) {
+    bool vehicle;
+    {
+      std::lock_guard lock(mutex_);
+      vehicle = same_address(*from, peer_);
+    }
+    if (!vehicle) {  // not the vehicle's address: not even parsed
+      ++foreign_datagrams_;
+      return;
+    }
+  }
   if (from && !same_address(*from, last_from_)) {
     parser_.discard_partial();
     last_from_ = *from;
@@ -237,16 +271,19 @@ void Link::handle_bytes(std::span<const uint8_t> bytes, const sockaddr_in* from)
 }
 
 // Replies go where the vehicle is, as PX4's offboard link expects, and the vehicle is
-// where its valid frames come from: anybody can send a datagram to the port, but only
-// the vehicle's CRC-checked frames may move the link (a stray packet would otherwise turn
-// every command away from the aircraft).
+// where its first valid frame came from: anybody can send a datagram to the port, and
+// anybody can forge a CRC-checked frame with the vehicle's system id (the CRC is no
+// secret), so once the vehicle is known its address is kept. A vehicle that comes back on
+// another port (a SITL restarted on a new port) is a lost link, not a new peer.
 void Link::follow_sender(const std::vector<Frame>& frames, const sockaddr_in& from) {
+  if (locked_) return;  // only the vehicle's address gets here (handle_bytes)
   uint8_t wanted = follow_sysid_;
   for (const Frame& f : frames)
     if (wanted == 0 || f.sysid == wanted) {
       std::lock_guard lock(mutex_);
       peer_ = from;
       has_peer_ = true;
+      if (wanted != 0) locked_ = true;
       return;
     }
 }

@@ -28,7 +28,10 @@ class Link {
  public:
   /// Opens the socket (binds, or connects for TCP) and starts the receive thread.
   /// `reconnect_s`: TCP only, the pause between attempts to reopen a closed connection.
-  static OpenResult open(const Endpoint& endpoint, FrameHandler on_frame, double reconnect_s = 1.0);
+  /// `verify`: check signed frames against this key from the first datagram on, and drop
+  /// unsigned ones when `require_signed` (see verify_with).
+  static OpenResult open(const Endpoint& endpoint, FrameHandler on_frame, double reconnect_s = 1.0,
+                         const std::optional<SigningKey>& verify = std::nullopt, bool require_signed = false);
   /// Stops and joins the receive thread, then closes the socket: after it returns the
   /// handler is never called again.
   ~Link();
@@ -43,10 +46,23 @@ class Link {
   const Endpoint& endpoint() const { return endpoint_; }
   /// Parser counters so far (garbage, bad CRCs), copied under the lock.
   ParserStats stats() const;
-  /// udp:// only: replies go to whoever last sent a valid frame (CRC-checked and parsed)
-  /// from system `sysid`; 0 (the default, before the vehicle is known): from any system.
-  /// A datagram of garbage, or a frame of another system, never redirects the link.
+  /// udp:// only. 0 (the default, before the vehicle is known): replies go to whoever last
+  /// sent a valid frame (CRC-checked and parsed) of any system. Else the first valid frame of
+  /// system `sysid` fixes the vehicle's address for good: from then on every datagram from
+  /// another address is dropped unread and counted (foreign_datagrams), so a forged frame
+  /// with the vehicle's system id from another port neither reaches the adapter nor turns
+  /// its commands away. A datagram of garbage never redirects the link.
   void follow_only(uint8_t sysid) { follow_sysid_ = sysid; }
+  /// udp://: datagrams dropped because they came from another address than the vehicle's.
+  uint64_t foreign_datagrams() const { return foreign_datagrams_; }
+  /// udp://: the vehicle's address is fixed (see follow_only).
+  bool locked() const { return locked_; }
+  /// From the next datagram on, signed frames are checked against `key` and dropped when
+  /// the signature, its stream's timestamp order or its age is wrong (signing.h); unsigned
+  /// frames are dropped too when `required`. Counted in stats().signing_dropped.
+  void verify_with(SigningKey key, bool required);
+  /// Turns the requirement on or off (after SETUP_SIGNING, say), keeping the key.
+  void require_signed(bool required);
 
  private:
   Link(Endpoint endpoint, int fd, int wake_read, int wake_write, FrameHandler on_frame);
@@ -69,9 +85,15 @@ class Link {
   sockaddr_in peer_{};          ///< the vehicle's last address (udp://) or the target (udpout://)
   bool has_peer_ = false;
   std::atomic<uint8_t> follow_sysid_{0};  ///< udp://: whose valid frames move peer_
+  std::atomic<bool> locked_{false};        ///< udp://: peer_ is the vehicle's, for good
+  std::atomic<uint64_t> foreign_datagrams_{0};
   sockaddr_in last_from_{};     ///< udp://: sender of the previous datagram (receive thread only)
   bool closed_ = false;         ///< TCP: the peer closed the connection; not yet reconnected
   ParserStats stats_;
+  /// Signing changes asked for from another thread, applied by the receive thread (which
+  /// alone touches parser_) before its next datagram; guarded by mutex_.
+  std::optional<SigningKey> pending_key_;
+  std::optional<bool> pending_required_;
   std::thread thread_;
 };
 

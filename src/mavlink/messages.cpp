@@ -97,6 +97,9 @@ std::vector<MessageDef> build_table() {
   t.push_back(make(msg::STATUSTEXT, "STATUSTEXT",
                    {{T::u8, "severity"}, {T::char_, "text", 50}, ext(T::u16, "id"),
                     ext(T::u8, "chunk_seq")}));
+  t.push_back(make(msg::SETUP_SIGNING, "SETUP_SIGNING",
+                   {{T::u8, "target_system"}, {T::u8, "target_component"}, {T::u8, "secret_key", 32},
+                    {T::u64, "initial_timestamp"}}));
   return t;
 }
 

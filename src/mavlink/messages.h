@@ -27,6 +27,7 @@ inline constexpr uint32_t SET_POSITION_TARGET_LOCAL_NED = 84;
 inline constexpr uint32_t BATTERY_STATUS = 147;
 inline constexpr uint32_t EXTENDED_SYS_STATE = 245;
 inline constexpr uint32_t STATUSTEXT = 253;
+inline constexpr uint32_t SETUP_SIGNING = 256;
 }  // namespace msg
 
 struct MessageDef {

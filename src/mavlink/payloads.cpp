@@ -328,4 +328,22 @@ std::optional<Statustext> unpack_statustext(const Message& m) {
                     r.get<uint8_t>("chunk_seq")};
 }
 
+Message pack(const SetupSigning& m) {
+  FieldWriter w(def_of(msg::SETUP_SIGNING));
+  w.set("target_system", m.target_system);
+  w.set("target_component", m.target_component);
+  for (int i = 0; i < 32; ++i) w.set("secret_key", m.secret_key[i], i);
+  w.set("initial_timestamp", m.initial_timestamp);
+  return w.take();
+}
+
+std::optional<SetupSigning> unpack_setup_signing(const Message& m) {
+  if (m.id != msg::SETUP_SIGNING) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  SetupSigning s{r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component"), {},
+                 r.get<uint64_t>("initial_timestamp")};
+  for (int i = 0; i < 32; ++i) s.secret_key[i] = r.get<uint8_t>("secret_key", i);
+  return s;
+}
+
 }  // namespace eamos::mavlink

@@ -165,6 +165,16 @@ Message pack(const ExtendedSysState& m);
 Message pack(const BatteryStatus& m);
 Message pack(const Statustext& m);
 
+/// Gives the vehicle the link's signing key (an all-zero key and timestamp turn signing off).
+struct SetupSigning {
+  uint8_t target_system = 0;
+  uint8_t target_component = 0;
+  std::array<uint8_t, 32> secret_key{};
+  uint64_t initial_timestamp = 0;  ///< signing clock (signing.h) to start from
+};
+Message pack(const SetupSigning& m);
+std::optional<SetupSigning> unpack_setup_signing(const Message& m);
+
 std::optional<Heartbeat> unpack_heartbeat(const Message& m);
 std::optional<ParamRequestRead> unpack_param_request_read(const Message& m);
 /// The name keeps only printable ASCII (anything else becomes '?'): it goes into messages.

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 
 #include "mavlink/enums.h"
 #include "mid/requests.h"
@@ -31,42 +32,26 @@ using mid::metres;
 
 MavlinkDrone::MavlinkDrone(fleet::DroneSettings settings, fleet::DroneType type,
                            mid::EventLoop& loop, MavlinkOptions options)
-    : settings_(std::move(settings)),
-      type_(std::move(type)),
-      loop_(loop),
+    : AdapterDrone(loop, std::move(type)),
+      settings_(std::move(settings)),
       options_(options),
-      commands_(loop, [this](const ml::Message& m) { send(m); }, options.commands),
-      tracker_(loop, [this](ActionId id) { stop_action(id); }) {}
+      commands_(loop, [this](const ml::Message& m) { send(m); }, options.commands) {}
 
 MavlinkDrone::~MavlinkDrone() {
+  if (link_ && link_->foreign_datagrams() > 0)
+    std::cerr << "mavlink: " << settings_.name << ": " << link_->foreign_datagrams()
+              << " datagram(s) from other addresses than the vehicle's were ignored in all\n";
   link_.reset();  // joins the receive thread: nothing new gets posted
-  for (auto& [id, timer] : action_timers_) loop_.cancel(timer);
   for (mid::TimerId t : {stream_timer_, heartbeat_timer_, watchdog_timer_}) loop_.cancel(t);
 }
 
 // --- starting actions ----------------------------------------------------------------------
 
-ActionId MavlinkDrone::start(const mid::ActionRequest& request, mid::EndCallback on_end) {
-  if (!failsafe_reason_.empty())
-    return tracker_.refuse(request, std::move(on_end), "failsafe active (" + failsafe_reason_ + ")");
-  if (link_lost_)
-    return tracker_.refuse(request, std::move(on_end),
-                           "link lost: no HEARTBEAT from system " + std::to_string(sysid_));
-  mid::RequestCheck check = mid::check_request(request, type_);
-  if (!check.spec) return tracker_.refuse(request, std::move(on_end), check.error);
-  if (std::string why = refusal(request, *check.spec); !why.empty())
-    return tracker_.refuse(request, std::move(on_end), why);
-
-  double timeout = timeout_for(request);
-  fleet::ActionClass cls = check.spec->action_class;
-  if (cls == fleet::ActionClass::motion) clear_action_timer(tracker_.motion());  // preempted
-  ActionId id = tracker_.begin(request, cls, std::move(on_end), timeout);
-  switch (cls) {
-    case fleet::ActionClass::system: start_system(id, request); break;
-    case fleet::ActionClass::payload: start_payload(id, request); break;
-    case fleet::ActionClass::motion: start_motion(id, request); break;
-  }
-  return id;
+std::optional<mid::ActionEnd> MavlinkDrone::unavailable() const {
+  if (!link_lost_) return std::nullopt;
+  return mid::ActionEnd{.outcome = Outcome::failed,
+                        .reason = "link lost: no HEARTBEAT from system " + std::to_string(sysid_),
+                        .failure = mid::FailureReason::link_lost};
 }
 
 std::string MavlinkDrone::refusal(const mid::ActionRequest& r, const fleet::ActionSpec& spec) const {
@@ -140,7 +125,8 @@ void MavlinkDrone::start_payload(ActionId id, const mid::ActionRequest& r) {
                    [this, id](const CommandResult& result) {
                      if (!tracker_.running(id)) return;
                      if (!result.accepted) {
-                       tracker_.end(id, Outcome::failed, "no picture: " + result.error);
+                       auto why = result.answered ? mid::FailureReason::refused : mid::FailureReason::timed_out;
+                       tracker_.fail(id, why, "no picture: " + result.error, result.error);
                        return;
                      }
                      ++pictures_;
@@ -150,8 +136,7 @@ void MavlinkDrone::start_payload(ActionId id, const mid::ActionRequest& r) {
     return;
   }
   int k = fleet::sensor_index(r.name, type_.sensors);
-  action_timers_[id] = loop_.after(0.1, [this, id, k] {
-    action_timers_.erase(id);
+  after_for(id, 0.1, [this, id, k] {
     tracker_.end(id, Outcome::succeeded, "", sensor_value(k));
   });
 }
@@ -186,8 +171,7 @@ void MavlinkDrone::start_motion(ActionId id, const mid::ActionRequest& r) {
   if (r.name == "Orbit") return start_orbit(id, here, r.args.empty() ? 5.0 : r.args[0]);
   stream_setpoints();  // Hover: hold where it is; Hover(s) ends after s seconds
   if (r.args.size() == 1) {
-    action_timers_[id] = loop_.after(r.args[0], [this, id] {
-      action_timers_.erase(id);
+    after_for(id, r.args[0], [this, id] {
       if (motion_owner_ == id) motion_owner_ = mid::kNoAction;
       tracker_.end(id, Outcome::succeeded);
     });
@@ -222,8 +206,7 @@ void MavlinkDrone::start_takeoff(ActionId id, double altitude) {
       // PX4 takes off to an altitude above mean sea level, which GLOBAL_POSITION_INT tells;
       // right after connecting it may not have come yet. Ask again shortly; the action's
       // timeout bounds the wait.
-      action_timers_[id] = loop_.after(0.1, [this, id, altitude] {
-        action_timers_.erase(id);
+      after_for(id, 0.1, [this, id, altitude] {
         if (motion_owner_ == id && tracker_.running(id)) start_takeoff(id, altitude);
       });
       return;
@@ -260,29 +243,23 @@ void MavlinkDrone::end_refused(ActionId id, const CommandResult& result) {
   }
   std::string reason = std::string("refused by ") + autopilot_->name + ": " + result.error;
   if (!result.answered) {
-    tracker_.end(id, Outcome::failed, reason);
+    // No COMMAND_ACK after every retry: the autopilot never said no, it said nothing.
+    tracker_.fail(id, mid::FailureReason::timed_out, reason, result.error);
     return;
   }
   // The autopilot's reason ("Arm: LAND mode not armable") comes as STATUSTEXT, which
   // ArduPilot queues and sends after the COMMAND_ACK: wait a moment for it.
   double since = tracker_.started_at(id);
-  action_timers_[id] = loop_.after(options_.statustext_wait_s, [this, id, reason, since] {
-    action_timers_.erase(id);
-    if (tracker_.running(id)) tracker_.end(id, Outcome::failed, reason + autopilot_says(since));
+  after_for(id, options_.statustext_wait_s, [this, id, reason, since, error = result.error] {
+    std::string says = autopilot_says(since);
+    tracker_.fail(id, mid::FailureReason::refused, reason + says, error + says);
   });
 }
 
 // --- stopping ------------------------------------------------------------------------------
 
-bool MavlinkDrone::cancel(ActionId id) {
-  if (!tracker_.running(id)) return false;
-  stop_action(id);
-  tracker_.end(id, Outcome::cancelled, "cancelled");
-  return true;
-}
-
 void MavlinkDrone::stop_action(ActionId id) {
-  clear_action_timer(id);
+  clear_action_timer(id);  // also called for a failsafe, where the base has not cleared it
   if (id != motion_owner_) return;
   motion_owner_ = mid::kNoAction;
   goal_.reset();
@@ -291,13 +268,6 @@ void MavlinkDrone::stop_action(ActionId id) {
   orbit_ = {};
   if (autopilot_orbits) leave_orbit();
   hold_here();
-}
-
-void MavlinkDrone::clear_action_timer(ActionId id) {
-  auto it = action_timers_.find(id);
-  if (it == action_timers_.end()) return;
-  loop_.cancel(it->second);
-  action_timers_.erase(it);
 }
 
 void MavlinkDrone::hold_here() {
@@ -309,22 +279,17 @@ void MavlinkDrone::hold_here() {
   stream_setpoints();
 }
 
-void MavlinkDrone::fail_all(const std::string& reason) {
-  for (ActionId id : tracker_.running_ids()) {
-    clear_action_timer(id);
-    tracker_.end(id, Outcome::failed, reason);
-  }
+void MavlinkDrone::fail_all(mid::FailureReason why, const std::string& reason) {
+  end_all({.outcome = Outcome::failed, .reason = reason, .failure = why});
   motion_owner_ = mid::kNoAction;
   goal_.reset();
   orbit_ = {};
 }
 
 void MavlinkDrone::failsafe(fleet::Failsafe what) {
-  failsafe_reason_ = std::string("failsafe: ") + fleet::failsafe_name(what);
-  for (ActionId id : tracker_.running_ids()) {
-    stop_action(id);
-    tracker_.end(id, Outcome::cancelled, failsafe_reason_);
-  }
+  refuse_from_now(std::string("failsafe: ") + fleet::failsafe_name(what));
+  for (ActionId id : tracker_.running_ids()) stop_action(id);
+  end_all({Outcome::cancelled, failsafe_reason_});
   if (vehicle_.landed()) {
     streaming_ = false;
     armed_waiting_ = false;

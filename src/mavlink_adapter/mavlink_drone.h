@@ -20,6 +20,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 
@@ -28,12 +29,14 @@
 #include "mavlink_adapter/autopilot_params.h"
 #include "mavlink_adapter/command_sender.h"
 #include "mavlink_adapter/telemetry.h"
-#include "mid/action_tracker.h"
+#include "mid/adapter_drone.h"
 #include "mid/drone_api.h"
 #include "mid/location_validator.h"
 #include "mid/state_broker.h"
 
 namespace eamos::mavlink_adapter {
+
+struct FirstHeartbeat;  ///< mavlink_drone_link.cpp
 
 struct MavlinkOptions {
   bool real_time = false;          ///< the loop runs in real time: required (a real vehicle
@@ -64,7 +67,7 @@ struct MavlinkOptions {
   double settled_mps = 0.3;        ///< ... and no faster than this (stopped, not passing by)
 };
 
-class MavlinkDrone final : public mid::Drone {
+class MavlinkDrone final : public mid::AdapterDrone {
  public:
   MavlinkDrone(fleet::DroneSettings settings, fleet::DroneType type, mid::EventLoop& loop,
                MavlinkOptions options);
@@ -75,8 +78,6 @@ class MavlinkDrone final : public mid::Drone {
   std::string connect(const mavlink::Endpoint& endpoint);
 
   const std::string& name() const override { return settings_.name; }
-  mid::ActionId start(const mid::ActionRequest& request, mid::EndCallback on_end) override;
-  bool cancel(mid::ActionId id) override;
   std::optional<double> progress(mid::ActionId id) const override;
   mid::DroneState state() const override;
   mid::SubscriptionId subscribe(mid::StateCallback fn) override;
@@ -105,25 +106,31 @@ class MavlinkDrone final : public mid::Drone {
   };
 
   // actions (mavlink_drone.cpp)
-  std::string refusal(const mid::ActionRequest& r, const fleet::ActionSpec& spec) const;
-  void start_system(mid::ActionId id, const mid::ActionRequest& r);
-  void start_payload(mid::ActionId id, const mid::ActionRequest& r);
-  void start_motion(mid::ActionId id, const mid::ActionRequest& r);
+  std::optional<mid::ActionEnd> unavailable() const override;
+  std::string refusal(const mid::ActionRequest& r, const fleet::ActionSpec& spec) const override;
+  void start_system(mid::ActionId id, const mid::ActionRequest& r) override;
+  void start_payload(mid::ActionId id, const mid::ActionRequest& r) override;
+  void start_motion(mid::ActionId id, const mid::ActionRequest& r) override;
   void start_takeoff(mid::ActionId id, double altitude);
   /// Arms, first switching to a mode where arming is allowed when the vehicle is in one where
   /// it is not (ArduPilot cannot arm in LAND, where a landing leaves it); `armed` runs once
   /// the autopilot accepted.
   void arm(mid::ActionId id, std::function<void()> armed);
   void send_arm(mid::ActionId id, std::function<void()> armed);
-  double timeout_for(const mid::ActionRequest& r) const;
+  double timeout_for(const mid::ActionRequest& r) const override;
   void command_motion(mid::ActionId id, uint16_t cmd, std::array<float, 7> params = {});
+  /// The autopilot refused (or never answered) a command of `id`: it ends `failed`, refused
+  /// (timed_out without an answer), its MAV_RESULT and STATUSTEXT the detail.
   void end_refused(mid::ActionId id, const CommandResult& result);
-  void stop_action(mid::ActionId id);
-  void clear_action_timer(mid::ActionId id);
+  void stop_action(mid::ActionId id) override;
   void hold_here();
-  void fail_all(const std::string& reason);
+  /// Ends every running action `failed` for `why`, dropping the motion's goal and orbit.
+  void fail_all(mid::FailureReason why, const std::string& reason);
   /// Ends the motion the adapter flies (if any) `failed`, dropping its goal and orbit.
-  void fail_motion(const std::string& reason);
+  void fail_motion(mid::FailureReason why, const std::string& reason, const std::string& detail);
+
+  /// fleet `signing: {setup: true}`: gives the vehicle the key at connect (mavlink_drone_link.cpp).
+  std::string give_key(FirstHeartbeat& first, std::unique_lock<std::mutex>& lock, const mavlink::SigningKey& key);
 
   // the vehicle's own words (mavlink_drone_link.cpp)
   void on_statustext(const mavlink::Statustext& t);
@@ -136,6 +143,9 @@ class MavlinkDrone final : public mid::Drone {
   void on_frame(const mavlink::Frame& frame);
   /// A frame of the vehicle refused for its values: counted and logged, never applied.
   void note_rejected(const char* what);
+  /// Datagrams the udp:// link dropped for coming from another address than the vehicle's:
+  /// logged (the first, then every thousandth) and the first one put in the trace.
+  void note_foreign();
   void on_heartbeat();
   void link_watchdog();
   void lose_link();
@@ -164,12 +174,11 @@ class MavlinkDrone final : public mid::Drone {
   double remaining(fleet::Vec3 from) const;  ///< path still to fly for the running motion
 
   fleet::DroneSettings settings_;
-  fleet::DroneType type_;
-  mid::EventLoop& loop_;
   MavlinkOptions options_;
   const Autopilot* autopilot_ = nullptr;
   uint8_t sysid_ = 0;  ///< the vehicle's system id (0 until known)
   uint64_t rejected_frames_ = 0;  ///< frames of the vehicle refused for their values
+  uint64_t foreign_reported_ = 0; ///< link's foreign_datagrams() when last looked at
 
   /// Posted frames hold a weak pointer to this: a frame that reaches the loop after the
   /// drone is gone is dropped instead of touching freed memory.
@@ -177,12 +186,10 @@ class MavlinkDrone final : public mid::Drone {
   std::unique_ptr<mavlink::Link> link_;
   mavlink::Encoder encoder_;
   CommandSender commands_;
-  mid::ActionTracker tracker_;
   mid::StateBroker broker_;
   VehicleState vehicle_;
   bool link_lost_ = false;
   bool telemetry_requested_ = false;
-  std::string failsafe_reason_;  ///< "" = none; else why new actions are refused
   int pictures_ = 0;
   FlightLimits limits_;
   std::function<void(const std::string&)> message_sink_;
@@ -222,7 +229,6 @@ class MavlinkDrone final : public mid::Drone {
   /// and the stream does not ask for the setpoint mode again.
   int mode_commands_pending_ = 0;
 
-  std::map<mid::ActionId, mid::TimerId> action_timers_;  ///< Hover(s), SensorK
   mid::TimerId stream_timer_ = mid::kNoTimer;
   mid::TimerId heartbeat_timer_ = mid::kNoTimer;
   mid::TimerId watchdog_timer_ = mid::kNoTimer;

@@ -19,20 +19,21 @@ using fleet::Vec3;
 using mid::ActionId;
 using mid::Outcome;
 
-namespace {
-
-constexpr uint8_t kLastMavResult = 9;  ///< MAV_RESULT_UNSUPPORTED_MAV_FRAME
-
 /// The first autopilot HEARTBEAT and the parameters read at connect, handed from the link's
 /// thread to connect().
 struct FirstHeartbeat {
   std::mutex mutex;
   std::condition_variable cv;
   bool heard = false;
+  bool signed_heard = false;  ///< a HEARTBEAT with a verified signature came
   uint8_t sysid = 0;
   uint8_t autopilot = 0;
   std::map<std::string, float> params;  ///< PARAM_VALUE of the autopilot, by name
 };
+
+namespace {
+
+constexpr uint8_t kLastMavResult = 9;  ///< MAV_RESULT_UNSUPPORTED_MAV_FRAME
 
 /// Reads `params` by name, asking again every half second for those missing, for at most
 /// `timeout_s` wall seconds; blocking like the wait for the HEARTBEAT (`lock` holds
@@ -71,6 +72,33 @@ const char* severity_name(uint8_t s) {
 
 }  // namespace
 
+/// The link id of our signed frames: one link per drone, so any fixed value serves.
+constexpr uint8_t kSigningLinkId = 1;
+
+// setup: true: SETUP_SIGNING to the vehicle (again every half second) until its first signed
+// HEARTBEAT, then unsigned frames are dropped. Sent unsigned: a vehicle without a key drops
+// signed frames it cannot check (ours does; ArduPilot would take them), and one with another
+// key must refuse it anyway. Without setup the vehicle has signed from its first frame (the
+// link required it), and there is nothing to do.
+std::string MavlinkDrone::give_key(FirstHeartbeat& first, std::unique_lock<std::mutex>& lock,
+                                   const ml::SigningKey& key) {
+  if (!settings_.signing_setup) return "";
+  ml::SetupSigning setup{sysid_, ml::comp::AUTOPILOT1, key.bytes, ml::signing_time_now()};
+  auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(options_.connect_timeout_s);
+  while (!first.signed_heard && std::chrono::steady_clock::now() < until) {
+    send(ml::pack(setup));
+    first.cv.wait_for(lock, std::chrono::milliseconds(500), [&] { return first.signed_heard; });
+  }
+  if (!first.signed_heard)
+    return "system " + std::to_string(sysid_) + " did not sign its frames after SETUP_SIGNING within " +
+           std::to_string(static_cast<int>(options_.connect_timeout_s)) +
+           " s; does its autopilot support MAVLink 2 signing (ArduPilot does; PX4 needs MAV_SIGN_CFG)?";
+  link_->require_signed(true);
+  std::cerr << "eamos: " << settings_.name << ": system " << int(sysid_)
+            << " took the signing key; unsigned frames are dropped from now on\n";
+  return "";
+}
+
 std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
   auto first = std::make_shared<FirstHeartbeat>();
   const uint8_t wanted = static_cast<uint8_t>(settings_.sysid);
@@ -92,13 +120,22 @@ std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
         first->sysid = frame.sysid;
         first->autopilot = hb->autopilot;
       }
+      if (frame.sysid == first->sysid && frame.signature_verified) first->signed_heard = true;
       first->cv.notify_all();
     }
     loop->post([this, alive, frame = std::move(frame)] {
       if (alive.lock()) this->on_frame(frame);
     });
   };
-  ml::OpenResult opened = ml::Link::open(endpoint, handler);
+  std::optional<ml::SigningKey> key;
+  if (!settings_.signing_key.empty()) {
+    std::string error;
+    key = ml::parse_signing_key(settings_.signing_key, error);
+    if (!key) return "signing key of " + settings_.name + ": " + error;
+  }
+  // With a key the vehicle must sign from the first frame on, unless we are to give it the
+  // key (setup): then its unsigned frames count until it signs.
+  ml::OpenResult opened = ml::Link::open(endpoint, handler, 1.0, key, key && !settings_.signing_setup);
   if (!opened.link) return opened.error;
   link_ = std::move(opened.link);
   link_->follow_only(wanted);
@@ -107,12 +144,16 @@ std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
   auto wait = std::chrono::duration<double>(options_.connect_timeout_s);
   if (!first->cv.wait_for(lock, wait, [&] { return first->heard; })) {
     lock.unlock();
-    link_.reset();
     char text[64];
     std::snprintf(text, sizeof text, "%.0f s", options_.connect_timeout_s);
     std::string who = wanted ? "system " + std::to_string(wanted) : std::string("any autopilot");
+    std::string signing = key ? " Signing is on for this drone: unsigned or badly signed frames are dropped (" +
+                                    std::to_string(link_->stats().signing_dropped) +
+                                    " so far); does the vehicle have this key (`setup: true` gives it)?"
+                              : "";
+    link_.reset();
     return "no HEARTBEAT from " + who + " on " + endpoint.url + " within " + text +
-           "; is the vehicle (or its SITL) running and sending to this address, with this system id?";
+           "; is the vehicle (or its SITL) running and sending to this address, with this system id?" + signing;
   }
   sysid_ = first->sysid;
   autopilot_ = autopilot_for(first->autopilot);
@@ -123,6 +164,14 @@ std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
   }
   link_->follow_only(sysid_);  // from now on only the vehicle's frames move a udp:// link
   encoder_ = {sysid_, ml::comp::ONBOARD_COMPUTER, 0};
+  if (key) {
+    if (std::string error = give_key(*first, lock, *key); !error.empty()) {
+      lock.unlock();
+      link_.reset();
+      return error;
+    }
+    encoder_.signer.emplace(*key, kSigningLinkId);  // every frame from here on is signed
+  }
   // Before the mission starts, so that its first deadline already knows how fast the
   // autopilot flies.
   std::map<std::string, float> values = read_params(*first, lock, limit_params(*autopilot_), options_.param_timeout_s,
@@ -219,7 +268,21 @@ void MavlinkDrone::note_rejected(const char* what) {
               << " (" << rejected_frames_ << " dropped so far)\n";
 }
 
+void MavlinkDrone::note_foreign() {
+  uint64_t n = link_ ? link_->foreign_datagrams() : 0;
+  if (n == foreign_reported_) return;
+  bool first = foreign_reported_ == 0;
+  bool thousandth = n / 1000 > foreign_reported_ / 1000;
+  foreign_reported_ = n;
+  if (!first && !thousandth) return;
+  std::string text = "ignored " + std::to_string(n) + " datagram(s) from other addresses than system " +
+                     std::to_string(sysid_) + "'s (not the vehicle: someone else is sending to this port)";
+  std::cerr << "mavlink: " << settings_.name << ": " << text << "\n";
+  if (first) note(text);
+}
+
 void MavlinkDrone::on_heartbeat() {
+  note_foreign();
   link_lost_ = false;
   link_watchdog();
   if (!telemetry_requested_) request_telemetry();
@@ -235,17 +298,18 @@ void MavlinkDrone::on_heartbeat() {
   // the setpoint mode: give way instead of switching back.
   streaming_ = false;
   in_control_ = false;
-  fail_motion(std::string("the vehicle left ") + autopilot_->setpoint_mode_name + " for " +
-              mode_name(*autopilot_, vehicle_.custom_mode));
+  std::string mode = mode_name(*autopilot_, vehicle_.custom_mode);
+  fail_motion(mid::FailureReason::pilot_took_over,
+              std::string("the vehicle left ") + autopilot_->setpoint_mode_name + " for " + mode, "mode " + mode);
 }
 
-void MavlinkDrone::fail_motion(const std::string& reason) {
+void MavlinkDrone::fail_motion(mid::FailureReason why, const std::string& reason, const std::string& detail) {
   if (motion_owner_ == mid::kNoAction) return;
   ActionId id = motion_owner_;
   motion_owner_ = mid::kNoAction;
   goal_.reset();
   orbit_ = {};
-  tracker_.end(id, Outcome::failed, reason);
+  tracker_.fail(id, why, reason, detail);
 }
 
 void MavlinkDrone::link_watchdog() {
@@ -264,7 +328,7 @@ void MavlinkDrone::lose_link() {
   char text[128];
   std::snprintf(text, sizeof text, "link lost: no HEARTBEAT from system %d for %.1f s", sysid_,
                 options_.link_timeout_s);
-  fail_all(text);
+  fail_all(mid::FailureReason::link_lost, text);
   commands_.fail_all("link lost");
 }
 
@@ -373,8 +437,10 @@ void MavlinkDrone::switch_to_setpoint_mode() {
       return;
     }
     streaming_ = false;
-    fail_motion(std::string("switch to ") + autopilot_->setpoint_mode_name + " refused by " + autopilot_->name +
-                ": " + r.error);
+    fail_motion(r.answered ? mid::FailureReason::refused : mid::FailureReason::timed_out,
+                std::string("switch to ") + autopilot_->setpoint_mode_name + " refused by " + autopilot_->name +
+                    ": " + r.error,
+                r.error);
   });
 }
 

@@ -78,10 +78,9 @@ bool MavlinkDrone::left_orbit_mode() {
   ActionId id = motion_owner_;
   motion_owner_ = mid::kNoAction;
   orbit_ = {};
-  if (tracker_.running(id))
-    tracker_.end(id, Outcome::failed,
-                 "the vehicle left " + mode_name(*autopilot_, autopilot_->orbit_mode) + " for " +
-                     mode_name(*autopilot_, vehicle_.custom_mode));
+  std::string mode = mode_name(*autopilot_, vehicle_.custom_mode);
+  tracker_.fail(id, mid::FailureReason::pilot_took_over,
+                "the vehicle left " + mode_name(*autopilot_, autopilot_->orbit_mode) + " for " + mode, "mode " + mode);
   return true;
 }
 

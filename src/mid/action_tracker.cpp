@@ -32,7 +32,8 @@ ActionId ActionTracker::begin(const ActionRequest& request, fleet::ActionClass a
       if (it == actions_.end()) return;
       it->second.deadline = kNoTimer;  // firing now; end() must not cancel it
       on_timeout_(id);
-      end(id, Outcome::failed, "timed out after " + seconds_text(timeout_s));
+      fail(id, FailureReason::timed_out, "timed out after " + seconds_text(timeout_s),
+           "deadline " + seconds_text(timeout_s) + " after start");
     });
   }
   actions_.emplace(id, Running{request, action_class, std::move(on_end), loop_.now(), deadline});
@@ -40,21 +41,34 @@ ActionId ActionTracker::begin(const ActionRequest& request, fleet::ActionClass a
   return id;
 }
 
-ActionId ActionTracker::refuse(const ActionRequest&, EndCallback on_end, std::string reason) {
+ActionId ActionTracker::refuse(const ActionRequest&, EndCallback on_end, ActionEnd why) {
   ActionId id = next_id_++;
-  report(std::move(on_end), {Outcome::failed, std::move(reason), std::nullopt});
+  why.outcome = Outcome::failed;
+  if (why.failure == FailureReason::none) why.failure = FailureReason::refused;
+  report(std::move(on_end), std::move(why));
   return id;
 }
 
 bool ActionTracker::end(ActionId id, Outcome outcome, std::string reason,
                         std::optional<double> value) {
+  return end(id, ActionEnd{outcome, std::move(reason), value});
+}
+
+bool ActionTracker::fail(ActionId id, FailureReason why, std::string reason, std::string detail) {
+  return end(id, ActionEnd{Outcome::failed, std::move(reason), std::nullopt, why, std::move(detail)});
+}
+
+bool ActionTracker::end(ActionId id, ActionEnd e) {
+  // A failure always names its kind: one that would not is a vehicle fault, never "none".
+  if (e.outcome == Outcome::failed && e.failure == FailureReason::none) e.failure = FailureReason::vehicle_fault;
+  if (e.outcome != Outcome::failed) e.failure = FailureReason::none;
   auto it = actions_.find(id);
   if (it == actions_.end()) return false;
   Running r = std::move(it->second);
   actions_.erase(it);
   if (r.deadline != kNoTimer) loop_.cancel(r.deadline);
   if (motion_ == id) motion_ = kNoAction;
-  report(std::move(r.on_end), {outcome, std::move(reason), value});
+  report(std::move(r.on_end), std::move(e));
   return true;
 }
 

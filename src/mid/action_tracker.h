@@ -29,12 +29,17 @@ class ActionTracker {
   /// motion action takes the motion slot; the one holding it ends `preempted`.
   ActionId begin(const ActionRequest& request, fleet::ActionClass action_class,
                  EndCallback on_end, double timeout_s);
-  /// Registers an action that is refused: it ends `failed` with `reason` at once (reported
-  /// through the loop like every other end).
-  ActionId refuse(const ActionRequest& request, EndCallback on_end, std::string reason);
-  /// Ends a running action; false (and nothing reported) when it is not running.
+  /// Registers an action that is not started: it ends `failed` at once with `why` (its
+  /// failure set: refused, link_lost, …), reported through the loop like every other end.
+  ActionId refuse(const ActionRequest& request, EndCallback on_end, ActionEnd why);
+  /// Ends a running action; false (and nothing reported) when it is not running. For
+  /// succeeded, preempted and cancelled ends; a failure goes through fail().
   bool end(ActionId id, Outcome outcome, std::string reason = "",
            std::optional<double> value = std::nullopt);
+  /// Ends a running action `failed` for `why`, with the vehicle's own `detail`.
+  bool fail(ActionId id, FailureReason why, std::string reason, std::string detail = "");
+  /// Ends a running action as `e` says.
+  bool end(ActionId id, ActionEnd e);
 
   bool running(ActionId id) const { return actions_.count(id) != 0; }
   /// The running motion action; kNoAction when none.

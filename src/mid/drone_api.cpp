@@ -12,4 +12,16 @@ const char* outcome_name(Outcome o) {
   return "failed";
 }
 
+const char* failure_reason_name(FailureReason r) {
+  switch (r) {
+    case FailureReason::none: return "";
+    case FailureReason::refused: return "refused";
+    case FailureReason::timed_out: return "timed_out";
+    case FailureReason::link_lost: return "link_lost";
+    case FailureReason::vehicle_fault: return "vehicle_fault";
+    case FailureReason::pilot_took_over: return "pilot_took_over";
+  }
+  return "";
+}
+
 }  // namespace eamos::mid

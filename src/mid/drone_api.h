@@ -12,6 +12,8 @@
 //  - The drone refuses what a real autopilot refuses (Takeoff while disarmed, Disarm in the
 //    air, Arm with an empty battery, motion while disarmed): the action ends `failed` with
 //    the reason in words. An action that exceeds its timeout (mid/timeouts.h) ends `failed`.
+//  - Every `failed` end names its FailureReason (the same five kinds for every adapter); what
+//    the vehicle itself said about it (an autopilot's MAV_RESULT and STATUSTEXT) is its detail.
 //  - Hover() and Orbit() have no end of their own: they run until preempted or cancelled.
 #include <cstdint>
 #include <functional>
@@ -34,6 +36,20 @@ enum class Outcome {
 };
 const char* outcome_name(Outcome o);
 
+/// Why an action ended `failed`, in the uniform API's words: a mission (and a person reading
+/// its trace) can tell a refusal from a lost link whatever flies the vehicle. Preempted and
+/// cancelled ends are not failures and carry `none`.
+enum class FailureReason {
+  none,             ///< the action did not fail
+  refused,          ///< the drone or its autopilot would not do it (uniform rule, MAV_RESULT)
+  timed_out,        ///< no end within its deadline, or the autopilot never answered the command
+  link_lost,        ///< the link to the vehicle went silent
+  vehicle_fault,    ///< the vehicle could not go on (battery empty, an autopilot failure)
+  pilot_took_over,  ///< a pilot or the autopilot's own failsafe took the vehicle out of our control
+};
+/// "refused", "timed_out", "link_lost", "vehicle_fault", "pilot_took_over"; "" for none.
+const char* failure_reason_name(FailureReason r);
+
 /// A uniform action call, as the mission writes it: `FlyTo(1, 2, 3)` is {"FlyTo", {1, 2, 3}}.
 /// Names and arities are the platform catalog's (fleet/catalog.h); a sensor read is "SensorK".
 struct ActionRequest {
@@ -46,6 +62,8 @@ struct ActionEnd {
   Outcome outcome = Outcome::succeeded;
   std::string reason;           ///< words for people: why it failed / who preempted it; "" on success
   std::optional<double> value;  ///< the reading of a succeeded SensorK action; empty otherwise
+  FailureReason failure = FailureReason::none;  ///< set exactly when outcome is `failed`
+  std::string detail;  ///< the vehicle's own words on a failure (MAV_RESULT, STATUSTEXT), or ""
 };
 
 /// The newest known properties of a drone: what the broker publishes and state() returns.

@@ -18,42 +18,22 @@ using mid::metres;
 
 SimDrone::SimDrone(fleet::DroneSettings settings, fleet::DroneType type, mid::EventLoop& loop,
                    SimOptions options)
-    : settings_(std::move(settings)),
-      type_(std::move(type)),
-      loop_(loop),
+    : AdapterDrone(loop, std::move(type)),
+      settings_(std::move(settings)),
       options_(options),
-      battery_(settings_.battery_percent, loop.now()),
-      tracker_(loop, [this](ActionId id) { stop_action(id); }) {
+      battery_(settings_.battery_percent, loop.now()) {
   kin_.position = settings_.home;
 }
 
 SimDrone::~SimDrone() {
-  for (auto& [id, timer] : action_timers_) loop_.cancel(timer);
   for (mid::TimerId t : {step_timer_, telemetry_timer_, empty_timer_, publish_timer_})
     loop_.cancel(t);
 }
 
 // --- actions -------------------------------------------------------------------------------
 
-ActionId SimDrone::start(const mid::ActionRequest& request, mid::EndCallback on_end) {
-  if (!failsafe_reason_.empty())
-    return tracker_.refuse(request, std::move(on_end), "failsafe active (" + failsafe_reason_ + ")");
-  mid::RequestCheck check = mid::check_request(request, type_);
-  if (!check.spec) return tracker_.refuse(request, std::move(on_end), check.error);
-  if (std::string why = refusal(request, *check.spec); !why.empty())
-    return tracker_.refuse(request, std::move(on_end), why);
-
-  double timeout = mid::action_timeout(request, kin_.position, settings_);
-  fleet::ActionClass cls = check.spec->action_class;
-  if (cls == fleet::ActionClass::motion) clear_action_timer(tracker_.motion());  // preempted
-  ActionId id = tracker_.begin(request, cls, std::move(on_end), timeout);
-  switch (cls) {
-    case fleet::ActionClass::system: start_system(id, request); break;
-    case fleet::ActionClass::payload: start_payload(id, request); break;
-    case fleet::ActionClass::motion: start_motion(id, request); break;
-  }
-  update_timers();
-  return id;
+double SimDrone::timeout_for(const mid::ActionRequest& r) const {
+  return mid::action_timeout(r, kin_.position, settings_);
 }
 
 std::string SimDrone::refusal(const mid::ActionRequest& r, const fleet::ActionSpec& spec) const {
@@ -67,8 +47,7 @@ void SimDrone::start_system(ActionId id, const mid::ActionRequest& r) {
   // The autopilot acknowledges at once, but the change and the end both come from the loop:
   // nothing a subscriber sees may happen inside start().
   bool arm = r.name == "Arm";
-  action_timers_[id] = loop_.after(0.0, [this, id, arm] {
-    action_timers_.erase(id);
+  after_for(id, 0.0, [this, id, arm] {
     set_armed(arm);
     publish();
     tracker_.end(id, Outcome::succeeded);
@@ -78,10 +57,7 @@ void SimDrone::start_system(ActionId id, const mid::ActionRequest& r) {
 
 void SimDrone::start_payload(ActionId id, const mid::ActionRequest& r) {
   double duration = r.name == "TakePicture" ? options_.picture_s : options_.sensor_read_s;
-  action_timers_[id] = loop_.after(duration, [this, id, name = r.name] {
-    action_timers_.erase(id);
-    finish_payload(id, name);
-  });
+  after_for(id, duration, [this, id, name = r.name] { finish_payload(id, name); });
 }
 
 void SimDrone::finish_payload(ActionId id, const std::string& name) {
@@ -146,23 +122,14 @@ void SimDrone::start_motion(ActionId id, const mid::ActionRequest& r) {
   stop_motion();
   motion_owner_ = id;
   if (r.args.size() == 1) {
-    action_timers_[id] = loop_.after(r.args[0], [this, id] {
-      action_timers_.erase(id);
+    after_for(id, r.args[0], [this, id] {
       if (motion_owner_ == id) motion_owner_ = mid::kNoAction;
       tracker_.end(id, Outcome::succeeded);
     });
   }
 }
 
-bool SimDrone::cancel(ActionId id) {
-  if (!tracker_.running(id)) return false;
-  stop_action(id);
-  tracker_.end(id, Outcome::cancelled, "cancelled");
-  return true;
-}
-
 void SimDrone::stop_action(ActionId id) {
-  clear_action_timer(id);
   if (id == motion_owner_) {
     motion_owner_ = mid::kNoAction;
     stop_motion();
@@ -178,13 +145,6 @@ void SimDrone::stop_motion() {
     motion_.kind = MotionKind::hold;
     motion_.target = kin_.position;
   }
-}
-
-void SimDrone::clear_action_timer(ActionId id) {
-  auto it = action_timers_.find(id);
-  if (it == action_timers_.end()) return;
-  loop_.cancel(it->second);
-  action_timers_.erase(it);
 }
 
 std::optional<double> SimDrone::progress(ActionId id) const {
@@ -207,15 +167,12 @@ std::optional<double> SimDrone::progress(ActionId id) const {
 // --- failsafe ------------------------------------------------------------------------------
 
 void SimDrone::failsafe(fleet::Failsafe what) {
-  enter_failsafe(what, Outcome::cancelled, std::string("failsafe: ") + fleet::failsafe_name(what));
+  enter_failsafe(what, {Outcome::cancelled, std::string("failsafe: ") + fleet::failsafe_name(what)});
 }
 
-void SimDrone::enter_failsafe(fleet::Failsafe what, Outcome outcome, const std::string& reason) {
-  failsafe_reason_ = reason;
-  for (ActionId id : tracker_.running_ids()) {
-    clear_action_timer(id);
-    tracker_.end(id, outcome, reason);
-  }
+void SimDrone::enter_failsafe(fleet::Failsafe what, const mid::ActionEnd& end) {
+  refuse_from_now(end.reason);
+  end_all(end);
   motion_owner_ = mid::kNoAction;
   if (landed_) {
     // On the ground every failsafe means the same: motors off.
@@ -246,7 +203,10 @@ void SimDrone::enter_failsafe(fleet::Failsafe what, Outcome outcome, const std::
 void SimDrone::battery_empty() {
   empty_timer_ = mid::kNoTimer;
   // What an autopilot does at critical charge: fail what it was doing and land where it is.
-  enter_failsafe(fleet::Failsafe::land, Outcome::failed, "battery empty");
+  char detail[64];
+  std::snprintf(detail, sizeof detail, "battery at %.1f %%", battery_.at(loop_.now()));
+  enter_failsafe(fleet::Failsafe::land, {.outcome = Outcome::failed, .reason = "battery empty",
+                                         .failure = mid::FailureReason::vehicle_fault, .detail = detail});
   publish();
 }
 

@@ -10,7 +10,7 @@
 
 #include "fleet/catalog.h"
 #include "fleet/fleet.h"
-#include "mid/action_tracker.h"
+#include "mid/adapter_drone.h"
 #include "mid/drone_api.h"
 #include "mid/event_loop.h"
 #include "mid/mover.h"
@@ -29,15 +29,13 @@ struct SimOptions {
   double sensor_read_s = 0.1;      ///< SensorK read duration
 };
 
-class SimDrone final : public mid::Drone {
+class SimDrone final : public mid::AdapterDrone {
  public:
   SimDrone(fleet::DroneSettings settings, fleet::DroneType type, mid::EventLoop& loop,
            SimOptions options = {});
   ~SimDrone() override;
 
   const std::string& name() const override { return settings_.name; }
-  mid::ActionId start(const mid::ActionRequest& request, mid::EndCallback on_end) override;
-  bool cancel(mid::ActionId id) override;
   std::optional<double> progress(mid::ActionId id) const override;
   mid::DroneState state() const override;
   mid::SubscriptionId subscribe(mid::StateCallback fn) override;
@@ -50,16 +48,18 @@ class SimDrone final : public mid::Drone {
   fleet::Vec3 velocity() const { return kin_.velocity; }
 
  private:
-  std::string refusal(const mid::ActionRequest& r, const fleet::ActionSpec& spec) const;
-  void start_system(mid::ActionId id, const mid::ActionRequest& r);
-  void start_payload(mid::ActionId id, const mid::ActionRequest& r);
-  void start_motion(mid::ActionId id, const mid::ActionRequest& r);
+  std::string refusal(const mid::ActionRequest& r, const fleet::ActionSpec& spec) const override;
+  double timeout_for(const mid::ActionRequest& r) const override;
+  void start_system(mid::ActionId id, const mid::ActionRequest& r) override;
+  void start_payload(mid::ActionId id, const mid::ActionRequest& r) override;
+  void start_motion(mid::ActionId id, const mid::ActionRequest& r) override;
+  void started() override { update_timers(); }
   void finish_payload(mid::ActionId id, const std::string& name);
 
-  void stop_action(mid::ActionId id);  ///< what cancel and timeouts do to the vehicle
-  void stop_motion();                  ///< brake and hold where it is
-  void clear_action_timer(mid::ActionId id);
-  void enter_failsafe(fleet::Failsafe what, mid::Outcome outcome, const std::string& reason);
+  void stop_action(mid::ActionId id) override;  ///< what cancel and timeouts do to the vehicle
+  void stop_motion();                           ///< brake and hold where it is
+  /// Ends every running action as `end` says and flies the failsafe `what`.
+  void enter_failsafe(fleet::Failsafe what, const mid::ActionEnd& end);
 
   void step();
   void set_armed(bool armed);
@@ -74,8 +74,6 @@ class SimDrone final : public mid::Drone {
   double ground_z() const { return settings_.home.z; }
 
   fleet::DroneSettings settings_;
-  fleet::DroneType type_;
-  mid::EventLoop& loop_;
   SimOptions options_;
 
   mid::Kinematics kin_;
@@ -84,14 +82,11 @@ class SimDrone final : public mid::Drone {
   int pictures_ = 0;
   double heading_ = 0.0;  ///< degrees from north; a drone starts facing north
   Battery battery_;
-  std::string failsafe_reason_;  ///< "" = no failsafe; otherwise why new actions are refused
 
   Motion motion_;
   mid::ActionId motion_owner_ = mid::kNoAction;  ///< the action motion_ flies for; none in failsafe
-  mid::ActionTracker tracker_;
   mid::StateBroker broker_;
 
-  std::map<mid::ActionId, mid::TimerId> action_timers_;  ///< ends of payload, system, Hover(s)
   mid::TimerId step_timer_ = mid::kNoTimer;
   double steps_origin_ = 0.0;     ///< mission time of step 0 of the current run of steps
   std::uint64_t steps_in_run_ = 0;

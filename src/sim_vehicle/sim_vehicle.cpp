@@ -93,6 +93,20 @@ void SimVehicle::on_frame(const ml::Frame& frame) {
   }
   if (auto sp = ml::unpack_set_position_target_local_ned(frame.message)) return on_setpoint(*sp);
   if (auto r = ml::unpack_param_request_read(frame.message)) return on_param_request(*r);
+  if (auto s = ml::unpack_setup_signing(frame.message)) return on_setup_signing(*s);
+}
+
+// Like ArduPilot after SETUP_SIGNING: sign every frame from now on and drop every unsigned
+// or badly signed one (ArduPilot lets RADIO_STATUS through unsigned; we have none). An
+// all-zero key would turn signing off there; here it is ignored.
+void SimVehicle::on_setup_signing(const ml::SetupSigning& s) {
+  if (s.target_system != options_.sysid && s.target_system != 0) return;
+  bool all_zero = true;
+  for (uint8_t b : s.secret_key) all_zero = all_zero && b == 0;
+  if (all_zero || !link_) return;
+  ml::SigningKey key{s.secret_key};
+  encoder_.signer.emplace(key, 0);
+  link_->verify_with(key, true);
 }
 
 // The speed parameters the real autopilot has, valued as the simulator flies (its default

@@ -89,6 +89,7 @@ class SimVehicle {
   void on_frame(const mavlink::Frame& frame);
   void on_command(const mavlink::CommandLong& c);
   void on_param_request(const mavlink::ParamRequestRead& r);
+  void on_setup_signing(const mavlink::SetupSigning& s);
   uint8_t execute(const mavlink::CommandLong& c);  ///< the MAV_RESULT to acknowledge with,
                                                   ///< or kAckLater
   uint8_t set_mode(Mode mode);

@@ -248,6 +248,8 @@ eamos_wire_Lifecycle to_wire(const LifecycleSample& s) {
   w.failed_drone = borrow(s.failure ? s.failure->drone : empty);
   w.failed_action = borrow(s.failure ? s.failure->action : empty);
   w.failed_line = s.failure ? s.failure->line : 0;
+  w.failed_kind = s.failure ? static_cast<int32_t>(s.failure->kind) : 0;
+  w.failed_detail = borrow(s.failure ? s.failure->detail : empty);
   return w;
 }
 
@@ -275,7 +277,11 @@ bool from_wire(const eamos_wire_Lifecycle& w, const WireLimits& limits, Lifecycl
   std::string failed_drone = check.text("failed_drone", w.failed_drone, kMaxWireName);
   std::string failed_action = check.text("failed_action", w.failed_action, kMaxWireName);
   check.at_least("failed_line", w.failed_line, 0);
-  if (!failed_drone.empty()) s.failure = dex::Failure{failed_drone, failed_action, w.failed_line, s.reason};
+  check.one_of("failed_kind", w.failed_kind, static_cast<long long>(mid::FailureReason::pilot_took_over) + 1);
+  std::string failed_detail = check.text("failed_detail", w.failed_detail, kMaxWireText);
+  if (!failed_drone.empty() && check.ok())
+    s.failure = dex::Failure{failed_drone, failed_action, w.failed_line, s.reason,
+                             static_cast<mid::FailureReason>(w.failed_kind), failed_detail};
   return check.ok();
 }
 

@@ -288,6 +288,7 @@ void check_failure(const Setup& s, const Flight& f, std::vector<Violation>& out)
   at.message = fail->drone + "." + fail->action + " fails at " + seconds(f.result.duration) + ": " + fail->reason +
                "; the mission would abort and every drone run its failsafe";
   out.push_back(make("action_failed", f.result.duration, {fail->drone}, at));
+  out.back().failure = mid::failure_reason_name(fail->kind);
 }
 
 bool waits_for(const dex::Node& n, bool value) {

@@ -76,6 +76,7 @@ std::string json_report(const graph::Compilation& c, const VerifyReport& r) {
                            {"value", d.value}, {"forced", d.forced}});
     e["timing"] = v.timing;
     e["paths_seen"] = v.paths_seen;
+    if (!v.failure.empty()) e["failure"] = v.failure;
     j["violations"].push_back(e);
   }
   return j.dump(2) + "\n";

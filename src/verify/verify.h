@@ -45,6 +45,7 @@ struct Violation {
   std::vector<Decision> path;  ///< the condition outcomes of the run that found it
   std::string timing;          ///< "" nominal; else which drones flew slower or faster
   int paths_seen = 1;          ///< explored paths on which it happened
+  std::string failure;         ///< action_failed: the uniform FailureReason ("refused", …), else ""
 };
 
 /// One flown path, as needed to fly it again: the outcomes it forced and its timing.

@@ -115,3 +115,31 @@ TEST(MissionHash, DoesNotDependOnTheSourcePath) {
 
 }  // namespace
 }  // namespace eamos
+
+namespace eamos {
+namespace {
+
+// A distributed run flies each drone from its mission file: a signing key the fleet file
+// gave must come back from it, or the DEX would fly that drone unsigned.
+TEST(MissionFile, ADronesSigningKeyAndSetupComeBackFromItsFileOnly) {
+  std::string fleet = std::string(test::kListing2Fleet) + "";
+  const std::string key = "0f1e2d3c4b5a69788796a5b4c3d2e1f000112233445566778899aabbccddeeff";
+  fleet.replace(fleet.find("    failsafe: return_home\n"), 0, "    signing: {key: " + key + ", setup: true}\n");
+  auto c = test::compile_mission(test::listing2_text(), fleet);
+  ASSERT_TRUE(c);
+  std::string hash = deploy::mission_hash(*c);
+  for (int d = 0; d < c->drone_count(); ++d) {
+    std::ostringstream out;
+    ASSERT_TRUE(deploy::write_drone_mission(out, *c, d, hash));
+    dex::Mission m;
+    std::vector<std::string> errors;
+    ASSERT_TRUE(deploy::read_mission(out.str(), c->drone_name(d), m, errors)) << errors.front();
+    bool is_drone2 = c->drone_name(d) == "Drone2";
+    EXPECT_EQ(m.settings.signing_key, is_drone2 ? key : "") << c->drone_name(d);
+    EXPECT_EQ(m.settings.signing_setup, is_drone2) << c->drone_name(d);
+    EXPECT_EQ(out.str().find(key) != std::string::npos, is_drone2) << c->drone_name(d);
+  }
+}
+
+}  // namespace
+}  // namespace eamos

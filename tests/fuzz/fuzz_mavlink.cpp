@@ -1,5 +1,5 @@
-// libFuzzer target of the MAVLink parser: any bytes, cut into chunks the input itself chooses,
-// must give frames whose payloads have their message's full length and survive a re-encode —
+// libFuzzer target of the MAVLink parser, with and without a signing key: any bytes, cut into
+// chunks the input itself chooses, must give frames whose payloads have their message's full length and survive a re-encode —
 // never a crash, a hang or a read past the buffer.
 #include <cstddef>
 #include <cstdint>
@@ -12,6 +12,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   using namespace eamos::mavlink;
   if (size == 0) return 0;
   Parser parser;
+  // Its top bit: check signatures too (signed frames verified, unsigned ones required or not).
+  if (data[0] & 0x80) {
+    SigningKey key;
+    key.bytes.fill(0x5A);
+    parser.verify_with(key);
+    parser.require_signed(data[0] & 0x40);
+  }
   std::vector<Frame> frames;
   // The first byte picks the chunk size, so the fuzzer explores frames split anywhere.
   std::size_t chunk = 1 + data[0] % 64;

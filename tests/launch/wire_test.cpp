@@ -89,7 +89,7 @@ TEST(Wire, LifecycleKeepsStartAndFailure) {
   s.t = 9.75;
   s.nonces = {11, 12, 13};
   s.reason = "Drone1.Takeoff (line 3) failed: disarmed";
-  s.failure = dex::Failure{"Drone1", "Takeoff", 3, s.reason};
+  s.failure = dex::Failure{"Drone1", "Takeoff", 3, s.reason, mid::FailureReason::refused, "MAV_RESULT_DENIED"};
   LifecycleSample back = back_from<LifecycleSample>(to_wire(s));
   EXPECT_EQ(back.drone, kGround);
   EXPECT_EQ(back.kind, LifecycleKind::abort);
@@ -104,6 +104,17 @@ TEST(Wire, LifecycleKeepsStartAndFailure) {
   EXPECT_EQ(back.failure->drone, "Drone1");
   EXPECT_EQ(back.failure->action, "Takeoff");
   EXPECT_EQ(back.failure->line, 3);
+  EXPECT_EQ(back.failure->kind, mid::FailureReason::refused);
+  EXPECT_EQ(back.failure->detail, "MAV_RESULT_DENIED");
+}
+
+TEST(Wire, AnAbortWithAnUnknownFailureKindIsRefused) {
+  LifecycleSample s;
+  s.kind = LifecycleKind::abort;
+  s.failure = dex::Failure{"Drone1", "Takeoff", 3, "r", mid::FailureReason::refused, ""};
+  eamos_wire_Lifecycle w = to_wire(s);
+  w.failed_kind = 99;
+  EXPECT_NE(refusal<LifecycleSample>(w).find("failed_kind 99 is not a known value"), std::string::npos);
 }
 
 TEST(Wire, LifecycleWithoutFailureHasNone) {

@@ -41,7 +41,7 @@ const std::map<uint32_t, uint8_t> kPublished = {
     {msg::COMMAND_INT, 158},        {msg::COMMAND_LONG, 152},
     {msg::COMMAND_ACK, 143},        {msg::SET_POSITION_TARGET_LOCAL_NED, 143},
     {msg::BATTERY_STATUS, 154},     {msg::EXTENDED_SYS_STATE, 130},
-    {msg::STATUSTEXT, 83},
+    {msg::STATUSTEXT, 83},          {msg::SETUP_SIGNING, 71},
 };
 
 TEST(CrcExtra, EveryTableMessageMatchesThePublishedValue) {

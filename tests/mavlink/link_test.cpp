@@ -63,8 +63,8 @@ TEST(UdpLink, ListenerRepliesToTheLastSender) {
   EXPECT_EQ(unpack_command_ack(vehicle_side.frames[0].message)->command, 400);
 }
 
-TEST(UdpLink, ListenerIgnoresAGarbageDatagramAndOtherSystemsButFollowsTheVehicleToANewPort) {
-  Mailbox adapter_side, vehicle_side, stranger_side, moved_side;
+TEST(UdpLink, ListenerIgnoresAGarbageDatagramAndOtherSystemsFromAnotherAddress) {
+  Mailbox adapter_side, vehicle_side, stranger_side;
   OpenResult listen = Link::open(endpoint("udp://127.0.0.1:25303"), adapter_side.handler());
   ASSERT_TRUE(listen.link) << listen.error;
   listen.link->follow_only(7);
@@ -77,28 +77,59 @@ TEST(UdpLink, ListenerIgnoresAGarbageDatagramAndOtherSystemsButFollowsTheVehicle
   ASSERT_TRUE(adapter_side.wait_for(1));
 
   // From another port: a datagram of garbage (with a MAVLink v2 start byte in it), then
-  // a valid frame of another system. The frame reaching the adapter shows both were read.
+  // a valid frame of another system. Both are dropped unread: the vehicle's next frame is
+  // the adapter's second.
   std::vector<uint8_t> garbage = {0xFD, 0x09, 0x00, 0x00, 0x01, 0x07, 0x01, 0x00, 0x00, 0x00, 0xAA, 0x55};
   ASSERT_TRUE(stranger.link->send(garbage));
   ASSERT_TRUE(stranger.link->send(stranger_enc.encode(pack(Heartbeat{}))));
+  ASSERT_TRUE(vehicle.link->send(vehicle_enc.encode(pack(Heartbeat{}))));
   ASSERT_TRUE(adapter_side.wait_for(2));
-  EXPECT_EQ(adapter_side.frames[1].sysid, 99);
+  EXPECT_EQ(adapter_side.frames[1].sysid, 7);
+  EXPECT_EQ(listen.link->foreign_datagrams(), 2u);
 
   // Replies still go to the vehicle: it gets the ACK, so the stranger did not.
   ASSERT_TRUE(listen.link->send(adapter.encode(pack(CommandAck{400, 0}))));
   ASSERT_TRUE(vehicle_side.wait_for(1));
   EXPECT_EQ(unpack_command_ack(vehicle_side.frames[0].message)->command, 400);
 
-  // The vehicle's own valid frame from a new port (a restarted SITL) moves the link.
-  OpenResult moved = Link::open(endpoint("udpout://127.0.0.1:25303"), moved_side.handler());
-  ASSERT_TRUE(moved.link);
-  ASSERT_TRUE(moved.link->send(vehicle_enc.encode(pack(Heartbeat{}))));
-  ASSERT_TRUE(adapter_side.wait_for(3));
-  ASSERT_TRUE(listen.link->send(adapter.encode(pack(CommandAck{176, 0}))));
-  ASSERT_TRUE(moved_side.wait_for(1));
-  EXPECT_EQ(unpack_command_ack(moved_side.frames[0].message)->command, 176);
   std::lock_guard lock(stranger_side.m);
   EXPECT_TRUE(stranger_side.frames.empty());
+}
+
+TEST(UdpLink, ListenerKeepsTheVehiclesAddressAndCountsFramesFromAnyOther) {
+  Mailbox adapter_side, vehicle_side, forger_side;
+  OpenResult listen = Link::open(endpoint("udp://127.0.0.1:25305"), adapter_side.handler());
+  ASSERT_TRUE(listen.link) << listen.error;
+  listen.link->follow_only(7);
+  OpenResult vehicle = Link::open(endpoint("udpout://127.0.0.1:25305"), vehicle_side.handler());
+  OpenResult forger = Link::open(endpoint("udpout://127.0.0.1:25305"), forger_side.handler());
+  ASSERT_TRUE(vehicle.link && forger.link);
+  Encoder vehicle_enc{7, 1}, forged_enc{7, 1}, adapter{7, 191};
+  ASSERT_TRUE(vehicle.link->send(vehicle_enc.encode(pack(Heartbeat{}))));
+  ASSERT_TRUE(adapter_side.wait_for(1));
+  EXPECT_TRUE(listen.link->locked());
+
+  // Valid frames with the vehicle's own system id, from another port: a forged DENIED ACK
+  // and a HEARTBEAT. Neither reaches the adapter, and neither moves the link.
+  ASSERT_TRUE(forger.link->send(forged_enc.encode(pack(CommandAck{400, 2}))));
+  ASSERT_TRUE(forger.link->send(forged_enc.encode(pack(Heartbeat{}))));
+  // The vehicle's next frame comes after them on the same loopback path: when it is in, the
+  // forged ones were read (and dropped) before it.
+  Heartbeat marker;
+  marker.custom_mode = 5;
+  ASSERT_TRUE(vehicle.link->send(vehicle_enc.encode(pack(marker))));
+  ASSERT_TRUE(adapter_side.wait_for(2));
+  {
+    std::lock_guard lock(adapter_side.m);
+    ASSERT_EQ(adapter_side.frames.size(), 2u);
+    EXPECT_EQ(unpack_heartbeat(adapter_side.frames[1].message)->custom_mode, 5u);
+  }
+  EXPECT_EQ(listen.link->foreign_datagrams(), 2u);
+  ASSERT_TRUE(listen.link->send(adapter.encode(pack(CommandAck{176, 0}))));
+  ASSERT_TRUE(vehicle_side.wait_for(1));
+  EXPECT_EQ(unpack_command_ack(vehicle_side.frames[0].message)->command, 176);
+  std::lock_guard lock(forger_side.m);
+  EXPECT_TRUE(forger_side.frames.empty());
 }
 
 TEST(UdpLink, ListenerBeforeTheVehicleIsKnownFollowsTheLastValidFrameOfAnySystem) {

@@ -1,6 +1,7 @@
 #pragma once
 // The adapter's side of a loopback flight: a registry with the mavlink adapter, one drone
 // connected to a simulated vehicle (vehicle_thread.h), and a way to fly one action.
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,7 +20,9 @@ struct Flight {
   std::unique_ptr<mid::Drone> drone;
   mid::CreateResult created;
 
-  explicit Flight(int port, mavlink_adapter::MavlinkOptions options = {}) {
+  /// `edit` changes the drone's fleet settings before it is made (signing, say).
+  explicit Flight(int port, mavlink_adapter::MavlinkOptions options = {},
+                  const std::function<void(fleet::DroneSettings&)>& edit = {}) {
     options.real_time = true;
     options.speed = kSpeed;
     mavlink_adapter::register_adapter(registry, options);
@@ -28,6 +31,7 @@ struct Flight {
     s.adapter = "mavlink";
     s.connection = "udp://127.0.0.1:" + std::to_string(port);
     s.sysid = 1;
+    if (edit) edit(s);
     created = registry.create("mavlink", s, fleet::generic_multirotor("Quad"), loop);
     drone = std::move(created.drone);
   }

@@ -2,7 +2,9 @@
 // time sped up 4×: every test flies a few mission seconds. Each test has its own port.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
+#include <thread>
 
 #include "mavlink/enums.h"
 #include "mavlink/link.h"
@@ -78,6 +80,8 @@ TEST(MavlinkFlight, ArmRefusedByTheAutopilotFailsWithItsResultInWords) {
   mid::ActionEnd e = f.fly("Arm");
   EXPECT_EQ(e.outcome, mid::Outcome::failed);
   EXPECT_EQ(e.reason, "refused by PX4: MAV_CMD_COMPONENT_ARM_DISARM: MAV_RESULT_DENIED (denied by the autopilot)");
+  EXPECT_EQ(e.failure, mid::FailureReason::refused);
+  EXPECT_EQ(e.detail, "MAV_CMD_COMPONENT_ARM_DISARM: MAV_RESULT_DENIED (denied by the autopilot)");
   EXPECT_FALSE(f.drone->state().armed);
 }
 
@@ -110,9 +114,11 @@ TEST(MavlinkFlight, LinkLossFailsTheRunningAction) {
   ASSERT_TRUE(end);
   EXPECT_EQ(end->outcome, mid::Outcome::failed);
   EXPECT_EQ(end->reason, "link lost: no HEARTBEAT from system 1 for 2.0 s");
+  EXPECT_EQ(end->failure, mid::FailureReason::link_lost);
   mid::ActionEnd refused = f.fly("Land");
   EXPECT_EQ(refused.outcome, mid::Outcome::failed);
   EXPECT_EQ(refused.reason, "link lost: no HEARTBEAT from system 1");
+  EXPECT_EQ(refused.failure, mid::FailureReason::link_lost);
 }
 
 TEST(MavlinkFlight, APilotsModeSwitchFailsTheMotionAndTheAdapterGivesWay) {
@@ -144,9 +150,88 @@ TEST(MavlinkFlight, APilotsModeSwitchFailsTheMotionAndTheAdapterGivesWay) {
   ASSERT_TRUE(end);
   EXPECT_EQ(end->outcome, mid::Outcome::failed);
   EXPECT_EQ(end->reason, "the vehicle left OFFBOARD for POSCTL");
+  EXPECT_EQ(end->failure, mid::FailureReason::pilot_took_over);
+  EXPECT_EQ(end->detail, "mode POSCTL");
   f.loop.run_until(f.loop.now() + 2.0);  // and it does not switch back
   vehicle.halt();
   EXPECT_EQ(vehicle.mode(), sim_vehicle::Mode::manual);
+}
+
+TEST(MavlinkFlight, ForgedFramesWithTheVehiclesSystemIdFromAnotherPortAreIgnoredAndCounted) {
+  test::VehicleThread vehicle(25371, 1, kSpeed);
+  Flight f(25371);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  std::vector<std::string> messages;
+  f.drone->set_message_sink([&](const std::string& m) { messages.push_back(m); });
+  // An attacker on the adapter's port: DENIED for every arm command and HEARTBEATs, all with
+  // the vehicle's system id, while the mission arms and takes off.
+  auto forger = mavlink::Link::open(*mavlink::parse_url("udpout://127.0.0.1:25371").endpoint, [](mavlink::Frame) {});
+  ASSERT_TRUE(forger.link) << forger.error;
+  std::atomic<bool> stop{false};
+  std::thread attack([&] {
+    mavlink::Encoder forged{1, 1, 0};
+    while (!stop) {
+      forger.link->send(forged.encode(mavlink::pack(mavlink::CommandAck{mavlink::cmd::COMPONENT_ARM_DISARM, 2})));
+      forger.link->send(forged.encode(mavlink::pack(mavlink::Heartbeat{})));
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // a 50 Hz flood, not a wait
+    }
+  });
+  mid::ActionEnd arm = f.fly("Arm");
+  mid::ActionEnd takeoff = f.fly("Takeoff", {3});
+  stop = true;
+  attack.join();
+  EXPECT_EQ(arm.outcome, mid::Outcome::succeeded) << arm.reason;
+  EXPECT_EQ(takeoff.outcome, mid::Outcome::succeeded) << takeoff.reason;
+  auto* d = dynamic_cast<MavlinkDrone*>(f.drone.get());
+  ASSERT_NE(d, nullptr);
+  f.loop.run_until(f.loop.now() + 0.5);  // a HEARTBEAT or two: the adapter reports the count
+  ASSERT_FALSE(messages.empty());
+  EXPECT_NE(messages[0].find("ignored"), std::string::npos) << messages[0];
+  EXPECT_NE(messages[0].find("datagram(s) from other addresses than system 1's"), std::string::npos) << messages[0];
+}
+
+const char* kTestKey = "0f1e2d3c4b5a69788796a5b4c3d2e1f000112233445566778899aabbccddeeff";
+
+TEST(MavlinkFlight, SigningSetupGivesTheVehicleTheKeyAndAnUnsignedGroundStationIsIgnored) {
+  test::VehicleThread vehicle(25372, 1, kSpeed);
+  Flight f(25372, {}, [](fleet::DroneSettings& s) {
+    s.signing_key = kTestKey;
+    s.signing_setup = true;
+  });
+  ASSERT_TRUE(f.drone) << f.created.message;
+  ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
+  ASSERT_EQ(f.fly("Takeoff", {3}).outcome, mid::Outcome::succeeded);
+  // A ground station without the key switches the vehicle to POSCTL (as in
+  // APilotsModeSwitchFailsTheMotionAndTheAdapterGivesWay): the signed vehicle drops it.
+  auto gcs = mavlink::Link::open(*mavlink::parse_url("udpout://127.0.0.1:" + std::to_string(vehicle.port())).endpoint,
+                                 [](mavlink::Frame) {});
+  ASSERT_TRUE(gcs.link) << gcs.error;
+  mavlink::CommandLong c;
+  c.target_system = 1;
+  c.target_component = 1;
+  c.command = mavlink::cmd::DO_SET_MODE;
+  c.param = {1, mavlink::px4::MAIN_POSCTL, 0};
+  std::optional<mid::ActionEnd> end;
+  f.drone->start({"FlyTo", {30, 0, 3}}, [&](const mid::ActionEnd& e) {
+    end = e;
+    f.loop.stop();
+  });
+  f.loop.run_until(f.loop.now() + 1.0);
+  for (int i = 0; i < 5; ++i) gcs.link->send(mavlink::Encoder{255, 190, static_cast<uint8_t>(i)}.encode(mavlink::pack(c)));
+  f.loop.run_until(f.loop.now() + 30.0);
+  ASSERT_TRUE(end);
+  EXPECT_EQ(end->outcome, mid::Outcome::succeeded) << end->reason;
+  EXPECT_NEAR(f.drone->state().x, 30.0, 0.5);
+  EXPECT_EQ(f.fly("Land").outcome, mid::Outcome::succeeded);
+}
+
+TEST(MavlinkFlight, WithAKeyButNoSetupAVehicleThatDoesNotSignNeverConnects) {
+  test::VehicleThread vehicle(25373, 1, kSpeed);  // has no key: its frames are unsigned
+  MavlinkOptions options;
+  options.connect_timeout_s = 1.0;
+  Flight f(25373, options, [](fleet::DroneSettings& s) { s.signing_key = kTestKey; });
+  EXPECT_EQ(f.created.status, mid::CreateStatus::adapter_failed);
+  EXPECT_NE(f.created.message.find("Signing is on for this drone"), std::string::npos) << f.created.message;
 }
 
 TEST(MavlinkFlight, OrbitRunsUntilCancelledThenHolds) {
@@ -185,6 +270,7 @@ TEST(MavlinkFlight, FailsafeLandCancelsTheFlightLandsAndRefusesMore) {
   ASSERT_TRUE(end);
   EXPECT_EQ(end->outcome, mid::Outcome::cancelled);
   EXPECT_EQ(end->reason, "failsafe: land");
+  EXPECT_EQ(end->failure, mid::FailureReason::none);  // cancelled is no failure
   for (int i = 0; i < 100 && !f.drone->state().landed; ++i) f.loop.run_until(f.loop.now() + 0.5);
   EXPECT_TRUE(f.drone->state().landed);
   EXPECT_LT(f.drone->state().x, 29.0);  // landed where it was, not at the target

@@ -85,6 +85,8 @@ TEST(ActionTracker, DeadlineStopsThenFailsTheAction) {
   ASSERT_EQ(ends.seen.size(), 1u);
   EXPECT_EQ(ends.seen[0].second.outcome, Outcome::failed);
   EXPECT_EQ(ends.seen[0].second.reason, "timed out after 2.5 s");
+  EXPECT_EQ(ends.seen[0].second.failure, FailureReason::timed_out);
+  EXPECT_EQ(ends.seen[0].second.detail, "deadline 2.5 s after start");
   EXPECT_DOUBLE_EQ(loop.now(), 2.5);
   EXPECT_EQ(tracker.motion(), kNoAction);
 }
@@ -105,7 +107,7 @@ TEST(ActionTracker, RefusedActionEndsFailedThroughTheLoop) {
   EventLoop loop;
   ActionTracker tracker(loop, [](ActionId) {});
   Ends ends;
-  ActionId id = tracker.refuse({"Takeoff", {3}}, ends.tag(1), "disarmed: arm before Takeoff");
+  ActionId id = tracker.refuse({"Takeoff", {3}}, ends.tag(1), {.reason = "disarmed: arm before Takeoff"});
   EXPECT_NE(id, kNoAction);
   EXPECT_FALSE(tracker.running(id));
   EXPECT_TRUE(ends.seen.empty());
@@ -113,6 +115,28 @@ TEST(ActionTracker, RefusedActionEndsFailedThroughTheLoop) {
   ASSERT_EQ(ends.seen.size(), 1u);
   EXPECT_EQ(ends.seen[0].second.outcome, Outcome::failed);
   EXPECT_EQ(ends.seen[0].second.reason, "disarmed: arm before Takeoff");
+  EXPECT_EQ(ends.seen[0].second.failure, FailureReason::refused);  // a refusal unless it says otherwise
+}
+
+TEST(ActionTracker, AFailureCarriesItsKindAndDetailAndOnlyAFailureDoes) {
+  EventLoop loop;
+  ActionTracker tracker(loop, [](ActionId) {});
+  Ends ends;
+  ActionId lost = tracker.begin({"Hover", {}}, ActionClass::motion, ends.tag(1), 1e9);
+  ActionId picture = tracker.begin({"TakePicture", {}}, ActionClass::payload, ends.tag(2), 1e9);
+  ActionId read = tracker.begin({"Sensor1", {}}, ActionClass::payload, ends.tag(3), 1e9);
+  EXPECT_TRUE(tracker.fail(lost, FailureReason::link_lost, "link lost", "no HEARTBEAT"));
+  // A failure that names no kind is still one of the five, never "none".
+  EXPECT_TRUE(tracker.end(picture, ActionEnd{.outcome = Outcome::failed, .reason = "camera"}));
+  EXPECT_TRUE(tracker.end(read, ActionEnd{.outcome = Outcome::succeeded, .failure = FailureReason::refused}));
+  loop.run_until_idle();
+  ASSERT_EQ(ends.seen.size(), 3u);
+  EXPECT_EQ(ends.seen[0].second.failure, FailureReason::link_lost);
+  EXPECT_EQ(ends.seen[0].second.detail, "no HEARTBEAT");
+  EXPECT_EQ(ends.seen[1].second.failure, FailureReason::vehicle_fault);
+  EXPECT_EQ(ends.seen[2].second.failure, FailureReason::none);
+  EXPECT_STREQ(failure_reason_name(FailureReason::pilot_took_over), "pilot_took_over");
+  EXPECT_STREQ(failure_reason_name(FailureReason::none), "");
 }
 
 TEST(ActionTracker, ShutdownCancelsWhatStillRuns) {

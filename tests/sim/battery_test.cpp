@@ -43,6 +43,8 @@ TEST_F(BatteryDrain, EmptyBatteryInTheAirFailsMotionAndLands) {
   run_until_ended(*orbit, 60);
   EXPECT_EQ(orbit->end.outcome, Outcome::failed);
   EXPECT_EQ(orbit->end.reason, "battery empty");
+  EXPECT_EQ(orbit->end.failure, mid::FailureReason::vehicle_fault);
+  EXPECT_EQ(orbit->end.detail, "battery at 0.0 %");
   loop.run_until(loop.now() + 60);
   mid::DroneState s = d().state();
   EXPECT_TRUE(s.landed);

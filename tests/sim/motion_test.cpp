@@ -232,6 +232,7 @@ TEST_F(Motion, TimeoutFailsAction) {
   test::Result r = run("FlyTo", {500, 0, 5});
   EXPECT_EQ(r.end.outcome, Outcome::failed);
   EXPECT_EQ(r.end.reason, "timed out after 2.0 s");
+  EXPECT_EQ(r.end.failure, mid::FailureReason::timed_out);
   EXPECT_DOUBLE_EQ(r.t - t0, 2.0);
   loop.run_until(loop.now() + 10);
   EXPECT_TRUE(d().velocity() == fleet::Vec3{});  // holds where the deadline caught it

@@ -15,6 +15,7 @@ TEST_F(Refusals, TakeoffWhileDisarmedFails) {
   test::Result r = run("Takeoff", {5});
   EXPECT_EQ(r.end.outcome, Outcome::failed);
   EXPECT_EQ(r.end.reason, "disarmed: arm before Takeoff");
+  EXPECT_EQ(r.end.failure, mid::FailureReason::refused);
   EXPECT_TRUE(d().state().landed);
   EXPECT_DOUBLE_EQ(d().state().z, 0.0);
 }

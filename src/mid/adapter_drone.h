@@ -1,0 +1,66 @@
+#pragma once
+// What every adapter's drone does the same way around its vehicle: starting an action (the
+// failsafe and availability checks, the catalog check, the uniform refusals, the deadline,
+// the motion slot), cancelling one, and the per-action timers. The adapter says only what
+// its vehicle does: why it refuses beyond the uniform rules, how long an action may take,
+// how each class of action starts and how a running one stops. One place, so the simulator
+// and the MAVLink adapter cannot drift apart in what the DEX sees.
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "fleet/catalog.h"
+#include "mid/action_tracker.h"
+#include "mid/drone_api.h"
+#include "mid/event_loop.h"
+#include "mid/requests.h"
+
+namespace eamos::mid {
+
+class AdapterDrone : public Drone {
+ public:
+  AdapterDrone(EventLoop& loop, fleet::DroneType type);
+  ~AdapterDrone() override;
+
+  /// Refused (ends `failed` at once) in failsafe, when unavailable(), when the catalog or
+  /// refusal() says no; else registered with the tracker and handed to start_<class>().
+  ActionId start(const ActionRequest& request, EndCallback on_end) final;
+  /// Stops the vehicle's part (stop_action) and ends the action `cancelled`.
+  bool cancel(ActionId id) final;
+
+ protected:
+  /// Why the vehicle can take no action at all now (its link is lost, say), as the end to
+  /// report; empty when it can.
+  virtual std::optional<ActionEnd> unavailable() const { return std::nullopt; }
+  /// Why this drone refuses `r` (the uniform rules, mid/requests.h, plus its own); "" = start.
+  virtual std::string refusal(const ActionRequest& r, const fleet::ActionSpec& spec) const = 0;
+  /// The deadline of `r` in mission seconds (infinity: none).
+  virtual double timeout_for(const ActionRequest& r) const = 0;
+  virtual void start_system(ActionId id, const ActionRequest& r) = 0;
+  virtual void start_payload(ActionId id, const ActionRequest& r) = 0;
+  virtual void start_motion(ActionId id, const ActionRequest& r) = 0;
+  /// After every start() that registered an action (the simulator schedules its steps).
+  virtual void started() {}
+  /// What cancel() and a timeout do to the vehicle for a running action (its timer is
+  /// already cleared); the action's end is reported by the caller.
+  virtual void stop_action(ActionId id) = 0;
+
+  /// Runs `fn` after `delay_s` for a running action; cleared when the action stops.
+  void after_for(ActionId id, double delay_s, std::function<void()> fn);
+  void clear_action_timer(ActionId id);
+  /// From now on every start() is refused with `reason` ("failsafe: land").
+  void refuse_from_now(std::string reason) { failsafe_reason_ = std::move(reason); }
+  /// Ends every running action as `e` says (timers cleared, no stop_action).
+  void end_all(const ActionEnd& e);
+
+  EventLoop& loop_;
+  fleet::DroneType type_;
+  ActionTracker tracker_;
+  std::string failsafe_reason_;  ///< "" = no failsafe; otherwise why new actions are refused
+
+ private:
+  std::map<ActionId, TimerId> action_timers_;  ///< ends of payload, system, Hover(s), …
+};
+
+}  // namespace eamos::mid
