@@ -12,6 +12,7 @@ inline constexpr uint16_t NAV_LAND = 21;
 inline constexpr uint16_t NAV_TAKEOFF = 22;
 inline constexpr uint16_t DO_ORBIT = 34;
 inline constexpr uint16_t DO_SET_MODE = 176;
+inline constexpr uint16_t DO_DIGICAM_CONTROL = 203;
 inline constexpr uint16_t COMPONENT_ARM_DISARM = 400;
 inline constexpr uint16_t SET_MESSAGE_INTERVAL = 511;
 inline constexpr uint16_t IMAGE_START_CAPTURE = 2000;
@@ -67,6 +68,8 @@ inline constexpr uint8_t ONBOARD_COMPUTER = 191;
 /// POSITION_TARGET_TYPEMASK for "position only": velocity, acceleration, yaw and yaw rate
 /// ignored (bits 3-8, 10, 11).
 inline constexpr uint16_t kPositionOnlyMask = 0x0DF8;
+/// Position and velocity (feed-forward) set; acceleration, yaw and yaw rate ignored.
+inline constexpr uint16_t kPositionVelocityMask = 0x0DC0;
 inline constexpr uint8_t kFrameLocalNed = 1;  ///< MAV_FRAME_LOCAL_NED
 
 /// PX4's custom_mode: main mode << 16 | sub mode << 24 (PX4's px4_custom_mode.h).

@@ -153,6 +153,8 @@ void MavlinkDrone::on_frame(const ml::Frame& frame) {
       commands_.on_ack(*ack);
     return;
   }
+  // From the autopilot or from a camera component of the same system.
+  if (auto capture = ml::unpack_camera_capture(frame.message)) return on_camera_capture(*capture);
   if (auto hb = ml::unpack_heartbeat(frame.message); hb && hb->autopilot == ml::autopilot::INVALID)
     return;  // a camera, gimbal or companion of the same system: not the autopilot
   if (auto t = ml::unpack_statustext(frame.message); t && frame.compid == ml::comp::AUTOPILOT1)
@@ -204,11 +206,35 @@ void MavlinkDrone::note(const std::string& text) {
 // arms again. The mission sees the drone disarmed meanwhile, as it is.
 void MavlinkDrone::on_armed_changed() {
   if (vehicle_.armed || disarm_commanded_) return;
+  if (takeoff_disarmed_on_ground()) return;
   if (armed_waiting_ && vehicle_.landed())
     note(std::string(autopilot_->name) + " disarmed the vehicle on the ground by itself (auto-disarm); "
          "eamos arms it again before its Takeoff");
   else if (!vehicle_.landed())
     note(std::string(autopilot_->name) + " reports the vehicle disarmed in the air");
+}
+
+// The auto-disarm may also strike between our NAV_TAKEOFF and the autopilot's takeoff (it
+// counts from arming in the vehicle's clock, which a sped-up SITL keeps a little behind
+// ours): the takeoff then never starts. Arm again and send it again, once; a second disarm
+// fails the Takeoff rather than fight the autopilot.
+bool MavlinkDrone::takeoff_disarmed_on_ground() {
+  const mid::ActionRequest* r = tracker_.request(motion_owner_);
+  if (!r || r->name != "Takeoff" || !vehicle_.landed() || !tracker_.running(motion_owner_)) return false;
+  mid::ActionId id = motion_owner_;
+  if (takeoff_rearmed_ == id) {
+    fail_motion(std::string(autopilot_->name) + " disarmed the vehicle again before it took off" +
+                autopilot_says(tracker_.started_at(id)));
+    return true;
+  }
+  takeoff_rearmed_ = id;
+  note(std::string(autopilot_->name) + " disarmed the vehicle on the ground during the takeoff (auto-disarm); "
+       "eamos arms it again and repeats the takeoff");
+  double altitude = r->args[0];
+  streaming_ = false;
+  in_control_ = false;
+  start_takeoff(id, altitude);
+  return true;
 }
 
 void MavlinkDrone::note_rejected(const char* what) {
@@ -220,7 +246,10 @@ void MavlinkDrone::note_rejected(const char* what) {
 }
 
 void MavlinkDrone::on_heartbeat() {
-  link_lost_ = false;
+  if (link_lost_) {
+    link_lost_ = false;
+    publish();
+  }
   link_watchdog();
   if (!telemetry_requested_) request_telemetry();
   if (left_orbit_mode()) return;
@@ -266,6 +295,7 @@ void MavlinkDrone::lose_link() {
                 options_.link_timeout_s);
   fail_all(text);
   commands_.fail_all("link lost");
+  publish();
 }
 
 void MavlinkDrone::request_telemetry() {
@@ -350,6 +380,7 @@ void MavlinkDrone::stream_tick() {
   sp.x = static_cast<float>(ned.x);
   sp.y = static_cast<float>(ned.y);
   sp.z = static_cast<float>(ned.z);
+  if (orbit_.active && orbit_.on_circle) add_orbit_feed_forward(sp);
   send(ml::pack(sp));
   ++setpoints_sent_;
   if (!in_control_ && mode_commands_pending_ == 0 &&

@@ -98,4 +98,19 @@ void MavlinkDrone::advance_orbit(double dt) {
                orbit_.centre.y + r * std::sin(orbit_.angle), orbit_.centre.z};
 }
 
+void MavlinkDrone::add_orbit_feed_forward(ml::SetPositionTargetLocalNed& sp) const {
+  // A position setpoint alone is followed with a lag, and a lagging target on a circle is
+  // chased along a chord: ArduCopter circled at 4.5 m for a 5 m orbit. The circle's own
+  // velocity (tangential) and acceleration (towards the centre) as feed-forward let the
+  // position controller fly the circle itself, the position only correcting drift.
+  const double r = orbit_.radius;
+  const double v = orbit_speed(r);
+  const double c = std::cos(orbit_.angle), s = std::sin(orbit_.angle);
+  // Mission frame x east, y north; NED: north first, east second.
+  sp.vx = static_cast<float>(v * c);   // north: d/dt of r·sin(angle)
+  sp.vy = static_cast<float>(-v * s);  // east: d/dt of r·cos(angle)
+  sp.vz = 0;
+  sp.type_mask = ml::kPositionVelocityMask;
+}
+
 }  // namespace eamos::mavlink_adapter

@@ -58,6 +58,9 @@ struct DroneState {
   bool landed = true;
   std::map<std::string, double> sensors;  ///< "Sensor1" … "SensorN" of the drone's type
   int pictures = 0;      ///< TakePicture actions that succeeded
+  /// Nothing heard from the vehicle for its link timeout: the values above are the last
+  /// known, and no command (not even a failsafe) reaches it until it is heard again.
+  bool link_lost = false;
 };
 
 /// Identifies one started action of one drone; 0 (kNoAction) is never issued.

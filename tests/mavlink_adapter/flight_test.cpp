@@ -71,6 +71,35 @@ TEST(MavlinkFlight, ArduPilotTakesOffInGuidedToAnAltitudeAboveHome) {
   EXPECT_NEAR(f.drone->state().x, 0.0, 0.5);
 }
 
+// A picture is taken when the vehicle says so, not when it accepts the command: each
+// autopilot's own command (PX4 DO_DIGICAM_CONTROL, ArduPilot IMAGE_START_CAPTURE) and its
+// camera's confirmation (CAMERA_TRIGGER, CAMERA_FEEDBACK) make one picture.
+TEST(MavlinkFlight, TakePictureSucceedsOnceTheVehicleConfirmsItsPicture) {
+  for (const sim_vehicle::Dialect* d : {&sim_vehicle::px4_dialect(), &sim_vehicle::ardupilot_dialect()}) {
+    SCOPED_TRACE(d->name);
+    int port = d == &sim_vehicle::px4_dialect() ? 25370 : 25371;
+    test::VehicleThread vehicle(port, 1, kSpeed, *d);
+    Flight f(port);
+    ASSERT_TRUE(f.drone) << f.created.message;
+    mid::ActionEnd e = f.fly("TakePicture");
+    EXPECT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
+    EXPECT_EQ(f.drone->state().pictures, 1);
+    EXPECT_EQ(vehicle.inspect([&](sim_vehicle::SimVehicle& v) { return v.received(d->picture_command); }), 1);
+  }
+}
+
+TEST(MavlinkFlight, TakePictureAcceptedButNeverConfirmedFailsSayingSo) {
+  test::VehicleThread vehicle(25372, 1, kSpeed, sim_vehicle::ardupilot_dialect(), 100.0, /*camera_confirms=*/false);
+  Flight f(25372);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  mid::ActionEnd e = f.fly("TakePicture");
+  EXPECT_EQ(e.outcome, mid::Outcome::failed);
+  EXPECT_NE(e.reason.find("no picture: ArduPilot accepted MAV_CMD_IMAGE_START_CAPTURE but no camera confirmed"),
+            std::string::npos)
+      << e.reason;
+  EXPECT_EQ(f.drone->state().pictures, 0);
+}
+
 TEST(MavlinkFlight, ArmRefusedByTheAutopilotFailsWithItsResultInWords) {
   test::VehicleThread vehicle(25313, 1, kSpeed, sim_vehicle::px4_dialect(), 0.0);  // empty battery
   Flight f(25313);
@@ -90,11 +119,12 @@ TEST(MavlinkFlight, TakeoffWhileDisarmedIsRefusedBeforeReachingTheAutopilot) {
   EXPECT_EQ(e.reason, "disarmed: arm before Takeoff");
 }
 
-TEST(MavlinkFlight, LinkLossFailsTheRunningAction) {
+// The link timeout is mission time (3 s by default), like the deadlines of the actions it
+// must beat: at 4× a lost link is seen after 3 mission seconds, not after 3 wall seconds
+// (12 mission seconds, longer than most motions' deadlines).
+TEST(MavlinkFlight, LinkLossFailsTheRunningActionAfterTheLinkTimeoutInMissionTime) {
   test::VehicleThread vehicle(25314, 1, kSpeed);
-  MavlinkOptions options;
-  options.link_timeout_s = 0.5;  // wall seconds: 2 mission seconds at 4×
-  Flight f(25314, options);
+  Flight f(25314);
   ASSERT_TRUE(f.drone) << f.created.message;
   ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
   ASSERT_EQ(f.fly("Takeoff", {2}).outcome, mid::Outcome::succeeded);
@@ -106,10 +136,13 @@ TEST(MavlinkFlight, LinkLossFailsTheRunningAction) {
   f.loop.run_until(f.loop.now() + 1.0);
   EXPECT_FALSE(end);  // Hover() runs until something stops it
   vehicle.halt();
+  const double halted_at = f.loop.now();
   f.loop.run_until(f.loop.now() + 10.0);
   ASSERT_TRUE(end);
+  EXPECT_LT(f.loop.now() - halted_at, 4.0);
   EXPECT_EQ(end->outcome, mid::Outcome::failed);
-  EXPECT_EQ(end->reason, "link lost: no HEARTBEAT from system 1 for 2.0 s");
+  EXPECT_EQ(end->reason, "link lost: no HEARTBEAT from system 1 for 3.0 s");
+  EXPECT_TRUE(f.drone->state().link_lost);
   mid::ActionEnd refused = f.fly("Land");
   EXPECT_EQ(refused.outcome, mid::Outcome::failed);
   EXPECT_EQ(refused.reason, "link lost: no HEARTBEAT from system 1");
