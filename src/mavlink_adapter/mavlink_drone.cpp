@@ -93,7 +93,10 @@ double MavlinkDrone::timeout_for(const mid::ActionRequest& r) const {
   // deadline the fleet file sets is taken as written.
   if (r.name == "Takeoff" && !settings_.timeouts_s.contains("Takeoff"))
     timeout += limits_.takeoff_delay_s * mid::kTimeoutMargin;
-  return timeout;
+  // Deadlines are the vehicle's time: a SITL that cannot keep up with --speed on a loaded
+  // machine flies as fast as ever in its own clock, only its clock runs slow. Never shorter
+  // (a vehicle clock ahead of ours is jitter), and at most 5 times longer.
+  return timeout / std::clamp(vehicle_clock_rate(), 0.2, 1.0);
 }
 
 void MavlinkDrone::start_system(ActionId id, const mid::ActionRequest& r) {

@@ -49,9 +49,11 @@ struct MavlinkOptions {
   /// matters is how far the vehicle flies unheard, and every action's deadline is mission
   /// time too, so a lost link is seen before the running motion's deadline at any --speed.
   double link_timeout_s = 3.0;
-  /// ... but never less than this many wall seconds: the ground's own scheduling (two cores
-  /// shared with SITL) must not look like a lost link.
-  double link_timeout_min_wall_s = 0.5;
+  /// ... but never less than this many wall seconds: the ground's own scheduling must not
+  /// look like a lost link (0.5 s was too little: with --distributed and three PX4 SITL on a
+  /// loaded 2-core machine all three links "dropped" at once). At --speed 5: 7.5 mission s,
+  /// still before the deadline of a FlyBy of a few metres.
+  double link_timeout_min_wall_s = 1.5;
   CommandOptions commands;         ///< ACK timeouts in wall seconds
   double setpoint_hz = 10.0;       ///< setpoint stream rate (PX4 needs > 2 Hz in OFFBOARD)
   int setpoints_before_switch = 5; ///< PX4: setpoints sent before asking for OFFBOARD
@@ -146,6 +148,10 @@ class MavlinkDrone final : public mid::Drone {
   std::string autopilot_says(double since) const;
   void note(const std::string& text);  ///< to the trace (message sink)
   void on_armed_changed();
+  /// Folds a LOCAL_POSITION_NED's time_boot_ms into the vehicle's clock rate.
+  void on_vehicle_clock(uint32_t time_boot_ms);
+  /// Vehicle seconds per mission second over the last few seconds (1 until known).
+  double vehicle_clock_rate() const;
   /// A disarm by the autopilot while our Takeoff waits on the ground: arm and take off again.
   bool takeoff_disarmed_on_ground();
 
@@ -223,6 +229,10 @@ class MavlinkDrone final : public mid::Drone {
   bool armed_waiting_ = false;
   bool disarm_commanded_ = false;  ///< a disarm now is ours (Disarm, failsafe), not the autopilot's
   mid::ActionId takeoff_rearmed_ = mid::kNoAction;  ///< the Takeoff already re-armed once
+  /// (mission s, vehicle s) of recent position reports: a SITL on a loaded machine runs
+  /// slower than --speed, and every deadline is stretched by how much (timeout_for()).
+  std::deque<std::pair<double, double>> clock_samples_;
+  bool clock_noted_ = false;
 
   // the motion the adapter flies for an action
   mid::ActionId motion_owner_ = mid::kNoAction;

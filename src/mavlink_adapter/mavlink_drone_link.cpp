@@ -1,5 +1,6 @@
 // The MavlinkDrone's side of the wire: connecting, frames from the link, heartbeats both
 // ways, link loss, telemetry requests, goal checks and the setpoint stream.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -159,6 +160,7 @@ void MavlinkDrone::on_frame(const ml::Frame& frame) {
     return;  // a camera, gimbal or companion of the same system: not the autopilot
   if (auto t = ml::unpack_statustext(frame.message); t && frame.compid == ml::comp::AUTOPILOT1)
     return on_statustext(*t);
+  if (auto p = ml::unpack_local_position_ned(frame.message)) on_vehicle_clock(p->time_boot_ms);
   Changes c = apply_telemetry(vehicle_, frame);
   if (c.rejected) return note_rejected(c.rejected);
   if (c.armed) on_armed_changed();
@@ -237,6 +239,32 @@ bool MavlinkDrone::takeoff_disarmed_on_ground() {
   return true;
 }
 
+void MavlinkDrone::on_vehicle_clock(uint32_t time_boot_ms) {
+  const double vehicle_s = time_boot_ms / 1000.0;
+  // A reboot (or a reordered datagram) starts the window again.
+  if (!clock_samples_.empty() && vehicle_s < clock_samples_.back().second) clock_samples_.clear();
+  clock_samples_.push_back({loop_.now(), vehicle_s});
+  while (clock_samples_.size() > 2 && clock_samples_.back().first - clock_samples_.front().first > 10.0)
+    clock_samples_.pop_front();
+  double rate = vehicle_clock_rate();
+  if (rate < 0.8 && !clock_noted_) {
+    clock_noted_ = true;
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "the vehicle's clock runs at %.2f of mission time (a SITL slower than --speed?): deadlines are "
+                  "stretched to match",
+                  rate);
+    note(text);
+  }
+}
+
+double MavlinkDrone::vehicle_clock_rate() const {
+  if (clock_samples_.size() < 2) return 1.0;
+  double mission = clock_samples_.back().first - clock_samples_.front().first;
+  if (mission < 2.0) return 1.0;  // too short to tell jitter from rate
+  return (clock_samples_.back().second - clock_samples_.front().second) / mission;
+}
+
 void MavlinkDrone::note_rejected(const char* what) {
   ++rejected_frames_;
   // The first few, then every thousandth: a flood of bad frames must not flood the log.
@@ -279,7 +307,8 @@ void MavlinkDrone::fail_motion(const std::string& reason) {
 
 void MavlinkDrone::link_watchdog() {
   loop_.cancel(watchdog_timer_);
-  watchdog_timer_ = loop_.after(options_.link_timeout_s, [this] {
+  // Like the deadlines, in the vehicle's time: a slow SITL sends its heartbeats slower.
+  watchdog_timer_ = loop_.after(options_.link_timeout_s / std::clamp(vehicle_clock_rate(), 0.2, 1.0), [this] {
     watchdog_timer_ = mid::kNoTimer;
     lose_link();
   });

@@ -100,6 +100,22 @@ TEST(MavlinkFlight, TakePictureAcceptedButNeverConfirmedFailsSayingSo) {
   EXPECT_EQ(f.drone->state().pictures, 0);
 }
 
+// A vehicle whose clock runs at half of mission time (a SITL that cannot keep up with
+// --speed on a loaded machine): the FlyTo of 300 m takes over 30 s of the vehicle's time,
+// over 60 mission seconds, beyond its deadline from the limits (55 s); deadlines follow the
+// vehicle's clock.
+TEST(MavlinkFlight, DeadlinesFollowTheVehiclesClockWhenItRunsSlowerThanMissionTime) {
+  test::VehicleThread vehicle(25373, 1, kSpeed / 2);
+  Flight f(25373);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  mid::ActionEnd armed = f.fly("Arm");
+  ASSERT_EQ(armed.outcome, mid::Outcome::succeeded) << armed.reason;
+  mid::ActionEnd up = f.fly("Takeoff", {3});
+  ASSERT_EQ(up.outcome, mid::Outcome::succeeded) << up.reason;
+  mid::ActionEnd e = f.fly("FlyTo", {300, 0, 3}, 150);
+  EXPECT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
+}
+
 TEST(MavlinkFlight, ArmRefusedByTheAutopilotFailsWithItsResultInWords) {
   test::VehicleThread vehicle(25313, 1, kSpeed, sim_vehicle::px4_dialect(), 0.0);  // empty battery
   Flight f(25313);
@@ -121,10 +137,13 @@ TEST(MavlinkFlight, TakeoffWhileDisarmedIsRefusedBeforeReachingTheAutopilot) {
 
 // The link timeout is mission time (3 s by default), like the deadlines of the actions it
 // must beat: at 4× a lost link is seen after 3 mission seconds, not after 3 wall seconds
-// (12 mission seconds, longer than most motions' deadlines).
+// (12 mission seconds, longer than most motions' deadlines), when the wall-clock floor is
+// below it.
 TEST(MavlinkFlight, LinkLossFailsTheRunningActionAfterTheLinkTimeoutInMissionTime) {
   test::VehicleThread vehicle(25314, 1, kSpeed);
-  Flight f(25314);
+  MavlinkOptions options;
+  options.link_timeout_min_wall_s = 0.5;  // 2 mission s at 4×: the 3 s timeout decides
+  Flight f(25314, options);
   ASSERT_TRUE(f.drone) << f.created.message;
   ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
   ASSERT_EQ(f.fly("Takeoff", {2}).outcome, mid::Outcome::succeeded);

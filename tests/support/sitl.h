@@ -27,7 +27,8 @@ struct SitlOptions {
   double speedup = 1;           ///< simulation speed: ArduPilot --speedup, PX4_SIM_SPEED_FACTOR
   /// The autopilot's instance number of instance 0: it picks the ports (ArduPilot TCP
   /// 5760 + 10 n, PX4 UDP 14540 + n), so two fleets on one machine do not meet. Unset, it is
-  /// EAMOS_SITL_FIRST_INSTANCE or 0.
+  /// EAMOS_SITL_FIRST_INSTANCE or 0. PX4 instance n also listens on UDP 14580 + n and
+  /// 18570 + n: fleets 40 apart collide (one's 14540 + n is the other's 14580 + n).
   int first_instance = -1;
   /// A camera configured the way a user sets one up for pictures: ArduPilot CAM1_TYPE 1
   /// (servo-triggered; set with PARAM_SET and a reboot in wait_ready(), as its camera
