@@ -68,8 +68,6 @@ inline constexpr uint8_t ONBOARD_COMPUTER = 191;
 /// POSITION_TARGET_TYPEMASK for "position only": velocity, acceleration, yaw and yaw rate
 /// ignored (bits 3-8, 10, 11).
 inline constexpr uint16_t kPositionOnlyMask = 0x0DF8;
-/// Position and velocity (feed-forward) set; acceleration, yaw and yaw rate ignored.
-inline constexpr uint16_t kPositionVelocityMask = 0x0DC0;
 inline constexpr uint8_t kFrameLocalNed = 1;  ///< MAV_FRAME_LOCAL_NED
 
 /// PX4's custom_mode: main mode << 16 | sub mode << 24 (PX4's px4_custom_mode.h).

@@ -116,6 +116,7 @@ class MavlinkDrone final : public mid::Drone {
     bool on_circle = false;
     bool commanded = false; ///< the autopilot flies it (DO_ORBIT accepted), not our setpoints
     bool mode_seen = false; ///< a HEARTBEAT has shown the autopilot's orbit mode
+    double commanded_radius = 0.0;  ///< our setpoints' radius: `radius` corrected for the lag
   };
 
   // actions (mavlink_drone.cpp)
@@ -177,8 +178,6 @@ class MavlinkDrone final : public mid::Drone {
   void leave_orbit();
   bool left_orbit_mode();  ///< the vehicle left DO_ORBIT's mode: the orbit failed
   void advance_orbit(double dt);
-  /// The circle's velocity and acceleration on a setpoint of our orbit (ArduPilot).
-  void add_orbit_feed_forward(mavlink::SetPositionTargetLocalNed& sp) const;
   void switch_to_setpoint_mode();
   void send_mode_command(mavlink::CommandLong c, CommandDone done);
   void publish();

@@ -409,7 +409,6 @@ void MavlinkDrone::stream_tick() {
   sp.x = static_cast<float>(ned.x);
   sp.y = static_cast<float>(ned.y);
   sp.z = static_cast<float>(ned.z);
-  if (orbit_.active && orbit_.on_circle) add_orbit_feed_forward(sp);
   send(ml::pack(sp));
   ++setpoints_sent_;
   if (!in_control_ && mode_commands_pending_ == 0 &&

@@ -367,37 +367,46 @@ bool SitlFleet::set_up_ardupilot_camera(int i, double deadline, std::string& err
   std::unique_lock boots_lock(cs.mutex);
   float boots = ok ? *param("STAT_BOOTCNT") : 0;
   boots_lock.unlock();
-  if (ok) {
+  // ArduPilot saves a parameter from its IO thread, after the PARAM_VALUE echo: on a loaded
+  // machine a reboot right after the echo sometimes came first and CAM1_TYPE was 0 again.
+  // So: set, reboot, check; up to three times.
+  for (int attempt = 0; ok && attempt < 3; ++attempt) {
     step = "PARAM_SET CAM1_TYPE 1";
+    {
+      std::lock_guard lock(cs.mutex);
+      cs.params.erase("CAM1_TYPE");
+    }
     ok = wait_for(cs, deadline, [&] { send(ml::pack(ml::ParamSet{vehicle, 1, "CAM1_TYPE", 1.0f, ml::param_type::INT8})); },
                   [&] { return param("CAM1_TYPE") == 1.0f; });
-  }
-  if (ok) {
+    if (!ok) break;
     step = "rebooting";
     // param1 = 1: reboot the autopilot. SITL restarts by exec in the same process; connect
     // again until the new boot answers, repeating the reboot while the old one still does.
     auto reboot = [&] { send(command_long(vehicle, 246, {1, 0, 0, 0, 0, 0, 0})); };
     reboot();
     auto rebooted = [&] { return param("STAT_BOOTCNT") > boots; };
-    int attempts = 0;
+    int tries = 0;
     while (ok) {
       link.reset();
       link = open();
       ok = link != nullptr;
       if (ok && wait_for(cs, std::min(deadline, now_s() + 2.0), [&] { ask("STAT_BOOTCNT"); }, rebooted)) break;
       std::unique_lock lock(cs.mutex);
-      if (param("STAT_BOOTCNT") == boots && ++attempts % 2 == 0) reboot();  // the old boot answers still
+      if (param("STAT_BOOTCNT") == boots && ++tries % 2 == 0) reboot();  // the old boot answers still
       lock.unlock();
       ok = now_s() < deadline;
     }
-    if (ok) {
-      step = "checking CAM1_TYPE after the reboot";
-      {
-        std::lock_guard lock(cs.mutex);
-        cs.params.erase("CAM1_TYPE");
-      }
-      ok = wait_for(cs, deadline, [&] { ask("CAM1_TYPE"); }, [&] { return param("CAM1_TYPE") == 1.0f; });
+    if (!ok) break;
+    {
+      std::lock_guard lock(cs.mutex);
+      boots = *param("STAT_BOOTCNT");
+      cs.params.erase("CAM1_TYPE");
     }
+    step = "checking CAM1_TYPE after the reboot";
+    ok = wait_for(cs, deadline, [&] { ask("CAM1_TYPE"); }, [&] { return param("CAM1_TYPE").has_value(); });
+    std::lock_guard lock(cs.mutex);
+    if (ok && param("CAM1_TYPE") == 1.0f) break;
+    ok = ok && attempt < 2;
   }
   link.reset();
   if (!ok)
