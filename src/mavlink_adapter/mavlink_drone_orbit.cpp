@@ -18,7 +18,7 @@ using mid::Outcome;
 
 namespace {
 constexpr float kYawFrontToCentre = 0;  ///< ORBIT_YAW_BEHAVIOUR_HOLD_FRONT_TO_CIRCLE_CENTER
-constexpr double kRadiusGain = 0.5;     ///< 1/s: the radius error closes in a few seconds
+constexpr double kRadiusGain = 0.5;     ///< 1/s (2.0 was measured to oscillate, 4.5 .. 5.5 m)
 }  // namespace
 
 double MavlinkDrone::orbit_speed(double radius) const {
