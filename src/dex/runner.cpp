@@ -301,9 +301,13 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     // real-time loop waits for input until its limit even when nothing is scheduled, and a
     // MAVLink drone's heartbeats never leave it idle.
     const double until = loop.now() + 600.0;
+    // A drone whose link is lost cannot be told or watched: waiting for it only delays the
+    // end (its autopilot's own link-loss failsafe flies it, docs/faults.md).
     auto airborne = [&] {
-      for (const auto& d : drones)
-        if (!d->state().landed) return true;
+      for (const auto& d : drones) {
+        mid::DroneState st = d->state();
+        if (!st.landed && !st.link_lost) return true;
+      }
       return false;
     };
     do loop.run_until(std::min(until, loop.now() + 1.0));

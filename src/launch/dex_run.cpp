@@ -248,7 +248,8 @@ void DexProcess::wait_for_failsafe() {
   // Stay up (and alive for the others) until the drone is down, hovering as told, or the
   // failsafe has had ten minutes.
   mid::DroneState s = drone_->state();
-  bool done = s.landed || mission_.settings.failsafe == fleet::Failsafe::hover ||
+  // A lost link: nothing can reach or watch the drone, its autopilot's own failsafe flies it.
+  bool done = s.landed || s.link_lost || mission_.settings.failsafe == fleet::Failsafe::hover ||
               loop_->now() - failsafe_since_ > 600.0;
   if (done) {
     // Its final state: the ground reports this one, not the one at the abort.

@@ -26,6 +26,7 @@ std::string command_name(uint16_t c) {
     case cmd::COMPONENT_ARM_DISARM: return "MAV_CMD_COMPONENT_ARM_DISARM";
     case cmd::SET_MESSAGE_INTERVAL: return "MAV_CMD_SET_MESSAGE_INTERVAL";
     case cmd::IMAGE_START_CAPTURE: return "MAV_CMD_IMAGE_START_CAPTURE";
+    case cmd::DO_DIGICAM_CONTROL: return "MAV_CMD_DO_DIGICAM_CONTROL";
   }
   return "MAV_CMD " + std::to_string(c);
 }

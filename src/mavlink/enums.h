@@ -12,6 +12,7 @@ inline constexpr uint16_t NAV_LAND = 21;
 inline constexpr uint16_t NAV_TAKEOFF = 22;
 inline constexpr uint16_t DO_ORBIT = 34;
 inline constexpr uint16_t DO_SET_MODE = 176;
+inline constexpr uint16_t DO_DIGICAM_CONTROL = 203;
 inline constexpr uint16_t COMPONENT_ARM_DISARM = 400;
 inline constexpr uint16_t SET_MESSAGE_INTERVAL = 511;
 inline constexpr uint16_t IMAGE_START_CAPTURE = 2000;

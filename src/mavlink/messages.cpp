@@ -84,6 +84,9 @@ std::vector<MessageDef> build_table() {
                     {T::f32, "vx"}, {T::f32, "vy"}, {T::f32, "vz"}, {T::f32, "afx"},
                     {T::f32, "afy"}, {T::f32, "afz"}, {T::f32, "yaw"},
                     {T::f32, "yaw_rate"}}));
+  // A picture's confirmations: PX4's camera trigger (camera_trigger module), ArduPilot's
+  // camera feedback, and the camera protocol's captured image.
+  t.push_back(make(msg::CAMERA_TRIGGER, "CAMERA_TRIGGER", {{T::u64, "time_usec"}, {T::u32, "seq"}}));
   t.push_back(make(msg::BATTERY_STATUS, "BATTERY_STATUS",
                    {{T::u8, "id"}, {T::u8, "battery_function"}, {T::u8, "type"},
                     {T::i16, "temperature"}, {T::u16, "voltages", 10},
@@ -92,6 +95,11 @@ std::vector<MessageDef> build_table() {
                     ext(T::i32, "time_remaining"), ext(T::u8, "charge_state"),
                     ext(T::u16, "voltages_ext", 4), ext(T::u8, "mode"),
                     ext(T::u32, "fault_bitmask")}));
+  t.push_back(make(msg::CAMERA_FEEDBACK, "CAMERA_FEEDBACK",
+                   {{T::u64, "time_usec"}, {T::u8, "target_system"}, {T::u8, "cam_idx"},
+                    {T::u16, "img_idx"}, {T::i32, "lat"}, {T::i32, "lng"}, {T::f32, "alt_msl"},
+                    {T::f32, "alt_rel"}, {T::f32, "roll"}, {T::f32, "pitch"}, {T::f32, "yaw"},
+                    {T::f32, "foc_len"}, {T::u8, "flags"}, ext(T::u16, "completed_captures")}));
   t.push_back(make(msg::EXTENDED_SYS_STATE, "EXTENDED_SYS_STATE",
                    {{T::u8, "vtol_state"}, {T::u8, "landed_state"}}));
   t.push_back(make(msg::STATUSTEXT, "STATUSTEXT",
@@ -100,6 +108,11 @@ std::vector<MessageDef> build_table() {
   t.push_back(make(msg::SETUP_SIGNING, "SETUP_SIGNING",
                    {{T::u8, "target_system"}, {T::u8, "target_component"}, {T::u8, "secret_key", 32},
                     {T::u64, "initial_timestamp"}}));
+  t.push_back(make(msg::CAMERA_IMAGE_CAPTURED, "CAMERA_IMAGE_CAPTURED",
+                   {{T::u32, "time_boot_ms"}, {T::u64, "time_utc"}, {T::u8, "camera_id"},
+                    {T::i32, "lat"}, {T::i32, "lon"}, {T::i32, "alt"}, {T::i32, "relative_alt"},
+                    {T::f32, "q", 4}, {T::i32, "image_index"}, {T::i8, "capture_result"},
+                    {T::char_, "file_url", 205}}));
   return t;
 }
 

@@ -24,10 +24,13 @@ inline constexpr uint32_t COMMAND_INT = 75;
 inline constexpr uint32_t COMMAND_LONG = 76;
 inline constexpr uint32_t COMMAND_ACK = 77;
 inline constexpr uint32_t SET_POSITION_TARGET_LOCAL_NED = 84;
+inline constexpr uint32_t CAMERA_TRIGGER = 112;
 inline constexpr uint32_t BATTERY_STATUS = 147;
+inline constexpr uint32_t CAMERA_FEEDBACK = 180;
 inline constexpr uint32_t EXTENDED_SYS_STATE = 245;
 inline constexpr uint32_t STATUSTEXT = 253;
 inline constexpr uint32_t SETUP_SIGNING = 256;
+inline constexpr uint32_t CAMERA_IMAGE_CAPTURED = 263;
 }  // namespace msg
 
 struct MessageDef {

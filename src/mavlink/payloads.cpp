@@ -346,4 +346,30 @@ std::optional<SetupSigning> unpack_setup_signing(const Message& m) {
   return s;
 }
 
+Message pack(const CameraCapture& m) {
+  FieldWriter w(def_of(m.message_id));
+  if (m.message_id == msg::CAMERA_TRIGGER) w.set("seq", static_cast<uint32_t>(m.image_index));
+  if (m.message_id == msg::CAMERA_FEEDBACK) w.set("img_idx", static_cast<uint16_t>(m.image_index));
+  if (m.message_id == msg::CAMERA_IMAGE_CAPTURED) {
+    w.set("image_index", static_cast<int32_t>(m.image_index));
+    w.set("capture_result", static_cast<int8_t>(m.captured ? 1 : 0));
+  }
+  return w.take();
+}
+
+std::optional<CameraCapture> unpack_camera_capture(const Message& m) {
+  if (m.id != msg::CAMERA_TRIGGER && m.id != msg::CAMERA_FEEDBACK && m.id != msg::CAMERA_IMAGE_CAPTURED)
+    return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  CameraCapture c;
+  c.message_id = m.id;
+  if (m.id == msg::CAMERA_TRIGGER) c.image_index = r.get<uint32_t>("seq");
+  if (m.id == msg::CAMERA_FEEDBACK) c.image_index = r.get<uint16_t>("img_idx");
+  if (m.id == msg::CAMERA_IMAGE_CAPTURED) {
+    c.image_index = r.get<int32_t>("image_index");
+    c.captured = r.get<int8_t>("capture_result") == 1;
+  }
+  return c;
+}
+
 }  // namespace eamos::mavlink

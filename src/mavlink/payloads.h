@@ -117,6 +117,15 @@ struct Statustext {
   uint8_t chunk_seq = 0;
 };
 
+/// A vehicle's word that it took a picture, from whichever message its camera sends:
+/// CAMERA_TRIGGER (PX4's camera_trigger), CAMERA_FEEDBACK (ArduPilot's AP_Camera) or
+/// CAMERA_IMAGE_CAPTURED (the camera protocol; it may report a failed capture).
+struct CameraCapture {
+  uint32_t message_id = 0;
+  int64_t image_index = 0;  ///< the message's sequence or image number
+  bool captured = true;     ///< false: CAMERA_IMAGE_CAPTURED with capture_result 0
+};
+
 /// A parameter by name (param_index -1) or by index. Names are up to 16 characters.
 struct ParamRequestRead {
   uint8_t target_system = 0;
@@ -164,6 +173,8 @@ Message pack(const SetPositionTargetLocalNed& m);
 Message pack(const ExtendedSysState& m);
 Message pack(const BatteryStatus& m);
 Message pack(const Statustext& m);
+/// As the CameraCapture's message_id says (the other fields of that message zero).
+Message pack(const CameraCapture& m);
 
 /// Gives the vehicle the link's signing key (an all-zero key and timestamp turn signing off).
 struct SetupSigning {
@@ -190,5 +201,7 @@ std::optional<SetPositionTargetLocalNed> unpack_set_position_target_local_ned(co
 std::optional<ExtendedSysState> unpack_extended_sys_state(const Message& m);
 std::optional<BatteryStatus> unpack_battery_status(const Message& m);
 std::optional<Statustext> unpack_statustext(const Message& m);
+/// CAMERA_TRIGGER, CAMERA_FEEDBACK or CAMERA_IMAGE_CAPTURED; nullopt for any other message.
+std::optional<CameraCapture> unpack_camera_capture(const Message& m);
 
 }  // namespace eamos::mavlink

@@ -1,5 +1,6 @@
 #include "mavlink_adapter/adapter.h"
 
+#include <algorithm>
 #include <memory>
 
 #include "mavlink/url.h"
@@ -23,11 +24,12 @@ void register_adapter(mid::AdapterRegistry& registry, MavlinkOptions options) {
         mavlink::EndpointResult url = mavlink::parse_url(settings.connection);
         if (!url.endpoint) return failed(url.error);
         MavlinkOptions scaled = options;  // wall-clock budgets into mission seconds
-        scaled.link_timeout_s *= options.speed;
+        scaled.link_timeout_s = std::max(options.link_timeout_s, options.link_timeout_min_wall_s * options.speed);
         scaled.commands.ack_timeout_s *= options.speed;
         scaled.commands.in_progress_s *= options.speed;
         scaled.mode_confirm_s *= options.speed;
         scaled.statustext_wait_s *= options.speed;
+        scaled.picture_confirm_s *= options.speed;
         auto drone = std::make_unique<MavlinkDrone>(settings, type, loop, scaled);
         if (std::string error = drone->connect(*url.endpoint); !error.empty()) return failed(error);
         return {mid::CreateStatus::success, std::move(drone), ""};

@@ -16,12 +16,13 @@ const Autopilot kPx4{"PX4", mavlink::autopilot::PX4, px4::OFFBOARD, "OFFBOARD",
                      /*stream_before_switch=*/true, /*takeoff_in_setpoint_mode=*/false,
                      /*takeoff_altitude_amsl=*/true, /*main_sub_modes=*/true,
                      /*do_orbit=*/true, px4::ORBIT, px4::LOITER,
-                     /*arm_mode=*/px4::LOITER, px4::LAND, px4::RTL};
+                     /*arm_mode=*/px4::LOITER, px4::LAND, px4::RTL, mavlink::cmd::DO_DIGICAM_CONTROL};
 const Autopilot kArduPilot{"ArduPilot", mavlink::autopilot::ARDUPILOTMEGA, kCopterGuided, "GUIDED",
                            /*stream_before_switch=*/false, /*takeoff_in_setpoint_mode=*/true,
                            /*takeoff_altitude_amsl=*/false, /*main_sub_modes=*/false,
                            /*do_orbit=*/false, 0, kCopterLoiter,
-                           /*arm_mode=*/kCopterGuided, kCopterLand, kCopterRtl};
+                           /*arm_mode=*/kCopterGuided, kCopterLand, kCopterRtl,
+                           mavlink::cmd::IMAGE_START_CAPTURE};
 
 }  // namespace
 

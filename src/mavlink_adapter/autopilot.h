@@ -38,6 +38,9 @@ struct Autopilot {
   uint32_t arm_mode;
   uint32_t land_mode;
   uint32_t rtl_mode;
+  /// The command that takes one picture: ArduPilot (4.4+) MAV_CMD_IMAGE_START_CAPTURE to its
+  /// AP_Camera; PX4's camera_trigger takes only MAV_CMD_DO_DIGICAM_CONTROL (param5 = 1: shoot).
+  uint16_t picture_command;
 };
 
 /// False for the modes the autopilot refuses to arm in.

@@ -15,6 +15,7 @@ const std::vector<LimitParam> kArduPilot = {
     {"WPNAV_SPEED", LimitKind::speed, 0.01},     {"WPNAV_SPEED_UP", LimitKind::climb, 0.01},
     {"WPNAV_SPEED_DN", LimitKind::descent, 0.01}, {"LAND_SPEED", LimitKind::land, 0.01},
     {"LAND_SPEED_HIGH", LimitKind::land, 0.01},
+    {"MOT_SPOOL_TIME", LimitKind::takeoff_delay, 1.0}, {"TKOFF_SLEW_TIME", LimitKind::takeoff_delay, 1.0},
 };
 // PX4 (multicopter position control): m/s. A takeoff climbs at MPC_TKO_SPEED, a landing
 // ends at MPC_LAND_SPEED.
@@ -22,6 +23,7 @@ const std::vector<LimitParam> kPx4 = {
     {"MPC_XY_CRUISE", LimitKind::speed, 1.0},    {"MPC_Z_VEL_MAX_UP", LimitKind::climb, 1.0},
     {"MPC_TKO_SPEED", LimitKind::climb, 1.0},    {"MPC_Z_VEL_MAX_DN", LimitKind::descent, 1.0},
     {"MPC_LAND_SPEED", LimitKind::land, 1.0},
+    {"COM_SPOOLUP_TIME", LimitKind::takeoff_delay, 1.0}, {"MPC_TKO_RAMP_T", LimitKind::takeoff_delay, 1.0},
 };
 
 const char* fleet_key(LimitKind k) {
@@ -30,6 +32,7 @@ const char* fleet_key(LimitKind k) {
     case LimitKind::climb: return "max_climb";
     case LimitKind::descent:
     case LimitKind::land: return "max_descent";
+    case LimitKind::takeoff_delay: return "";
   }
   return "";
 }
@@ -94,6 +97,14 @@ FlightLimits combine_limits(const Autopilot& a, const fleet::Limits& fleet,
     slot.value = std::min(slot.value, *s.mps);
   }
   out.land_mps = std::min(out.land_mps, out.motion.max_descent_mps);
+  // Delays add up; one the autopilot does not have (an older version) is no delay.
+  for (const LimitParam& p : params) {
+    auto it = values.find(p.name);
+    if (p.kind != LimitKind::takeoff_delay || it == values.end() || !std::isfinite(it->second) || it->second <= 0)
+      continue;
+    out.takeoff_delay_s += it->second * p.to_mps;
+    out.summary += std::string(out.summary.empty() ? "" : ", ") + p.name + " " + number(it->second * p.to_mps) + " s";
+  }
   return out;
 }
 

@@ -15,9 +15,12 @@
 namespace eamos::mavlink_adapter {
 
 /// Which limit a parameter bounds.
-enum class LimitKind { speed, climb, descent, land };
+/// takeoff_delay: seconds a takeoff spends before and beside its climb (motor spool-up,
+/// the throttle or speed ramp); those of one autopilot add up.
+enum class LimitKind { speed, climb, descent, land, takeoff_delay };
 
-/// One parameter that bounds a limit: its name and the factor to m/s (ArduPilot: cm/s).
+/// One parameter that bounds a limit: its name and the factor to m/s (ArduPilot: cm/s), or
+/// to seconds for a takeoff delay.
 struct LimitParam {
   const char* name;
   LimitKind kind;
@@ -31,6 +34,10 @@ std::vector<LimitParam> limit_params(const Autopilot& a);
 struct FlightLimits {
   fleet::Limits motion;      ///< speed, climb, descent of flying actions (FlyTo, Takeoff, …)
   double land_mps = 0.0;     ///< descent of Land and ReturnHome (the autopilot's landing speed)
+  /// Seconds a Takeoff takes beyond its climb at `motion.max_climb_mps`: measured on PX4 SIH,
+  /// a 4 m takeoff spends 1 s spooling up (COM_SPOOLUP_TIME) and 3 s ramping its climb rate
+  /// up (MPC_TKO_RAMP_T) before it climbs at all, so a deadline from the climb alone expires.
+  double takeoff_delay_s = 0.0;
   std::vector<std::string> warnings;  ///< one line each: a fleet limit above the autopilot's,
                                       ///< or a parameter the autopilot did not tell
   std::string summary;       ///< "WPNAV_SPEED 10 m/s, …": what the autopilot said, for the log

@@ -73,7 +73,15 @@ double MavlinkDrone::timeout_for(const mid::ActionRequest& r) const {
   fleet::DroneSettings timing = settings_;
   timing.limits = limits_.motion;
   if (r.name == "Land" || r.name == "ReturnHome") timing.limits.max_descent_mps = limits_.land_mps;
-  return mid::action_timeout(r, reference(), timing);
+  double timeout = mid::action_timeout(r, reference(), timing);
+  // A takeoff spools up and ramps its climb before it climbs (autopilot_params.h); a
+  // deadline the fleet file sets is taken as written.
+  if (r.name == "Takeoff" && !settings_.timeouts_s.contains("Takeoff"))
+    timeout += limits_.takeoff_delay_s * mid::kTimeoutMargin;
+  // Deadlines are the vehicle's time: a SITL that cannot keep up with --speed on a loaded
+  // machine flies as fast as ever in its own clock, only its clock runs slow. Never shorter
+  // (a vehicle clock ahead of ours is jitter), and at most 5 times longer.
+  return timeout / std::clamp(vehicle_clock_rate(), 0.2, 1.0);
 }
 
 void MavlinkDrone::start_system(ActionId id, const mid::ActionRequest& r) {
@@ -119,26 +127,76 @@ void MavlinkDrone::send_arm(ActionId id, std::function<void()> armed) {
 }
 
 void MavlinkDrone::start_payload(ActionId id, const mid::ActionRequest& r) {
-  if (r.name == "TakePicture") {
-    // param3 = 1: one image; the autopilot forwards it to its camera.
-    commands_.send(command(ml::cmd::IMAGE_START_CAPTURE, {0, 0, 1}),
-                   [this, id](const CommandResult& result) {
-                     if (!tracker_.running(id)) return;
-                     if (!result.accepted) {
-                       auto why = result.answered ? mid::FailureReason::refused : mid::FailureReason::timed_out;
-                       tracker_.fail(id, why, "no picture: " + result.error, result.error);
-                       return;
-                     }
-                     ++pictures_;
-                     publish();
-                     tracker_.end(id, Outcome::succeeded);
-                   });
-    return;
-  }
+  if (r.name == "TakePicture") return take_picture(id);
   int k = fleet::sensor_index(r.name, type_.sensors);
   after_for(id, 0.1, [this, id, k] {
     tracker_.end(id, Outcome::succeeded, "", sensor_value(k));
   });
+}
+
+void MavlinkDrone::take_picture(ActionId id) {
+  std::array<float, 7> p{};
+  if (autopilot_->picture_command == ml::cmd::DO_DIGICAM_CONTROL) p[4] = 1;  // param5: shoot once
+  else p[2] = 1;                                                             // param3: one image
+  pictures_pending_[id] = {};
+  commands_.send(command(autopilot_->picture_command, p), [this, id](const CommandResult& result) {
+    auto it = pictures_pending_.find(id);
+    if (!tracker_.running(id) || it == pictures_pending_.end()) return;
+    if (!result.accepted) {
+      pictures_pending_.erase(it);
+      auto why = result.answered ? mid::FailureReason::refused : mid::FailureReason::timed_out;
+      tracker_.fail(id, why, "no picture: " + result.error, result.error);
+      return;
+    }
+    it->second.acked = true;
+    if (it->second.confirmed) return end_picture(id);  // the camera spoke before the ACK
+    after_for(id, options_.picture_confirm_s, [this, id] {
+      pictures_pending_.erase(id);
+      char text[256];
+      std::snprintf(text, sizeof text,
+                    "no picture: %s accepted %s but no camera confirmed a picture (CAMERA_TRIGGER, "
+                    "CAMERA_FEEDBACK or CAMERA_IMAGE_CAPTURED) within %.1f s; is a camera configured "
+                    "(ArduPilot CAM1_TYPE, PX4 TRIG_MODE and TRIG_INTERFACE)?",
+                    autopilot_->name, ml::command_name(autopilot_->picture_command).c_str(),
+                    options_.picture_confirm_s);
+      if (tracker_.running(id)) tracker_.fail(id, mid::FailureReason::timed_out, text);
+    });
+  });
+}
+
+// The oldest picture still waiting for its camera gets this confirmation; one nobody waits
+// for (a ground station's, a survey's trigger) is only noted.
+void MavlinkDrone::on_camera_capture(const ml::CameraCapture& c) {
+  auto it = std::find_if(pictures_pending_.begin(), pictures_pending_.end(),
+                         [](const auto& p) { return !p.second.confirmed; });
+  const char* what = c.message_id == ml::msg::CAMERA_TRIGGER    ? "CAMERA_TRIGGER"
+                     : c.message_id == ml::msg::CAMERA_FEEDBACK ? "CAMERA_FEEDBACK"
+                                                                : "CAMERA_IMAGE_CAPTURED";
+  note(std::string(autopilot_->name) + " camera: " + (c.captured ? "took" : "failed to take") + " image " +
+       std::to_string(c.image_index) + " (" + what + ")");
+  // PX4 reports one image twice (CAMERA_TRIGGER, then CAMERA_IMAGE_CAPTURED, same number):
+  // the second must not confirm the next picture before its camera has taken it.
+  if (last_image_index_ == c.image_index) return;
+  if (it == pictures_pending_.end()) return;
+  last_image_index_ = c.image_index;
+  ActionId id = it->first;
+  if (!c.captured) {
+    clear_action_timer(id);
+    pictures_pending_.erase(it);
+    tracker_.fail(id, mid::FailureReason::vehicle_fault,
+                  std::string("no picture: the camera reported a failed capture (") + what + ")", what);
+    return;
+  }
+  it->second.confirmed = true;
+  if (it->second.acked) end_picture(id);
+}
+
+void MavlinkDrone::end_picture(ActionId id) {
+  clear_action_timer(id);
+  pictures_pending_.erase(id);
+  ++pictures_;
+  publish();
+  tracker_.end(id, Outcome::succeeded);
 }
 
 void MavlinkDrone::start_motion(ActionId id, const mid::ActionRequest& r) {
@@ -260,6 +318,7 @@ void MavlinkDrone::end_refused(ActionId id, const CommandResult& result) {
 
 void MavlinkDrone::stop_action(ActionId id) {
   clear_action_timer(id);  // also called for a failsafe, where the base has not cleared it
+  pictures_pending_.erase(id);
   if (id != motion_owner_) return;
   motion_owner_ = mid::kNoAction;
   goal_.reset();
@@ -281,6 +340,7 @@ void MavlinkDrone::hold_here() {
 
 void MavlinkDrone::fail_all(mid::FailureReason why, const std::string& reason) {
   end_all({.outcome = Outcome::failed, .reason = reason, .failure = why});
+  pictures_pending_.clear();
   motion_owner_ = mid::kNoAction;
   goal_.reset();
   orbit_ = {};
@@ -362,6 +422,7 @@ mid::DroneState MavlinkDrone::state() const {
   s.pictures = pictures_;
   if (vehicle_.heading_deg >= 0) s.heading = vehicle_.heading_deg;
   if (autopilot_ && vehicle_.heard) s.mode = mode_name(*autopilot_, vehicle_.custom_mode);
+  s.link_lost = link_lost_;
   return s;
 }
 

@@ -10,7 +10,9 @@
 //   Hover           a position setpoint where the drone is
 //   Orbit           PX4: MAV_CMD_DO_ORBIT around where it is, flown in PX4's Orbit mode;
 //                   ArduPilot (Copter has no DO_ORBIT): setpoints moving around the circle
-//   TakePicture     MAV_CMD_IMAGE_START_CAPTURE to the autopilot
+//   TakePicture     ArduPilot MAV_CMD_IMAGE_START_CAPTURE, PX4 MAV_CMD_DO_DIGICAM_CONTROL;
+//                   done once the vehicle confirms the picture (CAMERA_TRIGGER, _FEEDBACK or
+//                   CAMERA_IMAGE_CAPTURED), not at the ACK
 //   SensorK         the fleet file's sensor model at the drone's position (MAVLink has no
 //                   standard "mission sensor"; a real payload needs its own adapter code)
 // Every frame arrives on the link's thread and is posted to the event loop, so all state
@@ -46,7 +48,15 @@ struct MavlinkOptions {
   /// up as much then gets the same slack in wall time as a real one.
   double speed = 1.0;
   double connect_timeout_s = 10.0; ///< wall seconds to wait for the vehicle's first HEARTBEAT
-  double link_timeout_s = 3.0;     ///< wall seconds without a HEARTBEAT = link lost
+  /// Mission seconds without a HEARTBEAT = link lost. Mission time, not wall time: what
+  /// matters is how far the vehicle flies unheard, and every action's deadline is mission
+  /// time too, so a lost link is seen before the running motion's deadline at any --speed.
+  double link_timeout_s = 3.0;
+  /// ... but never less than this many wall seconds: the ground's own scheduling must not
+  /// look like a lost link (0.5 s was too little: with --distributed and three PX4 SITL on a
+  /// loaded 2-core machine all three links "dropped" at once). At --speed 5: 7.5 mission s,
+  /// still before the deadline of a FlyBy of a few metres.
+  double link_timeout_min_wall_s = 1.5;
   CommandOptions commands;         ///< ACK timeouts in wall seconds
   double setpoint_hz = 10.0;       ///< setpoint stream rate (PX4 needs > 2 Hz in OFFBOARD)
   int setpoints_before_switch = 5; ///< PX4: setpoints sent before asking for OFFBOARD
@@ -63,6 +73,10 @@ struct MavlinkOptions {
   /// ArduPilot queues the STATUSTEXT that explains a refusal and sends it after the
   /// COMMAND_ACK: a refused action waits this long for it (seconds; scaled).
   double statustext_wait_s = 0.5;
+  /// A picture counts once the vehicle confirms it (CAMERA_TRIGGER, CAMERA_FEEDBACK or
+  /// CAMERA_IMAGE_CAPTURED), not when the command is accepted: an autopilot accepts the
+  /// command with no camera behind it. How long after the ACK to wait (seconds; scaled).
+  double picture_confirm_s = 2.0;
   mid::Tolerance tolerance;        ///< when a goal counts as reached: this close ...
   double settled_mps = 0.3;        ///< ... and no faster than this (stopped, not passing by)
 };
@@ -103,6 +117,7 @@ class MavlinkDrone final : public mid::AdapterDrone {
     bool on_circle = false;
     bool commanded = false; ///< the autopilot flies it (DO_ORBIT accepted), not our setpoints
     bool mode_seen = false; ///< a HEARTBEAT has shown the autopilot's orbit mode
+    double commanded_radius = 0.0;  ///< our setpoints' radius: `radius` corrected for the lag
   };
 
   // actions (mavlink_drone.cpp)
@@ -110,6 +125,9 @@ class MavlinkDrone final : public mid::AdapterDrone {
   std::string refusal(const mid::ActionRequest& r, const fleet::ActionSpec& spec) const override;
   void start_system(mid::ActionId id, const mid::ActionRequest& r) override;
   void start_payload(mid::ActionId id, const mid::ActionRequest& r) override;
+  void take_picture(mid::ActionId id);
+  void on_camera_capture(const mavlink::CameraCapture& c);
+  void end_picture(mid::ActionId id);  ///< acknowledged and confirmed: taken
   void start_motion(mid::ActionId id, const mid::ActionRequest& r) override;
   void start_takeoff(mid::ActionId id, double altitude);
   /// Arms, first switching to a mode where arming is allowed when the vehicle is in one where
@@ -138,6 +156,12 @@ class MavlinkDrone final : public mid::AdapterDrone {
   std::string autopilot_says(double since) const;
   void note(const std::string& text);  ///< to the trace (message sink)
   void on_armed_changed();
+  /// Folds a LOCAL_POSITION_NED's time_boot_ms into the vehicle's clock rate.
+  void on_vehicle_clock(uint32_t time_boot_ms);
+  /// Vehicle seconds per mission second over the last few seconds (1 until known).
+  double vehicle_clock_rate() const;
+  /// A disarm by the autopilot while our Takeoff waits on the ground: arm and take off again.
+  bool takeoff_disarmed_on_ground();
 
   // link, telemetry, setpoints (mavlink_drone_link.cpp)
   void on_frame(const mavlink::Frame& frame);
@@ -191,6 +215,12 @@ class MavlinkDrone final : public mid::AdapterDrone {
   bool link_lost_ = false;
   bool telemetry_requested_ = false;
   int pictures_ = 0;
+  struct Picture {
+    bool acked = false;      ///< the autopilot accepted the command
+    bool confirmed = false;  ///< the camera said it took one
+  };
+  std::map<mid::ActionId, Picture> pictures_pending_;  ///< oldest first (ids grow)
+  std::optional<int64_t> last_image_index_;  ///< the image that confirmed the last picture
   FlightLimits limits_;
   std::function<void(const std::string&)> message_sink_;
   struct Text {
@@ -204,6 +234,11 @@ class MavlinkDrone final : public mid::AdapterDrone {
   /// in this state is survived by arming again before the Takeoff.
   bool armed_waiting_ = false;
   bool disarm_commanded_ = false;  ///< a disarm now is ours (Disarm, failsafe), not the autopilot's
+  mid::ActionId takeoff_rearmed_ = mid::kNoAction;  ///< the Takeoff already re-armed once
+  /// (mission s, vehicle s) of recent position reports: a SITL on a loaded machine runs
+  /// slower than --speed, and every deadline is stretched by how much (timeout_for()).
+  std::deque<std::pair<double, double>> clock_samples_;
+  bool clock_noted_ = false;
 
   // the motion the adapter flies for an action
   mid::ActionId motion_owner_ = mid::kNoAction;

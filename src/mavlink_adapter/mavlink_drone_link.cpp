@@ -1,5 +1,6 @@
 // The MavlinkDrone's side of the wire: connecting, frames from the link, heartbeats both
 // ways, link loss, telemetry requests, goal checks and the setpoint stream.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -202,10 +203,13 @@ void MavlinkDrone::on_frame(const ml::Frame& frame) {
       commands_.on_ack(*ack);
     return;
   }
+  // From the autopilot or from a camera component of the same system.
+  if (auto capture = ml::unpack_camera_capture(frame.message)) return on_camera_capture(*capture);
   if (auto hb = ml::unpack_heartbeat(frame.message); hb && hb->autopilot == ml::autopilot::INVALID)
     return;  // a camera, gimbal or companion of the same system: not the autopilot
   if (auto t = ml::unpack_statustext(frame.message); t && frame.compid == ml::comp::AUTOPILOT1)
     return on_statustext(*t);
+  if (auto p = ml::unpack_local_position_ned(frame.message)) on_vehicle_clock(p->time_boot_ms);
   Changes c = apply_telemetry(vehicle_, frame);
   if (c.rejected) return note_rejected(c.rejected);
   if (c.armed) on_armed_changed();
@@ -253,11 +257,63 @@ void MavlinkDrone::note(const std::string& text) {
 // arms again. The mission sees the drone disarmed meanwhile, as it is.
 void MavlinkDrone::on_armed_changed() {
   if (vehicle_.armed || disarm_commanded_) return;
+  if (takeoff_disarmed_on_ground()) return;
   if (armed_waiting_ && vehicle_.landed())
     note(std::string(autopilot_->name) + " disarmed the vehicle on the ground by itself (auto-disarm); "
          "eamos arms it again before its Takeoff");
   else if (!vehicle_.landed())
     note(std::string(autopilot_->name) + " reports the vehicle disarmed in the air");
+}
+
+// The auto-disarm may also strike between our NAV_TAKEOFF and the autopilot's takeoff (it
+// counts from arming in the vehicle's clock, which a sped-up SITL keeps a little behind
+// ours): the takeoff then never starts. Arm again and send it again, once; a second disarm
+// fails the Takeoff rather than fight the autopilot.
+bool MavlinkDrone::takeoff_disarmed_on_ground() {
+  const mid::ActionRequest* r = tracker_.request(motion_owner_);
+  if (!r || r->name != "Takeoff" || !vehicle_.landed() || !tracker_.running(motion_owner_)) return false;
+  mid::ActionId id = motion_owner_;
+  if (takeoff_rearmed_ == id) {
+    fail_motion(mid::FailureReason::vehicle_fault,
+                std::string(autopilot_->name) + " disarmed the vehicle again before it took off" +
+                    autopilot_says(tracker_.started_at(id)),
+                "disarmed on the ground twice during the takeoff");
+    return true;
+  }
+  takeoff_rearmed_ = id;
+  note(std::string(autopilot_->name) + " disarmed the vehicle on the ground during the takeoff (auto-disarm); "
+       "eamos arms it again and repeats the takeoff");
+  double altitude = r->args[0];
+  streaming_ = false;
+  in_control_ = false;
+  start_takeoff(id, altitude);
+  return true;
+}
+
+void MavlinkDrone::on_vehicle_clock(uint32_t time_boot_ms) {
+  const double vehicle_s = time_boot_ms / 1000.0;
+  // A reboot (or a reordered datagram) starts the window again.
+  if (!clock_samples_.empty() && vehicle_s < clock_samples_.back().second) clock_samples_.clear();
+  clock_samples_.push_back({loop_.now(), vehicle_s});
+  while (clock_samples_.size() > 2 && clock_samples_.back().first - clock_samples_.front().first > 10.0)
+    clock_samples_.pop_front();
+  double rate = vehicle_clock_rate();
+  if (rate < 0.8 && !clock_noted_) {
+    clock_noted_ = true;
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "the vehicle's clock runs at %.2f of mission time (a SITL slower than --speed?): deadlines are "
+                  "stretched to match",
+                  rate);
+    note(text);
+  }
+}
+
+double MavlinkDrone::vehicle_clock_rate() const {
+  if (clock_samples_.size() < 2) return 1.0;
+  double mission = clock_samples_.back().first - clock_samples_.front().first;
+  if (mission < 2.0) return 1.0;  // too short to tell jitter from rate
+  return (clock_samples_.back().second - clock_samples_.front().second) / mission;
 }
 
 void MavlinkDrone::note_rejected(const char* what) {
@@ -283,7 +339,10 @@ void MavlinkDrone::note_foreign() {
 
 void MavlinkDrone::on_heartbeat() {
   note_foreign();
-  link_lost_ = false;
+  if (link_lost_) {
+    link_lost_ = false;
+    publish();
+  }
   link_watchdog();
   if (!telemetry_requested_) request_telemetry();
   if (left_orbit_mode()) return;
@@ -314,7 +373,8 @@ void MavlinkDrone::fail_motion(mid::FailureReason why, const std::string& reason
 
 void MavlinkDrone::link_watchdog() {
   loop_.cancel(watchdog_timer_);
-  watchdog_timer_ = loop_.after(options_.link_timeout_s, [this] {
+  // Like the deadlines, in the vehicle's time: a slow SITL sends its heartbeats slower.
+  watchdog_timer_ = loop_.after(options_.link_timeout_s / std::clamp(vehicle_clock_rate(), 0.2, 1.0), [this] {
     watchdog_timer_ = mid::kNoTimer;
     lose_link();
   });
@@ -330,6 +390,7 @@ void MavlinkDrone::lose_link() {
                 options_.link_timeout_s);
   fail_all(mid::FailureReason::link_lost, text);
   commands_.fail_all("link lost");
+  publish();
 }
 
 void MavlinkDrone::request_telemetry() {

@@ -18,6 +18,7 @@ using mid::Outcome;
 
 namespace {
 constexpr float kYawFrontToCentre = 0;  ///< ORBIT_YAW_BEHAVIOUR_HOLD_FRONT_TO_CIRCLE_CENTER
+constexpr double kRadiusGain = 0.5;     ///< 1/s (2.0 was measured to oscillate, 4.5 .. 5.5 m)
 }  // namespace
 
 double MavlinkDrone::orbit_speed(double radius) const {
@@ -29,7 +30,7 @@ double MavlinkDrone::orbit_speed(double radius) const {
 void MavlinkDrone::start_orbit(ActionId id, Vec3 centre, double radius) {
   // With DO_ORBIT the autopilot moves around the circle, not our setpoints: meanwhile (and
   // after a refusal) the stream holds the vehicle where it is.
-  orbit_ = {!autopilot_->do_orbit, centre, radius, 0.0, false, false, false};
+  orbit_ = {!autopilot_->do_orbit, centre, radius, 0.0, false, false, false, radius};
   stream_setpoints();
   if (!autopilot_->do_orbit) return;
   // Radius negative = counter-clockwise; centre and altitude NaN = where the vehicle is;
@@ -93,8 +94,18 @@ void MavlinkDrone::advance_orbit(double dt) {
     return;
   }
   orbit_.angle = std::fmod(orbit_.angle + orbit_speed(r) * dt / r, 2.0 * M_PI);
-  setpoint_ = {orbit_.centre.x + r * std::cos(orbit_.angle),
-               orbit_.centre.y + r * std::sin(orbit_.angle), orbit_.centre.z};
+  // A position setpoint moving around the circle is followed with a lag, along a chord:
+  // ArduCopter circled at 4.5 m for 5 m. Velocity feed-forward was tried and overshot (7.4 m
+  // with velocity, 3.3 m with velocity and acceleration: GUIDED moves its target by the
+  // velocity between our setpoints). So the commanded radius is corrected by what the
+  // vehicle flies: an integral on the radius error, within r … 1.5 r.
+  if (vehicle_.have_position) {
+    double flown = horizontal_norm(position() - orbit_.centre);
+    orbit_.commanded_radius = std::clamp(orbit_.commanded_radius + kRadiusGain * dt * (r - flown), r, 1.5 * r);
+  }
+  const double rc = orbit_.commanded_radius;
+  setpoint_ = {orbit_.centre.x + rc * std::cos(orbit_.angle),
+               orbit_.centre.y + rc * std::sin(orbit_.angle), orbit_.centre.z};
 }
 
 }  // namespace eamos::mavlink_adapter

@@ -81,6 +81,9 @@ struct DroneState {
   /// it. Telemetry for people (trace, monitor): no mission property reads it.
   double heading = std::numeric_limits<double>::quiet_NaN();
   std::string mode;      ///< the vehicle's flight mode in its own words ("OFFBOARD", "go"); "" unknown
+  /// Nothing heard from the vehicle for its link timeout: the values above are the last
+  /// known, and no command (not even a failsafe) reaches it until it is heard again.
+  bool link_lost = false;
 };
 
 /// Identifies one started action of one drone; 0 (kNoAction) is never issued.

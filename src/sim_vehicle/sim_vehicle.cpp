@@ -39,7 +39,8 @@ const Dialect& px4_dialect() {
   static const Dialect d{"PX4", ml::autopilot::PX4,
                          {px4::mode(px4::MAIN_POSCTL), px4::LOITER, px4::OFFBOARD, px4::TAKEOFF,
                           px4::LAND, px4::RTL, px4::ORBIT},
-                         Mode::hold, true, true, false, true, true, Mode::hold, true};
+                         Mode::hold, true, true, false, true, true, Mode::hold, true,
+                         ml::cmd::DO_DIGICAM_CONTROL, ml::msg::CAMERA_TRIGGER};
   return d;
 }
 
@@ -47,7 +48,8 @@ const Dialect& ardupilot_dialect() {
   // ArduCopter: STABILIZE 0, GUIDED 4, LOITER 5, RTL 6, CIRCLE 7, LAND 9; a GUIDED takeoff
   // stays GUIDED. CIRCLE is never entered here: no DO_ORBIT, and DO_SET_MODE cannot ask for it.
   static const Dialect d{"ArduPilot", ml::autopilot::ARDUPILOTMEGA, {0, 5, 4, 4, 9, 6, 7},
-                         Mode::manual, false, false, true, false, false, Mode::setpoint, false};
+                         Mode::manual, false, false, true, false, false, Mode::setpoint, false,
+                         ml::cmd::IMAGE_START_CAPTURE, ml::msg::CAMERA_FEEDBACK};
   return d;
 }
 
@@ -110,8 +112,8 @@ void SimVehicle::on_setup_signing(const ml::SetupSigning& s) {
 }
 
 // The speed parameters the real autopilot has, valued as the simulator flies (its default
-// limits: 10 m/s across, 3 up, 2 down); a name it does not know gets no answer, like on the
-// real ones.
+// limits: 10 m/s across, 3 up, 2 down; it takes off without spool-up or ramp); a name it
+// does not know gets no answer, like on the real ones.
 void SimVehicle::on_param_request(const ml::ParamRequestRead& r) {
   if ((r.target_system != options_.sysid && r.target_system != 0) || r.param_index != -1) return;
   const fleet::Limits l;
@@ -119,11 +121,13 @@ void SimVehicle::on_param_request(const ml::ParamRequestRead& r) {
   const std::map<std::string, double> params =
       px4 ? std::map<std::string, double>{{"MPC_XY_CRUISE", l.max_speed_mps}, {"MPC_Z_VEL_MAX_UP", l.max_climb_mps},
                                           {"MPC_TKO_SPEED", l.max_climb_mps}, {"MPC_Z_VEL_MAX_DN", l.max_descent_mps},
-                                          {"MPC_LAND_SPEED", l.max_descent_mps}}
+                                          {"MPC_LAND_SPEED", l.max_descent_mps}, {"COM_SPOOLUP_TIME", 0},
+                                          {"MPC_TKO_RAMP_T", 0}}
           : std::map<std::string, double>{{"WPNAV_SPEED", 100 * l.max_speed_mps},
                                           {"WPNAV_SPEED_UP", 100 * l.max_climb_mps},
                                           {"WPNAV_SPEED_DN", 100 * l.max_descent_mps},
-                                          {"LAND_SPEED", 100 * l.max_descent_mps}, {"LAND_SPEED_HIGH", 0}};
+                                          {"LAND_SPEED", 100 * l.max_descent_mps}, {"LAND_SPEED_HIGH", 0},
+                                          {"MOT_SPOOL_TIME", 0}, {"TKOFF_SLEW_TIME", 0}};
   auto it = params.find(r.param_id);
   if (it == params.end()) return;
   int index = static_cast<int>(std::distance(params.begin(), it));
@@ -136,7 +140,11 @@ void SimVehicle::on_command(const ml::CommandLong& c) {
   // A resend means our ACK was lost: answer again, but do not arm or take off twice.
   if (c.confirmation > 0 && has_last_ && last_command_ == c.command) return ack(c.command, last_result_);
   ++received_[c.command];
-  if (c.command == ml::cmd::IMAGE_START_CAPTURE) return start_then_ack(c.command, "TakePicture");
+  if (c.command == dialect_.picture_command)
+    return start_then_ack(c.command, "TakePicture", [this] {
+      if (options_.camera_confirms)
+        send(ml::pack(ml::CameraCapture{dialect_.picture_confirmation, pictures_taken_++, true}));
+    });
   uint8_t result = execute(c);
   if (result == kAckLater) return;
   last_command_ = c.command;
@@ -241,17 +249,18 @@ void SimVehicle::on_setpoint(const ml::SetPositionTargetLocalNed& sp) {
   fly_to_setpoint();
 }
 
-void SimVehicle::start_then_ack(uint16_t command, const std::string& action) {
+void SimVehicle::start_then_ack(uint16_t command, const std::string& action, std::function<void()> after) {
   // Acknowledged once done (a picture takes 0.5 s, arming a moment), so no HEARTBEAT sent
   // after the ACK can still show the state from before.
   std::weak_ptr<bool> alive = alive_;
-  drone_.start({action, {}}, [this, alive, command](const mid::ActionEnd& end) {
+  drone_.start({action, {}}, [this, alive, command, after = std::move(after)](const mid::ActionEnd& end) {
     if (!alive.lock()) return;
     uint8_t result = end.outcome == mid::Outcome::succeeded ? ml::result::ACCEPTED : ml::result::FAILED;
     last_command_ = command;
     last_result_ = result;
     has_last_ = true;
     ack(command, result);
+    if (after && result == ml::result::ACCEPTED) after();
   });
 }
 

@@ -7,7 +7,8 @@
 //  - COMMAND_LONG answered with COMMAND_ACK: ARM_DISARM, NAV_TAKEOFF (param7 above mean
 //    sea level; refused while disarmed), NAV_LAND, NAV_RETURN_TO_LAUNCH, DO_SET_MODE
 //    (OFFBOARD only while setpoints stream, AUTO.LOITER/LAND/RTL), SET_MESSAGE_INTERVAL,
-//    IMAGE_START_CAPTURE (acknowledged once the 0.5 s picture is taken), DO_ORBIT (PX4 only:
+//    the dialect's picture command (acknowledged once the 0.5 s picture is taken, then
+//    confirmed with the dialect's camera message), DO_ORBIT (PX4 only:
 //    around where it is, in PX4's Orbit mode; ArduPilot Copter has none); anything else
 //    MAV_RESULT_UNSUPPORTED. A resend (confirmation > 0) of the last command is
 //    acknowledged again, not executed twice;
@@ -19,6 +20,7 @@
 //  - PARAM_REQUEST_READ of the autopilot's speed parameters answered with PARAM_VALUE, valued
 //    as the simulator flies.
 // Its local NED origin is its home; it runs on its own event loop in real time.
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -50,6 +52,11 @@ struct Dialect {
   bool setpoint_loss_holds;      ///< PX4: OFFBOARD falls back to hold when setpoints stop
   Mode after_takeoff;            ///< PX4: AUTO.LOITER; ArduPilot: stays in GUIDED
   bool do_orbit;                 ///< PX4 flies MAV_CMD_DO_ORBIT; ArduPilot Copter does not know it
+  /// One picture: PX4's camera_trigger takes MAV_CMD_DO_DIGICAM_CONTROL and reports
+  /// CAMERA_TRIGGER; ArduPilot's AP_Camera takes MAV_CMD_IMAGE_START_CAPTURE and reports
+  /// CAMERA_FEEDBACK (each, in this vehicle, after the ACK).
+  uint16_t picture_command;
+  uint32_t picture_confirmation;
 };
 const Dialect& px4_dialect();
 const Dialect& ardupilot_dialect();
@@ -62,6 +69,9 @@ struct VehicleOptions {
   double offboard_loss_s = 1.0;    ///< OFFBOARD without a fresh setpoint this long: hold
   double disarm_after_land_s = 2.0;
   double default_rate_hz = 1.0;    ///< telemetry rate until SET_MESSAGE_INTERVAL says otherwise
+  /// false: the picture command is accepted but no camera confirms it, as an autopilot whose
+  /// camera is configured but absent (or broken) answers.
+  bool camera_confirms = true;
 };
 
 class SimVehicle {
@@ -95,7 +105,8 @@ class SimVehicle {
   uint8_t set_mode(Mode mode);
   /// The Mode a DO_SET_MODE asks for; false when the dialect has no such mode.
   bool requested_mode(const mavlink::CommandLong& c, Mode& out) const;
-  void start_then_ack(uint16_t command, const std::string& action);
+  /// Runs `action`, then acknowledges `command` with its outcome; `after` runs after an ACCEPTED.
+  void start_then_ack(uint16_t command, const std::string& action, std::function<void()> after = nullptr);
   void on_setpoint(const mavlink::SetPositionTargetLocalNed& sp);
   void fly_to_setpoint();
   void start(const std::string& action, std::vector<double> args,
@@ -129,6 +140,7 @@ class SimVehicle {
   uint16_t last_command_ = 0;           ///< for resends: acknowledge again, do not redo
   uint8_t last_result_ = 0;
   bool has_last_ = false;
+  int pictures_taken_ = 0;
   uint8_t ack_to_system_ = 0;           ///< who sent the newest command: its ACK goes there
   uint8_t ack_to_component_ = 0;
   std::map<uint32_t, mid::TimerId> streams_;  ///< message id -> its next send

@@ -42,6 +42,8 @@ const std::map<uint32_t, uint8_t> kPublished = {
     {msg::COMMAND_ACK, 143},        {msg::SET_POSITION_TARGET_LOCAL_NED, 143},
     {msg::BATTERY_STATUS, 154},     {msg::EXTENDED_SYS_STATE, 130},
     {msg::STATUSTEXT, 83},          {msg::SETUP_SIGNING, 71},
+    {msg::CAMERA_TRIGGER, 174},     {msg::CAMERA_FEEDBACK, 52},
+    {msg::CAMERA_IMAGE_CAPTURED, 133},
 };
 
 TEST(CrcExtra, EveryTableMessageMatchesThePublishedValue) {

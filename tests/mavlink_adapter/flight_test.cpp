@@ -73,6 +73,51 @@ TEST(MavlinkFlight, ArduPilotTakesOffInGuidedToAnAltitudeAboveHome) {
   EXPECT_NEAR(f.drone->state().x, 0.0, 0.5);
 }
 
+// A picture is taken when the vehicle says so, not when it accepts the command: each
+// autopilot's own command (PX4 DO_DIGICAM_CONTROL, ArduPilot IMAGE_START_CAPTURE) and its
+// camera's confirmation (CAMERA_TRIGGER, CAMERA_FEEDBACK) make one picture.
+TEST(MavlinkFlight, TakePictureSucceedsOnceTheVehicleConfirmsItsPicture) {
+  for (const sim_vehicle::Dialect* d : {&sim_vehicle::px4_dialect(), &sim_vehicle::ardupilot_dialect()}) {
+    SCOPED_TRACE(d->name);
+    int port = d == &sim_vehicle::px4_dialect() ? 25370 : 25371;
+    test::VehicleThread vehicle(port, 1, kSpeed, *d);
+    Flight f(port);
+    ASSERT_TRUE(f.drone) << f.created.message;
+    mid::ActionEnd e = f.fly("TakePicture");
+    EXPECT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
+    EXPECT_EQ(f.drone->state().pictures, 1);
+    EXPECT_EQ(vehicle.inspect([&](sim_vehicle::SimVehicle& v) { return v.received(d->picture_command); }), 1);
+  }
+}
+
+TEST(MavlinkFlight, TakePictureAcceptedButNeverConfirmedFailsSayingSo) {
+  test::VehicleThread vehicle(25372, 1, kSpeed, sim_vehicle::ardupilot_dialect(), 100.0, /*camera_confirms=*/false);
+  Flight f(25372);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  mid::ActionEnd e = f.fly("TakePicture");
+  EXPECT_EQ(e.outcome, mid::Outcome::failed);
+  EXPECT_NE(e.reason.find("no picture: ArduPilot accepted MAV_CMD_IMAGE_START_CAPTURE but no camera confirmed"),
+            std::string::npos)
+      << e.reason;
+  EXPECT_EQ(f.drone->state().pictures, 0);
+}
+
+// A vehicle whose clock runs at half of mission time (a SITL that cannot keep up with
+// --speed on a loaded machine): the FlyTo of 300 m takes over 30 s of the vehicle's time,
+// over 60 mission seconds, beyond its deadline from the limits (55 s); deadlines follow the
+// vehicle's clock.
+TEST(MavlinkFlight, DeadlinesFollowTheVehiclesClockWhenItRunsSlowerThanMissionTime) {
+  test::VehicleThread vehicle(25373, 1, kSpeed / 2);
+  Flight f(25373);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  mid::ActionEnd armed = f.fly("Arm");
+  ASSERT_EQ(armed.outcome, mid::Outcome::succeeded) << armed.reason;
+  mid::ActionEnd up = f.fly("Takeoff", {3});
+  ASSERT_EQ(up.outcome, mid::Outcome::succeeded) << up.reason;
+  mid::ActionEnd e = f.fly("FlyTo", {300, 0, 3}, 150);
+  EXPECT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
+}
+
 TEST(MavlinkFlight, ArmRefusedByTheAutopilotFailsWithItsResultInWords) {
   test::VehicleThread vehicle(25313, 1, kSpeed, sim_vehicle::px4_dialect(), 0.0);  // empty battery
   Flight f(25313);
@@ -94,10 +139,14 @@ TEST(MavlinkFlight, TakeoffWhileDisarmedIsRefusedBeforeReachingTheAutopilot) {
   EXPECT_EQ(e.reason, "disarmed: arm before Takeoff");
 }
 
-TEST(MavlinkFlight, LinkLossFailsTheRunningAction) {
+// The link timeout is mission time (3 s by default), like the deadlines of the actions it
+// must beat: at 4× a lost link is seen after 3 mission seconds, not after 3 wall seconds
+// (12 mission seconds, longer than most motions' deadlines), when the wall-clock floor is
+// below it.
+TEST(MavlinkFlight, LinkLossFailsTheRunningActionAfterTheLinkTimeoutInMissionTime) {
   test::VehicleThread vehicle(25314, 1, kSpeed);
   MavlinkOptions options;
-  options.link_timeout_s = 0.5;  // wall seconds: 2 mission seconds at 4×
+  options.link_timeout_min_wall_s = 0.5;  // 2 mission s at 4×: the 3 s timeout decides
   Flight f(25314, options);
   ASSERT_TRUE(f.drone) << f.created.message;
   ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
@@ -110,11 +159,14 @@ TEST(MavlinkFlight, LinkLossFailsTheRunningAction) {
   f.loop.run_until(f.loop.now() + 1.0);
   EXPECT_FALSE(end);  // Hover() runs until something stops it
   vehicle.halt();
+  const double halted_at = f.loop.now();
   f.loop.run_until(f.loop.now() + 10.0);
   ASSERT_TRUE(end);
+  EXPECT_LT(f.loop.now() - halted_at, 4.0);
   EXPECT_EQ(end->outcome, mid::Outcome::failed);
-  EXPECT_EQ(end->reason, "link lost: no HEARTBEAT from system 1 for 2.0 s");
+  EXPECT_EQ(end->reason, "link lost: no HEARTBEAT from system 1 for 3.0 s");
   EXPECT_EQ(end->failure, mid::FailureReason::link_lost);
+  EXPECT_TRUE(f.drone->state().link_lost);
   mid::ActionEnd refused = f.fly("Land");
   EXPECT_EQ(refused.outcome, mid::Outcome::failed);
   EXPECT_EQ(refused.reason, "link lost: no HEARTBEAT from system 1");

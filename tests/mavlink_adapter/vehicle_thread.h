@@ -16,9 +16,9 @@ class VehicleThread {
  public:
   VehicleThread(int port, uint8_t sysid, double speed,
                 const sim_vehicle::Dialect& dialect = sim_vehicle::px4_dialect(),
-                double battery_percent = 100.0)
+                double battery_percent = 100.0, bool camera_confirms = true)
       : loop_({mid::ClockMode::real_time, speed}),
-        vehicle_(loop_, {&dialect, sysid, battery_percent}) {
+        vehicle_(loop_, options(dialect, sysid, battery_percent, camera_confirms)) {
     std::string url = "udpout://127.0.0.1:" + std::to_string(port);
     if (std::string e = vehicle_.open(*mavlink::parse_url(url).endpoint); !e.empty())
       throw std::runtime_error(e);
@@ -27,6 +27,13 @@ class VehicleThread {
     });
   }
   ~VehicleThread() { halt(); }
+
+  static sim_vehicle::VehicleOptions options(const sim_vehicle::Dialect& dialect, uint8_t sysid,
+                                             double battery_percent, bool camera_confirms) {
+    sim_vehicle::VehicleOptions o{&dialect, sysid, battery_percent};
+    o.camera_confirms = camera_confirms;
+    return o;
+  }
 
   /// The vehicle's mode; only after halt(), when its loop no longer runs.
   sim_vehicle::Mode mode() const { return vehicle_.mode(); }

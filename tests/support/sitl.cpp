@@ -12,13 +12,18 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <map>
+#include <optional>
 #include <mutex>
 #include <sstream>
+#include <thread>
 
 #include "mavlink/enums.h"
 #include "mavlink/link.h"
 #include "mavlink/messages.h"
 #include "mavlink/payloads.h"
+#include "mavlink/url.h"
 
 namespace eamos_test {
 namespace fs = std::filesystem;
@@ -175,6 +180,8 @@ bool SitlFleet::start_one(int i, std::string& error) {
       setenv("PX4_HOME_LON", fixed(lon, 8).c_str(), 1);
       setenv("PX4_HOME_ALT", fixed(kOriginAlt, 1).c_str(), 1);
       setenv("PX4_SIM_SPEED_FACTOR", fixed(options_.speedup, 2).c_str(), 1);
+      // rcS sets parameters from PX4_PARAM_<name> before it starts camera_trigger.
+      if (options_.camera) setenv("PX4_PARAM_TRIG_MODE", "1", 1);
       std::string path = inst.dir + "/bin:" + (std::getenv("PATH") ? std::getenv("PATH") : "/usr/bin:/bin");
       setenv("PATH", path.c_str(), 1);
     }
@@ -284,12 +291,136 @@ void ask_for_status(ml::Link& link, ml::Encoder& encoder, uint8_t sysid) {
   }
 }
 
+// What the camera set-up has seen of one ArduPilot instance, filled on the link's thread.
+struct CameraSetup {
+  std::mutex mutex;
+  std::condition_variable changed;
+  bool heartbeat = false;
+  std::map<std::string, float> params;  ///< PARAM_VALUEs by name
+};
+
+ml::Message command_long(uint8_t sysid, uint16_t id, std::array<float, 7> params) {
+  ml::CommandLong c;
+  c.target_system = sysid;
+  c.target_component = 1;
+  c.command = id;
+  c.param = params;
+  return ml::pack(c);
+}
+
+// Waits (bounded by `deadline`, resending `ask` every half second) until `done` holds.
+bool wait_for(CameraSetup& cs, double deadline, const std::function<void()>& ask, const std::function<bool()>& done) {
+  std::unique_lock lock(cs.mutex);
+  while (!done()) {
+    if (now_s() > deadline) return false;
+    lock.unlock();
+    ask();
+    lock.lock();
+    cs.changed.wait_for(lock, std::chrono::milliseconds(500), done);
+  }
+  return true;
+}
+
 }  // namespace
+
+// ArduPilot creates its camera backend only at boot. CAM1_TYPE in a second --defaults file
+// did not take on this 4.7 build (PARAM_VALUE said 0 after boot), so the camera is set up as
+// a user does it: PARAM_SET CAM1_TYPE 1 (saved to the instance's eeprom.bin), then
+// MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN; the instance restarts in place and keeps the parameter.
+bool SitlFleet::set_up_ardupilot_camera(int i, double deadline, std::string& error) {
+  CameraSetup cs;
+  const uint8_t vehicle = static_cast<uint8_t>(sysid(i));
+  ml::FrameHandler handler = [&cs, vehicle](ml::Frame f) {
+    if (f.sysid != vehicle || f.compid != 1) return;
+    std::lock_guard lock(cs.mutex);
+    if (ml::unpack_heartbeat(f.message)) cs.heartbeat = true;
+    if (auto p = ml::unpack_param_value(f.message)) cs.params[p->param_id] = p->param_value;
+    cs.changed.notify_all();
+  };
+  auto open = [&]() -> std::unique_ptr<ml::Link> {
+    ml::OpenResult opened;
+    while (!opened.link && now_s() < deadline) {
+      opened = ml::Link::open(*ml::parse_url(connection(i)).endpoint, handler, 0.2);
+      if (!opened.link) usleep(100000);
+    }
+    return std::move(opened.link);
+  };
+  std::unique_ptr<ml::Link> link = open();
+  ml::Encoder encoder{250, 190, 0};
+  auto send = [&](const ml::Message& m) {
+    if (link) link->send(encoder.encode(m));
+  };
+  auto ask = [&](const char* param) {
+    ml::Heartbeat hb;
+    hb.type = 6;
+    hb.autopilot = 8;
+    send(ml::pack(hb));
+    send(ml::pack(ml::ParamRequestRead{vehicle, 1, param, -1}));
+  };
+  auto param = [&](const char* name) -> std::optional<float> {
+    auto it = cs.params.find(name);
+    return it == cs.params.end() ? std::nullopt : std::optional<float>(it->second);
+  };
+  // STAT_BOOTCNT counts the autopilot's boots: one more is the reboot done.
+  const char* step = "reading STAT_BOOTCNT";
+  bool ok = link && wait_for(cs, deadline, [&] { ask("STAT_BOOTCNT"); }, [&] { return param("STAT_BOOTCNT").has_value(); });
+  std::unique_lock boots_lock(cs.mutex);
+  float boots = ok ? *param("STAT_BOOTCNT") : 0;
+  boots_lock.unlock();
+  // ArduPilot saves a parameter from its IO thread, after the PARAM_VALUE echo: on a loaded
+  // machine a reboot right after the echo sometimes came first and CAM1_TYPE was 0 again.
+  // So: set, reboot, check; up to three times.
+  for (int attempt = 0; ok && attempt < 3; ++attempt) {
+    step = "PARAM_SET CAM1_TYPE 1";
+    {
+      std::lock_guard lock(cs.mutex);
+      cs.params.erase("CAM1_TYPE");
+    }
+    ok = wait_for(cs, deadline, [&] { send(ml::pack(ml::ParamSet{vehicle, 1, "CAM1_TYPE", 1.0f, ml::param_type::INT8})); },
+                  [&] { return param("CAM1_TYPE") == 1.0f; });
+    if (!ok) break;
+    step = "rebooting";
+    // param1 = 1: reboot the autopilot. SITL restarts by exec in the same process; connect
+    // again until the new boot answers, repeating the reboot while the old one still does.
+    auto reboot = [&] { send(command_long(vehicle, 246, {1, 0, 0, 0, 0, 0, 0})); };
+    reboot();
+    auto rebooted = [&] { return param("STAT_BOOTCNT") > boots; };
+    int tries = 0;
+    while (ok) {
+      link.reset();
+      link = open();
+      ok = link != nullptr;
+      if (ok && wait_for(cs, std::min(deadline, now_s() + 2.0), [&] { ask("STAT_BOOTCNT"); }, rebooted)) break;
+      std::unique_lock lock(cs.mutex);
+      if (param("STAT_BOOTCNT") == boots && ++tries % 2 == 0) reboot();  // the old boot answers still
+      lock.unlock();
+      ok = now_s() < deadline;
+    }
+    if (!ok) break;
+    {
+      std::lock_guard lock(cs.mutex);
+      boots = *param("STAT_BOOTCNT");
+      cs.params.erase("CAM1_TYPE");
+    }
+    step = "checking CAM1_TYPE after the reboot";
+    ok = wait_for(cs, deadline, [&] { ask("CAM1_TYPE"); }, [&] { return param("CAM1_TYPE").has_value(); });
+    std::lock_guard lock(cs.mutex);
+    if (ok && param("CAM1_TYPE") == 1.0f) break;
+    ok = ok && attempt < 2;
+  }
+  link.reset();
+  if (!ok)
+    error = "SITL instance " + std::to_string(i) + ": camera set-up did not finish: " + step + "\n" + log_tail(i);
+  return ok;
+}
 
 // Short-lived links of the test's own, one per instance and all open at once (a STATUSTEXT
 // is sent once, to whoever is connected then); closed before eamos opens the same ports.
 bool SitlFleet::wait_ready(double timeout_s, std::string& error) {
   double deadline = now_s() + timeout_s;
+  if (options_.camera && options_.autopilot == Autopilot::ardupilot)
+    for (int i = 0; i < size(); ++i)
+      if (!set_up_ardupilot_camera(i, deadline, error)) return false;
   std::vector<std::unique_ptr<Readiness>> state;
   std::vector<std::unique_ptr<ml::Link>> links;
   for (int i = 0; i < size(); ++i) {
@@ -327,6 +458,76 @@ bool SitlFleet::wait_ready(double timeout_s, std::string& error) {
     }
   }
   return true;
+}
+
+// --- a second ground station ---------------------------------------------------------------
+
+struct SitlWatch::State {
+  std::mutex mutex;
+  std::vector<VehicleSample> samples;
+  uint32_t custom_mode = 0;
+  std::unique_ptr<ml::Link> link;
+  std::thread asker;
+  std::mutex stop_mutex;
+  std::condition_variable stop_cv;
+  bool stop = false;
+};
+
+SitlWatch::SitlWatch(const SitlFleet& fleet, int i) : state_(std::make_unique<State>()) {
+  const uint8_t vehicle = static_cast<uint8_t>(fleet.sysid(i));
+  const int n = fleet.sysid(i) - 1;
+  std::string url = fleet.autopilot() == Autopilot::ardupilot ? "tcp://127.0.0.1:" + std::to_string(5762 + 10 * n)
+                                                              : "udpout://127.0.0.1:" + std::to_string(18570 + n);
+  State* st = state_.get();
+  auto opened = ml::Link::open(*ml::parse_url(url).endpoint, [st, vehicle](ml::Frame f) {
+    if (f.sysid != vehicle || f.compid != 1) return;
+    std::lock_guard lock(st->mutex);
+    if (auto hb = ml::unpack_heartbeat(f.message)) st->custom_mode = hb->custom_mode;
+    if (auto p = ml::unpack_local_position_ned(f.message))
+      st->samples.push_back({now_s(), p->x, p->y, p->z, std::hypot(p->vx, p->vy), st->custom_mode});
+  });
+  if (!opened.link) {
+    error_ = "cannot watch SITL instance " + std::to_string(i) + " on " + url + ": " + opened.error;
+    return;
+  }
+  st->link = std::move(opened.link);
+  // A ground station's HEARTBEAT (PX4 sends its GCS link to whoever spoke to it) and the rate
+  // of LOCAL_POSITION_NED, every second until the watch ends.
+  st->asker = std::thread([st, vehicle] {
+    ml::Encoder encoder{251, 190, 0};
+    std::unique_lock lock(st->stop_mutex);
+    while (!st->stop) {
+      ml::Heartbeat hb;
+      hb.type = 6;
+      hb.autopilot = 8;
+      st->link->send(encoder.encode(ml::pack(hb)));
+      ml::CommandLong c;
+      c.target_system = vehicle;
+      c.target_component = 1;
+      c.command = ml::cmd::SET_MESSAGE_INTERVAL;
+      c.param[0] = static_cast<float>(ml::msg::LOCAL_POSITION_NED);
+      c.param[1] = 50000;  // 20 Hz of the vehicle's time
+      st->link->send(encoder.encode(ml::pack(c)));
+      st->stop_cv.wait_for(lock, std::chrono::seconds(1), [st] { return st->stop; });
+    }
+  });
+}
+
+SitlWatch::~SitlWatch() {
+  if (state_->asker.joinable()) {
+    {
+      std::lock_guard lock(state_->stop_mutex);
+      state_->stop = true;
+    }
+    state_->stop_cv.notify_all();
+    state_->asker.join();
+  }
+  state_->link.reset();
+}
+
+std::vector<VehicleSample> SitlWatch::samples() const {
+  std::lock_guard lock(state_->mutex);
+  return state_->samples;
 }
 
 }  // namespace eamos_test

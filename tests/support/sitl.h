@@ -6,6 +6,8 @@
 // fails half-way, and nothing else on the machine is touched.
 #include <sys/types.h>
 
+#include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -25,8 +27,14 @@ struct SitlOptions {
   double speedup = 1;           ///< simulation speed: ArduPilot --speedup, PX4_SIM_SPEED_FACTOR
   /// The autopilot's instance number of instance 0: it picks the ports (ArduPilot TCP
   /// 5760 + 10 n, PX4 UDP 14540 + n), so two fleets on one machine do not meet. Unset, it is
-  /// EAMOS_SITL_FIRST_INSTANCE or 0.
+  /// EAMOS_SITL_FIRST_INSTANCE or 0. PX4 instance n also listens on UDP 14580 + n and
+  /// 18570 + n: fleets 40 apart collide (one's 14540 + n is the other's 14580 + n).
   int first_instance = -1;
+  /// A camera configured the way a user sets one up for pictures: ArduPilot CAM1_TYPE 1
+  /// (servo-triggered; set with PARAM_SET and a reboot in wait_ready(), as its camera
+  /// backend exists only from boot), PX4 TRIG_MODE 1 (camera_trigger on command; SITL's
+  /// TRIG_INTERFACE is 3, MAVLink). false: stock parameters, no camera.
+  bool camera = false;
 };
 
 class SitlFleet {
@@ -52,6 +60,7 @@ class SitlFleet {
   void stop();
 
   int size() const { return static_cast<int>(instances_.size()); }
+  Autopilot autopilot() const { return options_.autopilot; }
   /// The `connection:` URL that reaches instance i, as a fleet file writes it.
   std::string connection(int i) const;
   /// PX4 derives its system id from the instance number; ArduPilot is told the same one.
@@ -68,10 +77,38 @@ class SitlFleet {
   int instance_number(int i) const { return first_instance_ + i; }
   std::vector<std::string> command_line(int i, const std::string& binary) const;
   void prepare_px4_bin(const std::string& dir, const std::string& binary) const;
+  bool set_up_ardupilot_camera(int i, double deadline, std::string& error);
 
   SitlOptions options_;
   int first_instance_ = 0;
   std::vector<Instance> instances_;
+};
+
+/// One position report of a vehicle, as a ground station beside eamos sees it.
+struct VehicleSample {
+  double wall_s = 0;            ///< steady clock, seconds
+  double north = 0, east = 0, down = 0;  ///< LOCAL_POSITION_NED, m from the vehicle's home
+  double speed = 0;             ///< horizontal, m/s
+  uint32_t custom_mode = 0;     ///< the flight mode of the newest HEARTBEAT before it
+};
+
+/// A second ground station on one instance (ArduPilot SERIAL1, TCP 5762 + 10 n; PX4's GCS
+/// link, UDP 18570 + n): records what the vehicle does, independently of eamos' link, so a
+/// test can judge the flight from the vehicle's own telemetry.
+class SitlWatch {
+ public:
+  SitlWatch(const SitlFleet& fleet, int i);
+  ~SitlWatch();
+  SitlWatch(const SitlWatch&) = delete;
+  SitlWatch& operator=(const SitlWatch&) = delete;
+  /// "" when the link is open, else why not.
+  const std::string& error() const { return error_; }
+  std::vector<VehicleSample> samples() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+  std::string error_;
 };
 
 }  // namespace eamos_test

@@ -1,0 +1,31 @@
+// The deadlines' inputs read from the autopilot's parameters (autopilot_params.h).
+#include <gtest/gtest.h>
+
+#include "mavlink/enums.h"
+#include "mavlink_adapter/autopilot_params.h"
+
+namespace eamos::mavlink_adapter {
+namespace {
+
+// PX4 SIH took 9.7 s for a 4 m takeoff at MPC_TKO_SPEED 1.5 m/s: 1 s of spool-up and a 3 s
+// climb-rate ramp come first. A deadline from the climb alone (14 s) left too little margin.
+TEST(AutopilotParams, TakeoffDelaysAddUpFromSpoolUpAndRamp) {
+  const Autopilot& px4 = *autopilot_for(mavlink::autopilot::PX4);
+  FlightLimits l = combine_limits(px4, fleet::Limits{},
+                                  {{"MPC_TKO_SPEED", 1.5f}, {"COM_SPOOLUP_TIME", 1.0f}, {"MPC_TKO_RAMP_T", 3.0f}});
+  EXPECT_DOUBLE_EQ(l.takeoff_delay_s, 4.0);
+  EXPECT_DOUBLE_EQ(l.motion.max_climb_mps, 1.5);
+  EXPECT_NE(l.summary.find("MPC_TKO_RAMP_T 3 s"), std::string::npos) << l.summary;
+}
+
+TEST(AutopilotParams, AMissingOrZeroDelayIsNoDelayAndNoWarning) {
+  const Autopilot& ap = *autopilot_for(mavlink::autopilot::ARDUPILOTMEGA);
+  FlightLimits l = combine_limits(ap, fleet::Limits{},
+                                  {{"WPNAV_SPEED", 1000}, {"WPNAV_SPEED_UP", 300}, {"WPNAV_SPEED_DN", 200},
+                                   {"LAND_SPEED", 50}, {"MOT_SPOOL_TIME", 0.5f}});
+  EXPECT_DOUBLE_EQ(l.takeoff_delay_s, 0.5);
+  for (const std::string& w : l.warnings) EXPECT_EQ(w.find("SLEW"), std::string::npos) << w;
+}
+
+}  // namespace
+}  // namespace eamos::mavlink_adapter
