@@ -125,11 +125,13 @@ std::vector<nlohmann::json> read_trace(const fs::path& p) {
   return events;
 }
 
-/// Per drone, "event name outcome" in order (trace event `message` is not an action).
+/// Per drone, "event name outcome" of its actions and conditions in order (telemetry,
+/// messages, graph nodes and the header are not the mission's story).
 std::map<std::string, std::vector<std::string>> per_drone(const fs::path& trace) {
   std::map<std::string, std::vector<std::string>> order;
   for (const nlohmann::json& e : read_trace(trace)) {
-    if (e["event"] == "message" || e["event"] == "mission") continue;
+    std::string event = e.value("event", "");
+    if (event != "start" && event != "end" && event != "condition") continue;
     order[e["drone"]].push_back(e["event"].get<std::string>() + " " + e.value("name", "") + " " +
                                 e.value("outcome", ""));
   }

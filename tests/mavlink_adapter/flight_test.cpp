@@ -245,8 +245,8 @@ TEST(MavlinkFlight, ForgedFramesWithTheVehiclesSystemIdFromAnotherPortAreIgnored
 const char* kTestKey = "0f1e2d3c4b5a69788796a5b4c3d2e1f000112233445566778899aabbccddeeff";
 
 TEST(MavlinkFlight, SigningSetupGivesTheVehicleTheKeyAndAnUnsignedGroundStationIsIgnored) {
-  test::VehicleThread vehicle(25372, 1, kSpeed);
-  Flight f(25372, {}, [](fleet::DroneSettings& s) {
+  test::VehicleThread vehicle(25374, 1, kSpeed);
+  Flight f(25374, {}, [](fleet::DroneSettings& s) {
     s.signing_key = kTestKey;
     s.signing_setup = true;
   });
@@ -278,10 +278,10 @@ TEST(MavlinkFlight, SigningSetupGivesTheVehicleTheKeyAndAnUnsignedGroundStationI
 }
 
 TEST(MavlinkFlight, WithAKeyButNoSetupAVehicleThatDoesNotSignNeverConnects) {
-  test::VehicleThread vehicle(25373, 1, kSpeed);  // has no key: its frames are unsigned
+  test::VehicleThread vehicle(25375, 1, kSpeed);  // has no key: its frames are unsigned
   MavlinkOptions options;
   options.connect_timeout_s = 1.0;
-  Flight f(25373, options, [](fleet::DroneSettings& s) { s.signing_key = kTestKey; });
+  Flight f(25375, options, [](fleet::DroneSettings& s) { s.signing_key = kTestKey; });
   EXPECT_EQ(f.created.status, mid::CreateStatus::adapter_failed);
   EXPECT_NE(f.created.message.find("Signing is on for this drone"), std::string::npos) << f.created.message;
 }

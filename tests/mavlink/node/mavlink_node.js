@@ -16,10 +16,11 @@
 
 const fs = require('node:fs')
 const {
-  MavLinkPacketSplitter, MavLinkPacketParser, MavLinkProtocolV2, minimal, common,
+  MavLinkPacketSplitter, MavLinkPacketParser, MavLinkProtocolV2, minimal, common, ardupilotmega,
 } = require('node-mavlink')
 
-const REGISTRY = { ...minimal.REGISTRY, ...common.REGISTRY }
+// ardupilotmega for CAMERA_FEEDBACK (180), which ArduPilot sends for a picture taken.
+const REGISTRY = { ...minimal.REGISTRY, ...common.REGISTRY, ...ardupilotmega.REGISTRY }
 
 function toJson(value) {
   if (typeof value === 'bigint') return value.toString()
