@@ -72,7 +72,7 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   if (!r.monitor.empty()) {
     server = std::make_unique<monitor::MonitorServer>();
     if (!start_monitor(*server, r.monitor, view)) return 1;
-    live_monitor = std::make_unique<monitor::LiveSink>(*server);
+    live_monitor = std::make_unique<monitor::LiveSink>(*server, missions[0].fleet);
     std::cout << "eamos: monitor at " << server->url() << "\n" << std::flush;
   }
   mid::AdapterRegistry adapters;
@@ -107,7 +107,7 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   options.interrupt = &interrupt;
   // Samples cost a copy of every drone's state per tick: only when a trace file or the
   // terminal's status lines (their clock) take them.
-  options.telemetry_hz = jsonl || progress ? r.telemetry_hz : 0.0;
+  options.telemetry_hz = jsonl || progress || live_monitor ? r.telemetry_hz : 0.0;
   if (r.realtime || r.speed > 0) {
     options.clock.mode = mid::ClockMode::real_time;
     options.clock.speed = r.speed > 0 ? r.speed : 1.0;

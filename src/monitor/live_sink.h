@@ -4,6 +4,8 @@
 // a replay of the trace file see the same lines.
 #include <mutex>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "dex/trace_writers.h"
 #include "monitor/server.h"
@@ -12,7 +14,9 @@ namespace eamos::monitor {
 
 class LiveSink : public dex::TraceSink {
  public:
-  explicit LiveSink(MonitorServer& server) : server_(server), writer_(buffer_) {}
+  /// `fleet`: the drones' names by index, which message events name their ends by.
+  explicit LiveSink(MonitorServer& server, std::vector<std::string> fleet = {})
+      : server_(server), writer_(buffer_, std::move(fleet)) {}
   void record(const dex::TraceEvent& e) override;
 
  private:

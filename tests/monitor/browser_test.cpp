@@ -88,7 +88,12 @@ std::string v1_trace(const std::string& real_trace) {
   std::string out = header.dump() + "\n";
   std::ifstream in(real_trace);
   std::string line;
-  while (std::getline(in, line)) out += line + "\n";
+  // The real run's own header, telemetry and messages make way for the hand-written ones,
+  // so that what the page shows can only have come from these.
+  while (std::getline(in, line)) {
+    std::string event = nlohmann::json::parse(line, nullptr, false).value("event", "");
+    if (event != "header" && event != "telemetry" && event != "message") out += line + "\n";
+  }
   for (double t : {0.0, 2.0, 3.0, 5.0})
     out += nlohmann::json({{"t", t}, {"event", "telemetry"}, {"drone", "Drone1"}, {"x", t <= 2 ? 0.0 : -(t - 2) * 2},
                            {"y", 0.0}, {"z", t > 0 ? 4.0 : 0.0}, {"heading", 0}, {"armed", true}, {"landed", false},

@@ -75,8 +75,10 @@ function ingest(e) {
   if (!e || typeof e !== 'object' || typeof e.t !== 'number' || typeof e.event !== 'string') return;
   const t = e.t;
   D.end = Math.max(D.end, t);
-  D.eventTimes.push(t);
-  if (e.drone) addDrone(str(e.drone));
+  // "Next event" steps through the mission's story, not through telemetry samples,
+  // messages or graph-node bookkeeping.
+  if (['start', 'end', 'condition', 'failsafe', 'mission', 'violation'].includes(e.event)) D.eventTimes.push(t);
+  if (e.drone && e.drone !== '*' && e.event !== 'message') addDrone(str(e.drone));
   const key = str(e.drone) + '|' + str(e.name) + '|' + e.line + '|' + (e.node ?? '') + '|' + (e.instance ?? '');
   if (e.event === 'start') {
     const bar = { drone: str(e.drone), name: str(e.name), line: e.line | 0, text: str(e.text), start: t, end: null,
