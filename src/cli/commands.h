@@ -64,6 +64,7 @@ struct VerifyCommandOptions {
   double time_limit = 3600.0;
   bool json = false;       ///< the report as JSON on standard output
   std::string plot;        ///< SVG of the first path with the violations marked; "" = none
+  std::string trace;       ///< JSON Lines trace of that path with its violation events; "" = none
 };
 /// `eamos verify`: exit 0 when no path breaks a rule, 1 otherwise (or on bad input).
 int cmd_verify(const CommonOptions& o, const VerifyCommandOptions& v);

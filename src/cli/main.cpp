@@ -108,6 +108,7 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   verify->add_flag("--json", verify_opts.json, "Print the report as JSON");
   verify->add_option("--plot", verify_opts.plot, "Draw the first path with the violations marked in red as SVG to this file");
+  verify->add_option("--trace", verify_opts.trace, "Write the trace of the path --plot draws, with a violation event per broken rule, as JSON Lines to this file (`eamos monitor` replays it)");
 
   bool distributed = false;
   eamos::launch::LaunchOptions launch_opts;

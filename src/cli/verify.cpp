@@ -1,12 +1,60 @@
 // `eamos verify`: compile, read back every drone's mission file as `eamos run` does, and
 // let src/verify fly every explored path in the simulator and check it.
+#include <fstream>
 #include <iostream>
+
+#include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
 #include "deploy/mission_file.h"
+#include "deploy/synthesize.h"
+#include "dex/trace_writers.h"
 #include "verify/verify.h"
 
 namespace eamos::cli {
+
+namespace {
+
+/// {"t":..,"event":"violation","drone":..,"kind":..,"line":..,"text":..,"drones":[..]}
+std::string violation_line(const verify::PlacedViolation& p) {
+  const verify::Violation& v = p.violation;
+  nlohmann::ordered_json j;
+  j["t"] = v.t;
+  j["event"] = "violation";
+  j["drone"] = v.drones.empty() ? std::string() : v.drones.front();
+  j["kind"] = v.kind;
+  j["line"] = v.at.line;
+  j["col"] = v.at.col;
+  j["text"] = v.at.message;
+  if (v.drones.size() > 1) j["drones"] = std::vector<std::string>(v.drones.begin() + 1, v.drones.end());
+  j["x"] = p.x;
+  j["y"] = p.y;
+  j["z"] = p.z;
+  return j.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
+}
+
+/// The worst path's trace as `eamos run --trace` writes it, each violation merged in at its
+/// instant (before the first later event; the mission's end stays the last line).
+bool write_verify_trace(const std::string& path, const graph::Compilation& c, const std::vector<dex::Mission>& missions,
+                        const verify::VerifyOptions& options, const verify::VerifyReport& report) {
+  std::ofstream out(path, std::ios::trunc);
+  if (!out) {
+    std::cerr << "eamos: error: cannot write trace '" << path << "'\n";
+    return false;
+  }
+  verify::WorstFlight w = verify::fly_worst_path(c, missions, options, report);
+  dex::JsonlTrace jsonl(out, missions[0].fleet);
+  jsonl.write_header(deploy::trace_header(c, missions[0].hash, 0.0));
+  std::size_t next = 0;
+  for (const dex::TraceEvent& e : w.events) {
+    while (next < w.violations.size() && (e.event == "mission" || w.violations[next].violation.t < e.t))
+      out << violation_line(w.violations[next++]);
+    jsonl.record(e);
+  }
+  return static_cast<bool>(out);
+}
+
+}  // namespace
 
 int cmd_verify(const CommonOptions& o, const VerifyCommandOptions& v) {
   graph::Compilation c;
@@ -19,6 +67,7 @@ int cmd_verify(const CommonOptions& o, const VerifyCommandOptions& v) {
   options.time_limit_s = v.time_limit;
   verify::VerifyReport report = verify::verify(c, missions, options);
   if (!v.plot.empty() && !write_output(v.plot, verify::plot_worst_path(c, missions, options, report))) return 1;
+  if (!v.trace.empty() && report.error.empty() && !write_verify_trace(v.trace, c, missions, options, report)) return 1;
   std::cerr.flush();
   std::cout << (v.json ? verify::json_report(c, report) : verify::format_report(c, report));
   std::cout.flush();

@@ -83,6 +83,24 @@ void check_header(const json& j, LineCheck& c, std::set<std::string>& fleet) {
   }
 }
 
+/// `eamos verify --trace`: a rule the path broke, at the action responsible.
+void check_violation(const json& j, LineCheck& c, const std::set<std::string>& fleet) {
+  c.drone("drone", fleet);
+  c.one_of("kind", {"separation", "geofence", "battery", "speed", "climb", "descent", "occupied_home",
+                    "airborne_at_end", "armed_at_end", "never_ends", "action_failed"});
+  c.integer("line", 0);
+  c.optional_integer("col", 0);
+  c.string("text");
+  if (c.has("drones")) {
+    bool ok = j["drones"].is_array();
+    for (std::size_t i = 0; ok && i < j["drones"].size(); ++i)
+      ok = j["drones"][i].is_string() && fleet.count(j["drones"][i].get<std::string>());
+    if (!ok) c.fail("\"drones\" is not a list of drones of the header");
+  }
+  for (const char* f : {"x", "y", "z"})
+    if (c.has(f)) c.number(f);
+}
+
 const std::set<std::string> kOutcomes = {"succeeded", "preempted", "cancelled", "failed"};
 
 void check_event(const json& j, const std::string& event, LineCheck& c, const std::set<std::string>& fleet,
@@ -145,6 +163,8 @@ void check_event(const json& j, const std::string& event, LineCheck& c, const st
   } else if (event == "mission") {
     c.one_of("outcome", {"completed", "failed"});
     if (j.value("outcome", "") == "failed") c.string("reason");
+  } else if (event == "violation") {
+    check_violation(j, c, fleet);
   } else if (event == "error") {
     c.string("name");
   } else if (event == "header") {

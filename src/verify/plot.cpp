@@ -24,25 +24,53 @@ std::string caption(const VerifyReport& report) {
 
 }  // namespace
 
-std::string plot_worst_path(const graph::Compilation& c, const std::vector<dex::Mission>& missions,
-                            const VerifyOptions& options, const VerifyReport& report) {
-  Setup setup{c, missions, options};
+namespace {
+
+/// The worst path's flight, flown again: deterministic, so the same flight verify() checked.
+Flight fly_worst(const Setup& setup, const VerifyReport& report) {
   Assignment forced(report.worst.forced.begin(), report.worst.forced.end());
   std::vector<double> factors = report.worst.factors;
-  if (factors.size() != missions.size()) factors.assign(missions.size(), 1.0);
-  Flight f = fly(setup, forced, factors);  // deterministic: the same flight verify() checked
-  std::vector<dex::PlotMark> marks;
+  if (factors.size() != setup.missions.size()) factors.assign(setup.missions.size(), 1.0);
+  return fly(setup, forced, factors);
+}
+
+/// Each violation of `f` at the position of the first drone it names (its last published one).
+std::vector<PlacedViolation> place_violations(const Setup& setup, const Flight& f) {
+  std::vector<PlacedViolation> out;
   for (const Violation& v : check_flight(setup, f)) {
-    dex::PlotMark m{v.t, 0.0, 0.0, v.kind};
-    // Where the first drone named was at that moment (its last published position).
+    PlacedViolation p{v};
     for (const dex::DroneSummary& d : f.result.drones) {
       if (v.drones.empty() || d.name != v.drones.front()) continue;
       for (const dex::Sample& s : d.track)
-        if (s.t <= v.t) m.x = s.x, m.y = s.y;
+        if (s.t <= v.t) p.x = s.x, p.y = s.y, p.z = s.z;
     }
-    marks.push_back(m);
+    out.push_back(std::move(p));
   }
+  return out;
+}
+
+}  // namespace
+
+std::string plot_worst_path(const graph::Compilation& c, const std::vector<dex::Mission>& missions,
+                            const VerifyOptions& options, const VerifyReport& report) {
+  Setup setup{c, missions, options};
+  Flight f = fly_worst(setup, report);
+  std::vector<dex::PlotMark> marks;
+  for (const PlacedViolation& p : place_violations(setup, f))
+    marks.push_back(dex::PlotMark{p.violation.t, p.x, p.y, p.violation.kind});
   return dex::plot_svg(f.result, f.events, marks, caption(report));
+}
+
+WorstFlight fly_worst_path(const graph::Compilation& c, const std::vector<dex::Mission>& missions,
+                           const VerifyOptions& options, const VerifyReport& report) {
+  Setup setup{c, missions, options};
+  Flight f = fly_worst(setup, report);
+  WorstFlight out;
+  out.violations = place_violations(setup, f);
+  std::stable_sort(out.violations.begin(), out.violations.end(),
+                   [](const PlacedViolation& a, const PlacedViolation& b) { return a.violation.t < b.violation.t; });
+  out.events = std::move(f.events);
+  return out;
 }
 
 }  // namespace eamos::verify

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "dex/mission.h"
+#include "dex/trace.h"
 #include "graph/pipeline.h"
 
 namespace eamos::verify {
@@ -90,5 +91,19 @@ namespace eamos::verify {
 /// condition outcomes and its timing.
 std::string plot_worst_path(const graph::Compilation& c, const std::vector<dex::Mission>& missions,
                             const VerifyOptions& options, const VerifyReport& report);
+
+/// A violation where it happened: the drone's last published position at that moment.
+struct PlacedViolation {
+  Violation violation;
+  double x = 0.0, y = 0.0, z = 0.0;
+};
+
+/// The worst path flown again (the one --plot draws): its trace events and its violations.
+struct WorstFlight {
+  std::vector<dex::TraceEvent> events;
+  std::vector<PlacedViolation> violations;  ///< in time order
+};
+WorstFlight fly_worst_path(const graph::Compilation& c, const std::vector<dex::Mission>& missions,
+                           const VerifyOptions& options, const VerifyReport& report);
 
 }  // namespace eamos::verify

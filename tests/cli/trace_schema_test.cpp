@@ -163,6 +163,19 @@ TEST(TraceCheck, RefusesAnUnknownDroneOutcomeOrEventKind) {
   EXPECT_TRUE(eamos::dex::check_trace(in).empty());
 }
 
+TEST(TraceCheck, AViolationNeedsItsDroneKindLineAndText) {
+  std::string good = R"({"t":1,"event":"violation","drone":"D1","kind":"separation","line":3,"text":"too close","drones":["D1"]})";
+  EXPECT_EQ(joined(errors_of(kHeader + "\n" + good + "\n" + kEnd + "\n")), "");
+  std::string bare = R"({"t":1,"event":"violation","drone":"D1"})";
+  std::string wrong = R"({"t":1,"event":"violation","drone":"D1","kind":"rudeness","line":3,"text":"x","drones":["D9"]})";
+  EXPECT_EQ(joined(errors_of(kHeader + "\n" + bare + "\n" + wrong + "\n" + kEnd + "\n")),
+            "line 2: missing \"kind\", a string\n"
+            "line 2: missing \"line\", an integer of at least 0\n"
+            "line 2: missing \"text\", a string\n"
+            "line 3: \"kind\" is \"rudeness\", not one of the schema's values\n"
+            "line 3: \"drones\" is not a list of drones of the header\n");
+}
+
 TEST(TraceCheck, RefusesBrokenTelemetryAndMessages) {
   std::string telemetry = R"({"t":1,"event":"telemetry","drone":"D1","x":0,"y":"0","z":0,"heading":400,)"
                           R"("armed":true,"landed":false,"battery":90,"mode":"go"})";

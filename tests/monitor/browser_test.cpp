@@ -124,6 +124,27 @@ TEST(MonitorBrowser, ReplayOfASchemaV1TraceUsesItsHeaderTelemetryAndMessages) {
   fs::remove_all(dir);
 }
 
+TEST(MonitorBrowser, ReplayOfAVerifyTraceMarksTheViolationInRedInItsLane) {
+  if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
+  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-verify-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  std::string trace = (dir / "separation.jsonl").string();
+  auto run = eamos_test::run_eamos("verify -q tests/verify/missions/separation.eamos --fleet "
+                                   "tests/verify/missions/separation.fleet.yaml --trace " + trace);
+  ASSERT_EQ(run.status, 1) << run.out;  // the mission breaks the separation rule
+  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0"});
+  ASSERT_GT(monitor.pid, 0);
+  std::string url = read_url(monitor, "replaying");
+  ASSERT_FALSE(url.empty()) << monitor.seen;
+  std::string output;
+  bool passed = run_browser("violation", url, output);
+  int status = -1;
+  stop(monitor, status);
+  EXPECT_TRUE(passed) << output;
+  EXPECT_EQ(status, 0) << monitor.seen;
+  fs::remove_all(dir);
+}
+
 TEST(MonitorBrowser, AThousandDroneReplayDrawsItsLanesOnACanvas) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
   fs::path dir = fs::temp_directory_path() / ("eamos-monitor-scale-" + std::to_string(getpid()));

@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "dex/trace_schema.h"
 #include "support/run_eamos.h"
 
 namespace eamos {
@@ -106,6 +107,36 @@ TEST(VerifyPlot, MarksEachViolationOfTheDrawnPathInRed) {
     ++rings;
   EXPECT_EQ(rings, 3u) << "one ring per violation on the map";
   EXPECT_NE(picture.find("<line data-violation=\"occupied_home\""), std::string::npos);
+}
+
+// The trace of the drawn path carries one violation event per broken rule, at the line the
+// diagnostic names, and still passes the schema (strict: the kind is documented).
+TEST(VerifyTrace, WritesThePathWithAViolationEventAtTheResponsibleLine) {
+  fs::path trace = fs::temp_directory_path() / ("verify_trace_" + std::to_string(::getpid()) + ".jsonl");
+  eamos_test::Output run = eamos_test::run_eamos(
+      "verify separation.eamos --fleet separation.fleet.yaml --trace " + trace.string(), {}, kMissions.string());
+  EXPECT_EQ(run.status, 1) << run.out;
+  std::string text = read_file(trace);
+  fs::remove(trace);
+  std::istringstream in(text);
+  EXPECT_EQ(eamos::dex::check_trace(in, {.strict = true}), std::vector<std::string>{});
+  std::vector<nlohmann::json> violations;
+  bool has_actions = false;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
+    if (j.value("event", "") == "violation") violations.push_back(j);
+    if (j.value("event", "") == "start") has_actions = true;
+  }
+  EXPECT_TRUE(has_actions) << "the flight itself is in the trace";
+  ASSERT_EQ(violations.size(), 1u) << text;
+  EXPECT_EQ(violations[0]["kind"], "separation");
+  EXPECT_EQ(violations[0]["drone"], "Drone1");
+  EXPECT_EQ(violations[0]["line"], 8);
+  EXPECT_EQ(violations[0]["col"], 19);
+  EXPECT_EQ(violations[0]["drones"], nlohmann::json::array({"Drone2"}));
+  EXPECT_DOUBLE_EQ(violations[0]["t"].get<double>(), 3.75);
+  EXPECT_NE(violations[0]["text"].get<std::string>().find("come within 1.88 m"), std::string::npos);
 }
 
 // branch.eamos breaks a rule only when its If is forced the other way (the second path): the

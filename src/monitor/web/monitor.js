@@ -31,7 +31,7 @@ function str(v) { return typeof v === 'string' ? v : ''; }
 function resetDerived() {
   D = {
     drones: [], droneIndex: new Map(), bars: [], openBars: new Map(), conds: [], telemetry: new Map(),
-    messages: [], nodeHistory: new Map(), end: 0, outcome: '', failures: [], eventTimes: [],
+    messages: [], nodeHistory: new Map(), end: 0, outcome: '', failures: [], eventTimes: [], violations: [],
     nodeKey: new Map(), nodes: new Map(), lastIngested: 0,
   };
   const m = S.mission || {};
@@ -108,6 +108,13 @@ function ingest(e) {
   } else if (e.event === 'mission') {
     D.outcome = str(e.outcome);
     if (D.outcome === 'failed') D.failures.push(t);
+  } else if (e.event === 'violation') {
+    // `eamos verify --trace`: a rule the path broke, at the action responsible.
+    const others = Array.isArray(e.drones) ? e.drones.map(str).filter(n => n) : [];
+    D.violations.push({ drone: str(e.drone), kind: str(e.kind), line: e.line | 0, text: str(e.text), t, others,
+                        x: num(e.x, NaN), y: num(e.y, NaN) });
+    D.failures.push(t);
+    S.structureDirty = true;
   } else if (e.event === 'failsafe' || e.event === 'error') {
     D.failures.push(t);
     S.structureDirty = true;
@@ -295,7 +302,26 @@ function buildLanes() {
     c.el = mark;
     d.track.appendChild(mark);
   });
+  buildViolationMarks();
   buildTriggers();
+}
+
+// A red mark per violation in its drone's lane; the diagnostic is its title.
+function buildViolationMarks() {
+  for (const v of D.violations) {
+    const d = D.drones[D.droneIndex.get(v.drone)];
+    if (!d || !d.track) continue;
+    const mark = el('div', 'violation', '!');
+    mark.dataset.drone = v.drone;
+    mark.dataset.kind = v.kind;
+    mark.dataset.line = String(v.line);
+    mark.dataset.t = String(v.t);
+    mark.title = v.kind + ' at ' + v.t.toFixed(2) + ' s (line ' + v.line + '): ' + v.text +
+                 (v.others.length ? ' [with ' + v.others.join(', ') + ']' : '');
+    mark.addEventListener('click', () => select({ nodes: [], line: v.line, drone: v.drone, text: v.text, t: v.t }));
+    v.el = mark;
+    d.track.appendChild(mark);
+  }
 }
 
 // Each bar's row in its lane (the first free one) and its lane's row count.
@@ -374,6 +400,11 @@ function renderLanes() {
     c.el.style.left = px(c.t) + 'px';
     c.el.classList.toggle('future', c.t > now + 1e-9);
   }
+  for (const v of D.violations) {
+    if (!v.el) continue;
+    v.el.style.left = px(v.t) + 'px';
+    v.el.classList.toggle('future', v.t > now + 1e-9);
+  }
   const lanes = $('lanes');
   const svg = $('triggers');
   svg.setAttribute('width', String(lanes.scrollWidth));
@@ -448,6 +479,7 @@ function worldBounds() {
     if (d.geofence && Array.isArray(d.geofence.polygon)) for (const p of d.geofence.polygon) take(num(p[0], 0), num(p[1], 0), 0);
     for (const s of D.telemetry.get(d.name) || []) take(s.x, s.y, s.z);
   }
+  for (const v of D.violations) if (isFinite(v.x) && isFinite(v.y)) take(v.x, v.y, 0);
   if (!isFinite(minX)) { minX = -10; maxX = 10; minY = -10; maxY = 10; }
   const pad = Math.max(2, 0.08 * Math.max(maxX - minX, maxY - minY));
   return { minX: minX - pad, maxX: maxX + pad, minY: minY - pad, maxY: maxY + pad, maxZ: maxZ * 1.15 };
@@ -492,10 +524,22 @@ function renderMap() {
     g.beginPath(); g.arc(X(p.x), Y(p.y), many ? 2 : 5, 0, 2 * Math.PI); g.fill();
     if (!many) { g.fillStyle = '#222'; g.font = '11px sans-serif'; g.fillText(d.name, X(p.x) + 7, Y(p.y) - 6); }
   }
+  drawViolations(g, X, Y, many);
   renderSide(B);
   const hasTelemetry = D.telemetry.size > 0;
   $('map-note').textContent = hasTelemetry ? '' : (D.drones.some(d => d.home) ?
     'this trace has no telemetry: homes only' : 'this trace has no telemetry and names no homes');
+}
+
+// Violations that have happened by now: a red ring where the drone was.
+function drawViolations(g, X, Y, many) {
+  g.strokeStyle = '#d50000'; g.lineWidth = 2;
+  for (const v of D.violations) {
+    if (v.t > S.clock + 1e-9 || !isFinite(v.x) || !isFinite(v.y)) continue;
+    g.beginPath(); g.arc(X(v.x), Y(v.y), 9, 0, 2 * Math.PI); g.stroke();
+    if (!many) { g.fillStyle = '#d50000'; g.font = '11px sans-serif'; g.fillText(v.kind, X(v.x) + 11, Y(v.y) + 14); }
+  }
+  g.lineWidth = 1;
 }
 
 function drawGrid(g, W, H, B, X, Y) {

@@ -139,6 +139,28 @@ async function v1(browser) {
   await page.screenshot({ path: path.join(shots, 'replay-v1-header-t4.png'), fullPage: true });
 }
 
+// `eamos verify --trace` of separation.eamos: one red mark in Drone1's lane at 3.75 s, its
+// diagnostic as the title, and "next failure" stops there.
+async function violation(browser) {
+  const page = await open(browser, '?t=0');
+  await page.waitForSelector('body[data-finished="true"]', { timeout: 15000, polling: 100 });
+  const marks = await page.evaluate(() => [...document.querySelectorAll('.violation')].map(m => ({
+    lane: m.closest('.lane') ? m.closest('.lane').dataset.drone : '', drone: m.dataset.drone, kind: m.dataset.kind,
+    line: Number(m.dataset.line), t: Number(m.dataset.t), title: m.title,
+    colour: getComputedStyle(m).backgroundColor })));
+  check(marks.length === 1, 'one violation mark: ' + JSON.stringify(marks));
+  const m = marks[0] || {};
+  check(m.lane === 'Drone1' && m.drone === 'Drone1', 'the mark is in Drone1\'s lane: ' + m.lane);
+  check(m.kind === 'separation' && m.line === 8 && Math.abs(m.t - 3.75) < 1e-9, 'separation at line 8, 3.75 s');
+  check((m.title || '').includes('come within 1.88 m') && (m.title || '').includes('Drone2'),
+        'its title is the diagnostic: ' + m.title);
+  check(m.colour === 'rgb(213, 0, 0)', 'the mark is red: ' + m.colour);
+  await page.click('#next-failure');
+  const clock = await page.evaluate(() => Number(document.getElementById('clock').dataset.t));
+  check(Math.abs(clock - 3.75) < 1e-6, '"next failure" stops at the violation: ' + clock);
+  await page.screenshot({ path: path.join(shots, 'replay-verify-separation.png'), fullPage: true });
+}
+
 // 1,000 drones: lanes on a canvas, no element per bar, and a change of the clock redrawn fast.
 async function scale(browser) {
   const page = await open(browser, '?t=0');
@@ -198,6 +220,7 @@ async function live(browser) {
     else if (mode === 'live') await live(browser);
     else if (mode === 'v1') await v1(browser);
     else if (mode === 'scale') await scale(browser);
+    else if (mode === 'violation') await violation(browser);
     else failures.push('unknown mode ' + mode);
   } finally {
     await browser.close();
