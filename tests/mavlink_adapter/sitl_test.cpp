@@ -15,6 +15,7 @@
 #include <set>
 
 #include "mavlink/enums.h"
+#include "mavlink/payloads.h"
 
 #include <nlohmann/json.hpp>
 
@@ -251,30 +252,43 @@ TEST_P(Sitl, ThreeDronesFlyWithOneDexPerDrone) {
   for (int d = 1; d <= 3; ++d) EXPECT_EQ(f.actions["Drone" + std::to_string(d)], three_hops_of(d)) << f.run.out;
 }
 
-// Stock SITL has no camera: Listing 2's first TakePicture is refused by the autopilot
-// (ArduPilot MAV_RESULT_FAILED; PX4 has no camera_trigger running), its answer reaches the summary,
-// and the drones in the air run their failsafe (Drone3 still waits on the ground).
+// An action the autopilot itself refuses, for a reason only it knows: its answer and its own
+// words reach the summary as a refusal, and the drones already armed or in the air run their
+// failsafe. ArduPilot: stock SITL has no camera, so Listing 2's first TakePicture gets
+// MAV_RESULT_FAILED. PX4 takes camera commands without answering when no camera_trigger runs
+// (that would be a timeout, not a refusal), so there Drone2 is set up as a user might leave
+// it, with COM_ARM_MIS_REQ 1 ("require a valid mission to arm") and no mission uploaded: its
+// Arm is refused by PX4's arming checks.
 TEST_P(Sitl, ARefusedActionFailsTheMissionWithTheAutopilotsAnswerInTheSummary) {
   auto sitl = start_fleet(kHomes);
   if (HasFailure()) return;
+  const bool px4 = GetParam() == Autopilot::px4;
+  if (px4) {
+    std::string error;
+    ASSERT_TRUE(sitl->set_param(1, "COM_ARM_MIS_REQ", 1, eamos::mavlink::param_type::INT32, 30, error)) << error;
+  }
   Flight f = fly(listing2(), fleet_file(*sitl, kHomes, {{0, "Sensor1: 120"}}), dir_,
                  {.extra = "--summary " + (dir_ / "summary.json").string()});
   EXPECT_NE(f.run.status, 0) << f.run.out;
   std::ifstream in(dir_ / "summary.json");
   std::string summary((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  EXPECT_NE(summary.find("Drone2.TakePicture"), std::string::npos) << summary;
-  if (GetParam() == Autopilot::ardupilot) {
+  EXPECT_NE(summary.find("\"kind\": \"refused\""), std::string::npos) << summary;
+  if (!px4) {
+    EXPECT_NE(summary.find("Drone2.TakePicture"), std::string::npos) << summary;
     EXPECT_NE(summary.find("MAV_CMD_IMAGE_START_CAPTURE: MAV_RESULT_FAILED"), std::string::npos) << summary;
-    EXPECT_NE(summary.find("\"kind\": \"refused\""), std::string::npos) << summary;
-  } else {
-    // PX4 without camera_trigger (TRIG_MODE 0) gives no answer of its own: nobody takes
-    // DO_DIGICAM_CONTROL, so the picture times out, either waiting for the camera
-    // ("no picture: MAV_CMD_DO_DIGICAM_CONTROL accepted but no camera confirmed…") or at the
-    // action's deadline, whichever comes first on a loaded machine.
-    EXPECT_NE(summary.find("\"kind\": \"timed_out\""), std::string::npos) << summary;
+    std::set<std::string> failsafes(f.failsafes.begin(), f.failsafes.end());
+    EXPECT_TRUE(failsafes.contains("Drone1") && failsafes.contains("Drone2")) << f.run.out;
+    return;
   }
+  EXPECT_NE(summary.find("Drone2.Arm"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("refused by PX4"), std::string::npos) << summary;
+  // PX4's own words, sent as STATUSTEXT beside its COMMAND_ACK.
+  EXPECT_NE(summary.find("MAV_CMD_COMPONENT_ARM_DISARM: MAV_RESULT_TEMPORARILY_REJECTED"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("PX4 says: Arming denied"), std::string::npos) << summary;
+  EXPECT_EQ(f.actions["Drone2"].size(), 1u) << f.run.out;
+  // Drone1 and Drone3 had armed: they run their failsafe.
   std::set<std::string> failsafes(f.failsafes.begin(), f.failsafes.end());
-  EXPECT_TRUE(failsafes.contains("Drone1") && failsafes.contains("Drone2")) << f.run.out;
+  EXPECT_TRUE(failsafes.contains("Drone1") && failsafes.contains("Drone3")) << f.run.out;
 }
 
 // The test stops Drone2's autopilot in flight: its link is lost, the mission fails saying

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -105,6 +106,15 @@ bool SitlFleet::start(std::string& error) {
   std::string bin = binary(options_.autopilot);
   if (bin.empty()) {
     error = skip_message(options_.autopilot);
+    return false;
+  }
+  // PX4's rc.mavlink sends its offboard link to 14540 + n only up to instance 9 (above, every
+  // instance sends to 14549), so eamos could not tell the instances apart.
+  int last = first_instance_ + static_cast<int>(options_.homes.size()) - 1;
+  if (options_.autopilot == Autopilot::px4 && last > 9) {
+    error = "PX4 SITL instances above 9 all send to UDP 14549: use EAMOS_SITL_FIRST_INSTANCE <= " +
+            std::to_string(10 - static_cast<int>(options_.homes.size())) + " for " +
+            std::to_string(options_.homes.size()) + " instances";
     return false;
   }
   for (int i = 0; i < static_cast<int>(options_.homes.size()); ++i)
@@ -411,6 +421,54 @@ bool SitlFleet::set_up_ardupilot_camera(int i, double deadline, std::string& err
   link.reset();
   if (!ok)
     error = "SITL instance " + std::to_string(i) + ": camera set-up did not finish: " + step + "\n" + log_tail(i);
+  return ok;
+}
+
+// PX4 puts an integer parameter's bits in PARAM_VALUE's float (the MAVLink "bytewise"
+// encoding); ArduPilot sends the number as a float.
+static float wire_param(Autopilot autopilot, float value, uint8_t type) {
+  if (autopilot != Autopilot::px4 || type == ml::param_type::REAL32) return value;
+  int32_t as_int = static_cast<int32_t>(value);
+  float wire = 0;
+  std::memcpy(&wire, &as_int, sizeof wire);
+  return wire;
+}
+
+bool SitlFleet::set_param(int i, const std::string& name, float value, uint8_t type, double timeout_s,
+                          std::string& error) {
+  CameraSetup cs;
+  const uint8_t vehicle = static_cast<uint8_t>(sysid(i));
+  ml::OpenResult opened = ml::Link::open(
+      *ml::parse_url(connection(i)).endpoint,
+      [&cs, vehicle](ml::Frame f) {
+        if (f.sysid != vehicle || f.compid != 1) return;
+        auto p = ml::unpack_param_value(f.message);
+        if (!p) return;
+        std::lock_guard lock(cs.mutex);
+        cs.params[p->param_id] = p->param_value;
+        cs.changed.notify_all();
+      },
+      0.2);
+  if (!opened.link) {
+    error = "cannot set " + name + " on SITL instance " + std::to_string(i) + ": " + opened.error;
+    return false;
+  }
+  const float wire = wire_param(options_.autopilot, value, type);
+  ml::Encoder encoder{250, 190, 0};
+  auto send_set = [&] {
+    ml::Heartbeat hb;
+    hb.type = 6;       // MAV_TYPE_GCS
+    hb.autopilot = 8;  // MAV_AUTOPILOT_INVALID
+    opened.link->send(encoder.encode(ml::pack(hb)));
+    opened.link->send(encoder.encode(ml::pack(ml::ParamSet{vehicle, 1, name, wire, type})));
+  };
+  auto echoed = [&] {
+    auto it = cs.params.find(name);
+    return it != cs.params.end() && std::memcmp(&it->second, &wire, sizeof wire) == 0;
+  };
+  bool ok = wait_for(cs, now_s() + timeout_s, send_set, echoed);
+  opened.link.reset();
+  if (!ok) error = "SITL instance " + std::to_string(i) + ": no PARAM_VALUE " + name + " = " + fixed(value, 2) + "\n" + log_tail(i);
   return ok;
 }
 

@@ -28,7 +28,8 @@ struct SitlOptions {
   /// The autopilot's instance number of instance 0: it picks the ports (ArduPilot TCP
   /// 5760 + 10 n, PX4 UDP 14540 + n), so two fleets on one machine do not meet. Unset, it is
   /// EAMOS_SITL_FIRST_INSTANCE or 0. PX4 instance n also listens on UDP 14580 + n and
-  /// 18570 + n: fleets 40 apart collide (one's 14540 + n is the other's 14580 + n).
+  /// 18570 + n: fleets 40 apart collide (one's 14540 + n is the other's 14580 + n). PX4
+  /// instances must be 0..9: above, PX4 sends every offboard link to 14549 (start() refuses).
   int first_instance = -1;
   /// A camera configured the way a user sets one up for pictures: ArduPilot CAM1_TYPE 1
   /// (servo-triggered; set with PARAM_SET and a reboot in wait_ready(), as its camera
@@ -54,6 +55,10 @@ class SitlFleet {
   /// Waits (wall time, bounded) until every instance passes its pre-arm checks and reports a
   /// position: the state in which a pilot would arm. False with the instances not ready.
   bool wait_ready(double timeout_s, std::string& error);
+  /// Sets one parameter of a ready instance the way a ground station does (PARAM_SET until
+  /// the PARAM_VALUE echo carries the value; PX4's integers travel bytewise in the float).
+  /// Call it before eamos opens the instance's port. False with `error` set on timeout.
+  bool set_param(int i, const std::string& name, float value, uint8_t type, double timeout_s, std::string& error);
   /// Kills one instance at once (a vehicle whose link is lost mid-flight).
   void kill_instance(int i);
   /// SIGTERM, then SIGKILL after a grace period, for every instance still running.
