@@ -35,8 +35,9 @@ struct LaunchOptions {
   /// Mission seconds: a trigger or cancel received later than this after it was sent is a
   /// warning on the console and in the summary.
   double latency_warn_s = dex::kDefaultLatencyWarnS;
-  /// Mission seconds: a trigger or cancel later than this fails the mission (the DEX that
-  /// receives it abandons into the failsafe); passed to every DEX started here. 0 = no bound.
+  /// Mission seconds: a trigger or cancel later than this fails the mission: passed to every
+  /// DEX started here (the receiving DEX abandons into the failsafe); for a DEX started
+  /// elsewhere the ground writes the ABORT when it hears of the message. 0 = no bound.
   double max_trigger_latency_s = 0.0;
 };
 

@@ -1,7 +1,7 @@
 // How late each message between drones arrived (issue 13, item 4): every trigger's latency
 // is in the merged trace, the ground warns for each one later than --trigger-latency-warn
 // and reports the maximum and p99 in its summary, and --max-trigger-latency makes such a
-// message a fault. Real `eamos launch` processes on loopback, DDS domains 190-191. A late
+// message a fault. Real `eamos launch` processes on loopback, DDS domains 190-192. A late
 // message is made by something real: the receiving DEX frozen (SIGSTOP) while the trigger
 // to it is sent, and resumed when another drone's flight (the event, not a timer) is over.
 #include <gtest/gtest.h>
@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "dex/trace_schema.h"
+#include "support/eamos_process.h"
 #include "support/run_eamos.h"
 
 namespace {
@@ -68,7 +69,8 @@ class Latency : public ::testing::Test {
   /// `eamos launch` of hops.eamos with `extra` arguments; B's DEX is frozen from C's takeoff
   /// (so C's trigger to B, sent when C is up, waits in B's socket) until A has flown out on
   /// the same trigger (several mission seconds).
-  Output launch_with_b_frozen(const std::string& extra) {
+  /// `b_elsewhere`: B's DEX, started by the test (the ground starts the others), or -1.
+  Output launch_with_b_frozen(const std::string& extra, pid_t b_elsewhere = -1) {
     pid_t b = -1;
     bool resumed = false;
     std::string seen;
@@ -78,7 +80,7 @@ class Latency : public ::testing::Test {
         [&](const std::string& line) {
           seen += line;
           if (b < 0 && line.find(" start ") != std::string::npos && line.find("C.Takeoff(5)") != std::string::npos) {
-            b = dex_pid(seen, "B");
+            b = b_elsewhere > 0 ? b_elsewhere : dex_pid(seen, "B");
             if (b > 0) kill(b, SIGSTOP);
           }
           if (b > 0 && !resumed && line.find("A.FlyTo(10, 0, 5)  succeeded") != std::string::npos) {
@@ -149,6 +151,26 @@ TEST_F(Latency, TriggerLaterThanTheMaximumFailsTheMissionIntoEveryDronesFailsafe
   EXPECT_EQ(failsafes, (std::map<std::string, int>{{"A", 1}, {"B", 1}, {"C", 1}})) << r.out;
   for (const char* d : {"A", "B", "C"}) EXPECT_TRUE(s["drones"][d]["landed"]) << d << "\n" << s.dump(2);
   EXPECT_EQ(check_errors(dir_ / "trace.jsonl"), "");
+}
+
+// B's DEX started elsewhere (here: by the test) without the bound: the ground holds it for
+// B and aborts the run when it hears of the late trigger.
+TEST_F(Latency, TriggerLateToADexStartedElsewhereFailsTheMissionOnTheGroundsBound) {
+  eamos_test::EamosProcess b = eamos_test::start_eamos(
+      {"dex", (dir_ / "deploy" / "B").string(), "--speed", "10", "--liveliness-timeout", "3", "--domain", "192",
+       "--start-timeout", "60"});
+  ASSERT_GT(b.pid, 0);
+  Output r = launch_with_b_frozen("--domain 192 --drones A,C --max-trigger-latency 0.5", b.pid);
+  eamos_test::Exit b_exit = eamos_test::wait_exit(b);
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_EQ(b_exit.status, 1) << b.seen;
+  std::string error = summary().value("error", "");
+  EXPECT_NE(error.find("trigger from C to B (node "), std::string::npos) << error;
+  EXPECT_NE(error.find("(held by the ground: B's DEX was started elsewhere)"), std::string::npos) << error;
+  std::map<std::string, int> failsafes;
+  for (const nlohmann::json& e : read_trace(dir_ / "trace.jsonl"))
+    if (e["event"] == "failsafe") ++failsafes[e["drone"].get<std::string>()];
+  EXPECT_EQ(failsafes, (std::map<std::string, int>{{"A", 1}, {"B", 1}, {"C", 1}})) << r.out << b.seen;
 }
 
 }  // namespace

@@ -1,8 +1,8 @@
 // MAVLink 2 signing against real ArduCopter firmware (issue 13, item 3): `eamos run` gives
 // the SITL vehicle its key (SETUP_SIGNING) and flies a short mission signed; then a ground
-// station of the test on another of the vehicle's ports sends commands unsigned and signed
-// with a wrong key, and the vehicle ignores them: no COMMAND_ACK, no change of mode or arming
-// state. The same command signed with the right key is obeyed, so the probe's frames do reach
+// station of the test on another of the vehicle's ports sends commands unsigned, signed
+// with a wrong key and replayed, and the vehicle ignores them: no COMMAND_ACK, no change of
+// mode or arming state. The same command signed with the right key is obeyed, so the probe's frames do reach
 // the vehicle. ArduPilot accepts unsigned frames on its first serial port (SERIAL0, TCP 5760 +
 // 10 n: "assumed to be a secure channel, USB") whatever the key; every other port (SERIAL1,
 // 5762, which eamos uses here, and SERIAL2, 5763, the probe's) enforces it. Skipped without
@@ -41,7 +41,7 @@ const char* kKey = "5a17c0ffee0ddba11deadbeef0123456789abcdef0123456789abcdef0fe
 const char* kWrongKey = "00112233445566778899aabbccddeeff00112233445566778899aabbccddeeff";
 
 // ArduCopter's flight modes (custom_mode, DO_SET_MODE param2).
-constexpr uint32_t kGuided = 4, kLand = 9;
+constexpr uint32_t kStabilize = 0, kGuided = 4, kLand = 9;
 
 /// A ground station of the test on one of the vehicle's ports: it reads the vehicle's signed
 /// frames with the right key and sends whatever the test gives it.
@@ -56,7 +56,13 @@ class Probe {
   }
   bool open() const { return link_ != nullptr; }
   const std::string& error() const { return error_; }
-  void send(ml::Encoder& encoder, const ml::Message& m) { link_->send(encoder.encode(m)); }
+  /// Sends `m` through `encoder`; returns the bytes sent (to replay them).
+  std::vector<uint8_t> send(ml::Encoder& encoder, const ml::Message& m) {
+    std::vector<uint8_t> bytes = encoder.encode(m);
+    link_->send(bytes);
+    return bytes;
+  }
+  void send_bytes(const std::vector<uint8_t>& bytes) { link_->send(bytes); }
   /// Waits (wall time, bounded) until `done` holds over what the vehicle sent; false on timeout.
   bool wait(const std::function<bool()>& done, double timeout_s = 30) {
     std::unique_lock lock(mutex_);
@@ -101,13 +107,14 @@ ml::Encoder signed_encoder(const char* key_hex, uint8_t link_id) {
   return e;
 }
 
-bool acked(const std::vector<ml::CommandAck>& acks, uint16_t id) {
-  for (const auto& a : acks)
-    if (a.command == id) return true;
-  return false;
+int acks_of(const std::vector<ml::CommandAck>& acks, uint16_t id) {
+  int n = 0;
+  for (const auto& a : acks) n += a.command == id;
+  return n;
 }
+bool acked(const std::vector<ml::CommandAck>& acks, uint16_t id) { return acks_of(acks, id) > 0; }
 
-TEST(SitlSigning, ArduCopterWithTheKeyFliesSignedAndIgnoresUnsignedAndWronglySignedCommands) {
+TEST(SitlSigning, ArduCopterWithTheKeyFliesSignedAndIgnoresUnsignedWronglySignedAndReplayedCommands) {
   if (SitlFleet::binary(Autopilot::ardupilot).empty()) GTEST_SKIP() << SitlFleet::skip_message(Autopilot::ardupilot);
   fs::path dir = fs::temp_directory_path() / ("eamos-sitl-signing-" + std::to_string(getpid()));
   fs::create_directories(dir);
@@ -152,9 +159,22 @@ TEST(SitlSigning, ArduCopterWithTheKeyFliesSignedAndIgnoresUnsignedAndWronglySig
   EXPECT_EQ(probe.heartbeat->base_mode & ml::mode_flag::SAFETY_ARMED, 0);
 
   // The same mode switch signed with the right key is obeyed: refusing was the key's doing.
-  probe.send(right, ml::pack(command(vehicle, ml::cmd::DO_SET_MODE, {1, kGuided, 0, 0, 0, 0, 0})));
+  std::vector<uint8_t> to_guided =
+      probe.send(right, ml::pack(command(vehicle, ml::cmd::DO_SET_MODE, {1, kGuided, 0, 0, 0, 0, 0})));
   ASSERT_TRUE(probe.wait([&] { return acked(probe.acks, ml::cmd::DO_SET_MODE); }));
   ASSERT_TRUE(probe.wait([&] { return probe.heartbeat->custom_mode == kGuided; }));
+
+  // A replay: back to STABILIZE, then that correctly signed GUIDED frame again, byte for byte
+  // (its timestamp is no longer newer than its stream's last), then a fresh marker.
+  probe.send(right, ml::pack(command(vehicle, ml::cmd::DO_SET_MODE, {1, kStabilize, 0, 0, 0, 0, 0})));
+  ASSERT_TRUE(probe.wait([&] { return probe.heartbeat->custom_mode == kStabilize; }));
+  probe.send_bytes(to_guided);
+  probe.send(right, ml::pack(command(vehicle, ml::cmd::SET_MESSAGE_INTERVAL, {0, 1000000, 0, 0, 0, 0, 0})));
+  ASSERT_TRUE(probe.wait([&] { return acks_of(probe.acks, ml::cmd::SET_MESSAGE_INTERVAL) == 2; }));
+  EXPECT_EQ(acks_of(probe.acks, ml::cmd::DO_SET_MODE), 2) << "the replayed DO_SET_MODE was answered";
+  seen = probe.heartbeats;
+  ASSERT_TRUE(probe.wait([&] { return probe.heartbeats > seen; }));
+  EXPECT_EQ(probe.heartbeat->custom_mode, kStabilize) << "the replayed DO_SET_MODE was obeyed";
   std::error_code ec;
   fs::remove_all(dir, ec);
 }
