@@ -53,6 +53,17 @@ void add_security(CLI::App* cmd, eamos::cli::SecurityOptions& s) {
                 "No DDS Security: anyone on the network can command the drones (experiments only)");
 }
 
+void add_latency(CLI::App* cmd, eamos::launch::LaunchOptions& l, const std::string& prefix) {
+  cmd->add_option("--trigger-latency-warn", l.latency_warn_s,
+                  prefix + "Warn for each trigger or cancel between drones received more than this many mission "
+                           "seconds after it was sent")
+      ->default_val(eamos::dex::kDefaultLatencyWarnS)->check(CLI::PositiveNumber);
+  cmd->add_option("--max-trigger-latency", l.max_trigger_latency_s,
+                  prefix + "Fail the mission (every drone's failsafe) when a trigger or cancel between drones is "
+                           "received more than this many mission seconds after it was sent (default: no bound)")
+      ->check(CLI::PositiveNumber);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -121,6 +132,7 @@ int main(int argc, char** argv) {
                   "With --distributed: seconds to wait for a lost drone to report its final state (then: unknown)")
       ->check(CLI::NonNegativeNumber);
   add_dds(run, launch_opts.dds);
+  add_latency(run, launch_opts, "With --distributed: ");
   add_security(run, security);
 
   auto* launch = app.add_subcommand("launch", "Run a deployment folder as one DEX process per drone over Cyclone DDS, with a ground process that starts them together and collects their traces");
@@ -143,6 +155,7 @@ int main(int argc, char** argv) {
                      "Seconds to wait for a lost drone to come back and report its final state (then: unknown)")
       ->check(CLI::NonNegativeNumber);
   add_dds(launch, launch_opts.dds);
+  add_latency(launch, launch_opts, "");
   launch->add_flag("--insecure", launch_opts.insecure,
                    "Fly without DDS Security, even when the deployment has credentials (experiments only)");
 
@@ -160,6 +173,10 @@ int main(int argc, char** argv) {
   dexcmd->add_option("--launch-id", dex_opts.launch_id,
                      "Take a start only from the `eamos launch` with this id (set by the launch that starts the DEX)");
   add_dds(dexcmd, dex_opts.dds);
+  dexcmd->add_option("--max-trigger-latency", dex_opts.max_trigger_latency_s,
+                     "Fail the mission (failsafe, ABORT to every drone) when a trigger or cancel reaches this drone "
+                     "more than this many mission seconds after it was sent (default: no bound)")
+      ->check(CLI::PositiveNumber);
   dexcmd->add_flag("--insecure", dex_opts.insecure,
                    "Fly without DDS Security, even when the folder has credentials (experiments only)");
 

@@ -1,5 +1,7 @@
 // `eamos run`: compile, load every drone's mission file into a DEX, fly them together in
 // the built-in simulator (in-process transport), report like a ground station would.
+#include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iostream>
 
@@ -22,6 +24,19 @@
 namespace eamos::cli {
 
 namespace {
+
+/// The triggers and cancels between drones: how many, how late (mission seconds), and each
+/// one later than the warning bound.
+nlohmann::ordered_json latency_json(const dex::MessageLatency& m) {
+  // Microseconds, as in the trace.
+  auto us = [](double s) { return std::round(s * 1e6) / 1e6; };
+  nlohmann::ordered_json late = nlohmann::ordered_json::array();
+  for (const dex::LateMessage& l : m.late)
+    late.push_back({{"kind", l.kind}, {"from", l.from}, {"to", l.to}, {"node", l.node}, {"sent", us(l.sent)},
+                    {"latency", us(l.latency)}});
+  return {{"count", m.count}, {"latency_max", us(m.max_s)}, {"latency_p99", us(m.p99_s)}, {"warn_above", m.warn_s},
+          {"late", late}};
+}
 
 nlohmann::ordered_json summary_json(const dex::RunResult& r) {
   nlohmann::ordered_json j;
@@ -46,7 +61,18 @@ nlohmann::ordered_json summary_json(const dex::RunResult& r) {
       drones[d.name] = {{"state", "unknown"}, {"last_seen", state}};
   }
   j["drones"] = drones;
+  if (r.latency) j["messages"] = latency_json(*r.latency);
   return j;
+}
+
+void print_latency(const dex::MessageLatency& m) {
+  if (m.count == 0) return;
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "message latency: max %.3f s, p99 %.3f s over %zu triggers and cancels (mission time); %zu later "
+                "than %g s\n",
+                m.max_s, m.p99_s, m.count, m.late.size(), m.warn_s);
+  (m.late.empty() ? std::cout : std::cerr) << text;
 }
 
 }  // namespace
@@ -129,6 +155,7 @@ void hold_monitor(monitor::MonitorServer& server, MonitorHold& hold) {
 bool report_run(const RunCommandOptions& r, const dex::RunResult& result, const std::vector<dex::TraceEvent>& events) {
   if (!r.summary.empty() && !write_output(r.summary, summary_json(result).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n")) return false;
   if (!r.plot.empty() && !write_output(r.plot, dex::plot_svg(result, events))) return false;
+  if (result.latency) print_latency(*result.latency);
   if (result.completed)
     std::cout << "mission completed in " << result.duration << " s (mission time)\n";
   else

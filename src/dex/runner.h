@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "dex/engine.h"
+#include "dex/latency.h"
 #include "dex/mission.h"
 #include "dex/observer.h"
 #include "mid/adapter_registry.h"
@@ -86,6 +87,8 @@ struct RunResult {
   std::string error;                  ///< human summary of the failure
   std::vector<DroneSummary> drones;
   std::uint64_t activations = 0;      ///< node activations over all drones
+  /// Distributed runs: how late the messages between drones were (in process they take no time).
+  std::optional<MessageLatency> latency;
 };
 
 /// The event a trace ends with: `mission`, outcome `completed` or `failed` (reason: the

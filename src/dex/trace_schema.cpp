@@ -54,6 +54,16 @@ class LineCheck {
   int line_;
 };
 
+/// `latency` (added field, optional for traces written before it): received - sent, each
+/// rounded to the microsecond, so the difference may be off by one microsecond each way.
+void check_latency(const json& j, LineCheck& c) {
+  if (!c.has("latency") || !c.number("latency")) return;
+  double latency = j["latency"].get<double>();
+  double expected = j["received"].get<double>() - j["sent"].get<double>();
+  if (latency < 0) c.fail("\"latency\" is negative");
+  else if (std::abs(latency - expected) > 2.5e-6) c.fail("\"latency\" is not \"received\" - \"sent\"");
+}
+
 void check_header(const json& j, LineCheck& c, std::set<std::string>& fleet) {
   if (c.string("schema") && j["schema"] != "eamos-trace") c.fail("\"schema\" is not \"eamos-trace\"");
   if (c.integer("version", 1) && j["version"] != 1) c.fail("\"version\" " + j["version"].dump() + " is not 1, the version this eamos reads");
@@ -159,6 +169,7 @@ void check_event(const json& j, const std::string& event, LineCheck& c, const st
     if (c.number("sent") && c.number("received")) {
       if (j["received"] != j["t"]) c.fail("\"received\" is not the event's \"t\"");
       if (j["received"].get<double>() < j["sent"].get<double>()) c.fail("received before it was sent");
+      check_latency(j, c);
     }
   } else if (event == "mission") {
     c.one_of("outcome", {"completed", "failed"});

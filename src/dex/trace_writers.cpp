@@ -56,6 +56,7 @@ void JsonlTrace::record(const TraceEvent& e) {
     if (e.instance >= 0) j["instance"] = e.instance;
     j["sent"] = rounded(e.sent);
     j["received"] = rounded(e.t);
+    j["latency"] = rounded(e.t - e.sent);
     if (!e.reason.empty()) j["reason"] = e.reason;
   } else {
     j["drone"] = e.drone;

@@ -31,6 +31,9 @@ struct DexProcessOptions {
   bool log = true;                ///< live log on `out`
   /// Without DDS Security even when the folder holds credentials (docs/security.md).
   bool insecure = false;
+  /// Mission seconds: a trigger or cancel received later than this after it was sent fails
+  /// the mission (this drone's failsafe, ABORT naming the message). 0 = no bound.
+  double max_trigger_latency_s = 0.0;
 };
 
 /// Runs the process; returns its exit status: 0 when the mission completed, 1 otherwise

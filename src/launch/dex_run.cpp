@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "dex/latency.h"
 #include "dex/runner.h"
 #include "launch/dex_state.h"
 
@@ -58,10 +59,24 @@ void DexProcess::on_trigger(const TriggerSample& s) {
   // Σsent ≠ Σreceived and the mission waiting for ever.
   if (s.message.kind == dex::Message::Kind::ended) ++received_;
   if (phase_ == Phase::running) {
-    tee_.record(dex::message_event(mission_, s.message, mission_.self, loop_->now()));
+    dex::TraceEvent event = dex::message_event(mission_, s.message, mission_.self, loop_->now());
+    if (too_late(event)) return;
+    tee_.record(event);
     engine_->receive(s.message);
   }
   publish_status();
+}
+
+bool DexProcess::too_late(const dex::TraceEvent& event) {
+  double bound = o_.max_trigger_latency_s;
+  if (bound <= 0 || dex::latency_of(event) <= bound) return false;
+  // A late trigger means the drones no longer act together as planned (one waited, or
+  // the mission's timing moved): the bound makes that a fault, not a course to follow.
+  char limit[48];
+  std::snprintf(limit, sizeof limit, ", later than --max-trigger-latency %g s", bound);
+  abandon(dex::describe_late(dex::late_message(event, mission_.fleet)) + limit, std::nullopt, true);
+  tee_.record(event);  // recorded after the failsafe it caused, and never acted on
+  return true;
 }
 
 void DexProcess::seed_telemetry(const TelemetrySample& s) {

@@ -87,6 +87,9 @@ class DexProcess {
   // --- the mission (loop thread) ---
   bool begin();
   void on_trigger(const TriggerSample& s);
+  /// True when `event` (a trigger or cancel that arrived) came later than
+  /// --max-trigger-latency: the mission is then abandoned and the message not obeyed.
+  bool too_late(const dex::TraceEvent& event);
   void on_telemetry(const TelemetrySample& s);
   void seed_telemetry(const TelemetrySample& s);
   void on_lifecycle(const LifecycleSample& s);

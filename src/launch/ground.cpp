@@ -145,6 +145,10 @@ class Ground {
   void refuse_second_launch(const StatusSample& s);
   void on_status(const StatusSample& s);
   void on_trace(TraceSample s);
+  /// Says on the console that message event `e` came later than --trigger-latency-warn.
+  void warn_late(const dex::TraceEvent& e);
+  /// ABORT when `e` (a message to a DEX started elsewhere) came later than --max-trigger-latency.
+  void check_latency_bound(const dex::TraceEvent& e);
   void on_telemetry(const TelemetrySample& s);
   bool ours(const std::string& hash);
   /// The run's mission time now, from the start instant the ground chose (0 before it).
@@ -269,6 +273,7 @@ int Ground::run() {
     run.duration = finished_->t;
   }
   if (!error_.empty()) run.error = error_;
+  run.latency = dex::message_latency(r_.events, r_.fleet, o_.latency_warn_s);
   // The merged trace ends like an in-process one: how and when the mission ended.
   dex::TraceEvent end = dex::mission_end_event(run);
   if (live_) live_->record(end);
@@ -316,6 +321,10 @@ bool Ground::start_processes() {
     std::snprintf(number, sizeof number, "%.17g", o_.barrier_timeout_s + 5.0);
     argv.insert(argv.end(), {"--start-timeout", number});
     if (o_.insecure) argv.push_back("--insecure");
+    if (o_.max_trigger_latency_s > 0) {
+      std::snprintf(number, sizeof number, "%.17g", o_.max_trigger_latency_s);
+      argv.insert(argv.end(), {"--max-trigger-latency", number});
+    }
     argv.insert(argv.end(), {"--launch-id", std::to_string(launch_id_)});
     d.log = d.folder + "/dex.log";
     std::remove(d.log.c_str());
@@ -583,11 +592,41 @@ void Ground::on_trace(TraceSample s) {
   if (!ours(s.mission_hash) || s.run_id != r_.run_id || s.drone < 0 || s.drone >= static_cast<int>(drones_.size()))
     return;
   s.event.drone = drones_[s.drone].name;
+  if (dex::is_drone_message(s.event) && dex::latency_of(s.event) > o_.latency_warn_s)
+    warn_late(s.event);
+  if (dex::is_drone_message(s.event)) check_latency_bound(s.event);
   if (live_) {
     live_->record(s.event);
     out_ << std::flush;  // a live log: whoever watches it (a person, a test) sees each event now
   }
   r_.events.push_back(std::move(s.event));
+}
+
+void Ground::warn_late(const dex::TraceEvent& e) {
+  char bound[32];
+  std::snprintf(bound, sizeof bound, "%g", o_.latency_warn_s);
+  err_ << "ground: warning: " << dex::describe_late(dex::late_message(e, r_.fleet))
+       << ", later than --trigger-latency-warn " << bound << " s\n";
+}
+
+void Ground::check_latency_bound(const dex::TraceEvent& e) {
+  // A DEX started here has the bound itself and abandons first; one started elsewhere may
+  // have been started without it, so the ground holds it for that drone.
+  double bound = o_.max_trigger_latency_s;
+  if (bound <= 0 || dex::latency_of(e) <= bound || stage_ != Stage::running || abort_) return;
+  if (e.to < 0 || e.to >= static_cast<int>(drones_.size()) || drones_[e.to].local) return;
+  char limit[48];
+  std::snprintf(limit, sizeof limit, ", later than --max-trigger-latency %g s", bound);
+  LifecycleSample abort{hash_, transport::kGround, LifecycleKind::abort, r_.run_id};
+  abort.reason = dex::describe_late(dex::late_message(e, r_.fleet)) + limit + " (held by the ground: " +
+                 drones_[e.to].name + "'s DEX was started elsewhere)";
+  abort.t = mission_time();
+  node_->write(abort);  // first: the drones' failsafe must not wait for a terminal
+  abort_ = abort;
+  LifecycleSample heard = abort;
+  heard.t = mission_now();
+  record_lifecycle(heard);
+  err_ << "ground: " << abort.reason << "; aborting the run: every drone runs its failsafe\n";
 }
 
 void Ground::on_telemetry(const TelemetrySample& s) {

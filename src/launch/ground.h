@@ -32,6 +32,13 @@ struct LaunchOptions {
   /// Without DDS Security, for the ground and every DEX it starts (docs/security.md).
   bool insecure = false;
   double telemetry_hz = 5.0;  ///< telemetry events per drone per mission second in the trace; 0 = none
+  /// Mission seconds: a trigger or cancel received later than this after it was sent is a
+  /// warning on the console and in the summary.
+  double latency_warn_s = dex::kDefaultLatencyWarnS;
+  /// Mission seconds: a trigger or cancel later than this fails the mission: passed to every
+  /// DEX started here (the receiving DEX abandons into the failsafe); for a DEX started
+  /// elsewhere the ground writes the ABORT when it hears of the message. 0 = no bound.
+  double max_trigger_latency_s = 0.0;
 };
 
 struct LaunchResult {

@@ -85,6 +85,8 @@ TEST_F(TraceSchema, EveryExampleTraceKeepsTheSchemaEventByEvent) {
     for (const nlohmann::json& e : lines) {
       telemetry += e["event"] == "telemetry";
       messages += e["event"] == "message";
+      // In one process a message takes no time.
+      if (e["event"] == "message") EXPECT_EQ(e["latency"], 0.0) << name << ": " << e.dump();
       actions += e["event"] == "start" && e.contains("node");
       inits += e["event"] == "node" && e["kind"] == "init" && e.contains("instance");  // one clone per drone
     }
@@ -185,6 +187,20 @@ TEST(TraceCheck, RefusesBrokenTelemetryAndMessages) {
             "line 2: \"y\" is not a finite number\n"
             "line 2: \"heading\" is neither null nor degrees from 0 to 360\n"
             "line 3: received before it was sent\n");
+}
+
+TEST(TraceCheck, AMessagesLatencyIsItsReceivedMinusSentTime) {
+  std::string message = R"({"t":1.25,"event":"message","drone":"D1","kind":"trigger","from":"D1","to":"D1",)"
+                        R"("node":4,"sent":1,"received":1.25,)";
+  std::string end = R"({"t":2,"drone":"","event":"mission","name":"","line":0,"outcome":"completed"})";
+  EXPECT_EQ(joined(errors_of(kHeader + "\n" + message + R"("latency":0.25})" + "\n" + end + "\n")), "");
+  // Older traces have none: the field was added within version 1.
+  EXPECT_EQ(joined(errors_of(kHeader + "\n" + message.substr(0, message.size() - 1) + "}\n" + end + "\n")), "");
+  EXPECT_EQ(joined(errors_of(kHeader + "\n" + message + R"("latency":"0.25"})" + "\n" + message +
+                             R"("latency":0.5})" + "\n" + message + R"("latency":-0.25})" + "\n" + end + "\n")),
+            "line 2: \"latency\" is not a finite number\n"
+            "line 3: \"latency\" is not \"received\" - \"sent\"\n"
+            "line 4: \"latency\" is negative\n");
 }
 
 TEST(TraceCheck, RefusesANodeEventOfAnUnknownKindOrOutcome) {

@@ -309,7 +309,9 @@ TEST_P(Sitl, LinkLossFailsTheMissionAndEveryOtherDroneRunsItsFailsafe) {
   ASSERT_TRUE(killed) << f.run.out;
   EXPECT_NE(f.run.status, 0) << f.run.out;
   // 3 mission s, but at least 1.5 wall s: 7.5 s at --speed 5.
-  EXPECT_NE(f.run.out.find("Drone2.FlyByX(3)  failed [link_lost]  (link lost: no HEARTBEAT from system 2 for 7.5 s)"),
+  // The system id moves with EAMOS_SITL_FIRST_INSTANCE.
+  EXPECT_NE(f.run.out.find("Drone2.FlyByX(3)  failed [link_lost]  (link lost: no HEARTBEAT from system " +
+                           std::to_string(sitl->sysid(1)) + " for 7.5 s)"),
             std::string::npos)
       << f.run.out;
   // Nobody waits for the lost drone's failsafe (nothing reaches it): eamos ends once the
