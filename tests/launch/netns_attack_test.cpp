@@ -221,6 +221,8 @@ TEST_F(Netns, DexFrozenLongerThanTheLeasePutsEveryDroneInItsFailsafeAndAbandonsW
   std::string log = read_text(dir_ / "B.log");
   EXPECT_TRUE(log.find("B's DEX stalled for") != std::string::npos || log.find("lost: no liveliness") != std::string::npos)
       << log;
+  for (const char* why : {"stalled for", "lost: no liveliness"})
+    if (log.find(why) != std::string::npos) std::cout << "B: " << log.substr(log.find(why), 60) << "\n";
   ASSERT_GE(at["B"], 0) << logs();
   std::cout << "B: failsafe " << at["B"] - stopped_at << " mission s after the freeze (at its resume)\n";
   EXPECT_GE(at["B"] - stopped_at, lease * speed) << logs();  // not back-dated

@@ -223,7 +223,8 @@ class Netns : public ::testing::Test {
     for (std::size_t d = 0; d < kDrones.size(); ++d) {
       std::vector<std::string> args = {"ip", "netns", "exec", ns_name(static_cast<int>(d) + 1), EAMOS_BINARY, "dex",
                                        (dir_ / "deploy" / kDrones[d]).string(), "--dds-config",
-                                       config(static_cast<int>(d) + 1).string(), "--start-timeout", "25",
+                                       config(static_cast<int>(d) + 1).string(), "--start-timeout",
+                                       std::to_string(std::stoi(barrier_timeout_) + 5),
                                        "--trace", (dir_ / (kDrones[d] + ".jsonl")).string()};
       std::istringstream more(common + dex_extra_);
       for (std::string a; more >> a;) args.push_back(a);
@@ -232,7 +233,7 @@ class Netns : public ::testing::Test {
     std::vector<std::string> args = {"ip", "netns", "exec", ns_name(0), EAMOS_BINARY, "launch",
                                      (dir_ / "deploy").string(), "--remote-only", "--dds-config", config(0).string(),
                                      "--trace", (dir_ / "trace.jsonl").string(), "--summary",
-                                     (dir_ / "summary.json").string(), "--barrier-timeout", "20"};
+                                     (dir_ / "summary.json").string(), "--barrier-timeout", barrier_timeout_};
     std::istringstream more(common + " " + extra);
     for (std::string a; more >> a;) args.push_back(a);
     ground_ = start(args);
@@ -324,7 +325,7 @@ class Netns : public ::testing::Test {
     }
     nlohmann::json summary = nlohmann::json::parse(read_text(dir_ / "summary.json"));
     EXPECT_EQ(summary["status"], "failed");
-    for (const std::string& d : {"A", "C"}) EXPECT_TRUE(summary["drones"][d]["landed"]) << d << summary.dump(2);
+    for (std::string d : {"A", "C"}) EXPECT_TRUE(summary["drones"][d]["landed"]) << d << summary.dump(2);
     if (seconds > 0)  // B came back and reported how it ended
       EXPECT_TRUE(summary["drones"]["B"]["landed"]) << summary.dump(2) << logs();
     else
@@ -334,6 +335,7 @@ class Netns : public ::testing::Test {
   std::string mission_ = "hops.eamos";  ///< in tests/launch/missions; set before SetUp
   bool attacker_ = false;               ///< a namespace (and relay routes) for an attacker
   std::string dex_extra_;               ///< more options for every DEX (" --insecure")
+  std::string barrier_timeout_ = "20";  ///< the ground's --barrier-timeout, wall s
   std::string prefix_;
   int net_ = 0;
   int domain_ = 170;

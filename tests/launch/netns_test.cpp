@@ -23,8 +23,11 @@ TEST_F(Netns, TenPercentLossCompletesInTheSameOrder) {
 }
 
 TEST_F(Netns, ThirtyPercentLossCompletesInTheSameOrder) {
+  // At this loss a DDS Security handshake fails for good (docs/faults.md): refused at the
+  // barrier even after 90 s (measured), so a 10 s barrier decides as well as 20 s did.
   domain_ = 171;
   lease_ = "2";
+  barrier_timeout_ = "10";
   expect_completes_in_order({"--loss", "0.3", "--seed", "2"}, false);
 }
 
