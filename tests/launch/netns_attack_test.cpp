@@ -7,9 +7,10 @@
 // x = 50 sends it to 40). Expected: the mission completes with the in-process per-drone
 // order and nothing forged is obeyed; with --insecure the attacker's samples do reach the
 // DEXes (it reads the run's triggers and START) and the per-sample checks drop the invalid
-// ones. A frozen DEX (SIGSTOP, then SIGCONT) in its namespace: longer than the lease,
-// every drone is in its failsafe within the lease and the frozen one abandons when resumed;
-// shorter, the mission completes. DDS domains 180-189. Needs root and `ip netns`; skipped
+// ones, while forged telemetry, which nothing can tell from real, is believed. A frozen
+// DEX (SIGSTOP, then SIGCONT) in its namespace: longer than the lease, every drone is in
+// its failsafe within the lease and the frozen one abandons when resumed; shorter, the
+// mission completes. DDS domains 180-189. Needs root and `ip netns`; skipped
 // with a message otherwise.
 #include "netns_fixture.h"
 
@@ -118,7 +119,7 @@ TEST_F(NetnsAttack, ProcessWithoutCredentialsIsNotObeyed) {
   ASSERT_NO_FATAL_FAILURE(start_attacker());
   int status = fly_attacked(
       "", [&](const std::string& run) { forge_everything(run, {0, 1, 2}); },
-      [&](const std::string& run) { attack("telemetry " + run + " 0 50 150"); });
+      [&](const std::string& run) { attack("telemetry " + run + " 0 50 1500"); });
   std::string attacker = stop_attacker();
   std::string figures = stop_relay();
   std::cout << figures << attacker;
@@ -143,7 +144,7 @@ TEST_F(NetnsAttack, ProcessWithAnotherCompilationsCredentialsIsNotObeyed) {
   ASSERT_NO_FATAL_FAILURE(start_attacker((dir_ / "other" / "B" / "security").string(), 1));
   int status = fly_attacked(
       "", [&](const std::string& run) { forge_everything(run, {0, 1, 2}); },
-      [&](const std::string& run) { attack("telemetry " + run + " 0 50 150"); });
+      [&](const std::string& run) { attack("telemetry " + run + " 0 50 1500"); });
   std::string attacker = stop_attacker();
   std::string figures = stop_relay();
   std::cout << figures << attacker;
@@ -185,6 +186,25 @@ TEST_F(NetnsAttack, WithSecurityOffTheAttackReachesTheDexesAndTheChecksDropWhatI
                           "was already received", "the failed drone it names is not in the mission",
                           "dropped a lifecycle sample"})
     EXPECT_NE(all.find(why), std::string::npos) << why << "\n" << all;
+}
+
+TEST_F(NetnsAttack, WithSecurityOffForgedTelemetryIsBelieved) {
+  // What "C's largest x below 5" in the secure runs is measured against: the same flood
+  // of A at x = 50, with --insecure, sends C towards 40 (nothing can tell it from A's own
+  // telemetry). The mission still completes: C lands where it was sent.
+  domain_ = 185;
+  dex_extra_ = " --insecure";
+  ASSERT_NO_FATAL_FAILURE(start_relay({}));
+  ASSERT_NO_FATAL_FAILURE(start_attacker());
+  int status = fly_attacked(
+      "--insecure", [](const std::string&) {},
+      [&](const std::string& run) { attack("telemetry " + run + " 0 50 1500"); });
+  stop_attacker();
+  stop_relay();
+  ASSERT_EQ(status, 0) << logs();
+  double c_x = max_x(dir_ / "trace.jsonl", "C");
+  std::cout << "C's largest x: " << c_x << "\n";
+  EXPECT_GT(c_x, 30.0) << logs();
 }
 
 // --- a DEX frozen in its namespace (SIGSTOP, then SIGCONT) ---
