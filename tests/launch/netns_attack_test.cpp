@@ -18,6 +18,14 @@ namespace {
 
 using namespace netns_support;
 
+/// The mission time of the first `event` ("start", "end") of `drone`'s action `name` in
+/// the ground's merged trace (-1: none).
+double first(const fs::path& trace, const std::string& drone, const std::string& event, const std::string& name) {
+  for (const nlohmann::json& e : read_trace(trace))
+    if (e.value("drone", "") == drone && e.value("event", "") == event && e.value("name", "") == name) return e["t"];
+  return -1;
+}
+
 /// The largest x drone `drone` reported in the ground's merged trace (-1e9: none).
 double max_x(const fs::path& trace, const std::string& drone) {
   double x = -1e9;
@@ -91,6 +99,15 @@ class NetnsAttack : public Netns {
     std::cout << "C's largest x: " << c_x << " (A.X() forged as 50 would take it to 40)\n";
     EXPECT_LT(c_x, 5.0) << logs();
     EXPECT_EQ(logs().find("forged by the attacker"), std::string::npos) << logs();
+    // No early takeoff: each drone armed only once the one before it was up.
+    fs::path trace = dir_ / "trace.jsonl";
+    EXPECT_GE(first(trace, "B", "start", "Arm"), first(trace, "A", "end", "Takeoff")) << logs();
+    EXPECT_GE(first(trace, "C", "start", "Arm"), first(trace, "B", "end", "Takeoff")) << logs();
+    // Nobody completed early: the run lasted until the last disarm (in process: 22.55 s).
+    nlohmann::json summary = nlohmann::json::parse(read_text(dir_ / "summary.json"));
+    EXPECT_EQ(summary["status"], "completed");
+    EXPECT_GE(summary["duration"].get<double>(), first(trace, "A", "end", "Disarm")) << summary.dump(2);
+    EXPECT_GT(summary["duration"].get<double>(), 20.0) << summary.dump(2);
   }
 
   /// What the secure runs send: every kind the attacker sent, valid-looking where
