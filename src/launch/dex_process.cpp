@@ -122,7 +122,10 @@ void DexProcess::on_lifecycle_waiting(const LifecycleSample& s) {
   // The barrier ABORT of another launch (one that refused to run beside this one) is not
   // this DEX's: it waits for its own launch.
   bool other_launch = s.run_id == 0 && o_.launch_id != 0 && s.launch_id != o_.launch_id;
-  if (s.kind == LifecycleKind::abort && !other_launch) aborts_.emplace(s.run_id, s.reason);
+  // An ABORT the running DEX would ignore must not end the run before it starts either
+  // (the loop logs it when it handles the same sample, on_lifecycle).
+  std::string why;
+  if (s.kind == LifecycleKind::abort && !other_launch && abort_allowed(s, why)) aborts_.emplace(s.run_id, s.reason);
   wait_cv_.notify_all();
 }
 
