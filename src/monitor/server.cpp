@@ -97,7 +97,10 @@ bool MonitorServer::start(const Endpoint& at, std::string& error) {
                           : at.host + ":" + std::to_string(at.port);
   const char* options[] = {"listening_ports", ports.c_str(), "num_threads", "40",
                            "enable_directory_listing", "no", "request_timeout_ms", "10000",
-                           "enable_websocket_ping_pong", "yes", nullptr};
+                           "enable_websocket_ping_pong", "yes",
+                           // Each live event is a small write: with Nagle's algorithm one waits for
+                           // the browser's delayed ACK of the one before (tens of ms on loopback).
+                           "tcp_nodelay", "1", nullptr};
   mg_callbacks callbacks{};
   // civetweb would print to stderr; the error text is returned instead.
   callbacks.log_message = [](const mg_connection*, const char*) { return 1; };
@@ -285,7 +288,8 @@ void MonitorServer::send_pending(mg_connection* conn, Client& client) {
       dropped = dropped_;
     }
     if (count > 0) {
-      std::string message = "{\"type\":\"events\",\"from\":" + std::to_string(from) + ",\"dropped\":" +
+      double sent_ms = std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch()).count();
+      std::string message = "{\"type\":\"events\",\"sent\":" + stamp_text(sent_ms) + ",\"from\":" + std::to_string(from) + ",\"dropped\":" +
                             std::to_string(dropped) + ",\"events\":[" + batch + "],\"emitted\":[" + emitted + "]}";
       if (mg_websocket_write(conn, MG_WEBSOCKET_OPCODE_TEXT, message.data(), message.size()) <= 0) return;
       client.cursor = from + count;

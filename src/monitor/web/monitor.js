@@ -15,7 +15,7 @@ const DOM_LANES_MAX = 60;  // more drones: lanes on a canvas, no element per bar
 const S = {
   mission: null, live: false, finished: false, events: [], clock: 0, playing: false, speed: 1,
   follow: true, selected: null, dirty: true, structureDirty: true, itemsDirty: true, graphIndex: 0,
-  liveFrom: Infinity, undrawn: [], latencies: [], arrivals: [],
+  liveFrom: Infinity, undrawn: [], latencies: [], arrivals: [], serverDelays: [],
 };
 const LATENCIES_MAX = 200000;  // the newest this many; enough for any percentile worth asking
 
@@ -843,6 +843,7 @@ function onMessage(text) {
     S.undrawn = [];
     S.latencies = [];
     S.arrivals = [];
+    S.serverDelays = [];
     S.liveFrom = Infinity;
     resetDerived();
     $('mission-name').textContent = str(S.mission.mission);
@@ -858,8 +859,10 @@ function onMessage(text) {
         if (typeof emitted !== 'number' || emitted < S.liveFrom) continue;
         S.undrawn.push(emitted);
         S.arrivals.push(arrived - emitted);
+        if (typeof m.sent === 'number') S.serverDelays.push(m.sent - emitted);
       }
       if (S.arrivals.length > LATENCIES_MAX) S.arrivals.splice(0, S.arrivals.length - LATENCIES_MAX);
+      if (S.serverDelays.length > LATENCIES_MAX) S.serverDelays.splice(0, S.serverDelays.length - LATENCIES_MAX);
       // What happened before the page had shown the mission and its history is old news, not lateness.
       if (S.liveFrom === Infinity) S.liveFrom = arrived;
     }
@@ -919,6 +922,7 @@ window.eamosMonitor = {
   // to its arrival here (the part the network and the server take).
   liveLatency: () => latencyStats(S.latencies),
   arrivalLatency: () => latencyStats(S.arrivals),
+  serverLatency: () => latencyStats(S.serverDelays),
   triggers: () => (D.triggerList || []).map(t => ({ from: t.from, to: t.to, sent: t.sent, received: t.received, wait: t.received - t.waitFrom })),
 };
 

@@ -212,20 +212,23 @@ async function live(browser) {
 
 function ms(v) { return v === null ? '?' : v.toFixed(1) + ' ms'; }
 
-// 20 drones live, telemetry at the default rate: every event drawn within 100 ms of eamos
-// emitting it (p95), in the page that stays in front and follows the mission.
+// 20 drones live in real time, telemetry at the default rate: events drawn within 100 ms of
+// eamos emitting them (p95), in the page that stays in front and follows the mission. 800
+// live events (about 8 s of the flight) are enough; the test then stops the run.
 async function live20(browser) {
   const page = await open(browser, '');
-  await page.waitForFunction(() => document.body.dataset.finished === 'true', { timeout: 60000, polling: 100 });
+  await page.waitForFunction(() => window.eamosMonitor.liveLatency().count >= 800, { timeout: 60000, polling: 200 });
   const s = await page.evaluate(snapshot);
-  check(s.lanes.length === 20 && s.outcome === 'completed', `20 lanes and the mission completed (${s.lanes.length}, ${s.outcome})`);
+  check(s.lanes.length === 20 && s.mode === 'live', `20 lanes of a live mission (${s.lanes.length}, ${s.mode})`);
   const l = await page.evaluate(() => window.eamosMonitor.liveLatency());
   const a = await page.evaluate(() => window.eamosMonitor.arrivalLatency());
-  console.log(`info: ${l.count} live events drawn; emitted to drawn: median ${ms(l.median)}, p95 ${ms(l.p95)}, max ${ms(l.max)}`);
-  console.log(`info: emitted to arrived: median ${ms(a.median)}, p95 ${ms(a.p95)}, max ${ms(a.max)}`);
-  check(l.count > 1000, `most events arrived live, not as history (${l.count} of ${s.events})`);
+  const v = await page.evaluate(() => window.eamosMonitor.serverLatency());
+  console.log(`info: ${l.count} live events; emitted to drawn: median ${ms(l.median)}, p95 ${ms(l.p95)}, max ${ms(l.max)}`);
+  console.log(`info: emitted to arrived: median ${ms(a.median)}, p95 ${ms(a.p95)}, max ${ms(a.max)}; ` +
+              `to sent by the server: median ${ms(v.median)}, p95 ${ms(v.p95)}, max ${ms(v.max)}`);
+  console.log(`info: load average ${os.loadavg().map(x => x.toFixed(1)).join(' ')} on ${os.cpus().length} cores`);
   check(l.p95 !== null && l.p95 < 100, `p95 of emitted-to-drawn below 100 ms: ${ms(l.p95)}`);
-  await page.screenshot({ path: path.join(shots, 'live-20-drones-end.png'), fullPage: true });
+  await page.screenshot({ path: path.join(shots, 'live-20-drones.png') });
 }
 
 // `eamos launch DIR --monitor`: the ground's events of a deployment's DEX processes reach the
