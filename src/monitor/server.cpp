@@ -4,6 +4,7 @@
 
 #include <cctype>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <vector>
 
@@ -47,6 +48,14 @@ void send_status(mg_connection* conn, int code, const char* text) {
             code, text, std::strlen(text), text);
 }
 
+// Unix ms to the microsecond: enough for a latency in ms, short on the wire.
+std::string stamp_text(double ms) {
+  if (ms <= 0) return "0";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3f", ms);
+  return text;
+}
+
 }  // namespace
 
 bool parse_endpoint(const std::string& text, Endpoint& out, std::string& error) {
@@ -88,7 +97,10 @@ bool MonitorServer::start(const Endpoint& at, std::string& error) {
                           : at.host + ":" + std::to_string(at.port);
   const char* options[] = {"listening_ports", ports.c_str(), "num_threads", "40",
                            "enable_directory_listing", "no", "request_timeout_ms", "10000",
-                           "enable_websocket_ping_pong", "yes", nullptr};
+                           "enable_websocket_ping_pong", "yes",
+                           // Each live event is a small write: with Nagle's algorithm one waits for
+                           // the browser's delayed ACK of the one before (tens of ms on loopback).
+                           "tcp_nodelay", "1", nullptr};
   mg_callbacks callbacks{};
   // civetweb would print to stderr; the error text is returned instead.
   callbacks.log_message = [](const mg_connection*, const char*) { return 1; };
@@ -123,14 +135,15 @@ void MonitorServer::stop() {
   context_ = nullptr;
 }
 
-void MonitorServer::append(std::string event_json) {
+void MonitorServer::append(std::string event_json, double emitted_ms) {
   {
     std::lock_guard<std::mutex> lock(events_mutex_);
     if (events_.size() >= max_history) {
       ++dropped_;
       return;
     }
-    events_.push_back(std::move(event_json));
+    events_.push_back(Event{std::move(event_json), emitted_ms});
+    news_ = true;
   }
   events_changed_.notify_one();
 }
@@ -139,6 +152,7 @@ void MonitorServer::finish() {
   {
     std::lock_guard<std::mutex> lock(events_mutex_);
     finished_ = true;
+    news_ = true;
   }
   events_changed_.notify_one();
 }
@@ -215,6 +229,10 @@ void MonitorServer::on_ws_ready(mg_connection* conn, void* self_ptr) {
     auto it = self->clients_.find(conn);
     if (it != self->clients_.end()) it->second.ready = true;
   }
+  {
+    std::lock_guard<std::mutex> lock(self->events_mutex_);
+    self->news_ = true;
+  }
   self->events_changed_.notify_one();
 }
 
@@ -234,8 +252,10 @@ void MonitorServer::send_loop() {
   for (;;) {
     {
       std::unique_lock<std::mutex> lock(events_mutex_);
-      // Woken by an event; the timeout also catches a browser that just became ready.
-      events_changed_.wait_for(lock, std::chrono::milliseconds(50));
+      // Woken by news, also news that came while the last batch was being written (a notify
+      // then finds nobody waiting: waiting for it anyway cost up to the timeout per event).
+      events_changed_.wait_for(lock, std::chrono::milliseconds(50), [this] { return news_ || stopping_; });
+      news_ = false;
       if (stopping_) return;
     }
     std::lock_guard<std::mutex> lock(clients_mutex_);
@@ -251,7 +271,7 @@ void MonitorServer::send_pending(mg_connection* conn, Client& client) {
     client.sent_mission = true;
   }
   for (;;) {
-    std::string batch;
+    std::string batch, emitted;
     std::size_t from = client.cursor, count = 0, dropped = 0;
     bool finished = false;
     {
@@ -260,14 +280,17 @@ void MonitorServer::send_pending(mg_connection* conn, Client& client) {
       count = to - from;
       for (std::size_t i = from; i < to; ++i) {
         batch += i == from ? "" : ",";
-        batch += events_[i];
+        batch += events_[i].json;
+        emitted += i == from ? "" : ",";
+        emitted += stamp_text(events_[i].emitted_ms);
       }
       finished = finished_ && to == events_.size();
       dropped = dropped_;
     }
     if (count > 0) {
-      std::string message = "{\"type\":\"events\",\"from\":" + std::to_string(from) + ",\"dropped\":" +
-                            std::to_string(dropped) + ",\"events\":[" + batch + "]}";
+      double sent_ms = std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch()).count();
+      std::string message = "{\"type\":\"events\",\"sent\":" + stamp_text(sent_ms) + ",\"from\":" + std::to_string(from) + ",\"dropped\":" +
+                            std::to_string(dropped) + ",\"events\":[" + batch + "],\"emitted\":[" + emitted + "]}";
       if (mg_websocket_write(conn, MG_WEBSOCKET_OPCODE_TEXT, message.data(), message.size()) <= 0) return;
       client.cursor = from + count;
     }

@@ -40,8 +40,10 @@ class MonitorServer {
   bool start(const Endpoint& at, std::string& error);
   /// "http://127.0.0.1:8080/" once started.
   std::string url() const { return url_; }
-  /// One trace event (a JSON object's text). Never blocks on a browser.
-  void append(std::string event_json);
+  /// One trace event (a JSON object's text). Never blocks on a browser. `emitted_ms`: the wall
+  /// clock (Unix ms) when the mission emitted it, sent beside it so a page can tell how late it
+  /// drew it; 0 for a replay, whose events happened long ago.
+  void append(std::string event_json, double emitted_ms = 0);
   /// The mission's trace is complete: pages show it as a replay from now on.
   void finish();
   void stop();
@@ -74,8 +76,13 @@ class MonitorServer {
 
   mutable std::mutex events_mutex_;
   std::condition_variable events_changed_;
-  std::deque<std::string> events_;
+  struct Event {
+    std::string json;
+    double emitted_ms = 0;
+  };
+  std::deque<Event> events_;
   std::size_t dropped_ = 0;
+  bool news_ = false;  ///< something for the sender since it last looked (a notify alone can be missed)
   bool finished_ = false;
   bool stopping_ = false;
 

@@ -341,6 +341,8 @@ eamos_wire_TraceRecord to_wire(const TraceSample& s) {
   w.has_reading = e.reading.has_value();
   w.reading = e.reading.value_or(0.0);
   w.reason = borrow(e.reason);
+  w.failure = borrow(e.failure);
+  w.detail = borrow(e.detail);
   w.node = e.node;
   w.instance = e.instance;
   w.kind = borrow(e.kind);
@@ -375,6 +377,8 @@ bool from_wire(const eamos_wire_TraceRecord& w, const WireLimits& limits, TraceS
     e.reading = w.reading;
   }
   e.reason = check.text("reason", w.reason, kMaxWireText);
+  e.failure = check.text("failure", w.failure, kMaxWireName);
+  e.detail = check.text("detail", w.detail, kMaxWireText);
   check.at_least("node", w.node, -1);
   e.node = w.node;
   check.at_least("instance", w.instance, -1);

@@ -25,14 +25,14 @@ struct Failed {
   nlohmann::json summary;  ///< the summary's "failure"
 };
 
-Failed run_failing(const std::string& mission, const std::string& fleet) {
+Failed run_failing(const std::string& mission, const std::string& fleet, const std::string& options = "") {
   fs::path dir = fs::temp_directory_path() /
                  ("eamos-failure-" + std::to_string(::getpid()) + "-" +
                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
   fs::create_directories(dir);
   eamos_test::Output r = eamos_test::run_eamos("run " + kData + mission + (fleet.empty() ? "" : " --fleet " + kData + fleet) +
                                                " --trace " + (dir / "trace.jsonl").string() + " --summary " +
-                                               (dir / "summary.json").string());
+                                               (dir / "summary.json").string() + (options.empty() ? "" : " " + options));
   Failed f{r.status, r.out, {}, {}};
   std::ifstream trace(dir / "trace.jsonl");
   for (std::string line; std::getline(trace, line);) {
@@ -54,6 +54,16 @@ TEST(SimFailureReasons, ARefusalIsRefusedInTheTraceAndTheSummary) {
   EXPECT_EQ(f.end["reason"], "disarmed: arm before Takeoff");
   EXPECT_EQ(f.summary["kind"], "refused");
   EXPECT_NE(f.out.find("failed [refused]"), std::string::npos) << f.out;  // the live log
+}
+
+// A DEX process's failed action reaches the ground's live log and trace with its kind, the
+// same line an in-process run prints (DDS domain 203, used by no other test).
+TEST(SimFailureReasons, ARefusalInADistributedRunIsRefusedInTheLogAndTheTrace) {
+  Failed f = run_failing("takeoff-disarmed.eamos", "", "--distributed --insecure --speed 5 --domain 203");
+  EXPECT_EQ(f.status, 1) << f.out;
+  ASSERT_TRUE(f.end.is_object()) << f.out;
+  EXPECT_EQ(f.end["failure"], "refused");
+  EXPECT_NE(f.out.find("Takeoff(3)  failed [refused]  (disarmed: arm before Takeoff)"), std::string::npos) << f.out;
 }
 
 TEST(SimFailureReasons, ADeadlineIsTimedOutWithTheDeadlineAsDetail) {

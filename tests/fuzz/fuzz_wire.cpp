@@ -132,6 +132,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   r.has_reading = in.ConsumeBool();
   r.reading = number(in);
   r.reason = text(in, keep);
+  r.failure = text(in, keep);
+  r.detail = text(in, keep);
   TraceSample rs;
   check(from_wire(r, limits, rs, why), rs.drone, drones);
   return 0;

@@ -25,12 +25,15 @@
 
 #include "dex/trace_schema.h"
 #include "support/mission_edit.h"
+#include "support/read_files.h"
 #include "support/run_eamos.h"
 #include "transport/dds_node.h"
 
 namespace {
 
 namespace fs = std::filesystem;
+using eamos_test::read_json;
+using eamos_test::read_text;
 
 using eamos_test::Output;
 Output eamos(const std::string& args, const std::function<void(const std::string&)>& on_line = {}) {
@@ -95,18 +98,6 @@ std::string schema_errors(const fs::path& trace) {
   std::string all;
   for (const std::string& e : eamos::dex::check_trace(in, {.strict = true})) all += e + "\n";
   return all;
-}
-
-nlohmann::json read_json(const fs::path& p) {
-  std::ifstream in(p);
-  return nlohmann::json::parse(in);
-}
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 nlohmann::json last_event(const fs::path& trace) {

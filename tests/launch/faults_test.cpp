@@ -23,37 +23,21 @@
 #include <nlohmann/json.hpp>
 
 #include "support/eamos_process.h"
+#include "support/read_files.h"
 #include "support/run_eamos.h"
 #include "transport/dds_node.h"
 
 namespace {
 
 namespace fs = std::filesystem;
+using eamos_test::read_text;
+using eamos_test::read_json;
+using eamos_test::read_trace;
 using eamos_test::Output;
 
 std::string example(const std::string& name) { return std::string(EAMOS_SOURCE_DIR) + "/examples/" + name; }
 std::string test_mission(const std::string& name) {
   return std::string(EAMOS_SOURCE_DIR) + "/tests/launch/missions/" + name;
-}
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-nlohmann::json read_json(const fs::path& p) {
-  std::ifstream in(p);
-  return nlohmann::json::parse(in);
-}
-
-std::vector<nlohmann::json> read_trace(const fs::path& p) {
-  std::vector<nlohmann::json> events;
-  std::ifstream in(p);
-  for (std::string line; std::getline(in, line);)
-    if (!line.empty()) events.push_back(nlohmann::json::parse(line));
-  return events;
 }
 
 /// The pid the ground printed for `drone`'s DEX, or -1.

@@ -167,6 +167,22 @@ TEST(Wire, TraceKeepsOptionalValueAndReading) {
   EXPECT_EQ(*back.event.reading, 41.5);
 }
 
+// The ground's log line and trace of a failed action in a DEX process name its kind and the
+// vehicle's words, as an in-process run's do.
+TEST(Wire, TraceKeepsAFailedActionsKindAndDetail) {
+  TraceSample s;
+  s.drone = 0;
+  s.event.t = 1.5;
+  s.event.event = "end";
+  s.event.name = "Takeoff";
+  s.event.outcome = "failed";
+  s.event.failure = "refused";
+  s.event.detail = "MAV_RESULT_DENIED";
+  TraceSample back = back_from<TraceSample>(to_wire(s));
+  EXPECT_EQ(back.event.failure, "refused");
+  EXPECT_EQ(back.event.detail, "MAV_RESULT_DENIED");
+}
+
 TEST(WireRules, RefusesATriggerFromOrToADroneOutsideTheFleet) {
   TriggerSample s;
   s.to = 1;

@@ -14,8 +14,13 @@ const DOM_LANES_MAX = 60;  // more drones: lanes on a canvas, no element per bar
 
 const S = {
   mission: null, live: false, finished: false, events: [], clock: 0, playing: false, speed: 1,
-  follow: true, selected: null, dirty: true, structureDirty: true, graphIndex: 0, arrivals: [],
+  follow: true, selected: null, dirty: true, structureDirty: true, itemsDirty: true, graphIndex: 0,
+  liveFrom: Infinity, undrawn: [], latencies: [], arrivals: [], serverDelays: [],
 };
+const LATENCIES_MAX = 200000;  // the newest this many; enough for any percentile worth asking
+
+// The wall clock (Unix ms, sub-ms), comparable with the stamps eamos puts beside live events.
+function wallNow() { return performance.timeOrigin + performance.now(); }
 let D = null;  // what the events say, rebuilt incrementally (see resetDerived)
 
 function $(id) { return document.getElementById(id); }
@@ -86,17 +91,17 @@ function ingest(e) {
     D.bars.push(bar);
     if (!D.openBars.has(key)) D.openBars.set(key, []);
     D.openBars.get(key).push(bar);
-    S.structureDirty = true;
+    S.itemsDirty = true;
   } else if (e.event === 'end') {
     const open = D.openBars.get(key);
     const bar = open && open.length ? open.pop() : null;
-    if (bar) { bar.end = t; bar.outcome = str(e.outcome); bar.reason = str(e.reason); }
+    if (bar) { bar.end = t; bar.outcome = str(e.outcome); bar.reason = str(e.reason); bar.changed = true; }
     if (e.outcome === 'failed') D.failures.push(t);
-    S.structureDirty = true;
+    S.itemsDirty = true;
   } else if (e.event === 'condition') {
     D.conds.push({ drone: str(e.drone), name: str(e.name), line: e.line | 0, text: str(e.text), t, value: !!e.value,
                    nodes: nodesOf(e) });
-    S.structureDirty = true;
+    S.itemsDirty = true;
   } else if (e.event === 'telemetry') {
     if (!D.telemetry.has(e.drone)) D.telemetry.set(e.drone, []);
     D.telemetry.get(e.drone).push({ t, x: num(e.x, 0), y: num(e.y, 0), z: num(e.z, 0), battery: e.battery,
@@ -104,7 +109,7 @@ function ingest(e) {
   } else if (e.event === 'message') {
     D.messages.push({ kind: str(e.kind), from: str(e.from), to: str(e.to), node: e.node,
                       sent: num(e.sent, t), received: num(e.received, t) });
-    S.structureDirty = true;
+    S.itemsDirty = true;
   } else if (e.event === 'mission') {
     D.outcome = str(e.outcome);
     if (D.outcome === 'failed') D.failures.push(t);
@@ -114,10 +119,10 @@ function ingest(e) {
     D.violations.push({ drone: str(e.drone), kind: str(e.kind), line: e.line | 0, text: str(e.text), t, others,
                         x: num(e.x, NaN), y: num(e.y, NaN) });
     D.failures.push(t);
-    S.structureDirty = true;
+    S.itemsDirty = true;
   } else if (e.event === 'failsafe' || e.event === 'error') {
     D.failures.push(t);
-    S.structureDirty = true;
+    S.itemsDirty = true;
   }
   if (e.event !== 'telemetry' && e.event !== 'message') {
     const state = nodeState(e);
@@ -209,7 +214,11 @@ function tick(prev) {
 
 function render() {
   S.dirty = false;
-  if (S.structureDirty) { buildLanes(); S.structureDirty = false; }
+  // Layout is read once, before anything is written: a read after a write forces the
+  // browser to lay the page out again, and one per trigger arrow made a 20-drone page lag.
+  S.trackW = trackWidth();
+  if (S.structureDirty) { buildLanes(); S.structureDirty = false; S.itemsDirty = false; }
+  else if (S.itemsDirty) { addLaneItems(); S.itemsDirty = false; }
   renderControls();
   renderLanes();
   renderMap();
@@ -217,6 +226,25 @@ function render() {
   renderGraphStates();
   renderSourceActive();
   document.body.dataset.clock = S.clock.toFixed(3);
+  noteDrawn();
+}
+
+// Live latency: from eamos emitting an event to the end of the render that drew it (the
+// browser paints that frame right after). Only events emitted after the page got its history
+// count: what happened before it connected is old news, not lateness.
+function noteDrawn() {
+  if (!S.undrawn.length) return;
+  const now = wallNow();
+  for (const emitted of S.undrawn) S.latencies.push(now - emitted);
+  S.undrawn = [];
+  if (S.latencies.length > LATENCIES_MAX) S.latencies.splice(0, S.latencies.length - LATENCIES_MAX);
+}
+
+function latencyStats(values) {
+  const d = [...values].sort((a, b) => a - b);
+  if (!d.length) return { count: 0, median: null, p95: null, max: null };
+  const at = q => d[Math.min(d.length - 1, Math.ceil(q * d.length) - 1)];
+  return { count: d.length, median: at(0.5), p95: at(0.95), max: d[d.length - 1] };
 }
 
 function renderControls() {
@@ -240,8 +268,36 @@ function trackWidth() {
   const lanes = $('lanes');
   return Math.max(200, (lanes.clientWidth || 800) - 84);
 }
-function xOf(t) { return 76 + (t / missionEnd()) * trackWidth(); }
+function xOf(t) { return 76 + (t / axisEnd()) * S.trackW; }
 
+// The time the lanes span. A finished trace spans its end; a live one rounds up with
+// headroom, so what is drawn stays put as events come in and a frame rewrites only what
+// changed (rescaling every bar on every event is what made a 20-drone page fall behind).
+function axisEnd() {
+  const end = missionEnd();
+  if (!S.live || S.finished) return end;
+  for (let scale = 1; ; scale *= 10)
+    for (const step of [10, 15, 20, 30, 50, 75]) if (step * scale >= end * 1.1) return step * scale;
+}
+
+// Writes a style or an attribute only when it changes: an unchanged write still costs a restyle.
+function put(node, property, value) {
+  if (node['_s' + property] === value) return;
+  node['_s' + property] = value;
+  node.style[property] = value;
+}
+function putAttr(node, name, value) {
+  if (node['_a' + name] === value) return;
+  node['_a' + name] = value;
+  node.setAttribute(name, value);
+}
+function flag(node, cls, on) {
+  if (node['_' + cls] === on) return;
+  node['_' + cls] = on;
+  node.classList.toggle(cls, on);
+}
+
+// The lanes from scratch: on a new drone (or the first draw). Items come from addLaneItems.
 function buildLanes() {
   const lanes = $('lanes');
   lanes.textContent = '';
@@ -249,6 +305,11 @@ function buildLanes() {
   lanes.hidden = !useDom;
   $('lanes-canvas').hidden = useDom;
   lanes.dataset.drones = String(D.drones.length);
+  for (const item of [...D.bars, ...D.conds, ...D.violations]) item.el = null;
+  for (const tr of D.triggerList || []) tr.el = tr.waitEl = null;
+  D.triggerList = [];
+  $('triggers').textContent = '';
+  D.condRows = new Map();
   if (!useDom) return;
   for (const d of D.drones) {
     const lane = el('div', 'lane');
@@ -260,57 +321,69 @@ function buildLanes() {
     lanes.appendChild(lane);
     d.track = track;
   }
+  addLaneItems();
+}
+
+// Elements for the bars, marks and arrows that have none yet, and the bars that ended since.
+function addLaneItems() {
+  if (D.drones.length > DOM_LANES_MAX) return;
   const rows = barRows();
   D.bars.forEach((b, i) => {
-    const d = D.drones[D.droneIndex.get(b.drone)];
-    const [row, count] = rows.get(b);
-    const bar = el('div', 'bar', b.name);
-    bar.dataset.index = String(i);
-    bar.dataset.drone = b.drone;
-    bar.dataset.name = b.name;
-    bar.dataset.line = String(b.line);
-    bar.dataset.start = String(b.start);
-    bar.dataset.end = b.end === null ? '' : String(b.end);
-    bar.dataset.outcome = b.outcome;
-    bar.dataset.node = b.nodes.join(' ');
-    bar.title = b.text + (b.outcome ? ' — ' + b.outcome : '') + (b.reason ? ' (' + b.reason + ')' : '') +
-                '  line ' + b.line;
-    bar.addEventListener('click', () => select({ nodes: b.nodes, line: b.line, drone: b.drone, text: b.text, t: b.start }));
+    if (!b.el) { makeBar(b, i); b.changed = true; }
+    if (b.changed) {
+      b.el.dataset.end = b.end === null ? '' : String(b.end);
+      b.el.dataset.outcome = b.outcome;
+      b.el.title = b.text + (b.outcome ? ' — ' + b.outcome : '') + (b.reason ? ' (' + b.reason + ')' : '') +
+                   '  line ' + b.line;
+      b.changed = false;
+    }
     // Actions that overlap in one drone (a motion and a picture) share the lane in rows.
+    const [row, count] = rows.get(b);
     const h = Math.floor(28 / count);
-    bar.style.top = (2 + row * h) + 'px';
-    bar.style.height = (h - 1) + 'px';
-    if (count > 1) bar.style.fontSize = '9px';
-    b.el = bar;
-    d.track.appendChild(bar);
+    put(b.el, 'top', (2 + row * h) + 'px');
+    put(b.el, 'height', (h - 1) + 'px');
+    put(b.el, 'fontSize', count > 1 ? '9px' : '');
   });
-  const rowOf = new Map();
-  D.conds.forEach(c => {
-    const d = D.drones[D.droneIndex.get(c.drone)];
-    const mark = el('div', 'cond', c.name + (c.value ? ' ✓' : ' ✗'));
-    mark.dataset.drone = c.drone;
-    mark.dataset.name = c.name;
-    mark.dataset.line = String(c.line);
-    mark.dataset.value = String(c.value);
-    mark.dataset.t = String(c.t);
-    mark.title = c.text + ' → ' + c.value + ' at ' + c.t.toFixed(2) + ' s';
-    // Marks of one lane take turns between two rows, so neighbours do not overlap.
-    const row = (rowOf.get(c.drone) || 0);
-    rowOf.set(c.drone, row + 1);
-    mark.style.top = (row % 2 === 0 ? 42 : 54) + 'px';
-    mark.addEventListener('click', () => select({ nodes: c.nodes, line: c.line, drone: c.drone, text: c.text, t: c.t }));
-    c.el = mark;
-    d.track.appendChild(mark);
-  });
+  for (const c of D.conds) if (!c.el) makeCond(c);
   buildViolationMarks();
-  buildTriggers();
+  updateTriggers();
+}
+
+function makeBar(b, i) {
+  const bar = el('div', 'bar', b.name);
+  bar.dataset.index = String(i);
+  bar.dataset.drone = b.drone;
+  bar.dataset.name = b.name;
+  bar.dataset.line = String(b.line);
+  bar.dataset.start = String(b.start);
+  bar.dataset.node = b.nodes.join(' ');
+  bar.addEventListener('click', () => select({ nodes: b.nodes, line: b.line, drone: b.drone, text: b.text, t: b.start }));
+  b.el = bar;
+  D.drones[D.droneIndex.get(b.drone)].track.appendChild(bar);
+}
+
+function makeCond(c) {
+  const mark = el('div', 'cond', c.name + (c.value ? ' ✓' : ' ✗'));
+  mark.dataset.drone = c.drone;
+  mark.dataset.name = c.name;
+  mark.dataset.line = String(c.line);
+  mark.dataset.value = String(c.value);
+  mark.dataset.t = String(c.t);
+  mark.title = c.text + ' → ' + c.value + ' at ' + c.t.toFixed(2) + ' s';
+  // Marks of one lane take turns between two rows, so neighbours do not overlap.
+  const row = D.condRows.get(c.drone) || 0;
+  D.condRows.set(c.drone, row + 1);
+  mark.style.top = (row % 2 === 0 ? 42 : 54) + 'px';
+  mark.addEventListener('click', () => select({ nodes: c.nodes, line: c.line, drone: c.drone, text: c.text, t: c.t }));
+  c.el = mark;
+  D.drones[D.droneIndex.get(c.drone)].track.appendChild(mark);
 }
 
 // A red mark per violation in its drone's lane; the diagnostic is its title.
 function buildViolationMarks() {
   for (const v of D.violations) {
     const d = D.drones[D.droneIndex.get(v.drone)];
-    if (!d || !d.track) continue;
+    if (v.el || !d || !d.track) continue;
     const mark = el('div', 'violation', '!');
     mark.dataset.drone = v.drone;
     mark.dataset.kind = v.kind;
@@ -341,38 +414,53 @@ function barRows() {
   return result;
 }
 
-function buildTriggers() {
+// The arrows (and wait spans) as triggers() finds them now: the ones already drawn stay, new
+// ones are added; only when an earlier one changed are they all drawn again.
+function updateTriggers() {
   const svg = $('triggers');
-  svg.textContent = '';
   const NS = 'http://www.w3.org/2000/svg';
-  const defs = document.createElementNS(NS, 'defs');
-  defs.innerHTML = '<marker id="arrow" viewBox="0 0 10 10" refX="9" refY="5" markerWidth="7" markerHeight="7" orient="auto">' +
-                   '<path d="M0,0 L10,5 L0,10 z" fill="#6a1b9a"/></marker>';
-  svg.appendChild(defs);
-  D.triggerList = triggers();
-  for (const tr of D.triggerList) {
-    const line = document.createElementNS(NS, 'path');
-    line.setAttribute('class', 'trigger' + (tr.kind === 'abort' ? ' abort' : ''));
-    line.setAttribute('marker-end', 'url(#arrow)');
-    line.dataset.from = tr.from;
-    line.dataset.to = tr.to;
-    line.dataset.node = String(tr.node ?? '');
-    line.dataset.sent = String(tr.sent);
-    line.dataset.received = String(tr.received);
-    line.dataset.wait = (tr.received - tr.waitFrom).toFixed(2);
-    const title = document.createElementNS(NS, 'title');
-    title.textContent = tr.to + ' waited ' + (tr.received - tr.waitFrom).toFixed(2) + ' s on ' + tr.from;
-    line.appendChild(title);
-    svg.appendChild(line);
-    tr.el = line;
-    const d = D.drones[D.droneIndex.get(tr.to)];
-    if (d && d.track && tr.received - tr.waitFrom > 0.01) {
-      const wait = el('div', 'wait', 'waits ' + (tr.received - tr.waitFrom).toFixed(2) + ' s on ' + tr.from);
-      wait.dataset.drone = tr.to;
-      wait.dataset.on = tr.from;
-      tr.waitEl = wait;
-      d.track.appendChild(wait);
-    }
+  const old = D.triggerList || [], now = triggers();
+  const same = (a, b) => a.from === b.from && a.to === b.to && a.sent === b.sent && a.received === b.received &&
+                         a.kind === b.kind && a.waitFrom === b.waitFrom;
+  let kept = 0;
+  while (kept < old.length && kept < now.length && old[kept].el && same(old[kept], now[kept])) kept++;
+  if (kept < old.length) {
+    for (const tr of old) { if (tr.el) tr.el.remove(); if (tr.waitEl) tr.waitEl.remove(); }
+    kept = 0;
+  }
+  if (!svg.querySelector('defs')) {
+    const defs = document.createElementNS(NS, 'defs');
+    defs.innerHTML = '<marker id="arrow" viewBox="0 0 10 10" refX="9" refY="5" markerWidth="7" markerHeight="7" orient="auto">' +
+                     '<path d="M0,0 L10,5 L0,10 z" fill="#6a1b9a"/></marker>';
+    svg.appendChild(defs);
+  }
+  D.triggerList = old.slice(0, kept).concat(now.slice(kept));
+  for (const tr of D.triggerList.slice(kept)) drawTrigger(svg, tr);
+}
+
+function drawTrigger(svg, tr) {
+  const NS = 'http://www.w3.org/2000/svg';
+  const line = document.createElementNS(NS, 'path');
+  line.setAttribute('class', 'trigger' + (tr.kind === 'abort' ? ' abort' : ''));
+  line.setAttribute('marker-end', 'url(#arrow)');
+  line.dataset.from = tr.from;
+  line.dataset.to = tr.to;
+  line.dataset.node = String(tr.node ?? '');
+  line.dataset.sent = String(tr.sent);
+  line.dataset.received = String(tr.received);
+  line.dataset.wait = (tr.received - tr.waitFrom).toFixed(2);
+  const title = document.createElementNS(NS, 'title');
+  title.textContent = tr.to + ' waited ' + (tr.received - tr.waitFrom).toFixed(2) + ' s on ' + tr.from;
+  line.appendChild(title);
+  svg.appendChild(line);
+  tr.el = line;
+  const d = D.drones[D.droneIndex.get(tr.to)];
+  if (d && d.track && tr.received - tr.waitFrom > 0.01) {
+    const wait = el('div', 'wait', 'waits ' + (tr.received - tr.waitFrom).toFixed(2) + ' s on ' + tr.from);
+    wait.dataset.drone = tr.to;
+    wait.dataset.on = tr.from;
+    tr.waitEl = wait;
+    d.track.appendChild(wait);
   }
 }
 
@@ -384,46 +472,47 @@ function barState(b) {
 
 function renderLanes() {
   if (D.drones.length > DOM_LANES_MAX) { renderLanesCanvas(); return; }
-  const w = trackWidth(), end = missionEnd(), px = t => (t / end) * w;
+  const w = S.trackW, end = axisEnd(), px = t => (t / end) * w;
   const now = S.clock;
   for (const b of D.bars) {
     if (!b.el) continue;
     const state = barState(b);
     const stop = b.end === null ? D.end : b.end;
     const shown = state === 'running' ? Math.min(now, stop) : stop;
-    b.el.dataset.state = state;
-    b.el.style.left = px(b.start) + 'px';
-    b.el.style.width = Math.max(3, px((state === 'future' ? stop : shown) - b.start)) + 'px';
+    putAttr(b.el, 'data-state', state);
+    put(b.el, 'left', px(b.start) + 'px');
+    put(b.el, 'width', Math.max(3, px((state === 'future' ? stop : shown) - b.start)) + 'px');
   }
   for (const c of D.conds) {
     if (!c.el) continue;
-    c.el.style.left = px(c.t) + 'px';
-    c.el.classList.toggle('future', c.t > now + 1e-9);
+    put(c.el, 'left', px(c.t) + 'px');
+    flag(c.el, 'future', c.t > now + 1e-9);
   }
   for (const v of D.violations) {
     if (!v.el) continue;
-    v.el.style.left = px(v.t) + 'px';
-    v.el.classList.toggle('future', v.t > now + 1e-9);
+    put(v.el, 'left', px(v.t) + 'px');
+    flag(v.el, 'future', v.t > now + 1e-9);
   }
-  const lanes = $('lanes');
+  // The lanes' size from what is known, not read back from the page (see render).
+  const laneH = 68, height = D.drones.length * laneH;
   const svg = $('triggers');
-  svg.setAttribute('width', String(lanes.scrollWidth));
-  svg.setAttribute('height', String(lanes.scrollHeight));
+  putAttr(svg, 'width', String(w + 84));
+  putAttr(svg, 'height', String(height));
   for (const tr of D.triggerList || []) {
     const a = D.droneIndex.get(tr.from), b = D.droneIndex.get(tr.to);
-    const laneH = 68, y1 = a * laneH + 14, y2 = b * laneH + (b > a ? 4 : 26);
+    const y1 = a * laneH + 14, y2 = b * laneH + (b > a ? 4 : 26);
     const x1 = xOf(tr.sent), x2 = xOf(tr.received);
-    tr.el.setAttribute('d', `M${x1},${y1} C${x1 + 30},${y1} ${x2 - 30},${y2} ${x2},${y2}`);
-    tr.el.classList.toggle('future', tr.received > now + 1e-9);
+    putAttr(tr.el, 'd', `M${x1},${y1} C${x1 + 30},${y1} ${x2 - 30},${y2} ${x2},${y2}`);
+    flag(tr.el, 'future', tr.received > now + 1e-9);
     if (tr.waitEl) {
-      tr.waitEl.style.left = px(tr.waitFrom) + 'px';
-      tr.waitEl.style.width = Math.max(2, px(tr.received - tr.waitFrom)) + 'px';
-      tr.waitEl.classList.toggle('future', tr.waitFrom > now + 1e-9);
+      put(tr.waitEl, 'left', px(tr.waitFrom) + 'px');
+      put(tr.waitEl, 'width', Math.max(2, px(tr.received - tr.waitFrom)) + 'px');
+      flag(tr.waitEl, 'future', tr.waitFrom > now + 1e-9);
     }
   }
   const head = $('playhead');
-  head.style.left = xOf(now) + 'px';
-  head.style.height = lanes.scrollHeight + 'px';
+  put(head, 'left', xOf(now) + 'px');
+  put(head, 'height', height + 'px');
 }
 
 // Level of detail for large fleets: one pixel row group per drone, bars merged below a pixel.
@@ -751,8 +840,11 @@ function onMessage(text) {
     S.live = !!S.mission.live;
     S.finished = false;
     S.events = [];
-    S.batches = 0;
+    S.undrawn = [];
+    S.latencies = [];
     S.arrivals = [];
+    S.serverDelays = [];
+    S.liveFrom = Infinity;
     resetDerived();
     $('mission-name').textContent = str(S.mission.mission);
     buildSource();
@@ -761,22 +853,31 @@ function onMessage(text) {
   } else if (m.type === 'events' && Array.isArray(m.events) && D) {
     for (const e of m.events) { S.events.push(e); ingest(e); }
     document.body.dataset.events = String(S.events.length);
-    // Wall arrival time against mission time, for the latency a live page sees (real-time runs).
-    const last = m.events[m.events.length - 1];
-    // The first batch is the history so far, not news.
-    S.batches = (S.batches || 0) + 1;
-    if (S.live && !S.finished && S.batches > 1 && last && typeof last.t === 'number')
-      S.arrivals.push([performance.now() / 1000, last.t]);
+    if (Array.isArray(m.emitted)) {
+      const arrived = wallNow();
+      for (const emitted of m.emitted) {
+        if (typeof emitted !== 'number' || emitted < S.liveFrom) continue;
+        S.undrawn.push(emitted);
+        S.arrivals.push(arrived - emitted);
+        if (typeof m.sent === 'number') S.serverDelays.push(m.sent - emitted);
+      }
+      if (S.arrivals.length > LATENCIES_MAX) S.arrivals.splice(0, S.arrivals.length - LATENCIES_MAX);
+      if (S.serverDelays.length > LATENCIES_MAX) S.serverDelays.splice(0, S.serverDelays.length - LATENCIES_MAX);
+      // What happened before the page had shown the mission and its history is old news, not lateness.
+      if (S.liveFrom === Infinity) S.liveFrom = arrived;
+    }
     // A page in a background tab gets no animation frames: keep its DOM current anyway.
     if (document.hidden) { if (S.live && !S.finished && S.follow) S.clock = missionEnd(); render(); }
   } else if (m.type === 'finished') {
     const first = !S.finished;
+    if (S.live && S.follow) S.clock = missionEnd();  // every event is in: follow it to the end
     S.finished = true;
-    document.body.dataset.finished = 'true';
     const start = new URLSearchParams(location.search).get('t');
     if (start !== null) { S.playing = false; setClock(Number(start)); }
     else if (first && !S.live) { setClock(0); S.playing = true; }
-    S.dirty = true;
+    // Drawn before it says so: whoever waits for data-finished (a test) reads the finished page.
+    render();
+    document.body.dataset.finished = 'true';
   }
 }
 
@@ -817,12 +918,11 @@ window.eamosMonitor = {
   setClock: t => { S.playing = false; S.follow = false; $('follow').checked = false; setClock(t); render(); },
   clock: () => S.clock,
   nodeState: id => stateAt(id),
-  // Spread of (arrival wall time − mission time) over the live batches, seconds: in a
-  // real-time run, how much later than the earliest one an event reached the page.
-  latencySpread: () => {
-    const d = S.arrivals.map(([wall, t]) => wall - t);
-    return d.length ? Math.max(...d) - Math.min(...d) : null;
-  },
+  // Live events: ms from eamos emitting one to this page having drawn it (see noteDrawn), and
+  // to its arrival here (the part the network and the server take).
+  liveLatency: () => latencyStats(S.latencies),
+  arrivalLatency: () => latencyStats(S.arrivals),
+  serverLatency: () => latencyStats(S.serverDelays),
   triggers: () => (D.triggerList || []).map(t => ({ from: t.from, to: t.to, sent: t.sent, received: t.received, wait: t.received - t.waitFrom })),
 };
 
