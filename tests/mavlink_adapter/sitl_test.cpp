@@ -32,8 +32,10 @@ using Sequences = std::map<std::string, std::vector<std::string>>;
 // budgets scale with it). Chosen so that three instances stay real-time on two cores.
 constexpr double kSpeed = 5;
 
-// How far a single position report on the orbit may be from the fitted circle's centre
-// beyond 5 m: TO BE MEASURED.
+// How far a single position report on the orbit may be from 5 m (distance from the fitted
+// circle's centre): 10 %, twice the fitted circle's 5 %. A single report carries the EKF's
+// noise and the position controller's swing around the circle; measured on both autopilots
+// (docs/adapters.md) the samples stayed within 4.67 .. 5.12 m.
 constexpr double kSampleBound = 0.5;
 
 struct Flight {
@@ -347,7 +349,7 @@ void Sitl::fly_listing2(const std::string& extra) {
     trail += std::to_string(radii[k]).substr(0, 4) + " ";
   std::cout << "  radii along the orbit: " << trail << "\n";
   // Orbit() is 5 m, held within 5 % (issue 12) by the circle flown, and every sample within
-  // SAMPLE_BOUND.
+  // kSampleBound.
   EXPECT_NEAR(orbit->radius, 5.0, 0.25);
   EXPECT_GE(*low, 5.0 - kSampleBound);
   EXPECT_LE(*high, 5.0 + kSampleBound);
