@@ -346,12 +346,12 @@ bool wait_for(CameraSetup& cs, double deadline, const std::function<void()>& ask
 
 // ArduPilot creates its camera backend only at boot. CAM1_TYPE 1 in the --defaults file is
 // read back as 0 after boot on this 4.7 build, and a reboot by MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN
-// (SITL re-executes itself in place) lost the camera in about half the runs: with `-w` among
-// the arguments it re-executes with, the saved CAM1_TYPE was wiped again, and after it the
-// new boot sometimes never answered on the reconnected link. So the camera is set as a user
-// sets it, PARAM_SET CAM1_TYPE 1 (saved to the instance's eeprom.bin), and the fixture
-// restarts the instance itself: stopped, then started again in its folder without `-w`
-// (command_line()). wait_ready() then reads CAM1_TYPE back from the new boot.
+// (SITL re-executes itself in place, with its own arguments: `-w`, "wipe the saved
+// parameters", included) lost the camera in about half the runs, and once here the reboot
+// did not happen at all. So the camera is set as a user sets it, PARAM_SET CAM1_TYPE 1
+// (saved to the instance's eeprom.bin), and the fixture power-cycles the instance itself:
+// stopped, then started again in its folder, without `-w` (command_line()). wait_ready()
+// then reads CAM1_TYPE back from the new boot.
 bool SitlFleet::set_up_ardupilot_camera(int i, double deadline, std::string& error) {
   CameraSetup cs;
   const uint8_t vehicle = static_cast<uint8_t>(sysid(i));
