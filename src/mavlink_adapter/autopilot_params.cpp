@@ -16,6 +16,7 @@ const std::vector<LimitParam> kArduPilot = {
     {"WPNAV_SPEED_DN", LimitKind::descent, 0.01}, {"LAND_SPEED", LimitKind::land, 0.01},
     {"LAND_SPEED_HIGH", LimitKind::land, 0.01},
     {"MOT_SPOOL_TIME", LimitKind::takeoff_delay, 1.0}, {"TKOFF_SLEW_TIME", LimitKind::takeoff_delay, 1.0},
+    {"WPNAV_ACCEL", LimitKind::accel, 0.01},  // GUIDED's position controller limit (cm/s²)
 };
 // PX4 (multicopter position control): m/s. A takeoff climbs at MPC_TKO_SPEED, a landing
 // ends at MPC_LAND_SPEED.
@@ -24,6 +25,7 @@ const std::vector<LimitParam> kPx4 = {
     {"MPC_TKO_SPEED", LimitKind::climb, 1.0},    {"MPC_Z_VEL_MAX_DN", LimitKind::descent, 1.0},
     {"MPC_LAND_SPEED", LimitKind::land, 1.0},
     {"COM_SPOOLUP_TIME", LimitKind::takeoff_delay, 1.0}, {"MPC_TKO_RAMP_T", LimitKind::takeoff_delay, 1.0},
+    {"MPC_ACC_HOR", LimitKind::accel, 1.0},
 };
 
 const char* fleet_key(LimitKind k) {
@@ -32,7 +34,8 @@ const char* fleet_key(LimitKind k) {
     case LimitKind::climb: return "max_climb";
     case LimitKind::descent:
     case LimitKind::land: return "max_descent";
-    case LimitKind::takeoff_delay: return "";
+    case LimitKind::takeoff_delay:
+    case LimitKind::accel: return "";
   }
   return "";
 }
@@ -97,6 +100,11 @@ FlightLimits combine_limits(const Autopilot& a, const fleet::Limits& fleet,
     slot.value = std::min(slot.value, *s.mps);
   }
   out.land_mps = std::min(out.land_mps, out.motion.max_descent_mps);
+  // No warning either way: only the orbit's speed depends on it, and it flies slower.
+  if (Slowest a = slowest(params, LimitKind::accel, values); a.mps) {
+    out.motion.max_accel_mps2 = std::min(out.motion.max_accel_mps2, *a.mps);
+    out.summary += std::string(out.summary.empty() ? "" : ", ") + a.param + " " + number(*a.mps) + " m/s²";
+  }
   // Delays add up; one the autopilot does not have (an older version) is no delay.
   for (const LimitParam& p : params) {
     auto it = values.find(p.name);

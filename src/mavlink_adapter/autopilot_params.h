@@ -17,10 +17,12 @@ namespace eamos::mavlink_adapter {
 /// Which limit a parameter bounds.
 /// takeoff_delay: seconds a takeoff spends before and beside its climb (motor spool-up,
 /// the throttle or speed ramp); those of one autopilot add up.
-enum class LimitKind { speed, climb, descent, land, takeoff_delay };
+/// accel: the horizontal acceleration the autopilot's position controller allows (m/s²); an
+/// orbit's centripetal acceleration must stay below it or the vehicle swings wide.
+enum class LimitKind { speed, climb, descent, land, takeoff_delay, accel };
 
-/// One parameter that bounds a limit: its name and the factor to m/s (ArduPilot: cm/s), or
-/// to seconds for a takeoff delay.
+/// One parameter that bounds a limit: its name and the factor to m/s (ArduPilot: cm/s), to
+/// m/s² for an acceleration, or to seconds for a takeoff delay.
 struct LimitParam {
   const char* name;
   LimitKind kind;
@@ -32,7 +34,8 @@ std::vector<LimitParam> limit_params(const Autopilot& a);
 
 /// The limits deadlines are derived from.
 struct FlightLimits {
-  fleet::Limits motion;      ///< speed, climb, descent of flying actions (FlyTo, Takeoff, …)
+  fleet::Limits motion;      ///< speed, climb, descent of flying actions (FlyTo, Takeoff, …);
+                             ///< max_accel_mps2 bounds the orbit's speed
   double land_mps = 0.0;     ///< descent of Land and ReturnHome (the autopilot's landing speed)
   /// Seconds a Takeoff takes beyond its climb at `motion.max_climb_mps`: measured on PX4 SIH,
   /// a 4 m takeoff spends 1 s spooling up (COM_SPOOLUP_TIME) and 3 s ramping its climb rate

@@ -22,8 +22,12 @@ constexpr double kRadiusGain = 0.5;     ///< 1/s (2.0 was measured to oscillate,
 }  // namespace
 
 double MavlinkDrone::orbit_speed(double radius) const {
-  // The simulator's: as fast as allowed while the centripetal acceleration keeps a margin.
-  const fleet::Limits& l = settings_.limits;
+  // The simulator's: as fast as allowed while the centripetal acceleration keeps a margin,
+  // within the slower of the fleet's and the autopilot's acceleration (ArduPilot
+  // WPNAV_ACCEL, PX4 MPC_ACC_HOR). Above the autopilot's the vehicle cannot turn that tight:
+  // on ArduCopter at 4 m/s (3.2 m/s² for 5 m, WPNAV_ACCEL 2.5) the orbit came out 4.72 m,
+  // at 3.16 m/s 4.83 m before the radius correction below.
+  const fleet::Limits& l = limits_.motion;
   return std::min(l.max_speed_mps, std::sqrt(0.8 * l.max_accel_mps2 * radius));
 }
 
@@ -93,12 +97,17 @@ void MavlinkDrone::advance_orbit(double dt) {
     if (horizontal_norm(position() - setpoint_) <= options_.tolerance.horizontal_m) orbit_.on_circle = true;
     return;
   }
-  orbit_.angle = std::fmod(orbit_.angle + orbit_speed(r) * dt / r, 2.0 * M_PI);
+  // Moved by the vehicle's clock, which a SITL on a loaded machine runs slower than --speed:
+  // moved by mission time, the setpoint would go round faster than the vehicle can turn.
+  const double vehicle_dt = dt * std::clamp(vehicle_clock_rate(), 0.2, 2.0);
+  orbit_.angle = std::fmod(orbit_.angle + orbit_speed(r) * vehicle_dt / r, 2.0 * M_PI);
   // A position setpoint moving around the circle is followed with a lag, along a chord:
-  // ArduCopter circled at 4.5 m for 5 m. Velocity feed-forward was tried and overshot (7.4 m
-  // with velocity, 3.3 m with velocity and acceleration: GUIDED moves its target by the
-  // velocity between our setpoints). So the commanded radius is corrected by what the
-  // vehicle flies: an integral on the radius error, within r … 1.5 r.
+  // ArduCopter circled at 4.5 m for 5 m. Feed-forward was tried and measured on ArduCopter
+  // SITL, at the accel-bounded speed too: with velocity the orbit grew to 6.9 m, with
+  // velocity and acceleration it shrank to 4.3 m and wobbled (3.6 .. 5.0 m), with velocity
+  // setpoints steered by the measured radius it swung 4.6 .. 5.1 m. Position setpoints stay
+  // the tightest. So the commanded radius is corrected by what the vehicle flies: an
+  // integral on the radius error, within r … 1.5 r.
   if (vehicle_.have_position) {
     double flown = horizontal_norm(position() - orbit_.centre);
     orbit_.commanded_radius = std::clamp(orbit_.commanded_radius + kRadiusGain * dt * (r - flown), r, 1.5 * r);

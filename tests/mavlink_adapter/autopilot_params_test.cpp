@@ -27,5 +27,19 @@ TEST(AutopilotParams, AMissingOrZeroDelayIsNoDelayAndNoWarning) {
   for (const std::string& w : l.warnings) EXPECT_EQ(w.find("SLEW"), std::string::npos) << w;
 }
 
+// The orbit's speed keeps its centripetal acceleration below the autopilot's: beyond
+// WPNAV_ACCEL / MPC_ACC_HOR the vehicle cannot turn as tight and swings wide.
+TEST(AutopilotParams, TheHorizontalAccelerationIsTheSlowerOfTheFleetsAndTheAutopilots) {
+  const Autopilot& ap = *autopilot_for(mavlink::autopilot::ARDUPILOTMEGA);
+  EXPECT_DOUBLE_EQ(combine_limits(ap, fleet::Limits{}, {{"WPNAV_ACCEL", 250}}).motion.max_accel_mps2, 2.5);
+  const Autopilot& px4 = *autopilot_for(mavlink::autopilot::PX4);
+  fleet::Limits gentle;
+  gentle.max_accel_mps2 = 2.0;
+  EXPECT_DOUBLE_EQ(combine_limits(px4, gentle, {{"MPC_ACC_HOR", 3}}).motion.max_accel_mps2, 2.0);
+  FlightLimits told = combine_limits(px4, fleet::Limits{}, {{"MPC_ACC_HOR", 3}});
+  EXPECT_DOUBLE_EQ(told.motion.max_accel_mps2, 3.0);
+  EXPECT_NE(told.summary.find("MPC_ACC_HOR 3 m/s²"), std::string::npos) << told.summary;
+}
+
 }  // namespace
 }  // namespace eamos::mavlink_adapter

@@ -33,6 +33,13 @@ using Sequences = std::map<std::string, std::vector<std::string>>;
 // budgets scale with it). Chosen so that three instances stay real-time on two cores.
 constexpr double kSpeed = 5;
 
+// How far a single position report on the orbit may be from 5 m (distance from the fitted
+// circle's centre): 10 %, twice the fitted circle's 5 %. A single report carries the EKF's
+// noise and the position controller's swing around the circle; measured (docs/adapters.md)
+// ArduCopter's stayed within 4.76 .. 5.15 m, PX4's within 4.58 .. 5.32 m when its fitted
+// circle held 5 %.
+constexpr double kSampleBound = 0.5;
+
 struct Flight {
   eamos_test::Output run;
   std::map<std::string, std::vector<std::string>> actions;  ///< drone -> "Action outcome"
@@ -325,11 +332,6 @@ TEST_P(Sitl, LinkLossFailsTheMissionAndEveryOtherDroneRunsItsFailsafe) {
 // configured: every drone runs the same actions with the same outcomes as in the simulator,
 // Drone2's pictures are confirmed by its camera, and it orbits at 5 m within 5 %.
 void Sitl::fly_listing2(const std::string& extra) {
-  // Known failures on ArduCopter (docs/adapters.md, "SITL tests"): not hidden, but not run
-  // until fixed, so the suite stays a signal.
-  if (GetParam() == Autopilot::ardupilot)
-    GTEST_SKIP() << "known failure (issue 12): ArduCopter orbits from GUIDED setpoints at 4.72 m, not 5 m +- 5 %, "
-                    "and its camera (CAM1_TYPE, set before a reboot) is not always there after the reboot";
   std::string sim_out;
   eamos_test::Output sim = eamos_test::run_eamos("run " + listing2() + " --fleet " + EAMOS_SOURCE_DIR +
                                                  "/examples/listing2-right.yaml --trace " + (dir_ / "sim.jsonl").string());
@@ -363,10 +365,11 @@ void Sitl::fly_listing2(const std::string& extra) {
   for (std::size_t k = 0; k < radii.size(); k += std::max<std::size_t>(1, radii.size() / 20))
     trail += std::to_string(radii[k]).substr(0, 4) + " ";
   std::cout << "  radii along the orbit: " << trail << "\n";
-  // Orbit() is 5 m. Issue 12 asks for 5 %; PX4's own ORBIT mode has been measured at
-  // 4.66-4.97 m fitted, single samples swinging 4.41-5.15 m (docs/adapters.md), so this
-  // holds the fitted circle to 10 % until the adapter leads PX4's orbit.
-  EXPECT_NEAR(orbit->radius, 5.0, 0.5);
+  // Orbit() is 5 m, held within 5 % (issue 12) by the circle flown, and every sample within
+  // kSampleBound.
+  EXPECT_NEAR(orbit->radius, 5.0, 0.25);
+  EXPECT_GE(*low, 5.0 - kSampleBound);
+  EXPECT_LE(*high, 5.0 + kSampleBound);
 }
 
 TEST_P(Sitl, Listing2FliesTheSimulatorsActionsWithConfirmedPicturesAndAFiveMetreOrbit) { fly_listing2(""); }

@@ -127,10 +127,15 @@ std::vector<std::string> SitlFleet::command_line(int i, const std::string& bin) 
   geographic_home(options_.homes[i], lat, lon);
   if (options_.autopilot == Autopilot::ardupilot) {
     std::string parm = (fs::path(bin).parent_path() / "copter.parm").string();
-    return {bin, "-I", std::to_string(instance_number(i)), "--model", "+", "--speedup", fixed(options_.speedup, 2),
-            "--sysid", std::to_string(sysid(i)),
-            "--home", fixed(lat, 8) + "," + fixed(lon, 8) + "," + fixed(kOriginAlt, 1) + ",0",
-            "--defaults", parm, "-w", "--serial0", "tcp:0"};
+    std::vector<std::string> args = {
+        bin, "-I", std::to_string(instance_number(i)), "--model", "+", "--speedup", fixed(options_.speedup, 2),
+        "--sysid", std::to_string(sysid(i)), "--home", fixed(lat, 8) + "," + fixed(lon, 8) + "," + fixed(kOriginAlt, 1) + ",0",
+        "--defaults", parm, "--serial0", "tcp:0"};
+    // -w wipes the saved parameters. The folder is new and empty, so there is nothing to wipe
+    // at the first boot, and the camera set-up restarts the instance with the same arguments
+    // to keep the CAM1_TYPE it saved (set_up_ardupilot_camera()).
+    if (!options_.camera) args.insert(args.end() - 2, "-w");
+    return args;
   }
   std::string etc = (fs::path(bin).parent_path().parent_path() / "etc").string();
   return {instances_[i].dir + "/bin/px4", "-i", std::to_string(instance_number(i)), "-d", etc};
@@ -163,7 +168,14 @@ bool SitlFleet::start_one(int i, std::string& error) {
   inst.dir = tmpl;
   instances_.push_back(inst);
   if (options_.autopilot == Autopilot::px4) prepare_px4_bin(inst.dir, bin);
-  std::vector<std::string> args = command_line(i, bin);
+  return spawn(i, error);
+}
+
+// Starts instance i's process in its folder (again, after restart_instance()'s stop: it
+// keeps what the instance saved there).
+bool SitlFleet::spawn(int i, std::string& error) {
+  const Instance& inst = instances_.at(i);
+  std::vector<std::string> args = command_line(i, binary(options_.autopilot));
   double lat, lon;
   geographic_home(options_.homes[i], lat, lon);
   std::string log = inst.dir + "/out.log";
@@ -177,7 +189,7 @@ bool SitlFleet::start_one(int i, std::string& error) {
     // otherwise outlive a crashed test; ArduPilot watches its parent by itself).
     prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (chdir(inst.dir.c_str()) != 0) _exit(127);
-    int out = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    int out = open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
     int in = open("/dev/null", O_RDONLY);
     if (out < 0 || in < 0) _exit(127);
     dup2(in, 0);
@@ -201,7 +213,7 @@ bool SitlFleet::start_one(int i, std::string& error) {
     execv(argv[0], argv.data());
     _exit(127);
   }
-  instances_.back().pid = pid;
+  instances_[i].pid = pid;
   return true;
 }
 
@@ -262,9 +274,18 @@ struct Readiness {
   bool position = false;
   bool ekf_uses_gps = false;  ///< ArduPilot: "EKF3 IMU0 is using GPS"; GUIDED needs it
   bool need_ekf_text = false;
-  bool ready() const { return heartbeat && prearm_ok && position && (ekf_uses_gps || !need_ekf_text); }
+  bool need_camera = false;  ///< ArduPilot with a camera: CAM1_TYPE must read back 1
+  std::optional<float> cam1_type;
+  bool camera_ok() const { return !need_camera || cam1_type == 1.0f; }
+  bool booted() const { return heartbeat && prearm_ok && position && (ekf_uses_gps || !need_ekf_text); }
+  bool ready() const { return booted() && camera_ok(); }
+  /// Ready, but CAM1_TYPE was read and is not 1: the camera did not take.
+  bool ready_but_camera() const { return booted() && cam1_type && !camera_ok(); }
   std::string missing() const {
     if (!heartbeat) return "no HEARTBEAT";
+    if (!camera_ok())
+      return cam1_type ? "CAM1_TYPE reads " + std::to_string(*cam1_type) + " after boot, not 1 (no camera)"
+                       : "no answer to PARAM_REQUEST_READ CAM1_TYPE";
     if (!prearm_ok) return "pre-arm checks not passed (SYS_STATUS)";
     if (!position) return "no position (GLOBAL_POSITION_INT)";
     return "the EKF does not use GPS yet (no STATUSTEXT 'is using GPS')";
@@ -279,13 +300,16 @@ void on_probe_frame(Readiness& r, uint8_t sysid, const ml::Frame& f) {
   // health checks pass; ArduPilot sets it in both. So the health bit alone decides.
   if (auto s = ml::unpack_sys_status(f.message)) r.prearm_ok = (s->sensors_health & kPrearmCheck) != 0;
   if (auto g = ml::unpack_global_position_int(f.message)) r.position = g->lat != 0 || g->lon != 0;
+  if (auto p = ml::unpack_param_value(f.message))
+    if (p->param_id == "CAM1_TYPE") r.cam1_type = p->param_value;
   if (auto t = ml::unpack_statustext(f.message))
     if (t->text.find("is using GPS") != std::string::npos) r.ekf_uses_gps = true;
   r.changed.notify_all();
 }
 
-// Asks for the two messages readiness is judged by, at 2 Hz, announcing a ground station.
-void ask_for_status(ml::Link& link, ml::Encoder& encoder, uint8_t sysid) {
+// Asks for the two messages readiness is judged by, at 2 Hz, announcing a ground station;
+// `camera`: and for CAM1_TYPE (ArduPilot), which must be 1.
+void ask_for_status(ml::Link& link, ml::Encoder& encoder, uint8_t sysid, bool camera) {
   ml::Heartbeat hb;
   hb.type = 6;       // MAV_TYPE_GCS
   hb.autopilot = 8;  // MAV_AUTOPILOT_INVALID
@@ -299,6 +323,7 @@ void ask_for_status(ml::Link& link, ml::Encoder& encoder, uint8_t sysid) {
     c.param[1] = 500000;
     link.send(encoder.encode(ml::pack(c)));
   }
+  if (camera) link.send(encoder.encode(ml::pack(ml::ParamRequestRead{sysid, 1, "CAM1_TYPE", -1})));
 }
 
 // What the camera set-up has seen of one ArduPilot instance, filled on the link's thread.
@@ -309,13 +334,9 @@ struct CameraSetup {
   std::map<std::string, float> params;  ///< PARAM_VALUEs by name
 };
 
-ml::Message command_long(uint8_t sysid, uint16_t id, std::array<float, 7> params) {
-  ml::CommandLong c;
-  c.target_system = sysid;
-  c.target_component = 1;
-  c.command = id;
-  c.param = params;
-  return ml::pack(c);
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
 // Waits (bounded by `deadline`, resending `ask` every half second) until `done` holds.
@@ -333,10 +354,14 @@ bool wait_for(CameraSetup& cs, double deadline, const std::function<void()>& ask
 
 }  // namespace
 
-// ArduPilot creates its camera backend only at boot. CAM1_TYPE in a second --defaults file
-// did not take on this 4.7 build (PARAM_VALUE said 0 after boot), so the camera is set up as
-// a user does it: PARAM_SET CAM1_TYPE 1 (saved to the instance's eeprom.bin), then
-// MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN; the instance restarts in place and keeps the parameter.
+// ArduPilot creates its camera backend only at boot. CAM1_TYPE 1 in the --defaults file is
+// read back as 0 after boot on this 4.7 build, and a reboot by MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN
+// (SITL re-executes itself in place, with its own arguments: `-w`, "wipe the saved
+// parameters", included) lost the camera in about half the runs, and once here the reboot
+// did not happen at all. So the camera is set as a user sets it, PARAM_SET CAM1_TYPE 1
+// (saved to the instance's eeprom.bin), and the fixture power-cycles the instance itself:
+// stopped, then started again in its folder, without `-w` (command_line()). wait_ready()
+// then reads CAM1_TYPE back from the new boot.
 bool SitlFleet::set_up_ardupilot_camera(int i, double deadline, std::string& error) {
   CameraSetup cs;
   const uint8_t vehicle = static_cast<uint8_t>(sysid(i));
@@ -347,81 +372,76 @@ bool SitlFleet::set_up_ardupilot_camera(int i, double deadline, std::string& err
     if (auto p = ml::unpack_param_value(f.message)) cs.params[p->param_id] = p->param_value;
     cs.changed.notify_all();
   };
-  auto open = [&]() -> std::unique_ptr<ml::Link> {
-    ml::OpenResult opened;
-    while (!opened.link && now_s() < deadline) {
-      opened = ml::Link::open(*ml::parse_url(connection(i)).endpoint, handler, 0.2);
-      if (!opened.link) usleep(100000);
-    }
-    return std::move(opened.link);
-  };
-  std::unique_ptr<ml::Link> link = open();
-  ml::Encoder encoder{250, 190, 0};
-  auto send = [&](const ml::Message& m) {
-    if (link) link->send(encoder.encode(m));
-  };
-  auto ask = [&](const char* param) {
-    ml::Heartbeat hb;
-    hb.type = 6;
-    hb.autopilot = 8;
-    send(ml::pack(hb));
-    send(ml::pack(ml::ParamRequestRead{vehicle, 1, param, -1}));
-  };
-  auto param = [&](const char* name) -> std::optional<float> {
-    auto it = cs.params.find(name);
-    return it == cs.params.end() ? std::nullopt : std::optional<float>(it->second);
-  };
-  // STAT_BOOTCNT counts the autopilot's boots: one more is the reboot done.
-  const char* step = "reading STAT_BOOTCNT";
-  bool ok = link && wait_for(cs, deadline, [&] { ask("STAT_BOOTCNT"); }, [&] { return param("STAT_BOOTCNT").has_value(); });
-  std::unique_lock boots_lock(cs.mutex);
-  float boots = ok ? *param("STAT_BOOTCNT") : 0;
-  boots_lock.unlock();
-  // ArduPilot saves a parameter from its IO thread, after the PARAM_VALUE echo: on a loaded
-  // machine a reboot right after the echo sometimes came first and CAM1_TYPE was 0 again.
-  // So: set, reboot, check; up to three times.
-  for (int attempt = 0; ok && attempt < 3; ++attempt) {
-    step = "PARAM_SET CAM1_TYPE 1";
-    {
-      std::lock_guard lock(cs.mutex);
-      cs.params.erase("CAM1_TYPE");
-    }
-    ok = wait_for(cs, deadline, [&] { send(ml::pack(ml::ParamSet{vehicle, 1, "CAM1_TYPE", 1.0f, ml::param_type::INT8})); },
-                  [&] { return param("CAM1_TYPE") == 1.0f; });
-    if (!ok) break;
-    step = "rebooting";
-    // param1 = 1: reboot the autopilot. SITL restarts by exec in the same process; connect
-    // again until the new boot answers, repeating the reboot while the old one still does.
-    auto reboot = [&] { send(command_long(vehicle, 246, {1, 0, 0, 0, 0, 0, 0})); };
-    reboot();
-    auto rebooted = [&] { return param("STAT_BOOTCNT") > boots; };
-    int tries = 0;
-    while (ok) {
-      link.reset();
-      link = open();
-      ok = link != nullptr;
-      if (ok && wait_for(cs, std::min(deadline, now_s() + 2.0), [&] { ask("STAT_BOOTCNT"); }, rebooted)) break;
-      std::unique_lock lock(cs.mutex);
-      if (param("STAT_BOOTCNT") == boots && ++tries % 2 == 0) reboot();  // the old boot answers still
-      lock.unlock();
-      ok = now_s() < deadline;
-    }
-    if (!ok) break;
-    {
-      std::lock_guard lock(cs.mutex);
-      boots = *param("STAT_BOOTCNT");
-      cs.params.erase("CAM1_TYPE");
-    }
-    step = "checking CAM1_TYPE after the reboot";
-    ok = wait_for(cs, deadline, [&] { ask("CAM1_TYPE"); }, [&] { return param("CAM1_TYPE").has_value(); });
-    std::lock_guard lock(cs.mutex);
-    if (ok && param("CAM1_TYPE") == 1.0f) break;
-    ok = ok && attempt < 2;
+  ml::OpenResult opened;
+  while (!opened.link && now_s() < deadline) {
+    opened = ml::Link::open(*ml::parse_url(connection(i)).endpoint, handler, 0.2);
+    if (!opened.link) usleep(100000);  // ArduPilot opens its TCP port a moment after start
   }
-  link.reset();
-  if (!ok)
-    error = "SITL instance " + std::to_string(i) + ": camera set-up did not finish: " + step + "\n" + log_tail(i);
-  return ok;
+  ml::Encoder encoder{250, 190, 0};
+  auto set = [&] {
+    opened.link->send(encoder.encode(ml::pack(ml::ParamSet{vehicle, 1, "CAM1_TYPE", 1.0f, ml::param_type::INT8})));
+  };
+  auto echoed = [&] {
+    auto it = cs.params.find("CAM1_TYPE");
+    return it != cs.params.end() && it->second == 1.0f;
+  };
+  // The PARAM_VALUE echo comes before ArduPilot's IO thread has written the parameter to
+  // eeprom.bin; stopped before that, the instance boots without it. So the restart waits for
+  // the file to change (nothing else is saved a few seconds after boot).
+  const std::string eeprom = instances_.at(i).dir + "/eeprom.bin";
+  const std::string before = read_file(eeprom);
+  bool ok = opened.link && wait_for(cs, deadline, set, echoed);
+  opened.link.reset();
+  if (!ok) {
+    error = "SITL instance " + std::to_string(i) + ": PARAM_SET CAM1_TYPE 1 not echoed\n" + log_tail(i);
+    return false;
+  }
+  const double saved_by = std::min(deadline, now_s() + 10.0);
+  while (read_file(eeprom) == before) {
+    if (now_s() > saved_by) {
+      error = "SITL instance " + std::to_string(i) + ": CAM1_TYPE 1 echoed but eeprom.bin did not change\n" + log_tail(i);
+      return false;
+    }
+    usleep(20000);
+  }
+  return restart_instance(i, error);
+}
+
+bool SitlFleet::restart_instance(int i, std::string& error) {
+  Instance& inst = instances_.at(i);
+  kill(inst.pid, SIGTERM);
+  double deadline = now_s() + 5.0;
+  while (waitpid(inst.pid, nullptr, WNOHANG) == 0) {
+    if (now_s() > deadline) {
+      kill(inst.pid, SIGKILL);
+      waitpid(inst.pid, nullptr, 0);
+      break;
+    }
+    usleep(20000);
+  }
+  inst.pid = -1;
+  return spawn(i, error);
+}
+
+bool SitlFleet::wait_ready(double timeout_s, std::string& error) {
+  const double deadline = now_s() + timeout_s;
+  if (!options_.camera || options_.autopilot != Autopilot::ardupilot) return wait_all_ready(deadline, false, error);
+  // The camera is set once the instance has booted completely (ready): a PARAM_SET during
+  // its start-up was overwritten by ArduPilot's own start-up (CAM1_TYPE 0 after the restart).
+  // Checked on the new boot; set again if it still did not take.
+  if (!wait_all_ready(deadline, false, error)) return false;
+  std::vector<int> todo;
+  for (int i = 0; i < size(); ++i) todo.push_back(i);
+  for (int attempt = 0; attempt < 3 && !todo.empty(); ++attempt) {
+    for (int i : todo)
+      if (!set_up_ardupilot_camera(i, deadline, error)) return false;
+    todo.clear();
+    if (!wait_all_ready(deadline, true, error, &todo)) return false;
+  }
+  if (todo.empty()) return true;
+  error = "SITL instance " + std::to_string(todo.front()) + ": CAM1_TYPE still 0 after three restarts\n" +
+          log_tail(todo.front());
+  return false;
 }
 
 // PX4 puts an integer parameter's bits in PARAM_VALUE's float (the MAVLink "bytewise"
@@ -474,16 +494,15 @@ bool SitlFleet::set_param(int i, const std::string& name, float value, uint8_t t
 
 // Short-lived links of the test's own, one per instance and all open at once (a STATUSTEXT
 // is sent once, to whoever is connected then); closed before eamos opens the same ports.
-bool SitlFleet::wait_ready(double timeout_s, std::string& error) {
-  double deadline = now_s() + timeout_s;
-  if (options_.camera && options_.autopilot == Autopilot::ardupilot)
-    for (int i = 0; i < size(); ++i)
-      if (!set_up_ardupilot_camera(i, deadline, error)) return false;
+// `camera`: CAM1_TYPE must read 1 too; the instances where it reads 0 go to `no_camera`
+// (then the others are still waited for and true is returned), or fail when it is null.
+bool SitlFleet::wait_all_ready(double deadline, bool camera, std::string& error, std::vector<int>* no_camera) {
   std::vector<std::unique_ptr<Readiness>> state;
   std::vector<std::unique_ptr<ml::Link>> links;
   for (int i = 0; i < size(); ++i) {
     state.push_back(std::make_unique<Readiness>());
     state.back()->need_ekf_text = options_.autopilot == Autopilot::ardupilot;
+    state.back()->need_camera = camera;
     Readiness* r = state.back().get();
     uint8_t vehicle = static_cast<uint8_t>(sysid(i));
     // ArduPilot opens its TCP port a moment after it starts: try again until the deadline.
@@ -503,17 +522,19 @@ bool SitlFleet::wait_ready(double timeout_s, std::string& error) {
   for (int i = 0; i < size(); ++i) {
     Readiness& r = *state[i];
     std::unique_lock lock(r.mutex);
-    while (!r.ready()) {
+    auto settled = [&] { return r.ready() || (no_camera && r.ready_but_camera()); };
+    while (!settled()) {
       if (now_s() > deadline) {
-        error = "SITL instance " + std::to_string(i) + " not ready after " + fixed(timeout_s, 0) +
-                " s: " + r.missing() + "\n" + log_tail(i);
+        error = "SITL instance " + std::to_string(i) + " not ready: " + r.missing() + "\n" + log_tail(i);
         return false;
       }
       lock.unlock();
-      for (int k = 0; k < size(); ++k) ask_for_status(*links[k], encoder, static_cast<uint8_t>(sysid(k)));
+      for (int k = 0; k < size(); ++k)
+        ask_for_status(*links[k], encoder, static_cast<uint8_t>(sysid(k)), state[k]->need_camera);
       lock.lock();
-      r.changed.wait_for(lock, std::chrono::milliseconds(500), [&] { return r.ready(); });
+      r.changed.wait_for(lock, std::chrono::milliseconds(500), settled);
     }
+    if (!r.ready()) no_camera->push_back(i);
   }
   return true;
 }

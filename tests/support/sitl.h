@@ -32,9 +32,9 @@ struct SitlOptions {
   /// instances must be 0..9: above, PX4 sends every offboard link to 14549 (start() refuses).
   int first_instance = -1;
   /// A camera configured the way a user sets one up for pictures: ArduPilot CAM1_TYPE 1
-  /// (servo-triggered; set with PARAM_SET and a reboot in wait_ready(), as its camera
-  /// backend exists only from boot), PX4 TRIG_MODE 1 (camera_trigger on command; SITL's
-  /// TRIG_INTERFACE is 3, MAVLink). false: stock parameters, no camera.
+  /// (servo-triggered; set with PARAM_SET and the instance restarted in wait_ready(), as its
+  /// camera backend exists only from boot, and read back once ready), PX4 TRIG_MODE 1 (camera_trigger on command;
+  /// SITL's TRIG_INTERFACE is 3, MAVLink). false: stock parameters, no camera.
   bool camera = false;
 };
 
@@ -79,10 +79,14 @@ class SitlFleet {
     std::string dir;
   };
   bool start_one(int i, std::string& error);
+  bool spawn(int i, std::string& error);
+  /// Stops instance i and starts it again in its folder, as a power cycle.
+  bool restart_instance(int i, std::string& error);
   int instance_number(int i) const { return first_instance_ + i; }
   std::vector<std::string> command_line(int i, const std::string& binary) const;
   void prepare_px4_bin(const std::string& dir, const std::string& binary) const;
   bool set_up_ardupilot_camera(int i, double deadline, std::string& error);
+  bool wait_all_ready(double deadline, bool camera, std::string& error, std::vector<int>* no_camera = nullptr);
 
   SitlOptions options_;
   int first_instance_ = 0;
