@@ -37,6 +37,11 @@ constexpr double kOriginLat = 47.397742;
 constexpr double kOriginLon = 8.545594;
 constexpr double kOriginAlt = 488.0;
 constexpr uint32_t kPrearmCheck = 0x10000000;  // MAV_SYS_STATUS_PREARM_CHECK
+// ArduCopter SITL's battery current in flight (`--model +`, stock copter.parm), measured on
+// this binary: with the stock BATT_CAPACITY 3300 mAh its remaining % fell by 1 every 4.1 s
+// hovering at 10 m (and as fast during the takeoff), 33 mAh per 4.1 s. Turns a drain time
+// into BATT_CAPACITY.
+constexpr double kArduCopterSitlHoverA = 29;
 
 double now_s() {
   using namespace std::chrono;
@@ -105,6 +110,16 @@ bool SitlFleet::start(std::string& error) {
   std::string bin = binary(options_.autopilot);
   if (bin.empty()) {
     error = skip_message(options_.autopilot);
+    return false;
+  }
+  // px4-rc.mavlink: "[ $px4_instance -gt 9 ] && udp_offboard_port_remote=14549", so every
+  // instance above 9 sends its offboard link to one port and the fleet's udp://:14540+n hears
+  // nothing (seen as "not ready: no HEARTBEAT" after the whole wait).
+  int last = instance_number(static_cast<int>(options_.homes.size()) - 1);
+  if (options_.autopilot == Autopilot::px4 && last > 9) {
+    error = "PX4 SITL instance " + std::to_string(last) + " would send to UDP 14549, not " +
+            std::to_string(14540 + last) + " (instances above 9 share that port): set EAMOS_SITL_FIRST_INSTANCE to " +
+            std::to_string(10 - static_cast<int>(options_.homes.size())) + " or less";
     return false;
   }
   for (int i = 0; i < static_cast<int>(options_.homes.size()); ++i)
@@ -182,6 +197,9 @@ bool SitlFleet::start_one(int i, std::string& error) {
       setenv("PX4_SIM_SPEED_FACTOR", fixed(options_.speedup, 2).c_str(), 1);
       // rcS sets parameters from PX4_PARAM_<name> before it starts camera_trigger.
       if (options_.camera) setenv("PX4_PARAM_TRIG_MODE", "1", 1);
+      // battery_simulator drains SIM_BAT_DRAIN seconds (vehicle time) from full to empty.
+      if (options_.battery_drain_s > 0)
+        setenv("PX4_PARAM_SIM_BAT_DRAIN", fixed(options_.battery_drain_s, 1).c_str(), 1);
       std::string path = inst.dir + "/bin:" + (std::getenv("PATH") ? std::getenv("PATH") : "/usr/bin:/bin");
       setenv("PATH", path.c_str(), 1);
     }
@@ -414,6 +432,37 @@ bool SitlFleet::set_up_ardupilot_camera(int i, double deadline, std::string& err
   return ok;
 }
 
+// One parameter set as a ground station sets it: PARAM_SET, resent until PARAM_VALUE echoes
+// the value. For parameters ArduPilot reads while it runs (no reboot).
+bool SitlFleet::set_ardupilot_param(int i, const char* name, float value, double deadline, std::string& error) {
+  CameraSetup cs;  // the same bookkeeping: HEARTBEAT seen, PARAM_VALUEs by name
+  const uint8_t vehicle = static_cast<uint8_t>(sysid(i));
+  ml::FrameHandler handler = [&cs, vehicle](ml::Frame f) {
+    if (f.sysid != vehicle || f.compid != 1) return;
+    std::lock_guard lock(cs.mutex);
+    if (auto p = ml::unpack_param_value(f.message)) cs.params[p->param_id] = p->param_value;
+    cs.changed.notify_all();
+  };
+  ml::OpenResult opened;
+  while (!opened.link && now_s() < deadline) {
+    opened = ml::Link::open(*ml::parse_url(connection(i)).endpoint, handler, 0.2);
+    if (!opened.link) usleep(100000);
+  }
+  ml::Encoder encoder{250, 190, 0};
+  bool ok = opened.link && wait_for(cs, deadline,
+                                    [&] {
+                                      opened.link->send(encoder.encode(ml::pack(
+                                          ml::ParamSet{vehicle, 1, name, value, ml::param_type::INT32})));
+                                    },
+                                    [&] {
+                                      auto it = cs.params.find(name);
+                                      return it != cs.params.end() && std::fabs(it->second - value) < 0.01f;
+                                    });
+  opened.link.reset();
+  if (!ok) error = "SITL instance " + std::to_string(i) + ": " + name + " was not set\n" + log_tail(i);
+  return ok;
+}
+
 // Short-lived links of the test's own, one per instance and all open at once (a STATUSTEXT
 // is sent once, to whoever is connected then); closed before eamos opens the same ports.
 bool SitlFleet::wait_ready(double timeout_s, std::string& error) {
@@ -421,6 +470,14 @@ bool SitlFleet::wait_ready(double timeout_s, std::string& error) {
   if (options_.camera && options_.autopilot == Autopilot::ardupilot)
     for (int i = 0; i < size(); ++i)
       if (!set_up_ardupilot_camera(i, deadline, error)) return false;
+  // Remaining % is consumed mAh against BATT_CAPACITY: the capacity that lasts
+  // battery_drain_s at the SITL copter's hover current.
+  if (options_.battery_drain_s > 0 && options_.autopilot == Autopilot::ardupilot)
+    for (int i = 0; i < size(); ++i)
+      if (!set_ardupilot_param(i, "BATT_CAPACITY",
+                               static_cast<float>(kArduCopterSitlHoverA * options_.battery_drain_s / 3.6), deadline,
+                               error))
+        return false;
   std::vector<std::unique_ptr<Readiness>> state;
   std::vector<std::unique_ptr<ml::Link>> links;
   for (int i = 0; i < size(); ++i) {
