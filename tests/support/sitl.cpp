@@ -433,7 +433,8 @@ bool SitlFleet::set_up_ardupilot_camera(int i, double deadline, std::string& err
 }
 
 // One parameter set as a ground station sets it: PARAM_SET, resent until PARAM_VALUE echoes
-// the value. For parameters ArduPilot reads while it runs (no reboot).
+// the value (a whole number for an integer parameter: ArduPilot rounds). For parameters
+// ArduPilot reads while it runs (no reboot).
 bool SitlFleet::set_ardupilot_param(int i, const char* name, float value, double deadline, std::string& error) {
   CameraSetup cs;  // the same bookkeeping: HEARTBEAT seen, PARAM_VALUEs by name
   const uint8_t vehicle = static_cast<uint8_t>(sysid(i));
@@ -475,7 +476,7 @@ bool SitlFleet::wait_ready(double timeout_s, std::string& error) {
   if (options_.battery_drain_s > 0 && options_.autopilot == Autopilot::ardupilot)
     for (int i = 0; i < size(); ++i)
       if (!set_ardupilot_param(i, "BATT_CAPACITY",
-                               static_cast<float>(kArduCopterSitlHoverA * options_.battery_drain_s / 3.6), deadline,
+                               std::round(static_cast<float>(kArduCopterSitlHoverA * options_.battery_drain_s / 3.6)), deadline,
                                error))
         return false;
   std::vector<std::unique_ptr<Readiness>> state;
