@@ -1,6 +1,7 @@
 #include "mavlink_adapter/autopilot_params.h"
 
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <optional>
 
@@ -17,6 +18,11 @@ const std::vector<LimitParam> kArduPilot = {
     {"LAND_SPEED_HIGH", LimitKind::land, 0.01},
     {"MOT_SPOOL_TIME", LimitKind::takeoff_delay, 1.0}, {"TKOFF_SLEW_TIME", LimitKind::takeoff_delay, 1.0},
     {"WPNAV_ACCEL", LimitKind::accel, 0.01},  // GUIDED's position controller limit (cm/s²)
+    // RTL (mode_rtl): climb to RTL_ALT (cm), at least RTL_CLIMB_MIN more; home at RTL_SPEED
+    // (cm/s, 0: WPNAV_SPEED); loiter RTL_LOIT_TIME (ms); land, or stop at RTL_ALT_FINAL (cm).
+    {"RTL_ALT", LimitKind::return_home, 0.01},       {"RTL_CLIMB_MIN", LimitKind::return_home, 0.01},
+    {"RTL_SPEED", LimitKind::return_home, 0.01},     {"RTL_LOIT_TIME", LimitKind::return_home, 0.001},
+    {"RTL_ALT_FINAL", LimitKind::return_home, 0.01},
 };
 // PX4 (multicopter position control): m/s. A takeoff climbs at MPC_TKO_SPEED, a landing
 // ends at MPC_LAND_SPEED.
@@ -26,6 +32,9 @@ const std::vector<LimitParam> kPx4 = {
     {"MPC_LAND_SPEED", LimitKind::land, 1.0},
     {"COM_SPOOLUP_TIME", LimitKind::takeoff_delay, 1.0}, {"MPC_TKO_RAMP_T", LimitKind::takeoff_delay, 1.0},
     {"MPC_ACC_HOR", LimitKind::accel, 1.0},
+    // Return mode: climb to RTL_RETURN_ALT (m) above home, fly home, descend, wait
+    // RTL_LAND_DELAY (s; negative: hover there for good), land.
+    {"RTL_RETURN_ALT", LimitKind::return_home, 1.0}, {"RTL_LAND_DELAY", LimitKind::return_home, 1.0},
 };
 
 const char* fleet_key(LimitKind k) {
@@ -36,6 +45,7 @@ const char* fleet_key(LimitKind k) {
     case LimitKind::land: return "max_descent";
     case LimitKind::takeoff_delay:
     case LimitKind::accel: return "";
+    case LimitKind::return_home: return "";
   }
   return "";
 }
@@ -65,6 +75,36 @@ Slowest slowest(const std::vector<LimitParam>& params, LimitKind kind,
     if (!s.mps || mps < *s.mps) s = {mps, p.name};
   }
   return s;
+}
+
+// The return-to-launch parameters the autopilot told, in metres, m/s and seconds; 0 is a
+// value here (RTL_ALT 0: return at the current altitude). One it did not tell leaves the
+// straight way home, with a warning.
+void read_return_profile(const Autopilot& a, const std::vector<LimitParam>& params,
+                         const std::map<std::string, float>& values, FlightLimits& out) {
+  std::map<std::string, double> rtl;
+  for (const LimitParam& p : params) {
+    if (p.kind != LimitKind::return_home) continue;
+    auto it = values.find(p.name);
+    if (it == values.end() || !std::isfinite(it->second)) {
+      out.warnings.push_back(std::string(a.name) + " did not tell " + p.name +
+                             "; ReturnHome's deadline assumes its return flies straight home and down");
+      continue;
+    }
+    rtl[p.name] = it->second * p.to_mps;
+    out.summary += std::string(out.summary.empty() ? "" : ", ") + p.name + " " + number(rtl[p.name]);
+  }
+  auto value = [&rtl](const char* name) { return rtl.contains(name) ? rtl[name] : 0.0; };
+  ReturnProfile& r = out.rtl;
+  r.altitude_m = std::max({0.0, value("RTL_ALT"), value("RTL_RETURN_ALT")});
+  r.min_climb_m = std::max(0.0, value("RTL_CLIMB_MIN"));
+  r.speed_mps = std::max(0.0, value("RTL_SPEED"));
+  r.wait_s = std::max({0.0, value("RTL_LOIT_TIME"), value("RTL_LAND_DELAY")});
+  r.lands = value("RTL_ALT_FINAL") <= 0 && value("RTL_LAND_DELAY") >= 0;
+  if (!r.lands)
+    out.warnings.push_back(std::string(a.name) + "'s return does not land (" +
+                           (value("RTL_ALT_FINAL") > 0 ? "RTL_ALT_FINAL > 0" : "RTL_LAND_DELAY < 0") +
+                           "): a ReturnHome will time out hovering over home");
 }
 
 }  // namespace
@@ -113,7 +153,16 @@ FlightLimits combine_limits(const Autopilot& a, const fleet::Limits& fleet,
     out.takeoff_delay_s += it->second * p.to_mps;
     out.summary += std::string(out.summary.empty() ? "" : ", ") + p.name + " " + number(it->second * p.to_mps) + " s";
   }
+  read_return_profile(a, params, values, out);
   return out;
+}
+
+double return_home_duration_s(const FlightLimits& l, double height_m, double distance_m) {
+  const ReturnProfile& r = l.rtl;
+  double top = std::max({height_m, r.altitude_m, height_m + r.min_climb_m});
+  double speed = r.speed_mps > 0 ? std::min(r.speed_mps, l.motion.max_speed_mps) : l.motion.max_speed_mps;
+  return (top - height_m) / l.motion.max_climb_mps + distance_m / speed + r.wait_s +
+         std::max(0.0, top) / l.land_mps;
 }
 
 }  // namespace eamos::mavlink_adapter

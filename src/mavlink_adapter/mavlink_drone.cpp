@@ -74,6 +74,14 @@ double MavlinkDrone::timeout_for(const mid::ActionRequest& r) const {
   timing.limits = limits_.motion;
   if (r.name == "Land" || r.name == "ReturnHome") timing.limits.max_descent_mps = limits_.land_mps;
   double timeout = mid::action_timeout(r, reference(), timing);
+  // ReturnHome is the autopilot's own return, which climbs and waits before it lands
+  // (autopilot_params.h, ReturnProfile); a deadline the fleet file sets is taken as written.
+  if (r.name == "ReturnHome" && !settings_.timeouts_s.contains("ReturnHome")) {
+    Vec3 from = reference();
+    timeout = return_home_duration_s(limits_, from.z - settings_.home.z, horizontal_norm(from - settings_.home)) *
+                  mid::kTimeoutMargin +
+              mid::kTimeoutSlack_s;
+  }
   // A takeoff spools up and ramps its climb before it climbs (autopilot_params.h); a
   // deadline the fleet file sets is taken as written.
   if (r.name == "Takeoff" && !settings_.timeouts_s.contains("Takeoff"))

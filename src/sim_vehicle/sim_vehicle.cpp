@@ -112,7 +112,8 @@ void SimVehicle::on_setup_signing(const ml::SetupSigning& s) {
 }
 
 // The speed parameters the real autopilot has, valued as the simulator flies (its default
-// limits: 10 m/s across, 3 up, 2 down, 4 m/s²; it takes off without spool-up or ramp); a name it
+// limits: 10 m/s across, 3 up, 2 down, 4 m/s²; it takes off without spool-up or ramp, and returns
+// home at its altitude without waiting); a name it
 // does not know gets no answer, like on the real ones.
 void SimVehicle::on_param_request(const ml::ParamRequestRead& r) {
   if ((r.target_system != options_.sysid && r.target_system != 0) || r.param_index != -1) return;
@@ -122,13 +123,15 @@ void SimVehicle::on_param_request(const ml::ParamRequestRead& r) {
       px4 ? std::map<std::string, double>{{"MPC_XY_CRUISE", l.max_speed_mps}, {"MPC_Z_VEL_MAX_UP", l.max_climb_mps},
                                           {"MPC_TKO_SPEED", l.max_climb_mps}, {"MPC_Z_VEL_MAX_DN", l.max_descent_mps},
                                           {"MPC_LAND_SPEED", l.max_descent_mps}, {"COM_SPOOLUP_TIME", 0},
-                                          {"MPC_TKO_RAMP_T", 0}, {"MPC_ACC_HOR", l.max_accel_mps2}}
+                                          {"MPC_TKO_RAMP_T", 0}, {"MPC_ACC_HOR", l.max_accel_mps2}, {"RTL_RETURN_ALT", 0}, {"RTL_LAND_DELAY", 0}}
           : std::map<std::string, double>{{"WPNAV_SPEED", 100 * l.max_speed_mps},
                                           {"WPNAV_SPEED_UP", 100 * l.max_climb_mps},
                                           {"WPNAV_SPEED_DN", 100 * l.max_descent_mps},
                                           {"LAND_SPEED", 100 * l.max_descent_mps}, {"LAND_SPEED_HIGH", 0},
                                           {"MOT_SPOOL_TIME", 0}, {"TKOFF_SLEW_TIME", 0},
-                                          {"WPNAV_ACCEL", 100 * l.max_accel_mps2}};
+                                          {"WPNAV_ACCEL", 100 * l.max_accel_mps2}, {"RTL_ALT", 0},
+                                          {"RTL_CLIMB_MIN", 0}, {"RTL_SPEED", 0}, {"RTL_LOIT_TIME", 0},
+                                          {"RTL_ALT_FINAL", 0}};
   auto it = params.find(r.param_id);
   if (it == params.end()) return;
   int index = static_cast<int>(std::distance(params.begin(), it));

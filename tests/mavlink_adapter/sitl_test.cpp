@@ -384,8 +384,8 @@ TEST_P(Sitl, Listing2FliesTheSimulatorsActionsWithConfirmedPicturesAndAFiveMetre
 
 TEST_P(Sitl, Listing2WithOneDexPerDroneFliesTheSimulatorsActions) { fly_listing2("--distributed"); }
 
-// Every other example of examples/ on two instances of each autopilot: it completes, and no
-// action of any drone fails. (Listing 2 has its own tests above.)
+// relay and survey on two instances of each autopilot: each completes, and no action of any
+// drone fails. (Listing 2 and patrol have their own tests.)
 struct ExampleFlight {
   std::string example;
   Autopilot autopilot;
@@ -401,17 +401,22 @@ std::vector<std::string> declared_drones(const std::string& mission) {
   return names;
 }
 
+// A fleet file naming the instances as the mission's drones.
+std::string named_fleet(const SitlFleet& sitl, const std::vector<std::string>& names,
+                        const std::vector<eamos_test::SitlHome>& homes) {
+  std::string fleet = "drones:\n";
+  for (int i = 0; i < sitl.size(); ++i)
+    fleet += "  " + names[i] + ": {adapter: mavlink, connection: \"" + sitl.connection(i) + "\", sysid: " +
+             std::to_string(sitl.sysid(i)) + ", home: [" + std::to_string(homes[i].x) + ", " +
+             std::to_string(homes[i].y) + ", 0]}\n";
+  return fleet;
+}
+
 TEST_P(SitlExample, FliesToTheEndWithNoFailedAction) {
   const ExampleFlight& p = GetParam();
   if (SitlFleet::binary(p.autopilot).empty()) GTEST_SKIP() << SitlFleet::skip_message(p.autopilot);
   // Known failures, seen on PX4 (docs/adapters.md, "SITL tests"): not hidden, but not run
   // until fixed, so the suite stays a signal.
-  if (p.example == "relay" || p.example == "survey")
-    GTEST_SKIP() << "known failure (issue 12): ReturnHome times out: the autopilot's RTL climbs to RTL_RETURN_ALT / "
-                    "RTL_ALT and waits (RTL_LAND_DELAY, RTL_LOIT_TIME), which the ReturnHome deadline does not count";
-  if (p.example == "patrol")
-    GTEST_SKIP() << "known failure (issue 12): the lead orbits until Lead.Battery() <= 98, and SITL's battery did "
-                    "not drain that far within --time-limit 300";
   const std::string mission = std::string(EAMOS_SOURCE_DIR) + "/examples/" + p.example + ".eamos";
   std::vector<std::string> names = declared_drones(mission);
   ASSERT_EQ(names.size(), 2u) << mission;
@@ -419,17 +424,11 @@ TEST_P(SitlExample, FliesToTheEndWithNoFailedAction) {
   fs::path dir = fs::temp_directory_path() / ("eamos-sitl-example-" + std::to_string(getpid()));
   fs::create_directories(dir);
   eamos_test::SitlOptions options{p.autopilot, homes, kSpeed};
-  options.camera = true;  // patrol photographs
+  options.camera = true;  // relay and survey photograph
   SitlFleet sitl(options);
   std::string error;
   ASSERT_TRUE(sitl.start(error) && sitl.wait_ready(120, error)) << error;
-  std::string fleet = "drones:\n";
-  for (int i = 0; i < 2; ++i)
-    fleet += "  " + names[i] + ": {adapter: mavlink, connection: \"" + sitl.connection(i) + "\", sysid: " +
-             std::to_string(sitl.sysid(i)) + ", home: [" + std::to_string(homes[i].x) + ", " +
-             std::to_string(homes[i].y) + ", 0]}\n";
-  // Bounded: patrol orbits until its lead's battery reads 98 % or less.
-  Flight f = fly(mission, fleet, dir, {.extra = "--time-limit 300"});
+  Flight f = fly(mission, named_fleet(sitl, names, homes), dir, {.extra = "--time-limit 300"});
   EXPECT_EQ(f.run.status, 0) << f.run.out;
   for (const auto& [drone, actions] : f.actions)
     for (const std::string& a : actions) EXPECT_EQ(a.find(" failed"), std::string::npos) << a << "\n" << f.run.out;
@@ -439,10 +438,152 @@ TEST_P(SitlExample, FliesToTheEndWithNoFailedAction) {
 
 std::vector<ExampleFlight> example_flights() {
   std::vector<ExampleFlight> out;
-  for (const char* e : {"patrol", "relay", "survey"})
+  for (const char* e : {"relay", "survey"})
     for (Autopilot a : {Autopilot::ardupilot, Autopilot::px4}) out.push_back({e, a});
   return out;
 }
+
+// Mission time of the trace's first event matching `kind` and `text` (a condition's text with
+// its value, or an action's "text outcome"); -1 when there is none.
+double first_event_t(const fs::path& trace, const std::string& kind, const std::string& text) {
+  std::ifstream in(trace);
+  for (std::string line; std::getline(in, line);) {
+    auto e = nlohmann::json::parse(line, nullptr, false);
+    if (e.is_discarded() || e.value("event", "") != kind) continue;
+    std::string what = e.value("text", "");
+    if (kind == "condition") what += e.value("value", false) ? " true" : " false";
+    if (kind == "end") what += " " + e.value("outcome", "");
+    if (what == text) return e.value("t", 0.0);
+  }
+  return -1;
+}
+
+// The watch's samples from wall time `from_s` on, while the vehicle is in the air (above 1 m).
+std::vector<eamos_test::VehicleSample> airborne_after(const std::vector<eamos_test::VehicleSample>& samples,
+                                                      double from_s) {
+  std::vector<eamos_test::VehicleSample> out;
+  for (const auto& s : samples)
+    if (s.wall_s >= from_s && -s.down > 1.0) out.push_back(s);
+  return out;
+}
+
+// How far apart (horizontally) the samples are at most: a vehicle still orbiting at radius r
+// spans 2 r, one that holds or lands spans its drift.
+double horizontal_span(const std::vector<eamos_test::VehicleSample>& samples) {
+  double span = 0;
+  for (const auto& a : samples)
+    for (const auto& b : samples) span = std::max(span, std::hypot(a.north - b.north, a.east - b.east));
+  return span;
+}
+
+double wall_now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Full drain in vehicle seconds: Battery() > 98 turns false after 0.01-0.02 of it (the
+// autopilots report whole percent). The lead orbits from 10-14 s after it arms (the takeoff
+// to 10 m), so 98 % at 20-40 s leaves it some circles before the battery ends them.
+constexpr double kPatrolDrain_s = 2000;
+
+// How long after its Orbit was cancelled a vehicle may still circle, in wall seconds: 5
+// mission seconds at --speed 5, covering the GCS link's 1 Hz HEARTBEAT (the mode change
+// shows at the next one), the command's ACK round trip and braking from orbit speed.
+constexpr double kLeaveBound_s = 5.0 / kSpeed;
+
+// From the vehicles' own telemetry: the lead circled until its Orbit was cancelled, was in the
+// autopilot's RTL within kLeaveBound_s and landed at home; the wing stopped circling within
+// kLeaveBound_s of its Orbit's cancel (what it flies after stays within a 2 m span, a circle
+// of radius 4 m spans 8 m).
+void expect_left_the_orbit(Autopilot autopilot, const std::vector<eamos_test::VehicleSample>& lead,
+                           const std::vector<eamos_test::VehicleSample>& wing, double lead_cancelled_s,
+                           double wing_cancelled_s) {
+  const uint32_t rtl = autopilot == Autopilot::ardupilot ? 6u : eamos::mavlink::px4::RTL;
+  ASSERT_FALSE(lead.empty());
+  ASSERT_FALSE(wing.empty());
+  auto before = [](const std::vector<eamos_test::VehicleSample>& v, double t) {
+    std::vector<eamos_test::VehicleSample> out;
+    for (const auto& s : v)
+      if (s.wall_s >= t - 2.0 / kSpeed && s.wall_s < t) out.push_back(s);
+    return out;
+  };
+  // Moving around the circle right up to the cancel: 2 mission seconds at orbit speed.
+  EXPECT_GT(horizontal_span(before(lead, lead_cancelled_s)), 1.0);
+  double in_rtl_s = -1;
+  for (const auto& s : lead)
+    if (s.wall_s >= lead_cancelled_s && s.custom_mode == rtl) {
+      in_rtl_s = s.wall_s;
+      break;
+    }
+  ASSERT_GT(in_rtl_s, 0) << "the lead never showed RTL after its Orbit was cancelled";
+  std::cout << "Lead in RTL " << (in_rtl_s - lead_cancelled_s) * kSpeed << " mission s after its Orbit's cancel\n";
+  EXPECT_LT(in_rtl_s - lead_cancelled_s, kLeaveBound_s);
+  EXPECT_LT(std::hypot(lead.back().north, lead.back().east), 1.5) << "the lead did not land at home";
+  EXPECT_LT(-lead.back().down, 0.5) << "the lead is not on the ground";
+  EXPECT_GT(horizontal_span(before(wing, wing_cancelled_s)), 1.0);
+  std::vector<eamos_test::VehicleSample> after = airborne_after(wing, wing_cancelled_s + kLeaveBound_s);
+  ASSERT_FALSE(after.empty()) << "no telemetry of the wing in the air after its Orbit's cancel";
+  std::cout << "Wing after its Orbit's cancel: " << after.size() << " samples in the air, spanning "
+            << horizontal_span(after) << " m\n";
+  EXPECT_LT(horizontal_span(after), 2.0);
+}
+
+class SitlPatrol : public ::testing::TestWithParam<Autopilot> {};
+
+// examples/patrol.eamos on the real autopilots, its Do* interruptions cancelling running
+// motions: the lead orbits until the vehicle's own battery reads 98 %, then its Orbit ends
+// `cancelled` and the vehicle leaves the circle for the autopilot's RTL and lands at home;
+// the wing photographs until the lead (in the autopilot's RTL) sinks below 9 m, then orbits
+// until the lead has landed, and that Orbit ends `cancelled` with the vehicle no longer
+// circling. The battery drains at a rate the test sets (SitlOptions::battery_drain_s), so
+// the lead orbits for some seconds, not minutes.
+TEST_P(SitlPatrol, TheBatteryAndTheLeadsHeightCancelTheRunningOrbitsOnTheAutopilot) {
+  const Autopilot autopilot = GetParam();
+  if (SitlFleet::binary(autopilot).empty()) GTEST_SKIP() << SitlFleet::skip_message(autopilot);
+  const std::string mission = std::string(EAMOS_SOURCE_DIR) + "/examples/patrol.eamos";
+  fs::path dir = fs::temp_directory_path() / ("eamos-sitl-patrol-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  const std::vector<eamos_test::SitlHome> homes = {{0, 0}, {0, 5}};
+  eamos_test::SitlOptions options{autopilot, homes, kSpeed};
+  options.camera = true;  // the wing photographs
+  options.battery_drain_s = kPatrolDrain_s;
+  SitlFleet sitl(options);
+  std::string error;
+  ASSERT_TRUE(sitl.start(error) && sitl.wait_ready(120, error)) << error;
+  eamos_test::SitlWatch lead(sitl, 0), wing(sitl, 1);
+  ASSERT_EQ(lead.error() + wing.error(), "");
+  double lead_cancelled_s = -1, wing_cancelled_s = -1;
+  Flight f = fly(mission, named_fleet(sitl, {"Lead", "Wing"}, homes), dir,
+                 {.extra = "--time-limit 300", .on_line = [&](const std::string& line) {
+                    if (line.find("Lead.Orbit(8)  cancelled") != std::string::npos) lead_cancelled_s = wall_now_s();
+                    if (line.find("Wing.Orbit(4)  cancelled") != std::string::npos) wing_cancelled_s = wall_now_s();
+                  }});
+  ASSERT_EQ(f.run.status, 0) << f.run.out;
+  for (const auto& [drone, actions] : f.actions)
+    for (const std::string& a : actions) EXPECT_EQ(a.find(" failed"), std::string::npos) << a << "\n" << f.run.out;
+  const fs::path trace = dir / "trace.jsonl";
+  // The battery, not a time limit, ended the lead's orbit, and the lead went home.
+  double low = first_event_t(trace, "condition", "Lead.Battery() > 98 false");
+  EXPECT_GE(low, 0) << f.run.out;
+  EXPECT_NEAR(first_event_t(trace, "end", "Lead.Orbit(8) cancelled"), low, 0.5) << f.run.out;
+  EXPECT_GE(first_event_t(trace, "end", "Lead.ReturnHome() succeeded"), low) << f.run.out;
+  // The wing's pictures stopped when the lead sank below 9 m, and its escort orbit began.
+  double sank = first_event_t(trace, "condition", "Lead.Z() < 9 true");
+  EXPECT_GT(sank, low) << f.run.out;
+  EXPECT_GE(first_event_t(trace, "start", "Wing.Orbit(4)"), sank) << f.run.out;
+  EXPECT_NEAR(first_event_t(trace, "end", "Wing.Orbit(4) cancelled"),
+              first_event_t(trace, "condition", "Lead.Landed() true"), 0.5) << f.run.out;
+  ASSERT_GT(lead_cancelled_s, 0) << f.run.out;
+  ASSERT_GT(wing_cancelled_s, 0) << f.run.out;
+  expect_left_the_orbit(autopilot, lead.samples(), wing.samples(), lead_cancelled_s, wing_cancelled_s);
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
+
+INSTANTIATE_TEST_SUITE_P(Autopilots, SitlPatrol, ::testing::Values(Autopilot::ardupilot, Autopilot::px4),
+                         [](const auto& info) {
+                           return info.param == Autopilot::ardupilot ? std::string("ArduCopter")
+                                                                     : std::string("PX4");
+                         });
 
 INSTANTIATE_TEST_SUITE_P(Examples, SitlExample, ::testing::ValuesIn(example_flights()), [](const auto& info) {
   return info.param.example + (info.param.autopilot == Autopilot::ardupilot ? "_ArduCopter" : "_PX4");

@@ -38,6 +38,11 @@ constexpr double kOriginLat = 47.397742;
 constexpr double kOriginLon = 8.545594;
 constexpr double kOriginAlt = 488.0;
 constexpr uint32_t kPrearmCheck = 0x10000000;  // MAV_SYS_STATUS_PREARM_CHECK
+// ArduCopter SITL's battery current in flight (`--model +`, stock copter.parm), measured on
+// this binary: with the stock BATT_CAPACITY 3300 mAh its remaining % fell by 1 every 4.1 s
+// hovering at 10 m (and as fast during the takeoff), 33 mAh per 4.1 s. Turns a drain time
+// into BATT_CAPACITY.
+constexpr double kArduCopterSitlHoverA = 29;
 
 double now_s() {
   using namespace std::chrono;
@@ -108,13 +113,14 @@ bool SitlFleet::start(std::string& error) {
     error = skip_message(options_.autopilot);
     return false;
   }
-  // PX4's rc.mavlink sends its offboard link to 14540 + n only up to instance 9 (above, every
-  // instance sends to 14549), so eamos could not tell the instances apart.
-  int last = first_instance_ + static_cast<int>(options_.homes.size()) - 1;
+  // px4-rc.mavlink: "[ $px4_instance -gt 9 ] && udp_offboard_port_remote=14549", so every
+  // instance above 9 sends its offboard link to one port and the fleet's udp://:14540+n hears
+  // nothing (seen as "not ready: no HEARTBEAT" after the whole wait).
+  int last = instance_number(static_cast<int>(options_.homes.size()) - 1);
   if (options_.autopilot == Autopilot::px4 && last > 9) {
-    error = "PX4 SITL instances above 9 all send to UDP 14549: use EAMOS_SITL_FIRST_INSTANCE <= " +
-            std::to_string(10 - static_cast<int>(options_.homes.size())) + " for " +
-            std::to_string(options_.homes.size()) + " instances";
+    error = "PX4 SITL instance " + std::to_string(last) + " would send to UDP 14549, not " +
+            std::to_string(14540 + last) + " (instances above 9 share that port): set EAMOS_SITL_FIRST_INSTANCE to " +
+            std::to_string(10 - static_cast<int>(options_.homes.size())) + " or less";
     return false;
   }
   for (int i = 0; i < static_cast<int>(options_.homes.size()); ++i)
@@ -204,6 +210,9 @@ bool SitlFleet::spawn(int i, std::string& error) {
       setenv("PX4_SIM_SPEED_FACTOR", fixed(options_.speedup, 2).c_str(), 1);
       // rcS sets parameters from PX4_PARAM_<name> before it starts camera_trigger.
       if (options_.camera) setenv("PX4_PARAM_TRIG_MODE", "1", 1);
+      // battery_simulator drains SIM_BAT_DRAIN seconds (vehicle time) from full to empty.
+      if (options_.battery_drain_s > 0)
+        setenv("PX4_PARAM_SIM_BAT_DRAIN", fixed(options_.battery_drain_s, 1).c_str(), 1);
       std::string path = inst.dir + "/bin:" + (std::getenv("PATH") ? std::getenv("PATH") : "/usr/bin:/bin");
       setenv("PATH", path.c_str(), 1);
     }
@@ -425,6 +434,18 @@ bool SitlFleet::restart_instance(int i, std::string& error) {
 
 bool SitlFleet::wait_ready(double timeout_s, std::string& error) {
   const double deadline = now_s() + timeout_s;
+  if (!wait_ready_with_camera(deadline, error)) return false;
+  // Remaining % is consumed mAh against BATT_CAPACITY: the capacity that lasts
+  // battery_drain_s at the SITL copter's hover current (PX4: SIM_BAT_DRAIN at start).
+  if (options_.battery_drain_s > 0 && options_.autopilot == Autopilot::ardupilot)
+    for (int i = 0; i < size(); ++i) {
+      float capacity = std::round(static_cast<float>(kArduCopterSitlHoverA * options_.battery_drain_s / 3.6));
+      if (!set_param(i, "BATT_CAPACITY", capacity, ml::param_type::INT32, deadline - now_s(), error)) return false;
+    }
+  return true;
+}
+
+bool SitlFleet::wait_ready_with_camera(double deadline, std::string& error) {
   if (!options_.camera || options_.autopilot != Autopilot::ardupilot) return wait_all_ready(deadline, false, error);
   // The camera is set once the instance has booted completely (ready): a PARAM_SET during
   // its start-up was overwritten by ArduPilot's own start-up (CAM1_TYPE 0 after the restart).

@@ -36,6 +36,13 @@ struct SitlOptions {
   /// camera backend exists only from boot, and read back once ready), PX4 TRIG_MODE 1 (camera_trigger on command;
   /// SITL's TRIG_INTERFACE is 3, MAVLink). false: stock parameters, no camera.
   bool camera = false;
+  /// A battery that drains at a rate the test chooses, so a mission that waits for it
+  /// (patrol's `Lead.Battery() > 98`) ends within a test's time: PX4 SIM_BAT_DRAIN = this
+  /// (seconds of the vehicle's time from 100 % to 0 % while armed; SIM_BAT_MIN_PCT stays
+  /// 50); ArduPilot BATT_CAPACITY = the mAh the SITL copter's hover current (measured,
+  /// sitl.cpp) uses up in this time (its remaining % counts consumed mAh against
+  /// BATT_CAPACITY). 0: the stock models (PX4 60 s, ArduPilot 3300 mAh).
+  double battery_drain_s = 0;
 };
 
 class SitlFleet {
@@ -87,6 +94,7 @@ class SitlFleet {
   void prepare_px4_bin(const std::string& dir, const std::string& binary) const;
   bool set_up_ardupilot_camera(int i, double deadline, std::string& error);
   bool wait_all_ready(double deadline, bool camera, std::string& error, std::vector<int>* no_camera = nullptr);
+  bool wait_ready_with_camera(double deadline, std::string& error);
 
   SitlOptions options_;
   int first_instance_ = 0;
