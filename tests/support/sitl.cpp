@@ -76,6 +76,19 @@ const char* variable(Autopilot a) {
   return a == Autopilot::ardupilot ? "EAMOS_ARDUPILOT_SITL" : "EAMOS_PX4_SITL";
 }
 
+// Waits for a child told to stop until `deadline`, then kills it: a test must never leave
+// one behind.
+void reap(pid_t pid, double deadline) {
+  while (waitpid(pid, nullptr, WNOHANG) == 0) {
+    if (now_s() > deadline) {
+      kill(pid, SIGKILL);
+      waitpid(pid, nullptr, 0);
+      return;
+    }
+    usleep(20000);
+  }
+}
+
 }  // namespace
 
 std::string SitlFleet::binary(Autopilot autopilot) {
@@ -254,15 +267,7 @@ void SitlFleet::stop() {
   double deadline = now_s() + 5.0;
   for (auto& inst : instances_) {
     if (inst.pid <= 0) continue;
-    // Reap with a bounded grace period, then force: a test must never leave one behind.
-    while (waitpid(inst.pid, nullptr, WNOHANG) == 0) {
-      if (now_s() > deadline) {
-        kill(inst.pid, SIGKILL);
-        waitpid(inst.pid, nullptr, 0);
-        break;
-      }
-      usleep(20000);
-    }
+    reap(inst.pid, deadline);
     inst.pid = -1;
   }
   for (auto& inst : instances_) {
@@ -335,11 +340,10 @@ void ask_for_status(ml::Link& link, ml::Encoder& encoder, uint8_t sysid, bool ca
   if (camera) link.send(encoder.encode(ml::pack(ml::ParamRequestRead{sysid, 1, "CAM1_TYPE", -1})));
 }
 
-// What the camera set-up has seen of one ArduPilot instance, filled on the link's thread.
-struct CameraSetup {
+// What set_param has seen of one instance, filled on the link's thread.
+struct ParamEchoes {
   std::mutex mutex;
   std::condition_variable changed;
-  bool heartbeat = false;
   std::map<std::string, float> params;  ///< PARAM_VALUEs by name
 };
 
@@ -349,7 +353,7 @@ std::string read_file(const std::string& path) {
 }
 
 // Waits (bounded by `deadline`, resending `ask` every half second) until `done` holds.
-bool wait_for(CameraSetup& cs, double deadline, const std::function<void()>& ask, const std::function<bool()>& done) {
+bool wait_for(ParamEchoes& cs, double deadline, const std::function<void()>& ask, const std::function<bool()>& done) {
   std::unique_lock lock(cs.mutex);
   while (!done()) {
     if (now_s() > deadline) return false;
@@ -372,39 +376,12 @@ bool wait_for(CameraSetup& cs, double deadline, const std::function<void()>& ask
 // stopped, then started again in its folder, without `-w` (command_line()). wait_ready()
 // then reads CAM1_TYPE back from the new boot.
 bool SitlFleet::set_up_ardupilot_camera(int i, double deadline, std::string& error) {
-  CameraSetup cs;
-  const uint8_t vehicle = static_cast<uint8_t>(sysid(i));
-  ml::FrameHandler handler = [&cs, vehicle](ml::Frame f) {
-    if (f.sysid != vehicle || f.compid != 1) return;
-    std::lock_guard lock(cs.mutex);
-    if (ml::unpack_heartbeat(f.message)) cs.heartbeat = true;
-    if (auto p = ml::unpack_param_value(f.message)) cs.params[p->param_id] = p->param_value;
-    cs.changed.notify_all();
-  };
-  ml::OpenResult opened;
-  while (!opened.link && now_s() < deadline) {
-    opened = ml::Link::open(*ml::parse_url(connection(i)).endpoint, handler, 0.2);
-    if (!opened.link) usleep(100000);  // ArduPilot opens its TCP port a moment after start
-  }
-  ml::Encoder encoder{250, 190, 0};
-  auto set = [&] {
-    opened.link->send(encoder.encode(ml::pack(ml::ParamSet{vehicle, 1, "CAM1_TYPE", 1.0f, ml::param_type::INT8})));
-  };
-  auto echoed = [&] {
-    auto it = cs.params.find("CAM1_TYPE");
-    return it != cs.params.end() && it->second == 1.0f;
-  };
   // The PARAM_VALUE echo comes before ArduPilot's IO thread has written the parameter to
   // eeprom.bin; stopped before that, the instance boots without it. So the restart waits for
   // the file to change (nothing else is saved a few seconds after boot).
   const std::string eeprom = instances_.at(i).dir + "/eeprom.bin";
   const std::string before = read_file(eeprom);
-  bool ok = opened.link && wait_for(cs, deadline, set, echoed);
-  opened.link.reset();
-  if (!ok) {
-    error = "SITL instance " + std::to_string(i) + ": PARAM_SET CAM1_TYPE 1 not echoed\n" + log_tail(i);
-    return false;
-  }
+  if (!set_param(i, "CAM1_TYPE", 1, ml::param_type::INT8, deadline - now_s(), error)) return false;
   const double saved_by = std::min(deadline, now_s() + 10.0);
   while (read_file(eeprom) == before) {
     if (now_s() > saved_by) {
@@ -419,15 +396,7 @@ bool SitlFleet::set_up_ardupilot_camera(int i, double deadline, std::string& err
 bool SitlFleet::restart_instance(int i, std::string& error) {
   Instance& inst = instances_.at(i);
   kill(inst.pid, SIGTERM);
-  double deadline = now_s() + 5.0;
-  while (waitpid(inst.pid, nullptr, WNOHANG) == 0) {
-    if (now_s() > deadline) {
-      kill(inst.pid, SIGKILL);
-      waitpid(inst.pid, nullptr, 0);
-      break;
-    }
-    usleep(20000);
-  }
+  reap(inst.pid, now_s() + 5.0);
   inst.pid = -1;
   return spawn(i, error);
 }
@@ -477,7 +446,7 @@ static float wire_param(Autopilot autopilot, float value, uint8_t type) {
 
 bool SitlFleet::set_param(int i, const std::string& name, float value, uint8_t type, double timeout_s,
                           std::string& error) {
-  CameraSetup cs;
+  ParamEchoes cs;
   const uint8_t vehicle = static_cast<uint8_t>(sysid(i));
   ml::OpenResult opened = ml::Link::open(
       *ml::parse_url(connection(i)).endpoint,
