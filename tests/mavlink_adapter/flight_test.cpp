@@ -17,6 +17,23 @@ namespace {
 using test::Flight;
 using test::kSpeed;
 
+// A second ground station on the same vehicle (its own address), as a pilot's or a
+// stranger's would be.
+mavlink::OpenResult ground_station_on(int port) {
+  return mavlink::Link::open(*mavlink::parse_url("udpout://127.0.0.1:" + std::to_string(port)).endpoint,
+                             [](mavlink::Frame) {});
+}
+
+// DO_SET_MODE to POSCTL, what a pilot's mode switch sends.
+mavlink::CommandLong posctl_for(uint8_t sysid) {
+  mavlink::CommandLong c;
+  c.target_system = sysid;
+  c.target_component = 1;
+  c.command = mavlink::cmd::DO_SET_MODE;
+  c.param = {1, mavlink::px4::MAIN_POSCTL, 0};
+  return c;
+}
+
 TEST(MavlinkFlight, ConnectsAndRecognisesPx4) {
   test::VehicleThread vehicle(25311, 1, kSpeed);
   Flight f(25311);
@@ -188,14 +205,9 @@ TEST(MavlinkFlight, APilotsModeSwitchFailsTheMotionAndTheAdapterGivesWay) {
   ASSERT_FALSE(end);
 
   // A ground station on the same vehicle switches to POSCTL, as a pilot's switch would.
-  auto gcs = mavlink::Link::open(*mavlink::parse_url("udpout://127.0.0.1:" + std::to_string(vehicle.port())).endpoint,
-                                 [](mavlink::Frame) {});
+  auto gcs = ground_station_on(vehicle.port());
   ASSERT_TRUE(gcs.link) << gcs.error;
-  mavlink::CommandLong c;
-  c.target_system = 1;
-  c.target_component = 1;
-  c.command = mavlink::cmd::DO_SET_MODE;
-  c.param = {1, mavlink::px4::MAIN_POSCTL, 0};
+  const mavlink::CommandLong c = posctl_for(1);
   gcs.link->send(mavlink::Encoder{1, 190, 0}.encode(mavlink::pack(c)));
 
   f.loop.run_until(f.loop.now() + 10.0);
@@ -255,14 +267,9 @@ TEST(MavlinkFlight, SigningSetupGivesTheVehicleTheKeyAndAnUnsignedGroundStationI
   ASSERT_EQ(f.fly("Takeoff", {3}).outcome, mid::Outcome::succeeded);
   // A ground station without the key switches the vehicle to POSCTL (as in
   // APilotsModeSwitchFailsTheMotionAndTheAdapterGivesWay): the signed vehicle drops it.
-  auto gcs = mavlink::Link::open(*mavlink::parse_url("udpout://127.0.0.1:" + std::to_string(vehicle.port())).endpoint,
-                                 [](mavlink::Frame) {});
+  auto gcs = ground_station_on(vehicle.port());
   ASSERT_TRUE(gcs.link) << gcs.error;
-  mavlink::CommandLong c;
-  c.target_system = 1;
-  c.target_component = 1;
-  c.command = mavlink::cmd::DO_SET_MODE;
-  c.param = {1, mavlink::px4::MAIN_POSCTL, 0};
+  const mavlink::CommandLong c = posctl_for(1);
   std::optional<mid::ActionEnd> end;
   f.drone->start({"FlyTo", {30, 0, 3}}, [&](const mid::ActionEnd& e) {
     end = e;
