@@ -72,7 +72,7 @@ bool DexProcess::too_late(const dex::TraceEvent& event) {
   if (bound <= 0 || dex::latency_of(event) <= bound) return false;
   // A late trigger means the drones no longer act together as planned (one waited, or
   // the mission's timing moved): the bound makes that a fault, not a course to follow.
-  char limit[48];
+  char limit[64];
   std::snprintf(limit, sizeof limit, ", later than --max-trigger-latency %g s", bound);
   abandon(dex::describe_late(dex::late_message(event, mission_.fleet)) + limit, std::nullopt, true);
   tee_.record(event);  // recorded after the failsafe it caused, and never acted on

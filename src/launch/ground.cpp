@@ -149,6 +149,9 @@ class Ground {
   void warn_late(const dex::TraceEvent& e);
   /// ABORT when `e` (a message to a DEX started elsewhere) came later than --max-trigger-latency.
   void check_latency_bound(const dex::TraceEvent& e);
+  /// Writes an ABORT of the running run (before anything is recorded), keeps the first one
+  /// for the report and the trace, and says why on the console.
+  void abort_run(const std::string& why);
   void on_telemetry(const TelemetrySample& s);
   bool ours(const std::string& hash);
   /// The run's mission time now, from the start instant the ground chose (0 before it).
@@ -411,6 +414,10 @@ void Ground::interrupt() {
   std::string why = std::string("the ground was interrupted (") + (g_signal == SIGINT ? "SIGINT" : "SIGTERM") + ")";
   g_signal = 0;
   if (stage_ == Stage::barrier) return fail_barrier(why);
+  abort_run(why);
+}
+
+void Ground::abort_run(const std::string& why) {
   LifecycleSample abort{hash_, transport::kGround, LifecycleKind::abort, r_.run_id};
   abort.reason = why;
   abort.t = mission_time();
@@ -592,9 +599,10 @@ void Ground::on_trace(TraceSample s) {
   if (!ours(s.mission_hash) || s.run_id != r_.run_id || s.drone < 0 || s.drone >= static_cast<int>(drones_.size()))
     return;
   s.event.drone = drones_[s.drone].name;
-  if (dex::is_drone_message(s.event) && dex::latency_of(s.event) > o_.latency_warn_s)
-    warn_late(s.event);
-  if (dex::is_drone_message(s.event)) check_latency_bound(s.event);
+  if (dex::is_drone_message(s.event)) {
+    if (dex::latency_of(s.event) > o_.latency_warn_s) warn_late(s.event);
+    check_latency_bound(s.event);
+  }
   if (live_) {
     live_->record(s.event);
     out_ << std::flush;  // a live log: whoever watches it (a person, a test) sees each event now
@@ -615,18 +623,10 @@ void Ground::check_latency_bound(const dex::TraceEvent& e) {
   double bound = o_.max_trigger_latency_s;
   if (bound <= 0 || dex::latency_of(e) <= bound || stage_ != Stage::running || abort_) return;
   if (e.to < 0 || e.to >= static_cast<int>(drones_.size()) || drones_[e.to].local) return;
-  char limit[48];
+  char limit[64];
   std::snprintf(limit, sizeof limit, ", later than --max-trigger-latency %g s", bound);
-  LifecycleSample abort{hash_, transport::kGround, LifecycleKind::abort, r_.run_id};
-  abort.reason = dex::describe_late(dex::late_message(e, r_.fleet)) + limit + " (held by the ground: " +
-                 drones_[e.to].name + "'s DEX was started elsewhere)";
-  abort.t = mission_time();
-  node_->write(abort);  // first: the drones' failsafe must not wait for a terminal
-  abort_ = abort;
-  LifecycleSample heard = abort;
-  heard.t = mission_now();
-  record_lifecycle(heard);
-  err_ << "ground: " << abort.reason << "; aborting the run: every drone runs its failsafe\n";
+  abort_run(dex::describe_late(dex::late_message(e, r_.fleet)) + limit + " (held by the ground: " +
+            drones_[e.to].name + "'s DEX was started elsewhere)");
 }
 
 void Ground::on_telemetry(const TelemetrySample& s) {
