@@ -1,6 +1,7 @@
 // `eamos monitor TRACE.jsonl` (replay a finished mission in the browser) and the views
 // `eamos run --monitor` / `eamos launch --monitor` serve live (src/monitor).
 #include <condition_variable>
+#include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <mutex>
@@ -142,7 +143,10 @@ nlohmann::json launch_view(const std::string& dir) {
 
 int cmd_monitor(const MonitorCommandOptions& m) {
   MonitorHold hold;
-  SignalWatch signals([&hold](const char*) { hold.signal(); });
+  SignalWatch signals([&hold](const char* name) {
+    std::fprintf(stderr, "eamos monitor: interrupted (%s): stopping\n", name);
+    hold.signal();
+  });
   std::ifstream in(m.trace, std::ios::binary);
   if (!in) {
     std::cerr << "eamos: error: cannot read trace '" << m.trace << "'; give the file `eamos run --trace` wrote\n";

@@ -75,23 +75,41 @@ void print_latency(const dex::MessageLatency& m) {
   (m.late.empty() ? std::cout : std::cerr) << text;
 }
 
+/// Nothing was started: no drone was created, nothing written.
+int interrupted_before_start() {
+  std::cerr << "eamos: no drone was started, nothing written\n";
+  return 1;
+}
+
 }  // namespace
 
 int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
+  // Ctrl-C or SIGTERM lands the drones instead of killing the process under them. Taken from
+  // the very start, before any thread exists (an adapter's would inherit the old mask): a
+  // signal while compiling or drawing the monitor's graphs (with --monitor, Graphviz runs
+  // for seconds on a loaded machine) used to kill the process with the default action
+  // (status 143), unlike one a moment later.
+  dex::RunInterrupt interrupt;
+  MonitorHold hold;
+  SignalWatch signals([&interrupt, &hold](const char* name) {
+    // Said before anything is done about it: the failsafes' log lines come after it.
+    if (interrupt.over())
+      std::fprintf(stderr, "eamos: interrupted (%s): the mission has ended; the monitor stops\n", name);
+    else if (interrupt.running())
+      std::fprintf(stderr,
+                   "eamos: interrupted (%s): every drone runs its failsafe; interrupt again to exit at once\n", name);
+    else
+      std::fprintf(stderr, "eamos: interrupted (%s) before the mission started\n", name);
+    interrupt.request(std::string("interrupted (") + name + ")");
+    hold.signal();
+  });
   graph::Compilation c;
   if (!compile_and_report(o, c)) return 1;
   std::vector<dex::Mission> missions;
   if (!load_compiled_missions(c, missions)) return 1;
   nlohmann::json view;
   if (!r.monitor.empty()) view = live_view(c, o.mission, o.fleet);
-  // From here on drones may fly: Ctrl-C or SIGTERM lands them instead of killing the process
-  // under them. First, before an adapter starts a thread that would inherit the old mask.
-  dex::RunInterrupt interrupt;
-  MonitorHold hold;
-  SignalWatch signals([&interrupt, &hold](const char* name) {
-    interrupt.request(std::string("interrupted (") + name + ")");
-    hold.signal();
-  });
+  if (hold.was_interrupted()) return interrupted_before_start();
   // Only a run with --monitor has a server at all: without it nothing of civetweb is touched.
   std::unique_ptr<monitor::MonitorServer> server;
   std::unique_ptr<monitor::LiveSink> live_monitor;
@@ -101,6 +119,7 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
     live_monitor = std::make_unique<monitor::LiveSink>(*server, missions[0].fleet);
     std::cout << "eamos: monitor at " << server->url() << "\n" << std::flush;
   }
+  // A signal from here on is the run's (RunInterrupt keeps it until the run starts).
   mid::AdapterRegistry adapters;
   sim::register_adapter(adapters);
   mavlink_adapter::register_adapter(adapters, {.real_time = r.realtime || r.speed > 0,

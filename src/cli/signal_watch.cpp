@@ -42,9 +42,7 @@ void SignalWatch::watch() {
     if (stopping_) return;
     const char* name = signal == SIGINT ? "SIGINT" : "SIGTERM";
     if (++seen == 1) {
-      std::fprintf(stderr, "eamos: interrupted (%s): every drone runs its failsafe; interrupt again to exit at once\n",
-                   name);
-      on_first_(name);
+      on_first_(name);  // it says what the first signal does: that depends on when it came
       continue;
     }
     // Nothing more is commanded: a drone keeps doing what its failsafe told it.

@@ -13,8 +13,9 @@ class SignalWatch {
  public:
   /// Blocks SIGINT and SIGTERM in this thread and every thread started after it (so the
   /// MAVLink and DDS threads never take them) and waits for them on a thread of its own,
-  /// which calls `on_first` with the first signal's name ("SIGINT") and exits the process
-  /// with 128 + signal on the second. Construct it before any other thread starts.
+  /// which calls `on_first` with the first signal's name ("SIGINT"; it tells the user what
+  /// that signal does) and exits the process with 128 + signal on the second. Construct it
+  /// before any other thread starts.
   explicit SignalWatch(std::function<void(const char* name)> on_first);
   ~SignalWatch();
   SignalWatch(const SignalWatch&) = delete;

@@ -12,7 +12,10 @@ namespace {
 /// Delivers messages through the event loop, in send order, with no latency. Telemetry
 /// goes only to the drones whose mission reads the sender (Mission::reads), the way a DDS
 /// reader subscribes to what it needs. `on_delivered` runs after each message is handled:
-/// the last message in flight may be what completes the mission.
+/// the last message in flight may be what completes the mission. Only triggers and cancels
+/// count as in flight: a sample cannot start anything in a fleet whose engines are all idle
+/// (no condition is watched), and a still, armed vehicle publishes for ever, so a sample on
+/// its way when the last engine settled kept the run waiting for its time limit.
 class InProcessTransport : public Transport {
  public:
   InProcessTransport(mid::EventLoop& loop, std::vector<std::unique_ptr<Engine>>& engines,
@@ -35,11 +38,7 @@ class InProcessTransport : public Transport {
   void publish(std::shared_ptr<const Telemetry> t) override {
     for (int to : readers_[t->from]) {
       if (to == t->from) continue;
-      ++in_flight_;
-      loop_.after(0.0, [this, to, t] {
-        --in_flight_;
-        engines_[to]->receive(t);
-      });
+      loop_.after(0.0, [this, to, t] { engines_[to]->receive(t); });
     }
   }
   int in_flight() const { return in_flight_; }
@@ -51,7 +50,7 @@ class InProcessTransport : public Transport {
   TraceSink* trace_;
   std::vector<std::vector<int>> readers_;  ///< per drone: the drones that read its telemetry
   std::function<void()> on_delivered_;
-  int in_flight_ = 0;
+  int in_flight_ = 0;  ///< triggers and cancels sent, not yet handled
 };
 
 /// The trace's last event: how the mission ended, at the instant it did.
@@ -124,7 +123,7 @@ TraceEvent mission_end_event(const RunResult& r) {
 
 bool command_failsafe(mid::Drone& drone, const fleet::DroneSettings& settings) {
   mid::DroneState s = drone.state();
-  if (s.landed && !s.armed) return false;  // already safe; an armed drone on the ground is disarmed
+  if (down_and_disarmed(s)) return false;  // already safe; an armed drone on the ground is disarmed
   drone.failsafe(settings.failsafe);
   return true;
 }
@@ -163,6 +162,16 @@ void RunInterrupt::attach(mid::EventLoop& loop, std::function<void(const std::st
   on_request_ = std::move(on_request);
   if (pending_) loop_->post([fn = on_request_, reason = *pending_] { fn(reason); });
   pending_.reset();
+}
+
+bool RunInterrupt::running() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return loop_ != nullptr;
+}
+
+bool RunInterrupt::over() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return over_;
 }
 
 void RunInterrupt::detach() {
@@ -297,21 +306,21 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     abandon();
   }
   if (failed || !result.completed) {
-    // Let failsafes finish: until every drone is down, at most 600 s. In slices, because a
-    // real-time loop waits for input until its limit even when nothing is scheduled, and a
-    // MAVLink drone's heartbeats never leave it idle.
+    // Let failsafes finish: until every drone is down with its motors off, at most 600 s. In
+    // slices, because a real-time loop waits for input until its limit even when nothing is
+    // scheduled, and a MAVLink drone's heartbeats never leave it idle.
     const double until = loop.now() + 600.0;
     // A drone whose link is lost cannot be told or watched: waiting for it only delays the
     // end (its autopilot's own link-loss failsafe flies it, docs/faults.md).
-    auto airborne = [&] {
+    auto not_safe_yet = [&] {
       for (const auto& d : drones) {
         mid::DroneState st = d->state();
-        if (!st.landed && !st.link_lost) return true;
+        if (!down_and_disarmed(st) && !st.link_lost) return true;
       }
       return false;
     };
     do loop.run_until(std::min(until, loop.now() + 1.0));
-    while (loop.now() < until && airborne());
+    while (loop.now() < until && not_safe_yet());
   }
   if (options.interrupt) options.interrupt->detach();
   result.duration = finished_at;

@@ -31,6 +31,9 @@ class RunInterrupt {
   /// For run_in_process: requests go to `on_request`, on `loop`'s thread, from now on.
   void attach(mid::EventLoop& loop, std::function<void(const std::string&)> on_request);
   void detach();
+  /// Whether a run is going on (attached) or over (detached): what a request does now.
+  bool running();
+  bool over();
 
  private:
   std::mutex mutex_;
@@ -56,6 +59,9 @@ struct Sample {
   bool landed;
   double battery;  ///< %
 };
+
+/// What a failsafe ends in, and what needs none: down with its motors off.
+inline bool down_and_disarmed(const mid::DroneState& s) { return s.landed && !s.armed; }
 
 /// The mission was abandoned: makes `drone` safe with its fleet failsafe when it is in the air
 /// or armed on the ground, then records a `failsafe` event (at mission time `t`) in `trace`

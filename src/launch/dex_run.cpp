@@ -260,11 +260,12 @@ void DexProcess::on_internal_error(const std::string& what) {
 }
 
 void DexProcess::wait_for_failsafe() {
-  // Stay up (and alive for the others) until the drone is down, hovering as told, or the
-  // failsafe has had ten minutes.
+  // Stay up (and alive for the others) until the drone is down with its motors off, hovering
+  // as told, or the failsafe has had ten minutes. Down alone is not safe: a DEX that ended at
+  // the touchdown left its vehicle armed on the ground (seen on PX4 SITL) and reported it so.
   mid::DroneState s = drone_->state();
   // A lost link: nothing can reach or watch the drone, its autopilot's own failsafe flies it.
-  bool done = s.landed || s.link_lost || mission_.settings.failsafe == fleet::Failsafe::hover ||
+  bool done = dex::down_and_disarmed(s) || s.link_lost || mission_.settings.failsafe == fleet::Failsafe::hover ||
               loop_->now() - failsafe_since_ > 600.0;
   if (done) {
     // Its final state: the ground reports this one, not the one at the abort.

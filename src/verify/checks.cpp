@@ -261,7 +261,7 @@ void check_end_state(const Setup& s, const Flight& f, std::vector<Violation>& ou
   for (std::size_t d = 0; d < f.result.drones.size(); ++d) {
     int drone = static_cast<int>(d);
     const mid::DroneState& st = f.result.drones[d].state;
-    if (st.landed && !st.armed) continue;
+    if (dex::down_and_disarmed(st)) continue;
     const ActionRun* last = responsible(f, drone, f.result.duration);
     bool airborne = !st.landed;
     std::string what = name_of(s, drone) + (airborne ? " is still in the air" : " is still armed") +

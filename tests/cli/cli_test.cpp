@@ -205,6 +205,35 @@ TEST_F(Cli, AsyncWorkInALoopIsNotWarnedAboutAndEveryPictureEndsOnce) {
   EXPECT_LT(summary["duration"].get<double>(), 60.0);  // not the time limit
 }
 
+// A Do* whose condition is false when reached runs neither branch: with the lead's pack
+// already below patrol's 98 % it must skip its orbit and still go home, not hover at 10 m
+// until the simulator's battery failsafe lands it (955 s, mission failed, before the fix).
+TEST_F(Cli, PatrolWithTheLeadsBatteryAlreadyLowSkipsTheOrbitAndBringsTheLeadHome) {
+  Output r = eamos("run -q " + std::string(EAMOS_SOURCE_DIR) + "/examples/patrol.eamos --fleet " + EAMOS_SOURCE_DIR +
+                   "/tests/cli/data/patrol-low-battery.yaml --trace " + (dir_ / "t.jsonl").string() +
+                   " --summary " + (dir_ / "s.json").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  nlohmann::json home, returned;
+  bool orbited = false;
+  for (const nlohmann::json& e : trace_lines(dir_ / "t.jsonl")) {
+    if (e["event"] == "telemetry" && e["drone"] == "Lead" && home.is_null()) home = e;
+    if (e["event"] == "start" && e["text"] == "Lead.Orbit(8)") orbited = true;
+    if (e["event"] == "end" && e["text"] == "Lead.ReturnHome()") returned = e;
+  }
+  EXPECT_FALSE(orbited);
+  ASSERT_TRUE(returned.is_object()) << r.out;
+  EXPECT_EQ(returned["outcome"], "succeeded");
+  std::ifstream in(dir_ / "s.json");
+  nlohmann::json summary = nlohmann::json::parse(in);
+  EXPECT_EQ(summary["status"], "completed") << r.out;
+  const nlohmann::json& lead = summary["drones"]["Lead"];
+  EXPECT_NEAR(lead["x"].get<double>(), home["x"].get<double>(), 0.5);
+  EXPECT_NEAR(lead["y"].get<double>(), home["y"].get<double>(), 0.5);
+  EXPECT_TRUE(lead["landed"].get<bool>());
+  EXPECT_FALSE(lead["armed"].get<bool>());
+  EXPECT_GT(lead["battery"].get<double>(), 90.0);  // home on its own, not by the failsafe
+}
+
 }  // namespace
 
 // `eamos dex` reads its mission through the one validating reader: a damaged or edited

@@ -3,7 +3,10 @@
 // what the process prints (a takeoff succeeded), never for a time.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -118,6 +121,30 @@ TEST_F(Interrupt, SigtermAlsoLandsEveryDrone) {
   nlohmann::json summary = nlohmann::json::parse(summary_file);
   EXPECT_NE(summary["error"].get<std::string>().find("interrupted (SIGTERM)"), std::string::npos);
   for (const char* d : {"A", "B"}) EXPECT_TRUE(summary["drones"][d]["landed"]) << d;
+}
+
+// A signal while eamos still reads and compiles the mission (with --monitor it then draws
+// the graphs, seconds on a loaded machine) is eamos' own too, not the default action that
+// killed the process with status 143. The mission file is a FIFO: eamos waits in its open
+// until the test opens the other end, so the signal comes at that known moment.
+TEST_F(Interrupt, SigtermWhileTheMissionIsReadEndsTheRunBeforeAnyDroneStarts) {
+  fs::path fifo = dir_ / "fifo.eamos";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  p_ = eamos_test::start_eamos({"run", "-q", fifo.string(), "--realtime", "--monitor", "127.0.0.1:0", "--summary",
+                                (dir_ / "summary.json").string()});
+  ASSERT_GT(p_.pid, 0);
+  int fd = open(fifo.c_str(), O_WRONLY);  // returns once eamos has opened it to read
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(kill(p_.pid, SIGTERM), 0);
+  ASSERT_EQ(write(fd, kHover, sizeof kHover - 1), static_cast<ssize_t>(sizeof kHover - 1));
+  close(fd);
+  eamos_test::Exit e = eamos_test::wait_exit(p_);
+  ASSERT_TRUE(e.exited) << "killed by signal " << e.status << "\n" << p_.seen;
+  EXPECT_EQ(e.status, 1) << p_.seen;
+  EXPECT_NE(p_.seen.find("interrupted (SIGTERM) before the mission started"), std::string::npos) << p_.seen;
+  EXPECT_NE(p_.seen.find("no drone was started, nothing written"), std::string::npos) << p_.seen;
+  EXPECT_EQ(p_.seen.find("A.Arm()"), std::string::npos) << p_.seen;
+  EXPECT_FALSE(fs::exists(dir_ / "summary.json")) << p_.seen;
 }
 
 // A second Ctrl-C is for when waiting for the failsafe is not wanted: the process ends at

@@ -86,14 +86,18 @@ TEST_F(TraceSchema, EveryExampleTraceKeepsTheSchemaEventByEvent) {
       telemetry += e["event"] == "telemetry";
       messages += e["event"] == "message";
       // In one process a message takes no time.
-      if (e["event"] == "message") EXPECT_EQ(e["latency"], 0.0) << name << ": " << e.dump();
+      if (e["event"] == "message") {
+        EXPECT_EQ(e["latency"], 0.0) << name << ": " << e.dump();
+      }
       actions += e["event"] == "start" && e.contains("node");
       inits += e["event"] == "node" && e["kind"] == "init" && e.contains("instance");  // one clone per drone
     }
     EXPECT_GT(telemetry, 0) << name;
     EXPECT_GT(actions, 0) << name;
     EXPECT_GE(inits, 1) << name;
-    if (lines.front()["drones"].size() > 1) EXPECT_GT(messages, 0) << name;
+    if (lines.front()["drones"].size() > 1) {
+      EXPECT_GT(messages, 0) << name;
+    }
   }
   EXPECT_GE(examples, 4);
 }

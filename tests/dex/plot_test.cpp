@@ -123,7 +123,9 @@ TEST(Plot, LabelsConditionMarksWithoutOverlap) {
   ASSERT_GE(xs.size(), 3u);
   for (std::size_t i = 0; i < xs.size(); ++i)
     for (std::size_t j = i + 1; j < xs.size(); ++j)
-      if (ys[i] == ys[j]) EXPECT_GT(std::abs(std::stod(xs[i]) - std::stod(xs[j])), 60) << xs[i] << " " << xs[j];
+      if (ys[i] == ys[j]) {
+        EXPECT_GT(std::abs(std::stod(xs[i]) - std::stod(xs[j])), 60) << xs[i] << " " << xs[j];
+      }
 }
 
 TEST(Plot, DrawsTheFailsafePhaseOnTheTimelineTheMapAndTheAltitude) {

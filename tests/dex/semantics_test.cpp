@@ -426,6 +426,21 @@ TEST(Semantics, DoAsyncDoneBranchThatEndsLastCompletesTheMissionWhenItEnds) {
   EXPECT_EQ(actions[actions.size() - 2].text, "A.Sensor1()");
 }
 
+// A still, armed drone publishes its state once a second (the simulator's idle telemetry):
+// B at 1 and 2 s. The If is A's and reads B, so B's samples go to A. A's pause ends at 2 s,
+// but was scheduled (at 1.5 s) after B's timer for 2 s (at 1 s): B's sample of 2 s is still
+// on its way to A when A reaches the end node.
+// Telemetry cannot start anything in a fleet whose engines are all idle; it used to count as
+// a message in flight, and its delivery never checked again: the run waited for the time
+// limit although every drone had reached the end (seen once on PX4 SITL, issue 12).
+TEST(Semantics, MissionCompletesWhenItsLastWorkEndsWithTelemetryStillOnItsWay) {
+  Flight f = fly(kTwo + "func INIT() { PAR_x() }\nfunc PAR_x() { A.Arm(); SEQ_b() }\n"
+                        "func SEQ_b() { B.Arm(); PauseFor(1.5); If(A.Armed() && B.Armed(), SEQ_p, SEQ_p) }\n"
+                        "func SEQ_p() { PauseFor(0.5) }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_DOUBLE_EQ(f.result.duration, 2.0);
+}
+
 TEST(Semantics, TraceEndsWithTheMissionEventAtTheInstantTheMissionEnded) {
   Flight done = fly(kOne + "func INIT() { A.Arm(); A.Disarm() }\n");
   ASSERT_TRUE(done.result.completed) << done.result.error;

@@ -19,8 +19,9 @@ struct Checked {
 Checked check(const std::string& body, const std::string& fleet_text = "") {
   fleet::Fleet fleet;
   Diagnostics diags;
-  if (!fleet_text.empty())
+  if (!fleet_text.empty()) {
     EXPECT_TRUE(fleet::parse_fleet(std::make_shared<SourceFile>("f.yaml", fleet_text), fleet, diags)) << diags.format();
+  }
   graph::Compilation c;
   std::string text = "var A Quad\nvar B Quad\n" + body;
   Checked r;

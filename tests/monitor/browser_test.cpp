@@ -186,6 +186,10 @@ TEST(MonitorBrowser, LiveRunProgressesAndSurvivesReloadAndSecondPage) {
   EXPECT_TRUE(held) << run.seen;
   EXPECT_EQ(status, 0) << run.seen;
   EXPECT_NE(run.seen.find("mission completed in 16.7 s"), std::string::npos) << run.seen;
+  // The signal that stops the page says so; it used to announce every drone's failsafe.
+  EXPECT_NE(run.seen.find("interrupted (SIGTERM): the mission has ended; the monitor stops"), std::string::npos)
+      << run.seen;
+  EXPECT_EQ(run.seen.find("failsafe"), std::string::npos) << run.seen;
 }
 
 }  // namespace

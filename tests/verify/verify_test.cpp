@@ -73,7 +73,9 @@ TEST_P(VerifyMission, EamosVerifyPrintsExpectedOutput) {
 
 TEST(VerifyMissions, EveryRuleMissionHasAFixedTwin) {
   for (const std::string& name : cases())
-    if (!is_fixed_twin(name)) EXPECT_TRUE(fs::exists(kMissions / (name + "_fixed.eamos"))) << name;
+    if (!is_fixed_twin(name)) {
+      EXPECT_TRUE(fs::exists(kMissions / (name + "_fixed.eamos"))) << name;
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(Files, VerifyMission, ::testing::ValuesIn(cases()),
@@ -194,7 +196,8 @@ INSTANTIATE_TEST_SUITE_P(Examples, VerifyExample,
                          ::testing::Values("listing2.eamos", "listing2.eamos --fleet listing2-left.yaml",
                                            "listing2.eamos --fleet listing2-right.yaml",
                                            "listing2.eamos --fleet listing2-range.yaml --jitter", "patrol.eamos",
-                                           "patrol.eamos --jitter", "relay.eamos", "relay.eamos --jitter",
+                                           "patrol.eamos --jitter",
+                                           "patrol.eamos --fleet ../tests/cli/data/patrol-low-battery.yaml", "relay.eamos", "relay.eamos --jitter",
                                            "survey.eamos", "survey.eamos --jitter"),
                          [](const auto& info) {
                            std::string n = info.param;
