@@ -359,6 +359,7 @@ class Reader {
       if (std::string why = fleet::signing_key_problem(s.signing_key); !why.empty() && !s.signing_key.empty())
         d_.add("/drone/signing_key", why);
     f_.boolean(*d, "signing_setup", "/drone", s.signing_setup, false);
+    f_.boolean(*d, "announce_as_gcs", "/drone", s.announce_as_gcs, false);
     vec3(*d, "home", "/drone", s.home);
     f_.number(*d, "battery", "/drone", s.battery_percent, 0, 100);
     int failsafe = 0;

@@ -50,6 +50,7 @@ void write_settings(JsonWriter& w, const fleet::DroneSettings& s, int index) {
   w.member("adapter", s.adapter);
   if (!s.connection.empty()) w.member("connection", s.connection);
   if (s.sysid > 0) w.member("sysid", s.sysid);
+  if (s.announce_as_gcs) w.member("announce_as_gcs", true);
   if (!s.signing_key.empty()) {  // the drone's own folder only, beside its private DDS key
     w.member("signing_key", s.signing_key);
     w.member("signing_setup", s.signing_setup);

@@ -44,6 +44,10 @@ struct DroneSettings {
   /// "" = frames unsigned. A secret: only the drone's own deployment folder holds it.
   std::string signing_key;
   bool signing_setup = false;  ///< send the key to the vehicle (SETUP_SIGNING) at connect
+  /// MAVLink: also send a ground station's HEARTBEAT (MAV_TYPE_GCS), so that a PX4 that
+  /// gives STATUSTEXT only to a link with a GCS tells us why it refused (docs/fleet.md:
+  /// it also hides the loss of the real ground station from PX4's link-loss failsafe).
+  bool announce_as_gcs = false;
 };
 
 /// "" when `hex` is a usable signing key (64 hex digits, not all zero), else what is wrong.

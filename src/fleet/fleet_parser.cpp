@@ -21,7 +21,7 @@ const std::vector<std::string> kTypeKeys = {"adapter", "capabilities", "sensors"
 const std::vector<std::string> kDroneKeys = {"home",     "battery",  "sensors",
                                              "limits",   "failsafe", "adapter",
                                              "connection", "sysid",  "timeouts",
-                                             "geofence", "signing"};
+                                             "geofence", "signing",  "announce_as_gcs"};
 const std::vector<std::string> kSigningKeys = {"key", "key_file", "setup"};
 const std::vector<std::string> kLimitKeys = {"max_speed", "max_climb", "max_descent",
                                              "max_accel", "max_altitude"};
@@ -241,6 +241,8 @@ void FleetParser::drone(const std::string& name, const YAML::Node& node) {
       if (key == "timeouts") timeouts(v, where, s);
       if (key == "geofence") geofence(v, where, o.geofence);
       if (key == "signing") signing(v, where, s);
+      if (key == "announce_as_gcs" && (!v.IsScalar() || !YAML::convert<bool>::decode(v, s.announce_as_gcs)))
+        r_.error(v, what + " must be true or false; got " + describe(v));
     }
   }
   out_.drones[name] = std::move(s);

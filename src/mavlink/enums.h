@@ -69,6 +69,12 @@ inline constexpr uint8_t ONBOARD_COMPUTER = 191;
 /// ignored (bits 3-8, 10, 11).
 inline constexpr uint16_t kPositionOnlyMask = 0x0DF8;
 inline constexpr uint8_t kFrameLocalNed = 1;  ///< MAV_FRAME_LOCAL_NED
+inline constexpr uint8_t kFrameGlobal = 0;    ///< MAV_FRAME_GLOBAL: x, y latitude, longitude
+/// MAV_FRAME_GLOBAL, _GLOBAL_RELATIVE_ALT, _GLOBAL_INT, _GLOBAL_RELATIVE_ALT_INT,
+/// _GLOBAL_TERRAIN_ALT, _GLOBAL_TERRAIN_ALT_INT: x and y are latitude and longitude.
+inline constexpr bool is_global_frame(uint8_t frame) {
+  return frame == 0 || frame == 3 || frame == 5 || frame == 6 || frame == 10 || frame == 11;
+}
 
 /// PX4's custom_mode: main mode << 16 | sub mode << 24 (PX4's px4_custom_mode.h).
 namespace px4 {

@@ -113,6 +113,9 @@ std::vector<MessageDef> build_table() {
                     {T::i32, "lat"}, {T::i32, "lon"}, {T::i32, "alt"}, {T::i32, "relative_alt"},
                     {T::f32, "q", 4}, {T::i32, "image_index"}, {T::i8, "capture_result"},
                     {T::char_, "file_url", 205}}));
+  t.push_back(make(msg::ORBIT_EXECUTION_STATUS, "ORBIT_EXECUTION_STATUS",
+                   {{T::u64, "time_usec"}, {T::f32, "radius"}, {T::u8, "frame"}, {T::i32, "x"},
+                    {T::i32, "y"}, {T::f32, "z"}}));
   return t;
 }
 

@@ -31,6 +31,7 @@ inline constexpr uint32_t EXTENDED_SYS_STATE = 245;
 inline constexpr uint32_t STATUSTEXT = 253;
 inline constexpr uint32_t SETUP_SIGNING = 256;
 inline constexpr uint32_t CAMERA_IMAGE_CAPTURED = 263;
+inline constexpr uint32_t ORBIT_EXECUTION_STATUS = 360;
 }  // namespace msg
 
 struct MessageDef {

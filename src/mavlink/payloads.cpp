@@ -164,6 +164,24 @@ std::optional<GlobalPositionInt> unpack_global_position_int(const Message& m) {
                            r.get<uint16_t>("hdg")};
 }
 
+Message pack(const OrbitExecutionStatus& m) {
+  FieldWriter w(def_of(msg::ORBIT_EXECUTION_STATUS));
+  w.set("time_usec", m.time_usec);
+  w.set("radius", m.radius);
+  w.set("frame", m.frame);
+  w.set("x", m.x);
+  w.set("y", m.y);
+  w.set("z", m.z);
+  return w.take();
+}
+
+std::optional<OrbitExecutionStatus> unpack_orbit_execution_status(const Message& m) {
+  if (m.id != msg::ORBIT_EXECUTION_STATUS) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  return OrbitExecutionStatus{r.get<uint64_t>("time_usec"), r.get<float>("radius"), r.get<uint8_t>("frame"),
+                              r.get<int32_t>("x"), r.get<int32_t>("y"), r.get<float>("z")};
+}
+
 Message pack(const CommandLong& m) {
   FieldWriter w(def_of(msg::COMMAND_LONG));
   w.set("target_system", m.target_system);

@@ -47,6 +47,16 @@ struct GlobalPositionInt {
   uint16_t hdg = UINT16_MAX;    ///< cdeg, UINT16_MAX unknown
 };
 
+/// What an autopilot flying MAV_CMD_DO_ORBIT says of its circle (PX4, while in its Orbit
+/// mode): the centre it circles, which the command may have left to the vehicle.
+struct OrbitExecutionStatus {
+  uint64_t time_usec = 0;
+  float radius = 0;    ///< m; positive clockwise, negative counter-clockwise
+  uint8_t frame = 0;   ///< MAV_FRAME of x, y, z
+  int32_t x = 0, y = 0;  ///< global frames: degE7 (lat, lon); local frames: m * 1e4
+  float z = 0;         ///< m, in `frame`
+};
+
 struct CommandLong {
   uint8_t target_system = 0;
   uint8_t target_component = 0;
@@ -166,6 +176,7 @@ Message pack(const ParamSet& m);
 Message pack(const SysStatus& m);
 Message pack(const LocalPositionNed& m);
 Message pack(const GlobalPositionInt& m);
+Message pack(const OrbitExecutionStatus& m);
 Message pack(const CommandLong& m);
 Message pack(const CommandInt& m);
 Message pack(const CommandAck& m);
@@ -194,6 +205,7 @@ std::optional<ParamSet> unpack_param_set(const Message& m);
 std::optional<SysStatus> unpack_sys_status(const Message& m);
 std::optional<LocalPositionNed> unpack_local_position_ned(const Message& m);
 std::optional<GlobalPositionInt> unpack_global_position_int(const Message& m);
+std::optional<OrbitExecutionStatus> unpack_orbit_execution_status(const Message& m);
 std::optional<CommandLong> unpack_command_long(const Message& m);
 std::optional<CommandInt> unpack_command_int(const Message& m);
 std::optional<CommandAck> unpack_command_ack(const Message& m);

@@ -35,6 +35,7 @@ const std::vector<LimitParam> kPx4 = {
     // Return mode: climb to RTL_RETURN_ALT (m) above home, fly home, descend, wait
     // RTL_LAND_DELAY (s; negative: hover there for good), land.
     {"RTL_RETURN_ALT", LimitKind::return_home, 1.0}, {"RTL_LAND_DELAY", LimitKind::return_home, 1.0},
+    {"MC_ORBIT_RAD_MAX", LimitKind::orbit_radius, 1.0},
 };
 
 const char* fleet_key(LimitKind k) {
@@ -45,7 +46,8 @@ const char* fleet_key(LimitKind k) {
     case LimitKind::land: return "max_descent";
     case LimitKind::takeoff_delay:
     case LimitKind::accel: return "";
-    case LimitKind::return_home: return "";
+    case LimitKind::return_home:
+    case LimitKind::orbit_radius: return "";
   }
   return "";
 }
@@ -154,6 +156,8 @@ FlightLimits combine_limits(const Autopilot& a, const fleet::Limits& fleet,
     out.summary += std::string(out.summary.empty() ? "" : ", ") + p.name + " " + number(it->second * p.to_mps) + " s";
   }
   read_return_profile(a, params, values, out);
+  // Unknown (ArduPilot, an older PX4): the autopilot judges the radius when DO_ORBIT comes.
+  if (Slowest r = slowest(params, LimitKind::orbit_radius, values); r.mps) out.orbit_radius_max_m = *r.mps;
   return out;
 }
 

@@ -20,7 +20,8 @@ namespace eamos::mavlink_adapter {
 /// accel: the horizontal acceleration the autopilot's position controller allows (m/s²); an
 /// orbit's centripetal acceleration must stay below it or the vehicle swings wide.
 /// return_home: how the autopilot's own return-to-launch flies (ReturnProfile), by name.
-enum class LimitKind { speed, climb, descent, land, takeoff_delay, accel, return_home };
+/// orbit_radius: the largest orbit the autopilot flies (PX4 MC_ORBIT_RAD_MAX, m).
+enum class LimitKind { speed, climb, descent, land, takeoff_delay, accel, return_home, orbit_radius };
 
 /// One parameter that bounds a limit: its name and the factor to m/s (ArduPilot: cm/s), to
 /// m/s² for an acceleration, or to seconds for a takeoff delay.
@@ -58,6 +59,7 @@ struct FlightLimits {
   /// up (MPC_TKO_RAMP_T) before it climbs at all, so a deadline from the climb alone expires.
   double takeoff_delay_s = 0.0;
   ReturnProfile rtl;         ///< how ReturnHome flies on this autopilot
+  double orbit_radius_max_m = 0.0;  ///< the largest DO_ORBIT radius it takes; 0 unknown
   std::vector<std::string> warnings;  ///< one line each: a fleet limit above the autopilot's,
                                       ///< or a parameter the autopilot did not tell
   std::string summary;       ///< "WPNAV_SPEED 10 m/s, …": what the autopilot said, for the log

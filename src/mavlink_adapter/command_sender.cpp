@@ -16,16 +16,23 @@ CommandSender::~CommandSender() {
     for (Pending& p : queue) loop_.cancel(p.timer);
 }
 
-void CommandSender::send(ml::CommandLong command, CommandDone done) {
+void CommandSender::send(ml::CommandLong command, CommandDone done, std::function<bool()> resend_while) {
   command.confirmation = 0;
   auto& queue = queues_[command.command];
-  queue.push_back({command, std::move(done)});
+  queue.push_back({command, std::nullopt, std::move(done), std::move(resend_while)});
+  if (queue.size() == 1) transmit_head(command.command);
+}
+
+void CommandSender::send(const ml::CommandInt& command, CommandDone done, std::function<bool()> resend_while) {
+  ml::CommandLong key{command.target_system, command.target_component, command.command, 0, {}};
+  auto& queue = queues_[command.command];
+  queue.push_back({key, command, std::move(done), std::move(resend_while)});
   if (queue.size() == 1) transmit_head(command.command);
 }
 
 void CommandSender::transmit_head(uint16_t id) {
   Pending& p = queues_[id].front();
-  transmit_(ml::pack(p.command));
+  transmit_(p.as_int ? ml::pack(*p.as_int) : ml::pack(p.command));
   p.timer = loop_.after(options_.ack_timeout_s, [this, id] { timed_out(id); });
 }
 
@@ -34,6 +41,10 @@ void CommandSender::timed_out(uint16_t id) {
   if (it == queues_.end() || it->second.empty()) return;
   Pending& p = it->second.front();
   p.timer = mid::kNoTimer;
+  if (p.resend_while && !p.resend_while()) {
+    finish(id, {false, ml::command_name(id) + ": no COMMAND_ACK, and not sent again: no longer wanted"});
+    return;
+  }
   if (p.command.confirmation < options_.retries) {
     ++p.command.confirmation;  // tells the autopilot this is a resend, not a new command
     transmit_head(id);

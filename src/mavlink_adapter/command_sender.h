@@ -8,6 +8,7 @@
 #include <deque>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 
 #include "mavlink/payloads.h"
@@ -36,8 +37,14 @@ class CommandSender {
   CommandSender(const CommandSender&) = delete;
   CommandSender& operator=(const CommandSender&) = delete;
 
-  /// Queues `command` (confirmation is set here); `done` runs once with the outcome.
-  void send(mavlink::CommandLong command, CommandDone done);
+  /// Queues `command` (confirmation is set here); `done` runs once with the outcome. With
+  /// `resend_while`, a command whose ACK is late is sent again only while it returns true:
+  /// a command that is no longer wanted must not reach the vehicle after the ones that
+  /// replaced it (it then ends unanswered at once).
+  void send(mavlink::CommandLong command, CommandDone done, std::function<bool()> resend_while = nullptr);
+  /// The same for a COMMAND_INT (a command with a position in degE7, exact where a float is
+  /// not); it has no confirmation field, so a resend is the same frame again.
+  void send(const mavlink::CommandInt& command, CommandDone done, std::function<bool()> resend_while = nullptr);
   /// Feeds a COMMAND_ACK from the vehicle.
   void on_ack(const mavlink::CommandAck& ack);
   /// Ends every queued command with `error` (the link is gone).
@@ -47,8 +54,10 @@ class CommandSender {
 
  private:
   struct Pending {
-    mavlink::CommandLong command;
+    mavlink::CommandLong command;  ///< its id and confirmation count; sent as is unless as_int
+    std::optional<mavlink::CommandInt> as_int;
     CommandDone done;
+    std::function<bool()> resend_while;
     mid::TimerId timer = mid::kNoTimer;
   };
   void transmit_head(uint16_t id);

@@ -64,7 +64,25 @@ std::string MavlinkDrone::refusal(const mid::ActionRequest& r, const fleet::Acti
   mid::VehicleFacts v{armed, vehicle_.landed(), reference(), ""};
   if (tracker_.motion() != mid::kNoAction) v.running_motion = tracker_.request(tracker_.motion())->name;
   if (r.name == "Disarm") v.position = position();
-  return mid::uniform_refusal(r, spec, v, settings_);
+  std::string uniform = mid::uniform_refusal(r, spec, v, settings_);
+  if (!uniform.empty() || r.name != "Orbit" || !autopilot_->do_orbit) return uniform;
+  return orbit_radius_refusal(r.args.empty() ? 5.0 : r.args[0]);
+}
+
+// PX4 orbits from 1 m to MC_ORBIT_RAD_MAX. The vehicle first flies out to the circle
+// (start_orbit), so a radius PX4 would refuse is refused before it moves, not at the circle.
+std::string MavlinkDrone::orbit_radius_refusal(double radius) const {
+  char text[160];
+  if (radius < 1.0) {
+    std::snprintf(text, sizeof text, "orbit radius %.1f m is below the smallest %s flies (1 m)", radius,
+                  autopilot_->name);
+    return text;
+  }
+  const double largest = limits_.orbit_radius_max_m;
+  if (largest <= 0.0 || radius <= largest) return "";
+  std::snprintf(text, sizeof text, "orbit radius %.1f m is above %s's MC_ORBIT_RAD_MAX %.0f m", radius,
+                autopilot_->name, largest);
+  return text;
 }
 
 // Deadlines from the slower of the fleet's and the autopilot's limits (autopilot_params.h);
@@ -234,7 +252,7 @@ void MavlinkDrone::start_motion(ActionId id, const mid::ActionRequest& r) {
     return;
   }
   setpoint_ = here;
-  if (r.name == "Orbit") return start_orbit(id, here, r.args.empty() ? 5.0 : r.args[0]);
+  if (r.name == "Orbit") return start_orbit(here, r.args.empty() ? 5.0 : r.args[0]);
   stream_setpoints();  // Hover: hold where it is; Hover(s) ends after s seconds
   if (r.args.size() == 1) {
     after_for(id, r.args[0], [this, id] {
@@ -277,7 +295,11 @@ void MavlinkDrone::start_takeoff(ActionId id, double altitude) {
       });
       return;
     }
-    p[6] = static_cast<float>(vehicle_.amsl_m - vehicle_.relative_alt_m + altitude);
+    // From where the vehicle stands, in the frame the goal is judged in: not from PX4's
+    // home (amsl - relative_alt), which PX4 sets where the vehicle stood when it armed and
+    // which its EKF puts 0.2-0.3 m off the ground some seconds later (SITL after a landing:
+    // a Takeoff(3) hovered at 2.7 m, the edge of the goal's band, and timed out).
+    p[6] = static_cast<float>(vehicle_.amsl_m + goal_->target().z - here.z);
   }
   if (!autopilot_->takeoff_in_setpoint_mode || vehicle_.custom_mode == autopilot_->setpoint_mode)
     return command_motion(id, ml::cmd::NAV_TAKEOFF, p);

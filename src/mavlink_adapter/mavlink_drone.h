@@ -18,6 +18,7 @@
 // Every frame arrives on the link's thread and is posted to the event loop, so all state
 // here is touched by the loop's thread only. No HEARTBEAT for `link_timeout_s` = link lost:
 // the running actions end `failed` and new ones are refused until heartbeats return.
+#include <array>
 #include <deque>
 #include <functional>
 #include <map>
@@ -117,7 +118,26 @@ class MavlinkDrone final : public mid::AdapterDrone {
     bool on_circle = false;
     bool commanded = false; ///< the autopilot flies it (DO_ORBIT accepted), not our setpoints
     bool mode_seen = false; ///< a HEARTBEAT has shown the autopilot's orbit mode
-    double commanded_radius = 0.0;  ///< our setpoints' radius: `radius` corrected for the lag
+    double commanded_radius = 0.0;  ///< our setpoints' (or DO_ORBIT's) radius: `radius`
+                                    ///< corrected by the radius flown
+    // DO_ORBIT's radius correction (mavlink_drone_orbit.cpp, correct_orbit_radius)
+    double sent_radius = 0.0;       ///< the radius the autopilot flies to, as last sent
+    double sent_speed = 0.0;        ///< ... and its speed
+    double flown_speed = 0.0;       ///< along the circle, smoothed like last_flown_m
+    bool up_to_speed = false;       ///< flown_speed no longer rises: the radius is corrected
+    double speed_check_s = 0.0, speed_at_check = 0.0;
+    double sent_at_s = 0.0;         ///< vehicle s the last correction was sent
+    double last_report_s = -1.0;    ///< vehicle s of the previous GLOBAL_POSITION_INT
+    double last_flown_m = 0.0;      ///< the radius flown, smoothed over kFlownSmoothingS
+    double recent_flown_m = 0.0;    ///< ... smoothed over kRecentSmoothingS only
+    bool correcting = false;        ///< a correction waits for its COMMAND_ACK
+    bool corrections_stopped = false;  ///< one was refused (or never answered): no more
+    /// The centre in degE7, named to PX4 in DO_ORBIT (centre_known: a global position was at
+    /// hand when the orbit started).
+    bool centre_known = false;
+    int32_t centre_lat_e7 = 0, centre_lon_e7 = 0;
+    bool do_orbit_sent = false;
+    double waited_at_start_s = 0.0;  ///< mission s at the east point, waiting to be still
   };
 
   // actions (mavlink_drone.cpp)
@@ -162,6 +182,9 @@ class MavlinkDrone final : public mid::AdapterDrone {
   double vehicle_clock_rate() const;
   /// A disarm by the autopilot while our Takeoff waits on the ground: arm and take off again.
   bool takeoff_disarmed_on_ground();
+  /// A motion still running on a vehicle down and disarmed (not by the mission): it fails.
+  void end_motion_on_the_ground();
+  void disarm_after_failsafe_landing();
 
   // link, telemetry, setpoints (mavlink_drone_link.cpp)
   void on_frame(const mavlink::Frame& frame);
@@ -183,13 +206,22 @@ class MavlinkDrone final : public mid::AdapterDrone {
 
   // orbit (mavlink_drone_orbit.cpp)
   double orbit_speed(double radius) const;
-  void start_orbit(mid::ActionId id, fleet::Vec3 centre, double radius);
+  void start_orbit(fleet::Vec3 centre, double radius);  ///< for motion_owner_
+  std::string orbit_radius_refusal(double radius) const;  ///< "" when the autopilot takes it
+  void send_do_orbit();  ///< PX4: DO_ORBIT around orbit_'s centre, from where the vehicle is
   void orbit_stopped_in_flight();
   void leave_orbit();
   bool left_orbit_mode();  ///< the vehicle left DO_ORBIT's mode: the orbit failed
   void advance_orbit(double dt);
+  /// DO_ORBIT: PX4 flies its circle a little off the radius asked for (docs/adapters.md);
+  /// from each position report (vehicle s) the radius asked for is corrected by the one flown.
+  void correct_orbit_radius();  ///< on a GLOBAL_POSITION_INT while the autopilot orbits
+  void send_due_orbit_correction();  ///< on a HEARTBEAT: the correction, if one is due
+  std::array<float, 7> do_orbit_params(double radius, double speed) const;
   void switch_to_setpoint_mode();
   void send_mode_command(mavlink::CommandLong c, CommandDone done);
+  void send_mode_command(const mavlink::CommandInt& c, CommandDone done);
+  CommandDone counted_mode_command(CommandDone done);  ///< mode_commands_pending_ while it is out
   void publish();
   fleet::Vec3 position() const;
   fleet::Vec3 reference() const;  ///< where relative motions start: holding_ or position()

@@ -209,7 +209,8 @@ void MavlinkDrone::on_frame(const ml::Frame& frame) {
     return;  // a camera, gimbal or companion of the same system: not the autopilot
   if (auto t = ml::unpack_statustext(frame.message); t && frame.compid == ml::comp::AUTOPILOT1)
     return on_statustext(*t);
-  if (auto p = ml::unpack_local_position_ned(frame.message)) on_vehicle_clock(p->time_boot_ms);
+  std::optional<ml::LocalPositionNed> report = ml::unpack_local_position_ned(frame.message);
+  if (report) on_vehicle_clock(report->time_boot_ms);
   Changes c = apply_telemetry(vehicle_, frame);
   if (c.rejected) return note_rejected(c.rejected);
   if (c.armed) on_armed_changed();
@@ -217,9 +218,40 @@ void MavlinkDrone::on_frame(const ml::Frame& frame) {
   if (c.landed && vehicle_.landed()) {
     streaming_ = false;  // on the ground: nothing to hold
     in_control_ = false;
+    disarm_after_failsafe_landing();
   }
   if (c.position || c.landed) check_goal();
+  if (c.global_position && orbit_.commanded) correct_orbit_radius();
+  if (c.armed || c.landed) end_motion_on_the_ground();
   if (c.position || c.armed || c.landed) publish();
+}
+
+// A failsafe ends with the motors off, as the simulator's does. An autopilot that does not
+// disarm by itself after landing (ArduPilot DISARM_DELAY 0, PX4 COM_DISARM_LAND -1), or
+// that takes its seconds to, would otherwise leave the vehicle armed on the ground when the
+// DEX, which waits for its drone to be safe, ends. Refused (not landed yet, PX4 says), the
+// autopilot's own auto-disarm remains, and the DEX waits for it.
+void MavlinkDrone::disarm_after_failsafe_landing() {
+  if (failsafe_reason_.empty() || !vehicle_.armed || disarm_commanded_) return;
+  disarm_commanded_ = true;
+  commands_.send(command(ml::cmd::COMPONENT_ARM_DISARM, {0.0f}), nullptr);
+}
+
+// A vehicle down and disarmed that the mission did not land (a kill switch, a crash, a GCS)
+// cannot fly what it was told: an Orbit or Hover() has no deadline and would run for ever,
+// and the mission with it, to its time limit. Land and ReturnHome ended in check_goal just
+// now; a Takeoff disarmed on the ground is takeoff_disarmed_on_ground's.
+void MavlinkDrone::end_motion_on_the_ground() {
+  if (vehicle_.armed || !vehicle_.landed() || motion_owner_ == mid::kNoAction || !tracker_.running(motion_owner_))
+    return;
+  const mid::ActionRequest* r = tracker_.request(motion_owner_);
+  if (!r || r->name == "Takeoff") return;
+  streaming_ = false;
+  in_control_ = false;
+  fail_motion(mid::FailureReason::vehicle_fault,
+              std::string(autopilot_->name) + " reports the vehicle on the ground and disarmed while " + r->name +
+                  " ran: it cannot go on" + autopilot_says(tracker_.started_at(motion_owner_)),
+              "landed and disarmed");
 }
 
 void MavlinkDrone::on_statustext(const ml::Statustext& t) {
@@ -346,6 +378,7 @@ void MavlinkDrone::on_heartbeat() {
   link_watchdog();
   if (!telemetry_requested_) request_telemetry();
   if (left_orbit_mode()) return;
+  send_due_orbit_correction();
   if (!streaming_ || !in_control_ || mode_commands_pending_ > 0) return;
   if (vehicle_.custom_mode == autopilot_->setpoint_mode) {
     mode_confirmed_ = true;
@@ -397,7 +430,9 @@ void MavlinkDrone::request_telemetry() {
   telemetry_requested_ = true;
   struct Rate { uint32_t id; double hz; };
   for (Rate r : {Rate{ml::msg::HEARTBEAT, options_.heartbeat_hz}, Rate{ml::msg::LOCAL_POSITION_NED, options_.position_hz},
-                 Rate{ml::msg::EXTENDED_SYS_STATE, 2.0}, Rate{ml::msg::GLOBAL_POSITION_INT, 2.0},
+                 Rate{ml::msg::EXTENDED_SYS_STATE, 2.0},
+                 // At the position rate: an orbit's radius is measured from it (mavlink_drone_orbit.cpp).
+                 Rate{ml::msg::GLOBAL_POSITION_INT, options_.position_hz}, Rate{ml::msg::ORBIT_EXECUTION_STATUS, 2.0},
                  Rate{ml::msg::SYS_STATUS, 1.0}, Rate{ml::msg::BATTERY_STATUS, 1.0}}) {
     // An autopilot that refuses a rate still streams its defaults: nothing to do about it.
     commands_.send(command(ml::cmd::SET_MESSAGE_INTERVAL,
@@ -439,6 +474,13 @@ void MavlinkDrone::send_heartbeat() {
   hb.autopilot = ml::autopilot::INVALID;
   hb.system_status = ml::state::ACTIVE;
   send(ml::pack(hb));
+  if (settings_.announce_as_gcs) {
+    // PX4 sends STATUSTEXT (why it refused) only to a link where it heard a ground station
+    // within 2.5 s. Asked for in the fleet file: it also keeps PX4's GCS link-loss failsafe
+    // from seeing the real ground station go (docs/fleet.md, docs/adapters.md).
+    hb.type = ml::mav_type::GCS;
+    send(ml::pack(hb));
+  }
   heartbeat_timer_ = loop_.after(1.0, [this] { send_heartbeat(); });
 }
 
@@ -505,12 +547,20 @@ void MavlinkDrone::switch_to_setpoint_mode() {
   });
 }
 
-void MavlinkDrone::send_mode_command(ml::CommandLong c, CommandDone done) {
+CommandDone MavlinkDrone::counted_mode_command(CommandDone done) {
   ++mode_commands_pending_;
-  commands_.send(c, [this, done = std::move(done)](const CommandResult& r) {
+  return [this, done = std::move(done)](const CommandResult& r) {
     --mode_commands_pending_;
     if (done) done(r);
-  });
+  };
+}
+
+void MavlinkDrone::send_mode_command(ml::CommandLong c, CommandDone done) {
+  commands_.send(c, counted_mode_command(std::move(done)));
+}
+
+void MavlinkDrone::send_mode_command(const ml::CommandInt& c, CommandDone done) {
+  commands_.send(c, counted_mode_command(std::move(done)));
 }
 
 }  // namespace eamos::mavlink_adapter

@@ -4,6 +4,9 @@
 // the simulator's speed, until the action is preempted or cancelled.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <tuple>
+#include <utility>
 
 #include "mavlink/enums.h"
 #include "mavlink_adapter/mavlink_drone.h"
@@ -19,6 +22,43 @@ using mid::Outcome;
 namespace {
 constexpr float kYawFrontToCentre = 0;  ///< ORBIT_YAW_BEHAVIOUR_HOLD_FRONT_TO_CIRCLE_CENTER
 constexpr double kRadiusGain = 0.5;     ///< 1/s (2.0 was measured to oscillate, 4.5 .. 5.5 m)
+/// ArduCopter SITL followed setpoints going round 5 m at 4.5 m (a lagging follower cuts in by
+/// 1 / sqrt(1 + (w tau)^2)), and with kRadiusGain alone a half-turn orbit still averaged
+/// 4.73-4.82 m from its centre: its setpoints start this much wider.
+constexpr double kSetpointLead = 1.08;
+// DO_ORBIT's correction. PX4 re-approaches its circle when a new radius is more than its
+// acceptance radius (FlightTaskOrbit: 1 m) from where the vehicle is: each step stays well
+// inside it, so the vehicle keeps circling while the radius moves.
+constexpr double kDoOrbitGain = 0.25;       ///< 1/s of vehicle time, on the radius error
+constexpr double kCorrectionEveryS = 0.5;   ///< at most two DO_ORBITs per vehicle second
+constexpr double kSmallestStepM = 0.03;     ///< a smaller change is not worth a command
+constexpr double kLargestStepM = 0.3;
+// PX4's radial term on this SITL is slow (a vehicle 0.6 m out came back at 0.15 m/s) and its
+// circle swings +-0.4 m over 10 s while it speeds up: the integral alone, started once up to
+// speed, came too late for a short orbit. So the radius sent also leads by the recent error.
+constexpr double kDoOrbitLead = 1.0;        ///< m of radius sent per m flown off the circle
+constexpr double kRecentSmoothingS = 0.3;
+constexpr double kAwayFromFlownM = 0.6;     ///< the radius sent stays this near the one flown
+constexpr double kOnCircleM = 1.0;          ///< PX4 circles from this close to the radius on
+constexpr double kSettledRadialMps = 0.3;   ///< ... and we correct once it no longer moves out
+constexpr double kFlownSmoothingS = 2.0;    ///< the radius flown, as the trace reports it
+// PX4 applies the centripetal feed-forward of the speed it is given at once, while the
+// vehicle still stands and speeds up slowly (0.2 m/s² on SIH): at 3.5 m/s asked for 5 m the
+// circle sank to 4.5 m within 2 s of the start and swung out to 5.5 m after. So it is given a
+// speed above the one it flies, raised slot by slot to the orbit's. The lead is a balance:
+// the vehicle's velocity lags its turning setpoint, which carries it outward, while the
+// feed-forward of a speed above the one flown pulls it in. 0.5 m/s above: drifted 0.3-0.6 m
+// out in the first 2 s; 1.0 m/s above: 0.1-0.3 m in, and twice as fast around (2 m/s).
+constexpr double kSpeedLeadMps = 1.0;
+constexpr double kSpeedSmoothingS = 0.5;
+constexpr double kSpeedCheckS = 2.0;  ///< up to speed: less than 0.1 m/s faster in this long
+// PX4's radial term is underdamped on a loaded SITL: started 0.28 m off its circle (OFFBOARD
+// holds the east point only that well), it swung 4.4 .. 5.6 m for 5 m. So it starts on the
+// circle the vehicle stands on, and the radius moves to the one asked for in small steps.
+constexpr double kStartWithinM = 0.2;       ///< ... of the radius asked for, at most
+constexpr double kStartStillMps = 0.08;     ///< DO_ORBIT once the vehicle is this still ...
+constexpr double kStartOnCircleM = 0.15;    ///< ... this close to the circle ...
+constexpr double kStartWaitS = 1.5;         ///< ... or has waited this long (mission s) there
 }  // namespace
 
 double MavlinkDrone::orbit_speed(double radius) const {
@@ -31,18 +71,37 @@ double MavlinkDrone::orbit_speed(double radius) const {
   return std::min(l.max_speed_mps, std::sqrt(0.8 * l.max_accel_mps2 * radius));
 }
 
-void MavlinkDrone::start_orbit(ActionId id, Vec3 centre, double radius) {
-  // With DO_ORBIT the autopilot moves around the circle, not our setpoints: meanwhile (and
-  // after a refusal) the stream holds the vehicle where it is.
-  orbit_ = {!autopilot_->do_orbit, centre, radius, 0.0, false, false, false, radius};
+void MavlinkDrone::start_orbit(Vec3 centre, double radius) {
+  // Out to the circle's east point on our setpoints first, like the simulator; from there
+  // ArduCopter goes round on our setpoints, PX4 by itself (send_do_orbit).
+  orbit_ = {true, centre, radius, 0.0, false, false, false, radius};
+  orbit_.sent_radius = radius;
+  // Our setpoints go round from the start at the radius they were measured to need, so the
+  // correction only fine-tunes it (a short orbit ends before it has integrated that much).
+  if (!autopilot_->do_orbit) orbit_.commanded_radius = radius * kSetpointLead;
+  char text[128];
+  std::snprintf(text, sizeof text, "orbit of %.2f m around x %.2f, y %.2f", radius, centre.x, centre.y);
+  note(text);  // where the vehicle circles, for a reader of the trace (and the SITL tests)
+  if (autopilot_->do_orbit && vehicle_.have_altitude) {
+    const Vec3 off = centre - position();
+    std::tie(orbit_.centre_lat_e7, orbit_.centre_lon_e7) =
+        offset_lat_lon(vehicle_.lat_e7, vehicle_.lon_e7, off.y, off.x);
+    orbit_.centre_known = true;
+  }
+  // Without a global position the centre cannot be named to PX4: it orbits where the vehicle
+  // is, from there (its own approach out to the circle overshoots it by up to 0.7 m).
+  if (autopilot_->do_orbit && !orbit_.centre_known) return send_do_orbit();
   stream_setpoints();
-  if (!autopilot_->do_orbit) return;
-  // Radius negative = counter-clockwise; centre and altitude NaN = where the vehicle is;
-  // param4 NaN = the autopilot's default number of turns (for ever).
-  float r = static_cast<float>(radius);
-  std::array<float, 7> p{-r, static_cast<float>(orbit_speed(radius)), kYawFrontToCentre,
-                         NAN, NAN, NAN, NAN};
-  send_mode_command(command(ml::cmd::DO_ORBIT, p), [this, id](const CommandResult& result) {
+}
+
+// PX4 circles from where it is when DO_ORBIT comes: started at the centre, its approach is
+// its circle's radial term from 5 m off, which overshot to 5.7 m and swung 4.4 .. 5.7 m on a
+// loaded SITL. Started on the circle, with the centre named (COMMAND_INT, degE7), it only
+// speeds up along it.
+void MavlinkDrone::send_do_orbit() {
+  const ActionId id = motion_owner_;  // the Orbit: any other motion would have reset orbit_
+  orbit_.do_orbit_sent = true;
+  auto done = [this, id](const CommandResult& result) {
     if (!result.accepted) {
       if (motion_owner_ == id) orbit_ = {};
       if (tracker_.running(id)) end_refused(id, result);
@@ -51,9 +110,39 @@ void MavlinkDrone::start_orbit(ActionId id, Vec3 centre, double radius) {
     if (motion_owner_ != id) return orbit_stopped_in_flight();
     streaming_ = false;
     in_control_ = false;
+    orbit_.active = false;  // PX4 moves around the circle now, not our setpoints
+    orbit_.on_circle = false;  // for the radius correction: PX4's own word on its circle
     orbit_.commanded = true;
+    vehicle_.have_orbit_centre = false;  // a report from before is of an orbit before this one
+    if (!orbit_.centre_known && vehicle_.have_position) orbit_.centre = position();
     vehicle_.custom_mode = autopilot_->orbit_mode;  // until the next HEARTBEAT says otherwise
-  });
+  };
+  // From the centre PX4 flies out first (no standstill on the circle): the orbit's speed at once.
+  orbit_.sent_speed = orbit_.centre_known ? std::min(kSpeedLeadMps, orbit_speed(orbit_.radius)) : orbit_speed(orbit_.radius);
+  orbit_.up_to_speed = !orbit_.centre_known;
+  if (!orbit_.centre_known)
+    return send_mode_command(command(ml::cmd::DO_ORBIT, do_orbit_params(orbit_.radius, orbit_.sent_speed)), done);
+  const double r = orbit_.radius;
+  const double here = horizontal_norm(position() - orbit_.centre);
+  orbit_.sent_radius = std::clamp(here, std::max(1.0, r * (1.0 - kStartWithinM)), r * (1.0 + kStartWithinM));
+  auto p = do_orbit_params(orbit_.sent_radius, orbit_.sent_speed);
+  ml::CommandInt c;
+  c.target_system = sysid_;
+  c.target_component = ml::comp::AUTOPILOT1;
+  c.frame = ml::kFrameGlobal;  // z NaN: the altitude it has
+  c.command = ml::cmd::DO_ORBIT;
+  c.param = {p[0], p[1], p[2], p[3]};
+  c.x = orbit_.centre_lat_e7, c.y = orbit_.centre_lon_e7;
+  c.z = NAN;
+  send_mode_command(c, done);
+}
+
+std::array<float, 7> MavlinkDrone::do_orbit_params(double radius, double speed) const {
+  // Radius negative = counter-clockwise; centre and altitude NaN = where the vehicle is when
+  // PX4 enters its Orbit mode, and, sent again in that mode, the centre it has: only radius
+  // and speed change. param4 NaN = the autopilot's default number of turns (for ever). The
+  // speed is at most the one of the radius asked for (PX4 lowers it to what it can turn at).
+  return {-static_cast<float>(radius), static_cast<float>(speed), kYawFrontToCentre, NAN, NAN, NAN, NAN};
 }
 
 void MavlinkDrone::orbit_stopped_in_flight() {
@@ -94,7 +183,21 @@ void MavlinkDrone::advance_orbit(double dt) {
   if (!orbit_.on_circle) {
     // Out to the circle's east point first, like the simulator, then around it.
     setpoint_ = {orbit_.centre.x + r, orbit_.centre.y, orbit_.centre.z};
-    if (horizontal_norm(position() - setpoint_) <= options_.tolerance.horizontal_m) orbit_.on_circle = true;
+    if (horizontal_norm(position() - setpoint_) > options_.tolerance.horizontal_m) return;
+    if (!autopilot_->do_orbit) {
+      orbit_.on_circle = true;
+      return;
+    }
+    // PX4 from a standstill there (send_do_orbit starts it on the circle it stands on): its
+    // radial term is slow, and a vehicle still drifting out at 0.15-0.3 m/s when DO_ORBIT came
+    // went on 0.3-0.6 m past its circle. A vehicle that does not come to rest (a gusty hold)
+    // starts after kStartWaitS all the same.
+    if (orbit_.do_orbit_sent) return;
+    orbit_.waited_at_start_s += dt;
+    const bool still = norm(vehicle_.ned_velocity) <= kStartStillMps &&
+                       std::fabs(horizontal_norm(position() - orbit_.centre) - r) <= kStartOnCircleM;
+    if (still || (orbit_.waited_at_start_s >= kStartWaitS && norm(vehicle_.ned_velocity) <= options_.settled_mps))
+      send_do_orbit();
     return;
   }
   // Moved by the vehicle's clock, which a SITL on a loaded machine runs slower than --speed:
@@ -115,6 +218,108 @@ void MavlinkDrone::advance_orbit(double dt) {
   const double rc = orbit_.commanded_radius;
   setpoint_ = {orbit_.centre.x + rc * std::cos(orbit_.angle),
                orbit_.centre.y + rc * std::sin(orbit_.angle), orbit_.centre.z};
+}
+
+// PX4's orbit is a velocity controller (tangential speed, a radial term on the radius error,
+// centripetal feed-forward): its circle is smooth but, measured on SITL, 4.12-5.10 m for 5 m,
+// different from run to run and with the machine's load. As on ArduCopter, the radius asked
+// for is corrected by the one flown, an integral on the error, here sent as DO_ORBIT again
+// with the centre left NaN. The radius flown is the distance from the centre PX4 reports
+// (ORBIT_EXECUTION_STATUS), measured in GLOBAL_POSITION_INT's frame: a circle fitted to the
+// last half turn, tried first, swung 4.3 .. 6.1 m while the vehicle flew 4.6 .. 5.4 m.
+// Without the autopilot's centre, the one it was given (start_orbit); without either, no
+// correction: PX4's own circle is better than one corrected by a wrong measure.
+void MavlinkDrone::correct_orbit_radius() {
+  Orbit& o = orbit_;
+  const double vehicle_s = vehicle_.global_time_boot_ms / 1000.0;
+  const double dt = o.last_report_s < 0 ? 0.0 : vehicle_s - o.last_report_s;
+  o.last_report_s = vehicle_s;
+  if (o.corrections_stopped) return;
+  // The centre PX4 says it circles, else the one it was given.
+  const bool said = vehicle_.have_orbit_centre;
+  if (!said && !o.centre_known) return;
+  const Vec3 out = north_east_between(said ? vehicle_.orbit_centre_lat_e7 : o.centre_lat_e7,
+                                      said ? vehicle_.orbit_centre_lon_e7 : o.centre_lon_e7, vehicle_.lat_e7,
+                                      vehicle_.lon_e7);
+  const double flown = std::hypot(out.x, out.y);
+  const Vec3& v = vehicle_.global_velocity;
+  const double outward = flown > 0.0 ? (v.x * out.x + v.y * out.y) / flown : 0.0;
+  const double along = std::sqrt(std::max(0.0, v.x * v.x + v.y * v.y - outward * outward));
+  if (!o.on_circle) {
+    // Out from the centre first (PX4's circle approach): an error meanwhile is no error.
+    if (std::fabs(flown - o.radius) > kOnCircleM || outward > kSettledRadialMps) return;
+    o.on_circle = true;
+    o.sent_at_s = o.speed_check_s = vehicle_s;
+    o.last_flown_m = o.recent_flown_m = flown;
+    return;
+  }
+  if (dt <= 0.0 || dt > 1.0) return;  // a gap or a report out of order: nothing to integrate over
+  o.last_flown_m += std::min(1.0, dt / kFlownSmoothingS) * (flown - o.last_flown_m);
+  o.recent_flown_m += std::min(1.0, dt / kRecentSmoothingS) * (flown - o.recent_flown_m);
+  o.flown_speed += std::min(1.0, dt / kSpeedSmoothingS) * (along - o.flown_speed);
+  // Up to speed: the orbit's, or the one PX4 keeps to (it caps a speed it cannot turn at).
+  if (!o.up_to_speed && vehicle_s - o.speed_check_s >= kSpeedCheckS) {
+    o.up_to_speed = o.flown_speed >= 0.95 * orbit_speed(o.radius) || o.flown_speed - o.speed_at_check < 0.1;
+    o.speed_check_s = vehicle_s, o.speed_at_check = o.flown_speed;
+  }
+  // Not while it speeds up: that error is the start's, and integrated it swings the circle out.
+  // Nor while the lead is at its bound: integrated while the lead pulled the vehicle back from
+  // 0.4 m off, the integral carried it 0.5 m past the circle.
+  const double led = o.commanded_radius + kDoOrbitLead * (o.radius - o.recent_flown_m);
+  if (!o.up_to_speed || std::fabs(led - o.recent_flown_m) >= kAwayFromFlownM) return;
+  o.commanded_radius =
+      std::clamp(o.commanded_radius + kDoOrbitGain * dt * (o.radius - flown), 0.8 * o.radius, 1.5 * o.radius);
+}
+
+// Sent only right after a HEARTBEAT that shows the Orbit mode: DO_ORBIT in any other mode
+// makes PX4 enter Orbit, and one that crossed a pilot's mode switch would take the vehicle
+// back from the pilot. Right after the HEARTBEAT that window is the link's latency, not the
+// heartbeat period.
+void MavlinkDrone::send_due_orbit_correction() {
+  Orbit& o = orbit_;
+  if (!o.commanded || !o.on_circle || o.corrections_stopped || o.correcting || !o.mode_seen) return;
+  if (vehicle_.custom_mode != autopilot_->orbit_mode || mode_commands_pending_ > 0) return;
+  if (o.last_flown_m <= 0.0 || o.last_report_s - o.sent_at_s < kCorrectionEveryS) return;
+  const double speed = std::min(orbit_speed(o.radius), std::max(o.sent_speed, o.flown_speed + kSpeedLeadMps));
+  // Within PX4's acceptance radius of where the vehicle is, else it re-approaches its circle.
+  const double led = std::clamp(o.commanded_radius + kDoOrbitLead * (o.radius - o.recent_flown_m),
+                                o.recent_flown_m - kAwayFromFlownM, o.recent_flown_m + kAwayFromFlownM);
+  const double wanted = std::clamp(led, 0.8 * o.radius, 1.5 * o.radius);
+  double step = std::clamp(wanted - o.sent_radius, -kLargestStepM, kLargestStepM);
+  if (std::fabs(step) < kSmallestStepM) step = 0.0;
+  if (step == 0.0 && speed < o.sent_speed + kSmallestStepM) return;
+  const double radius = o.sent_radius + step;
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "orbit of %.2f m: flown at %.2f m from the autopilot's centre at %.2f m/s, DO_ORBIT radius %.2f m at %.2f m/s",
+                o.radius, o.last_flown_m, o.flown_speed, radius, speed);
+  note(text);
+  const ActionId id = motion_owner_;
+  const double before_radius = o.sent_radius, before_speed = o.sent_speed;
+  o.correcting = true;
+  o.sent_at_s = o.last_report_s;
+  o.sent_radius = radius;
+  o.sent_speed = speed;
+  // Once the orbit ended (cancelled: AUTO.LOITER sent), a resend would put the vehicle back
+  // in its Orbit mode.
+  auto still_orbiting = [this, id] {
+    return motion_owner_ == id && orbit_.commanded && vehicle_.custom_mode == autopilot_->orbit_mode;
+  };
+  commands_.send(
+      command(ml::cmd::DO_ORBIT, do_orbit_params(radius, speed)),
+      [this, id, radius, before_radius, before_speed](const CommandResult& result) {
+        if (motion_owner_ != id || !orbit_.commanded) return;  // the orbit ended meanwhile
+        orbit_.correcting = false;
+        if (result.accepted) return;
+        // The orbit goes on as PX4 flies it: a refusal of a correction is no failure of the
+        // Orbit, but asking again would be refused again.
+        orbit_.sent_radius = before_radius, orbit_.sent_speed = before_speed;
+        orbit_.corrections_stopped = true;
+        char text[96];
+        std::snprintf(text, sizeof text, "orbit radius correction to %.2f m not taken: ", radius);
+        note(text + result.error + "; the orbit goes on without corrections");
+      },
+      still_orbiting);
 }
 
 }  // namespace eamos::mavlink_adapter

@@ -24,6 +24,10 @@ constexpr int32_t kMaxAltitudeMm = 100'000'000;  // 100 km
 
 bool within(float v, double bound) { return std::isfinite(v) && std::fabs(v) <= bound; }
 
+bool on_earth(int32_t lat_e7, int32_t lon_e7) {
+  return lat_e7 >= -900'000'000 && lat_e7 <= 900'000'000 && lon_e7 >= -1'800'000'000 && lon_e7 <= 1'800'000'000;
+}
+
 const char* refusal(const ml::Message& m) {
   if (auto p = ml::unpack_local_position_ned(m)) {
     bool ok = within(p->x, kMaxLocalPositionM) && within(p->y, kMaxLocalPositionM) &&
@@ -43,7 +47,12 @@ const char* refusal(const ml::Message& m) {
   if (auto g = ml::unpack_global_position_int(m)) {
     bool ok = g->alt >= -kMaxAltitudeMm && g->alt <= kMaxAltitudeMm && g->relative_alt >= -kMaxAltitudeMm &&
               g->relative_alt <= kMaxAltitudeMm;
-    return ok ? nullptr : "GLOBAL_POSITION_INT with an altitude beyond 100 km";
+    if (!ok) return "GLOBAL_POSITION_INT with an altitude beyond 100 km";
+    return on_earth(g->lat, g->lon) ? nullptr : "GLOBAL_POSITION_INT with a latitude or longitude off the earth";
+  }
+  if (auto o = ml::unpack_orbit_execution_status(m)) {
+    bool ok = within(o->radius, kMaxLocalPositionM) && (!ml::is_global_frame(o->frame) || on_earth(o->x, o->y));
+    return ok ? nullptr : "ORBIT_EXECUTION_STATUS with NaN, a radius out of range or a centre off the earth";
   }
   return nullptr;
 }
@@ -80,9 +89,38 @@ Changes apply_telemetry(VehicleState& v, const ml::Frame& frame) {
     v.relative_alt_m = g->relative_alt / 1000.0;
     // UINT16_MAX: the vehicle does not know; anything else beyond 359.99° is not a heading.
     v.heading_deg = g->hdg < 36000 ? g->hdg / 100.0 : -1.0;
+    v.lat_e7 = g->lat, v.lon_e7 = g->lon;
+    v.global_time_boot_ms = g->time_boot_ms;
+    v.global_velocity = {g->vx / 100.0, g->vy / 100.0, g->vz / 100.0};
+    c.global_position = true;
+  } else if (auto o = ml::unpack_orbit_execution_status(m)) {
+    // A centre in a local frame would need the autopilot's local origin: not used.
+    if (ml::is_global_frame(o->frame)) {
+      v.have_orbit_centre = true;
+      v.orbit_centre_lat_e7 = o->x, v.orbit_centre_lon_e7 = o->y;
+    }
   }
   c.landed = v.landed() != was_landed;
   return c;
+}
+
+namespace {
+constexpr double kEarthRadiusM = 6'371'000.0;  // PX4's and ArduPilot's mean radius
+constexpr double kRadPerE7 = M_PI / 180.0 * 1e-7;
+}  // namespace
+
+std::pair<int32_t, int32_t> offset_lat_lon(int32_t lat, int32_t lon, double north_m, double east_m) {
+  const double dlat = north_m / kEarthRadiusM / kRadPerE7;
+  const double mid_lat = (lat + dlat / 2.0) * kRadPerE7;
+  const double dlon = east_m / (kEarthRadiusM * std::cos(mid_lat)) / kRadPerE7;
+  return {static_cast<int32_t>(std::lround(lat + dlat)), static_cast<int32_t>(std::lround(lon + dlon))};
+}
+
+fleet::Vec3 north_east_between(int32_t from_lat, int32_t from_lon, int32_t to_lat, int32_t to_lon) {
+  const double mid_lat = (static_cast<double>(from_lat) + to_lat) / 2.0 * kRadPerE7;
+  const double north = (static_cast<double>(to_lat) - from_lat) * kRadPerE7 * kEarthRadiusM;
+  const double east = (static_cast<double>(to_lon) - from_lon) * kRadPerE7 * kEarthRadiusM * std::cos(mid_lat);
+  return {north, east, 0.0};
 }
 
 fleet::Vec3 ned_to_mission(fleet::Vec3 ned, fleet::Vec3 home) {

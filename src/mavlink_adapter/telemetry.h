@@ -6,6 +6,7 @@
 // with `home` the drone's home from the fleet file.
 #include <cstdint>
 #include <limits>
+#include <utility>
 
 #include "fleet/fleet.h"
 #include "mavlink/frame.h"
@@ -26,6 +27,13 @@ struct VehicleState {
   double amsl_m = 0.0;            ///< altitude above mean sea level
   double relative_alt_m = 0.0;    ///< altitude above home
   double heading_deg = -1.0;      ///< GLOBAL_POSITION_INT.hdg in degrees, -1 unknown
+  int32_t lat_e7 = 0, lon_e7 = 0; ///< GLOBAL_POSITION_INT's, degE7
+  uint32_t global_time_boot_ms = 0;
+  fleet::Vec3 global_velocity;    ///< m/s, north east down, GLOBAL_POSITION_INT's
+  /// The centre of the orbit the autopilot flies (ORBIT_EXECUTION_STATUS in a global frame),
+  /// degE7; have_orbit_centre only while the newest such report is of the current orbit.
+  bool have_orbit_centre = false;
+  int32_t orbit_centre_lat_e7 = 0, orbit_centre_lon_e7 = 0;
 
   /// On the ground: EXTENDED_SYS_STATE says so; without it, disarmed or within 0.3 m of
   /// the local origin's height.
@@ -38,16 +46,23 @@ struct Changes {
   bool position = false;
   bool armed = false;
   bool landed = false;
+  bool global_position = false;  ///< a GLOBAL_POSITION_INT was taken
   /// The frame was refused and changed nothing: which message and why (NaN, infinity, a
   /// value beyond any vehicle, an unknown enum value). nullptr for a frame taken.
   const char* rejected = nullptr;
 };
 
 /// Folds one telemetry frame (HEARTBEAT, LOCAL_POSITION_NED, EXTENDED_SYS_STATE,
-/// SYS_STATUS, BATTERY_STATUS, GLOBAL_POSITION_INT) into `v`; other messages change nothing.
+/// SYS_STATUS, BATTERY_STATUS, GLOBAL_POSITION_INT, ORBIT_EXECUTION_STATUS) into `v`; other messages change nothing.
 /// A frame has passed its CRC, but its values still come from outside: one with NaN, an
 /// infinity, a value out of range or an unknown enum value is refused whole (Changes::rejected).
 Changes apply_telemetry(VehicleState& v, const mavlink::Frame& frame);
+
+/// Horizontal metres (north, east) from `from` to `to`, both degE7: flat earth, which over the
+/// tens of metres of an orbit errs by far less than the position estimate.
+fleet::Vec3 north_east_between(int32_t from_lat, int32_t from_lon, int32_t to_lat, int32_t to_lon);
+/// The point `north_m`, `east_m` from (lat, lon), in degE7: north_east_between's inverse.
+std::pair<int32_t, int32_t> offset_lat_lon(int32_t lat, int32_t lon, double north_m, double east_m);
 
 fleet::Vec3 ned_to_mission(fleet::Vec3 ned, fleet::Vec3 home);
 fleet::Vec3 mission_to_ned(fleet::Vec3 mission, fleet::Vec3 home);

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <limits>
+#include <tuple>
+#include <utility>
 
 #include "mavlink/enums.h"
 #include "mid/vec.h"
@@ -25,6 +27,13 @@ fleet::DroneSettings vehicle_settings(uint8_t sysid, double battery) {
 // PX4 SITL's default home, so GLOBAL_POSITION_INT looks like a real one.
 constexpr double kHomeLat = 47.397742, kHomeLon = 8.545594;
 constexpr double kMetresPerDegree = 111'111.0;
+
+/// degE7 (lat, lon) of a point of the vehicle's frame (x east, y north of home).
+std::pair<int32_t, int32_t> lat_lon_e7(double x, double y) {
+  double lat = kHomeLat + y / kMetresPerDegree;
+  double lon = kHomeLon + x / (kMetresPerDegree * std::cos(kHomeLat * M_PI / 180.0));
+  return {static_cast<int32_t>(std::lround(lat * 1e7)), static_cast<int32_t>(std::lround(lon * 1e7))};
+}
 
 const uint32_t kStreamed[] = {ml::msg::LOCAL_POSITION_NED, ml::msg::EXTENDED_SYS_STATE,
                               ml::msg::SYS_STATUS, ml::msg::BATTERY_STATUS,
@@ -93,9 +102,16 @@ void SimVehicle::on_frame(const ml::Frame& frame) {
     ack_to_component_ = frame.compid;
     return on_command(*c);
   }
+  if (auto c = ml::unpack_command_int(frame.message)) {
+    ack_to_system_ = frame.sysid;
+    ack_to_component_ = frame.compid;
+    return on_command_int(*c);
+  }
   if (auto sp = ml::unpack_set_position_target_local_ned(frame.message)) return on_setpoint(*sp);
   if (auto r = ml::unpack_param_request_read(frame.message)) return on_param_request(*r);
   if (auto s = ml::unpack_setup_signing(frame.message)) return on_setup_signing(*s);
+  if (auto hb = ml::unpack_heartbeat(frame.message); hb && hb->autopilot == ml::autopilot::INVALID)
+    heartbeat_types_.insert(hb->type);
 }
 
 // Like ArduPilot after SETUP_SIGNING: sign every frame from now on and drop every unsigned
@@ -123,7 +139,8 @@ void SimVehicle::on_param_request(const ml::ParamRequestRead& r) {
       px4 ? std::map<std::string, double>{{"MPC_XY_CRUISE", l.max_speed_mps}, {"MPC_Z_VEL_MAX_UP", l.max_climb_mps},
                                           {"MPC_TKO_SPEED", l.max_climb_mps}, {"MPC_Z_VEL_MAX_DN", l.max_descent_mps},
                                           {"MPC_LAND_SPEED", l.max_descent_mps}, {"COM_SPOOLUP_TIME", 0},
-                                          {"MPC_TKO_RAMP_T", 0}, {"MPC_ACC_HOR", l.max_accel_mps2}, {"RTL_RETURN_ALT", 0}, {"RTL_LAND_DELAY", 0}}
+                                          {"MPC_TKO_RAMP_T", 0}, {"MPC_ACC_HOR", l.max_accel_mps2}, {"RTL_RETURN_ALT", 0}, {"RTL_LAND_DELAY", 0},
+                                          {"MC_ORBIT_RAD_MAX", 1000}}
           : std::map<std::string, double>{{"WPNAV_SPEED", 100 * l.max_speed_mps},
                                           {"WPNAV_SPEED_UP", 100 * l.max_climb_mps},
                                           {"WPNAV_SPEED_DN", 100 * l.max_descent_mps},
@@ -157,6 +174,23 @@ void SimVehicle::on_command(const ml::CommandLong& c) {
   ack(c.command, result);
 }
 
+// COMMAND_INT: DO_ORBIT only, with its centre in x, y (degE7 in a global frame; INT32_MAX
+// for both: where the vehicle is, as PX4 reads it). Anything else is unsupported here.
+void SimVehicle::on_command_int(const ml::CommandInt& c) {
+  if (c.target_system != options_.sysid && c.target_system != 0) return;
+  ++received_[c.command];
+  if (c.command != ml::cmd::DO_ORBIT) return ack(c.command, ml::result::UNSUPPORTED);
+  ml::CommandLong as_long{c.target_system, c.target_component, c.command, 0,
+                          {c.param[0], c.param[1], c.param[2], c.param[3], NAN, NAN, c.z}};
+  std::optional<Vec3> centre;
+  if (c.x != INT32_MAX || c.y != INT32_MAX) {
+    if (!ml::is_global_frame(c.frame)) return ack(c.command, ml::result::DENIED);
+    centre = Vec3{(c.y / 1e7 - kHomeLon) * kMetresPerDegree * std::cos(kHomeLat * M_PI / 180.0),
+                  (c.x / 1e7 - kHomeLat) * kMetresPerDegree, 0.0};
+  }
+  ack(c.command, start_orbit(as_long, centre));
+}
+
 uint8_t SimVehicle::execute(const ml::CommandLong& c) {
   mid::DroneState s = drone_.state();
   switch (c.command) {
@@ -180,7 +214,7 @@ uint8_t SimVehicle::execute(const ml::CommandLong& c) {
     }
     case ml::cmd::NAV_LAND: return set_mode(Mode::land);
     case ml::cmd::NAV_RETURN_TO_LAUNCH: return set_mode(Mode::rtl);
-    case ml::cmd::DO_ORBIT: return start_orbit(c);
+    case ml::cmd::DO_ORBIT: return start_orbit(c, std::nullopt);
     case ml::cmd::DO_SET_MODE: {
       Mode m;
       return requested_mode(c, m) ? set_mode(m) : ml::result::DENIED;
@@ -189,6 +223,8 @@ uint8_t SimVehicle::execute(const ml::CommandLong& c) {
       auto id = static_cast<uint32_t>(c.param[0]);
       bool known = false;
       for (uint32_t m : kStreamed) known = known || m == id;
+      // PX4's orbit status, sent while it orbits; ArduPilot Copter has no DO_ORBIT.
+      known = known || (id == ml::msg::ORBIT_EXECUTION_STATUS && dialect_.do_orbit);
       if (!known) return ml::result::DENIED;
       double us = c.param[1];
       set_rate(id, us < 0 ? 0.0 : us == 0 ? options_.default_rate_hz : 1e6 / us);
@@ -328,7 +364,7 @@ void SimVehicle::set_rate(uint32_t id, double hz) {
 }
 
 void SimVehicle::send_stream(uint32_t id) {
-  send(telemetry(id));
+  if (id != ml::msg::ORBIT_EXECUTION_STATUS || mode_ == Mode::orbit) send(telemetry(id));
   double hz = rates_hz_.count(id) ? rates_hz_[id] : 1.0;
   streams_[id] = loop_.after(1.0 / hz, [this, id] { send_stream(id); });
 }
@@ -370,15 +406,25 @@ ml::Message SimVehicle::telemetry(uint32_t id) const {
     case ml::msg::GLOBAL_POSITION_INT: {
       ml::GlobalPositionInt g;
       g.time_boot_ms = static_cast<uint32_t>(s.t * 1000.0);
-      double lat = kHomeLat + s.y / kMetresPerDegree;
-      double lon = kHomeLon + s.x / (kMetresPerDegree * std::cos(kHomeLat * M_PI / 180.0));
-      g.lat = static_cast<int32_t>(std::lround(lat * 1e7));
-      g.lon = static_cast<int32_t>(std::lround(lon * 1e7));
+      std::tie(g.lat, g.lon) = lat_lon_e7(s.x, s.y);
+      g.vx = static_cast<int16_t>(std::lround(v.y * 100.0));
+      g.vy = static_cast<int16_t>(std::lround(v.x * 100.0));
+      g.vz = static_cast<int16_t>(std::lround(-v.z * 100.0));
       g.alt = static_cast<int32_t>(std::lround((options_.home_amsl_m + s.z) * 1000.0));
-      g.relative_alt = static_cast<int32_t>(std::lround(s.z * 1000.0));
+      g.relative_alt = static_cast<int32_t>(std::lround((s.z - options_.home_above_origin_m) * 1000.0));
       // As a real autopilot: cdeg from north, UINT16_MAX when the vehicle does not know.
       if (std::isfinite(s.heading)) g.hdg = static_cast<uint16_t>(std::lround(s.heading * 100.0) % 36000);
       return ml::pack(g);
+    }
+    case ml::msg::ORBIT_EXECUTION_STATUS: {
+      // As PX4's FlightTaskOrbit reports it: MAV_FRAME_GLOBAL, the centre in degE7.
+      ml::OrbitExecutionStatus o;
+      o.time_usec = static_cast<uint64_t>(s.t * 1e6);
+      o.radius = static_cast<float>(-orbit_.direction * orbit_.radius);
+      o.frame = 0;
+      std::tie(o.x, o.y) = lat_lon_e7(orbit_.centre.x, orbit_.centre.y);
+      o.z = static_cast<float>(options_.home_amsl_m + orbit_.centre.z);
+      return ml::pack(o);
     }
   }
   ml::Heartbeat hb;

@@ -121,10 +121,11 @@ namespace {
 
 // A distributed run flies each drone from its mission file: a signing key the fleet file
 // gave must come back from it, or the DEX would fly that drone unsigned.
-TEST(MissionFile, ADronesSigningKeyAndSetupComeBackFromItsFileOnly) {
+TEST(MissionFile, ADronesSigningKeySetupAndGcsAnnouncementComeBackFromItsFileOnly) {
   std::string fleet = std::string(test::kListing2Fleet) + "";
   const std::string key = "0f1e2d3c4b5a69788796a5b4c3d2e1f000112233445566778899aabbccddeeff";
-  fleet.replace(fleet.find("    failsafe: return_home\n"), 0, "    signing: {key: " + key + ", setup: true}\n");
+  fleet.replace(fleet.find("    failsafe: return_home\n"), 0,
+               "    signing: {key: " + key + ", setup: true}\n    announce_as_gcs: true\n");
   auto c = test::compile_mission(test::listing2_text(), fleet);
   ASSERT_TRUE(c);
   std::string hash = deploy::mission_hash(*c);
@@ -137,6 +138,7 @@ TEST(MissionFile, ADronesSigningKeyAndSetupComeBackFromItsFileOnly) {
     bool is_drone2 = c->drone_name(d) == "Drone2";
     EXPECT_EQ(m.settings.signing_key, is_drone2 ? key : "") << c->drone_name(d);
     EXPECT_EQ(m.settings.signing_setup, is_drone2) << c->drone_name(d);
+    EXPECT_EQ(m.settings.announce_as_gcs, is_drone2) << c->drone_name(d);  // its DEX announces it too
     EXPECT_EQ(out.str().find(key) != std::string::npos, is_drone2) << c->drone_name(d);
   }
 }

@@ -149,5 +149,20 @@ TEST(Settings, FailsafeNamesAreTheFileSpelling) {
   EXPECT_STREQ(failsafe_name(Failsafe::hover), "hover");
 }
 
+// Announcing a ground station hides the real one's loss from PX4: only a drone whose entry
+// says so does it.
+TEST(Settings, AnnounceAsGcsIsOnlyForTheDronesThatAskAndTakesOnlyTrueOrFalse) {
+  auto p = parse("drones:\n  D1: {adapter: mavlink, announce_as_gcs: true}\n  D2: {adapter: mavlink}\n");
+  ASSERT_TRUE(p.ok);
+  EXPECT_TRUE(p.fleet.drones.at("D1").announce_as_gcs);
+  EXPECT_FALSE(p.fleet.drones.at("D2").announce_as_gcs);
+  auto bad = parse("drones:\n  D1: {announce_as_gcs: [yes]}\n  D2: {announce_as_gcs: sometimes}\n");
+  EXPECT_FALSE(bad.ok);
+  ASSERT_EQ(bad.diags.error_count(), 2u);
+  Diagnostic d = test::first_error(bad.diags);
+  EXPECT_EQ(d.loc.line, 2);
+  EXPECT_NE(d.message.find("announce_as_gcs of drone 'D1' must be true or false; got "), std::string::npos) << d.message;
+}
+
 }  // namespace
 }  // namespace eamos::fleet

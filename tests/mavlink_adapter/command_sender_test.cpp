@@ -80,6 +80,27 @@ TEST(CommandSender, SameCommandIdWaitsForThePreviousAck) {
   EXPECT_EQ(f.sender.pending(), 0u);
 }
 
+// A correction that an orbit's end made obsolete must not reach the vehicle after the mode
+// switch that ended it: its resend is dropped, and the next command of its id goes out.
+TEST(CommandSender, ACommandNoLongerWantedIsNotSentAgain) {
+  Fixture f;
+  bool wanted = true;
+  std::optional<CommandResult> result;
+  int next_done = 0;
+  f.sender.send(arm(), [&](const CommandResult& r) { result = r; }, [&] { return wanted; });
+  f.sender.send(arm(), [&](const CommandResult&) { ++next_done; });
+  wanted = false;
+  f.loop.run_until(1.5);
+  ASSERT_TRUE(result);
+  EXPECT_FALSE(result->accepted);
+  EXPECT_FALSE(result->answered);
+  EXPECT_EQ(result->error, "MAV_CMD_COMPONENT_ARM_DISARM: no COMMAND_ACK, and not sent again: no longer wanted");
+  ASSERT_EQ(f.sent.size(), 2u);  // the first once, then the next one: no resend between
+  EXPECT_EQ(f.sent[1].confirmation, 0);
+  f.sender.on_ack({ml::cmd::COMPONENT_ARM_DISARM, ml::result::ACCEPTED});
+  EXPECT_EQ(next_done, 1);
+}
+
 TEST(CommandSender, FailAllEndsEveryQueuedCommand) {
   Fixture f;
   std::vector<std::string> errors;

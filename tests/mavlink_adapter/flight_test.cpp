@@ -71,6 +71,23 @@ TEST(MavlinkFlight, ArmTakeoffFlyAndLand) {
   EXPECT_NEAR(f.drone->state().z, 0.0, 0.1);
 }
 
+// PX4 takes off to an altitude above mean sea level. Its home (relative_alt's reference) is
+// where it stood when it armed, which its EKF no longer puts at the ground's altitude some
+// seconds later (SITL: 0.2-0.3 m, a Takeoff(3) after the auto-disarm's re-arm hovered at
+// 2.7 m, the edge of the 0.3 m band, and timed out): the altitude is asked for from where
+// the vehicle is now, in the frame the goal is judged in.
+TEST(MavlinkFlight, Px4TakesOffToTheAltitudeAboveTheGroundWhenItsHomeIsNotWhereItStands) {
+  sim_vehicle::VehicleOptions o;
+  o.home_above_origin_m = -0.5;
+  test::VehicleThread vehicle(25321, kSpeed, o);
+  Flight f(25321);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
+  mid::ActionEnd e = f.fly("Takeoff", {3});
+  ASSERT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
+  EXPECT_NEAR(vehicle.inspect([](const sim_vehicle::SimVehicle& v) { return v.drone().state().z; }), 3.0, 0.3);
+}
+
 TEST(MavlinkFlight, ArduPilotTakesOffInGuidedToAnAltitudeAboveHome) {
   test::VehicleThread vehicle(25318, 1, kSpeed, sim_vehicle::ardupilot_dialect());
   Flight f(25318);
@@ -145,6 +162,25 @@ TEST(MavlinkFlight, ArmRefusedByTheAutopilotFailsWithItsResultInWords) {
   EXPECT_EQ(e.failure, mid::FailureReason::refused);
   EXPECT_EQ(e.detail, "MAV_CMD_COMPONENT_ARM_DISARM: MAV_RESULT_DENIED (denied by the autopilot)");
   EXPECT_FALSE(f.drone->state().armed);
+}
+
+// The adapter is an onboard controller; only a fleet file's `announce_as_gcs: true` makes
+// it a ground station too (PX4 then sends it STATUSTEXT, and no longer sees its real ground
+// station's link go: docs/fleet.md). Once the ARM is acknowledged the vehicle has had the
+// HEARTBEATs the adapter sent before it.
+TEST(MavlinkFlight, TheAdapterAnnouncesAGroundStationOnlyWhenTheFleetFileAsks) {
+  for (bool announce : {false, true}) {
+    const int port = announce ? 25394 : 25393;
+    test::VehicleThread vehicle(port, 1, kSpeed);
+    Flight f(port, {}, [&](fleet::DroneSettings& s) { s.announce_as_gcs = announce; });
+    ASSERT_TRUE(f.drone) << f.created.message;
+    ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
+    auto heard = [&](uint8_t type) {
+      return vehicle.inspect([type](const sim_vehicle::SimVehicle& v) { return v.heard_heartbeat_of_type(type); });
+    };
+    EXPECT_TRUE(heard(mavlink::mav_type::ONBOARD_CONTROLLER)) << announce;
+    EXPECT_EQ(heard(mavlink::mav_type::GCS), announce);
+  }
 }
 
 TEST(MavlinkFlight, TakeoffWhileDisarmedIsRefusedBeforeReachingTheAutopilot) {
@@ -222,14 +258,14 @@ TEST(MavlinkFlight, APilotsModeSwitchFailsTheMotionAndTheAdapterGivesWay) {
 }
 
 TEST(MavlinkFlight, ForgedFramesWithTheVehiclesSystemIdFromAnotherPortAreIgnoredAndCounted) {
-  test::VehicleThread vehicle(25371, 1, kSpeed);
-  Flight f(25371);
+  test::VehicleThread vehicle(25396, 1, kSpeed);
+  Flight f(25396);
   ASSERT_TRUE(f.drone) << f.created.message;
   std::vector<std::string> messages;
   f.drone->set_message_sink([&](const std::string& m) { messages.push_back(m); });
   // An attacker on the adapter's port: DENIED for every arm command and HEARTBEATs, all with
   // the vehicle's system id, while the mission arms and takes off.
-  auto forger = mavlink::Link::open(*mavlink::parse_url("udpout://127.0.0.1:25371").endpoint, [](mavlink::Frame) {});
+  auto forger = mavlink::Link::open(*mavlink::parse_url("udpout://127.0.0.1:25396").endpoint, [](mavlink::Frame) {});
   ASSERT_TRUE(forger.link) << forger.error;
   std::atomic<bool> stop{false};
   std::thread attack([&] {
@@ -336,6 +372,24 @@ TEST(MavlinkFlight, FailsafeLandCancelsTheFlightLandsAndRefusesMore) {
   mid::ActionEnd refused = f.fly("Takeoff", {3});
   EXPECT_EQ(refused.outcome, mid::Outcome::failed);
   EXPECT_EQ(refused.reason, "failsafe active (failsafe: land)");
+}
+
+// A failsafe ends with the motors off, as in the simulator, also on an autopilot that keeps
+// them on after landing (here for 1000 s: ArduPilot DISARM_DELAY 0, PX4 COM_DISARM_LAND -1):
+// the adapter disarms once the vehicle is down.
+TEST(MavlinkFlight, FailsafeLandingEndsWithTheMotorsOffWhenTheAutopilotKeepsThemOn) {
+  sim_vehicle::VehicleOptions o = test::VehicleThread::options(sim_vehicle::px4_dialect(), 1, 100.0, true);
+  o.disarm_after_land_s = 1000;
+  test::VehicleThread vehicle(25383, kSpeed, o);
+  Flight f(25383);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
+  ASSERT_EQ(f.fly("Takeoff", {3}).outcome, mid::Outcome::succeeded);
+  f.drone->failsafe(fleet::Failsafe::land);
+  for (int i = 0; i < 100 && !f.drone->state().landed; ++i) f.loop.run_until(f.loop.now() + 0.5);
+  ASSERT_TRUE(f.drone->state().landed);
+  for (int i = 0; i < 20 && f.drone->state().armed; ++i) f.loop.run_until(f.loop.now() + 0.25);
+  EXPECT_FALSE(f.drone->state().armed);
 }
 
 TEST(MavlinkAdapter, NoVehicleIsACreateErrorThatSaysWhatToCheck) {

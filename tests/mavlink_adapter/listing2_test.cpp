@@ -175,4 +175,34 @@ TEST(MavlinkRun, ARefusalFailsTheMissionWithTheAutopilotsReasonAndTheRunEnds) {
   EXPECT_LT(wall, 15.0);  // not the time limit: a failed run ends once the drones are down
 }
 
+// One DEX per drone: Drone2's Arm is refused, and Drone1, armed on the ground, runs its
+// failsafe. Its DEX stays until the vehicle is disarmed, not only down: the summary shows
+// every drone disarmed (a DEX that ended at "landed" left it armed, seen on PX4 SITL).
+TEST(MavlinkRun, ADistributedRefusalEndsWithEveryDroneDisarmed) {
+  fs::path dir = fs::temp_directory_path() / ("eamos-mavlink-refused-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  pid_t armed = spawn_vehicle(25381, 1, "120");
+  pid_t refusing = spawn_vehicle(25382, 2, "120", "0");  // an empty battery: arming is refused
+  std::string out;
+  const std::string data = EAMOS_TEST_DATA;
+  int status = run("run " + data + "/data/arm-refused-pair.eamos --fleet " + data +
+                       "/data/arm-refused-pair.yaml --distributed --domain 79 --speed 4 --time-limit 60 --deploy-dir " +
+                       (dir / "deploy").string() + " --summary " + (dir / "summary.json").string(),
+                   out);
+  for (pid_t pid : {armed, refusing}) {
+    kill(pid, SIGTERM);
+    waitpid(pid, nullptr, 0);
+  }
+  EXPECT_EQ(status, 1) << out;
+  auto summary = nlohmann::json::parse(read_text(dir / "summary.json"), nullptr, false);
+  ASSERT_FALSE(summary.is_discarded()) << out;
+  EXPECT_NE(summary.value("error", "").find("Drone2.Arm (line 6) failed: refused by PX4"), std::string::npos)
+      << summary.dump(2);
+  for (const char* d : {"Drone1", "Drone2"}) {
+    EXPECT_EQ(summary["drones"][d].value("armed", true), false) << d << "\n" << summary.dump(2) << "\n" << out;
+    EXPECT_EQ(summary["drones"][d].value("landed", false), true) << d << "\n" << summary.dump(2);
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace

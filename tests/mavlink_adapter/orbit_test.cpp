@@ -53,8 +53,24 @@ TEST(MavlinkOrbit, Px4FliesOrbitItselfAfterDoOrbitCirclingTheStartCounterClockwi
   Orbiting o;
   take_off_and_orbit(f, o, 8.0);
   EXPECT_FALSE(o.end);  // an orbit has no end of its own
-  EXPECT_EQ(do_orbits(vehicle), 1);
+  // The first DO_ORBIT started it; any later one only corrected its radius (next test).
+  auto sent = vehicle.inspect([](const sim_vehicle::SimVehicle& s) { return s.orbit_commands(); });
+  ASSERT_GE(sent.size(), 1u);
+  EXPECT_NEAR(-sent[0].param[0], kRadius, 0.5);  // the circle it stands on, then the one asked for
   EXPECT_EQ(vehicle_mode(vehicle), Mode::orbit);
+  // Sent from the circle's east point, with the centre named (COMMAND_INT): PX4 then starts on
+  // its circle instead of spiralling out to it from the centre.
+  auto start = vehicle.inspect([](const sim_vehicle::SimVehicle& s) { return s.orbit_start(); });
+  EXPECT_NEAR(start.centre.x, 0.0, 0.1);
+  EXPECT_NEAR(start.centre.y, 0.0, 0.1);
+  EXPECT_NEAR(start.vehicle.x, kRadius, 0.5);
+  EXPECT_NEAR(start.vehicle.y, 0.0, 0.5);
+  // From there a slow speed first, raised a little above the one flown, DO_ORBIT by DO_ORBIT:
+  // PX4's centripetal feed-forward is the one of the speed it is given.
+  EXPECT_LE(sent[0].param[1], 1.0f + 1e-4f);
+  ASSERT_GE(sent.size(), 3u);
+  for (std::size_t k = 1; k < sent.size(); ++k) EXPECT_GE(sent[k].param[1], sent[k - 1].param[1]) << k;
+  EXPECT_GT(sent.back().param[1], 1.0f);
   for (int i = 0; i < 3; ++i) {
     mid::DroneState before = f.drone->state();
     f.loop.run_until(f.loop.now() + 0.5);
@@ -63,6 +79,63 @@ TEST(MavlinkOrbit, Px4FliesOrbitItselfAfterDoOrbitCirclingTheStartCounterClockwi
     EXPECT_NEAR(after.z, 3.0, 0.3);
     EXPECT_GT(turned(bearing(before), bearing(after)), 0.2);  // going round, counter-clockwise
   }
+}
+
+// PX4 flies its orbit short of the radius it is given (SIH: 4.12-4.88 m for 5 m). The adapter
+// measures the radius flown and sends DO_ORBIT again, the centre still NaN (PX4 keeps its
+// own), the radius raised in steps of at most 0.3 m until the vehicle flies the one asked for.
+TEST(MavlinkOrbit, APx4OrbitFlownShortIsCorrectedByDoOrbitsSentAgainWithTheCentreKept) {
+  sim_vehicle::VehicleOptions options = VehicleThread::options(sim_vehicle::px4_dialect(), 1, 100.0, true);
+  options.orbit_shortfall = 0.1;  // 3 m asked for, 2.7 m flown
+  VehicleThread vehicle(25367, kSpeed, options);
+  Flight f(25367);
+  Orbiting o;
+  take_off_and_orbit(f, o, 24.0);  // up to speed first (the adapter raises it step by step), then corrected
+  EXPECT_FALSE(o.end);
+  EXPECT_EQ(vehicle_mode(vehicle), Mode::orbit);
+  auto sent = vehicle.inspect([](const sim_vehicle::SimVehicle& s) { return s.orbit_commands(); });
+  ASSERT_GE(sent.size(), 3u);
+  for (std::size_t k = 0; k < sent.size(); ++k) {
+    EXPECT_LT(sent[k].param[0], 0.0f) << k;  // counter-clockwise throughout
+    for (int p = 4; p < 7; ++p) EXPECT_TRUE(std::isnan(sent[k].param[p])) << k << " param" << p + 1;
+    if (k > 0) {
+      EXPECT_LE(std::fabs(sent[k].param[0] - sent[k - 1].param[0]), 0.3f + 1e-4f) << k;
+    }
+  }
+  EXPECT_NEAR(-sent[0].param[0], kRadius, 0.5);  // the circle it stands on, then the one asked for
+  // At least the shortfall made up (more: this vehicle also lags behind its moving point).
+  EXPECT_GE(-sent.back().param[0], 0.98 * kRadius / 0.9);
+  for (int i = 0; i < 4; ++i) {  // flown within 5 % of 3 m, around where it started
+    f.loop.run_until(f.loop.now() + 0.5);
+    EXPECT_NEAR(std::hypot(f.drone->state().x, f.drone->state().y), kRadius, 0.05 * kRadius);
+  }
+}
+
+// A correction PX4 refuses (here: below its smallest orbit, 1 m, for an Orbit(1) flown wide)
+// is noted and ends the corrections; the Orbit itself goes on.
+TEST(MavlinkOrbit, ARefusedRadiusCorrectionIsNotedAndTheOrbitGoesOn) {
+  sim_vehicle::VehicleOptions options = VehicleThread::options(sim_vehicle::px4_dialect(), 1, 100.0, true);
+  options.orbit_shortfall = -0.2;  // flown 20 % wide
+  VehicleThread vehicle(25368, kSpeed, options);
+  Flight f(25368);
+  std::vector<std::string> messages;
+  f.drone->set_message_sink([&](const std::string& m) { messages.push_back(m); });
+  Orbiting o;
+  take_off_and_orbit(f, o, 20.0, 1.0);
+  EXPECT_FALSE(o.end);
+  EXPECT_EQ(vehicle_mode(vehicle), Mode::orbit);
+  // The start and the steps of its speed, all at 1 m; one correction below 1 m refused, no
+  // DO_ORBIT after it.
+  auto taken = vehicle.inspect([](const sim_vehicle::SimVehicle& s) { return s.orbit_commands(); });
+  ASSERT_GE(taken.size(), 1u);
+  for (const auto& c : taken) EXPECT_FLOAT_EQ(c.param[0], -1.0f);
+  EXPECT_EQ(do_orbits(vehicle), static_cast<int>(taken.size()) + 1);
+  std::string refused;
+  for (const std::string& m : messages)
+    if (m.find("not taken") != std::string::npos) refused = m;
+  EXPECT_EQ(refused.rfind("orbit radius correction to 0.", 0), 0u) << refused;
+  EXPECT_NE(refused.find("MAV_RESULT_DENIED"), std::string::npos) << refused;
+  EXPECT_NE(refused.find("the orbit goes on without corrections"), std::string::npos) << refused;
 }
 
 TEST(MavlinkOrbit, CancellingAPx4OrbitLeavesOrbitModeAndHoldsWithSetpoints) {
@@ -112,16 +185,37 @@ TEST(MavlinkOrbit, ArduPilotOrbitIsStillFlownFromSetpointsInGuided) {
   EXPECT_GT(turned(bearing(before), bearing(after)), 0.2);
 }
 
+// The vehicle flies out to the circle first; PX4 refuses DO_ORBIT there: the Orbit fails with
+// PX4's answer in words and the vehicle holds on our setpoints where it was refused.
 TEST(MavlinkOrbit, DoOrbitRefusedByPx4FailsWithTheResultInWordsAndKeepsHolding) {
-  VehicleThread vehicle(25364, 1, kSpeed);
+  sim_vehicle::VehicleOptions options = VehicleThread::options(sim_vehicle::px4_dialect(), 1, 100.0, true);
+  options.refuse_orbit = true;
+  VehicleThread vehicle(25364, kSpeed, options);
   Flight f(25364);
   Orbiting o;
-  take_off_and_orbit(f, o, 4.0, 2000.0);  // beyond PX4's largest orbit (MC_ORBIT_RAD_MAX)
+  take_off_and_orbit(f, o, 6.0);
   ASSERT_TRUE(o.end);
   EXPECT_EQ(o.end->outcome, mid::Outcome::failed);
   EXPECT_EQ(o.end->reason,
             "refused by PX4: MAV_CMD_DO_ORBIT: MAV_RESULT_DENIED (denied by the autopilot)");
+  EXPECT_EQ(do_orbits(vehicle), 1);
   EXPECT_EQ(vehicle_mode(vehicle), Mode::setpoint);
+  EXPECT_NEAR(f.drone->state().x, kRadius, 0.5);  // the circle's east point, where it was refused
+  EXPECT_NEAR(f.drone->state().y, 0.0, 0.5);
+}
+
+// Beyond PX4's largest orbit (MC_ORBIT_RAD_MAX, read at connect): refused before the vehicle
+// flies out to a circle PX4 would not fly.
+TEST(MavlinkOrbit, AnOrbitBeyondPx4sLargestRadiusIsRefusedBeforeTheVehicleMoves) {
+  VehicleThread vehicle(25369, 1, kSpeed);
+  Flight f(25369);
+  Orbiting o;
+  take_off_and_orbit(f, o, 2.0, 2000.0);
+  ASSERT_TRUE(o.end);
+  EXPECT_EQ(o.end->outcome, mid::Outcome::failed);
+  EXPECT_EQ(o.end->failure, mid::FailureReason::refused);
+  EXPECT_EQ(o.end->reason, "orbit radius 2000.0 m is above PX4's MC_ORBIT_RAD_MAX 1000 m");
+  EXPECT_EQ(do_orbits(vehicle), 0);
   EXPECT_NEAR(std::hypot(f.drone->state().x, f.drone->state().y), 0.0, 0.5);
 }
 

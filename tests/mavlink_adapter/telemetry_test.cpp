@@ -96,6 +96,48 @@ TEST(Telemetry, RefusesUnknownLandedStatesAndBatteriesBeyondAHundredPercent) {
   EXPECT_FALSE(v.have_altitude);
 }
 
+// The orbit's radius is measured from the centre the autopilot reports (mavlink_drone_orbit.cpp):
+// a centre off the earth, a NaN radius or a position off the earth is refused whole.
+TEST(Telemetry, TakesTheOrbitCentreInAGlobalFrameAndRefusesOneOffTheEarth) {
+  VehicleState v;
+  ml::OrbitExecutionStatus o;
+  o.frame = 0;  // MAV_FRAME_GLOBAL
+  o.radius = -5;
+  o.x = 473'977'420, o.y = 85'455'940;
+  ASSERT_FALSE(apply_telemetry(v, frame(ml::pack(o))).rejected);
+  EXPECT_TRUE(v.have_orbit_centre);
+  EXPECT_EQ(v.orbit_centre_lat_e7, 473'977'420);
+  EXPECT_EQ(v.orbit_centre_lon_e7, 85'455'940);
+  ml::OrbitExecutionStatus off = o;
+  off.x = 950'000'000;  // 95° north
+  EXPECT_STREQ(apply_telemetry(v, frame(ml::pack(off))).rejected,
+               "ORBIT_EXECUTION_STATUS with NaN, a radius out of range or a centre off the earth");
+  off = o;
+  off.radius = std::nanf("");
+  EXPECT_TRUE(apply_telemetry(v, frame(ml::pack(off))).rejected);
+  EXPECT_EQ(v.orbit_centre_lat_e7, 473'977'420);  // the last good centre stays
+  // A centre in a local frame (m * 1e4 from an origin the adapter does not know) is not used.
+  VehicleState local;
+  ml::OrbitExecutionStatus l = o;
+  l.frame = ml::kFrameLocalNed;
+  EXPECT_FALSE(apply_telemetry(local, frame(ml::pack(l))).rejected);
+  EXPECT_FALSE(local.have_orbit_centre);
+  ml::GlobalPositionInt g;
+  g.lon = -1'900'000'000;
+  EXPECT_STREQ(apply_telemetry(v, frame(ml::pack(g))).rejected,
+               "GLOBAL_POSITION_INT with a latitude or longitude off the earth");
+}
+
+TEST(FrameMapping, MetresBetweenTwoPositionsAndBackAgree) {
+  const int32_t lat = 473'977'420, lon = 85'455'940;  // PX4 SITL's home
+  auto [lat2, lon2] = offset_lat_lon(lat, lon, 3.0, -4.0);
+  fleet::Vec3 d = north_east_between(lat, lon, lat2, lon2);
+  EXPECT_NEAR(d.x, 3.0, 0.01);  // degE7 is 1.1 cm
+  EXPECT_NEAR(d.y, -4.0, 0.01);
+  // One degree of latitude is 111.2 km on PX4's earth (radius 6371 km).
+  EXPECT_NEAR(north_east_between(lat, lon, lat + 10'000'000, lon).x, 111'195.0, 1.0);
+}
+
 TEST(Autopilots, Px4AndArduPilotSelectTheirSetpointModes) {
   const Autopilot* p = autopilot_for(ml::autopilot::PX4);
   const Autopilot* a = autopilot_for(ml::autopilot::ARDUPILOTMEGA);

@@ -17,8 +17,9 @@ class VehicleThread {
   VehicleThread(int port, uint8_t sysid, double speed,
                 const sim_vehicle::Dialect& dialect = sim_vehicle::px4_dialect(),
                 double battery_percent = 100.0, bool camera_confirms = true)
-      : loop_({mid::ClockMode::real_time, speed}),
-        vehicle_(loop_, options(dialect, sysid, battery_percent, camera_confirms)) {
+      : VehicleThread(port, speed, options(dialect, sysid, battery_percent, camera_confirms)) {}
+  VehicleThread(int port, double speed, const sim_vehicle::VehicleOptions& options)
+      : loop_({mid::ClockMode::real_time, speed}), vehicle_(loop_, options) {
     std::string url = "udpout://127.0.0.1:" + std::to_string(port);
     if (std::string e = vehicle_.open(*mavlink::parse_url(url).endpoint); !e.empty())
       throw std::runtime_error(e);

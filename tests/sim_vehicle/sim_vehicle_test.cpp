@@ -168,16 +168,56 @@ TEST(SimVehicle, Px4FliesDoOrbitInTheAirInItsOrbitMode) {
   EXPECT_EQ(vehicle.inspect([](const SimVehicle& v) { return v.mode(); }), Mode::orbit);
 }
 
-TEST(SimVehicle, Px4RefusesAnOrbitLargerThanItsLargest) {
-  Companion companion(25346);
-  test::VehicleThread vehicle(25346, 1, kSpeed);
-  await_first_frame(companion);
+/// Arms the PX4-like vehicle and takes it off (to 491 m AMSL, 3 m up), until it reports
+/// itself in the air. Fatal failures: call through ASSERT_NO_FATAL_FAILURE.
+void arm_and_climb(Companion& companion) {
   ASSERT_EQ(companion.command(ml::cmd::COMPONENT_ARM_DISARM, {1}), ml::result::ACCEPTED);
   ASSERT_EQ(companion.command(ml::cmd::NAV_TAKEOFF, {0, 0, 0, 0, NAN, NAN, 491}), ml::result::ACCEPTED);
   ASSERT_GE(companion.wait_for(companion.count(), [](const ml::Message& m) {
     auto e = ml::unpack_extended_sys_state(m);
     return e && e->landed_state == ml::landed::IN_AIR;
   }), 0);
+}
+
+// As PX4 (its Orbit task sets the centre only when it starts): DO_ORBIT again in the Orbit
+// mode changes the radius around the same centre, it does not start a new orbit where the
+// vehicle is.
+TEST(SimVehicle, Px4DoOrbitSentAgainInOrbitModeKeepsTheCentreAndTakesTheNewRadius) {
+  Companion companion(25348);
+  test::VehicleThread vehicle(25348, 1, kSpeed);
+  await_first_frame(companion);
+  ASSERT_NO_FATAL_FAILURE(arm_and_climb(companion));
+  ASSERT_EQ(companion.command(ml::cmd::SET_MESSAGE_INTERVAL, {float(ml::msg::LOCAL_POSITION_NED), 2e5f}),
+            ml::result::ACCEPTED);
+  auto where = [&] { return vehicle.inspect([](const SimVehicle& v) { return v.drone().state(); }); };
+  const mid::DroneState start = where();
+  auto within = [&](double radius) {  // a position report this far from the start
+    return [&start, radius](const ml::Message& m) {
+      auto p = ml::unpack_local_position_ned(m);
+      return p && std::fabs(std::hypot(p->y - start.x, p->x - start.y) - radius) < 0.2;
+    };
+  };
+  ASSERT_EQ(companion.command(ml::cmd::DO_ORBIT, orbit(-3)), ml::result::ACCEPTED);
+  ASSERT_GE(companion.wait_for(companion.count(), within(3.0)), 0);
+  ASSERT_EQ(companion.command(ml::cmd::DO_ORBIT, orbit(-3.5)), ml::result::ACCEPTED);
+  int on_new_circle = companion.wait_for(companion.count(), within(3.5));
+  ASSERT_GE(on_new_circle, 0);
+  // Then on it for the next ten reports (2 s, a third of a turn): around the first centre.
+  int from = on_new_circle + 1;
+  for (int k = 0; k < 10; ++k) {
+    int next = companion.wait_for(from, [](const ml::Message& m) { return ml::unpack_local_position_ned(m).has_value(); });
+    ASSERT_GE(next, 0);
+    EXPECT_TRUE(within(3.5)(companion.frame(next))) << "report " << k;
+    from = next + 1;
+  }
+  EXPECT_EQ(vehicle.inspect([](const SimVehicle& v) { return v.mode(); }), Mode::orbit);
+}
+
+TEST(SimVehicle, Px4RefusesAnOrbitLargerThanItsLargest) {
+  Companion companion(25346);
+  test::VehicleThread vehicle(25346, 1, kSpeed);
+  await_first_frame(companion);
+  ASSERT_NO_FATAL_FAILURE(arm_and_climb(companion));
   EXPECT_EQ(companion.command(ml::cmd::DO_ORBIT, orbit(2000)), ml::result::DENIED);
 }
 
