@@ -20,12 +20,12 @@ build: deps $(BUILD)/build.ninja
 demo: build
 	@bash scripts/demo.sh $(BUILD)
 
-# The fuzzers run first and briefly (10 s per target: a smoke run; `make fuzz` runs 120 s each); ctest's summary closes the run.
+# The fuzzers run first and briefly (5 s per target: a smoke run; `make fuzz` runs 120 s each); ctest's summary closes the run.
 # Real-time tests (DDS processes, SITL firmware, the browser) share two cores with each
 # other, so a failed test runs once more; one that fails twice fails the run, and the first
 # failure stays in the log.
 test: build
-	@bash scripts/fuzz.sh $(BUILD)-fuzz 10
+	@bash scripts/fuzz.sh $(BUILD)-fuzz 5
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) --repeat until-pass:2
 
 bench: build
