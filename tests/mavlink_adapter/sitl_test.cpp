@@ -3,6 +3,7 @@
 // saying how to get SITL, when EAMOS_ARDUPILOT_SITL / EAMOS_PX4_SITL is not set.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -33,12 +34,14 @@ using Sequences = std::map<std::string, std::vector<std::string>>;
 // budgets scale with it). Chosen so that three instances stay real-time on two cores.
 constexpr double kSpeed = 5;
 
-// How far a single position report on the orbit may be from 5 m (distance from the fitted
-// circle's centre): 10 %, twice the fitted circle's 5 %. A single report carries the EKF's
-// noise and the position controller's swing around the circle; measured (docs/adapters.md)
-// ArduCopter's stayed within 4.76 .. 5.15 m, PX4's within 4.58 .. 5.32 m when its fitted
-// circle held 5 %.
-constexpr double kSampleBound = 0.5;
+// How far a single position report on the orbit may be from 5 m (distance from the orbit's
+// centre), beside the 5 % that the samples' mean must hold. A single report carries the EKF's
+// noise and the position controller's swing around the circle. ArduCopter, on our setpoints:
+// 10 % (measured 4.72 .. 5.25 m). PX4, in its own ORBIT mode corrected by DO_ORBIT: 15 %; its
+// radial loop swings 0.3-0.6 m while it speeds up and the swing does not settle within
+// Listing 2's orbit (measured 4.56 .. 5.61 m, docs/adapters.md), so 10 % held in only about
+// two of three runs with one DEX per drone. Issue 12 asks for 5 %: still open for PX4.
+double sample_bound(Autopilot a) { return a == Autopilot::ardupilot ? 0.5 : 0.75; }
 
 struct Flight {
   eamos_test::Output run;
@@ -50,7 +53,7 @@ struct Flight {
 
 // A fleet file for the instances; `sensors`: extra YAML per drone (index -> "Sensor1: 120").
 std::string fleet_file(const SitlFleet& sitl, const std::vector<eamos_test::SitlHome>& homes,
-                       std::map<int, std::string> sensors = {}) {
+                       std::map<int, std::string> sensors = {}, const std::string& each_drone = "") {
   // No limits: the adapter reads the autopilot's own speeds and derives deadlines from them.
   std::string y = "types:\n  Quad: {adapter: mavlink}\ndrones:\n";
   for (int i = 0; i < sitl.size(); ++i) {
@@ -59,7 +62,7 @@ std::string fleet_file(const SitlFleet& sitl, const std::vector<eamos_test::Sitl
          "\", sysid: " + std::to_string(sitl.sysid(i)) + ", home: [" + std::to_string(homes[i].x) +
          ", " + std::to_string(homes[i].y) + ", 0]";
     if (sensors.contains(i)) y += ", sensors: {" + sensors[i] + "}";
-    y += "}\n";
+    y += each_drone + "}\n";
   }
   return y;
 }
@@ -67,18 +70,23 @@ std::string fleet_file(const SitlFleet& sitl, const std::vector<eamos_test::Sitl
 struct FlyOptions {
   std::string extra;  ///< more `eamos run` arguments (--distributed)
   std::function<void(const std::string&)> on_line;
+  double speed = kSpeed;  ///< eamos' --speed: the instances' speed-up (start_fleet's)
 };
 
 Flight fly(const std::string& mission, const std::string& fleet_yaml, const fs::path& dir, FlyOptions o = {}) {
   std::ofstream(dir / "fleet.yaml") << fleet_yaml;
   fs::remove(dir / "trace.jsonl");
   Flight f;
-  std::string speed = " --speed " + std::to_string(kSpeed);
+  std::string speed = " --speed " + std::to_string(o.speed);
+  const auto began = std::chrono::steady_clock::now();
   f.run = eamos_test::run_eamos("run " + mission + " --fleet " + (dir / "fleet.yaml").string() + speed + " " +
                                     o.extra + " --trace " + (dir / "trace.jsonl").string(),
                                 o.on_line);
   // EAMOS_SITL_VERBOSE=1: every flight's log, for docs/adapters.md's timings or a diagnosis.
-  if (std::getenv("EAMOS_SITL_VERBOSE")) std::cout << f.run.out << std::flush;
+  if (std::getenv("EAMOS_SITL_VERBOSE"))
+    std::cout << f.run.out << "[sitl] eamos run: "
+              << std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count() << " s\n"
+              << std::flush;
   std::ifstream in(dir / "trace.jsonl");
   for (std::string line; std::getline(in, line);) {
     auto e = nlohmann::json::parse(line, nullptr, false);
@@ -161,10 +169,16 @@ Circle fit_circle(const std::vector<std::pair<double, double>>& pts) {
 
 /// Drone2's orbit as its own LOCAL_POSITION_NED shows it to a second ground station: the
 /// samples while it was in the orbit's flight mode, at altitude, from 2 mission seconds after
-/// it first got 4 m from where it hovered (out on the circle) on. Returns the fitted circle
-/// and, in `radii`, each sample's distance from its centre.
+/// it was first in that mode once out on the circle (4 m from where it hovered). The centre is
+/// the one the adapter circles (its trace line "orbit of 5.00 m around x .., y .."; `centre`,
+/// north and east of the vehicle's home); returns it with the samples' mean distance from it
+/// as the radius, and, in `radii`, each sample's distance. Neither a circle fitted freely to
+/// a turn and a half of a wobbling orbit (one came out 5.60 m while the vehicle flew
+/// 4.50-5.54 m from its centre) nor the first ground sample (the estimate moves 0.4 m after
+/// boot) is a measure of it.
 std::optional<Circle> orbit_of(const std::vector<eamos_test::VehicleSample>& samples, uint32_t orbit_mode,
-                               std::vector<double>& radii, std::string& why_none) {
+                               std::pair<double, double> centre, double speed, std::vector<double>& radii,
+                               std::string& why_none) {
   std::optional<std::pair<double, double>> hover;
   std::size_t k = 0;
   for (; k < samples.size(); ++k) {
@@ -176,7 +190,13 @@ std::optional<Circle> orbit_of(const std::vector<eamos_test::VehicleSample>& sam
     why_none = "no hover at 10 m followed by a move out to the circle";
     return std::nullopt;
   }
-  const double settle_until = samples[k].wall_s + 2.0 / kSpeed;
+  // PX4 gets its DO_ORBIT once out on the circle (the adapter flies it there): from its mode on.
+  while (k < samples.size() && samples[k].custom_mode != orbit_mode) ++k;
+  if (k == samples.size()) {
+    why_none = "never in the orbit's mode after the move out to the circle";
+    return std::nullopt;
+  }
+  const double settle_until = samples[k].wall_s + 2.0 / speed;
   std::vector<std::pair<double, double>> on_circle;
   for (; k < samples.size() && samples[k].custom_mode == orbit_mode && -samples[k].down > 9.0; ++k)
     if (samples[k].wall_s >= settle_until) on_circle.push_back({samples[k].north, samples[k].east});
@@ -184,9 +204,24 @@ std::optional<Circle> orbit_of(const std::vector<eamos_test::VehicleSample>& sam
     why_none = "fewer than 10 samples on the circle in the orbit's mode";
     return std::nullopt;
   }
-  Circle c = fit_circle(on_circle);
+  Circle c{centre.first, centre.second, 0};
   for (auto [n, e] : on_circle) radii.push_back(std::hypot(n - c.north, e - c.east));
+  for (double r : radii) c.radius += r / radii.size();
+  Circle free = fit_circle(on_circle);
+  std::cout << "  a circle fitted freely: radius " << free.radius << " m, centre " << std::hypot(free.north - c.north, free.east - c.east)
+            << " m from the adapter's\n";
   return c;
+}
+
+/// Removes a test's flight folder (fleet file, trace, summary), unless EAMOS_KEEP_SITL_DIRS=1
+/// keeps it, like the instances' folders, for a look afterwards.
+void remove_flight_dir(const fs::path& dir) {
+  if (std::getenv("EAMOS_KEEP_SITL_DIRS")) {
+    std::cout << "[sitl] kept " << dir.string() << "\n";
+    return;
+  }
+  std::error_code ec;
+  fs::remove_all(dir, ec);
 }
 
 // Three drones 5 m apart along y, as docs/adapters.md places them.
@@ -199,13 +234,11 @@ class Sitl : public ::testing::TestWithParam<Autopilot> {
     dir_ = fs::temp_directory_path() / ("eamos-sitl-test-" + std::to_string(getpid()));
     fs::create_directories(dir_);
   }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
+  void TearDown() override { remove_flight_dir(dir_); }
   /// Three instances started and ready to arm; the test fails at once when they are not.
-  std::unique_ptr<SitlFleet> start_fleet(const std::vector<eamos_test::SitlHome>& homes, bool camera = false) {
-    eamos_test::SitlOptions options{GetParam(), homes, kSpeed};
+  std::unique_ptr<SitlFleet> start_fleet(const std::vector<eamos_test::SitlHome>& homes, bool camera = false,
+                                         double speed = kSpeed) {
+    eamos_test::SitlOptions options{GetParam(), homes, speed};
     options.camera = camera;
     auto sitl = std::make_unique<SitlFleet>(options);
     std::string error;
@@ -213,6 +246,9 @@ class Sitl : public ::testing::TestWithParam<Autopilot> {
     return sitl;
   }
   void fly_listing2(const std::string& extra);
+  void fly_link_loss(const std::string& extra);
+  void fly_second_mission(const std::string& extra);
+  void fly_refused(const std::string& extra);
   fs::path dir_;
 };
 
@@ -224,25 +260,20 @@ std::vector<std::string> three_hops_of(int d) {
 
 // The smallest mission every autopilot must carry, in one eamos process: each of three
 // drones arms, climbs, hops east and lands at the same time, and every action succeeds.
-TEST_P(Sitl, ThreeDronesArmTakeOffFlyAndLandInOneProcess) {
+// Then a second mission on the same autopilots without restarting them: Drone2 arms where
+// the first landing left it (ArduPilot: in LAND, where it cannot arm) and waits on the
+// ground longer than the autopilot's auto-disarm before its takeoff. (The first half was
+// once a test of its own, the same fleet, mission and assertions: one boot fewer.)
+// `extra`: --distributed, one DEX per drone for both missions (the three_hops half was
+// `ThreeDronesFlyWithOneDexPerDrone`).
+void Sitl::fly_second_mission(const std::string& extra) {
   auto sitl = start_fleet(kHomes);
   if (HasFailure()) return;
-  Flight f = fly(mission_path("three_hops.eamos"), fleet_file(*sitl, kHomes), dir_);
-  ASSERT_EQ(f.run.status, 0) << f.run.out;
-  for (int d = 1; d <= 3; ++d) EXPECT_EQ(f.actions["Drone" + std::to_string(d)], three_hops_of(d)) << f.run.out;
-}
-
-// A first mission, then a second on the same autopilots without restarting them: Drone2
-// arms where the first landing left it (ArduPilot: in LAND, where it cannot arm) and waits
-// on the ground longer than the autopilot's auto-disarm before its takeoff.
-TEST_P(Sitl, ASecondMissionRightAfterTheFirstWaitsArmedLongerThanTheAutoDisarm) {
-  auto sitl = start_fleet(kHomes);
-  if (HasFailure()) return;
-  Flight f = fly(mission_path("three_hops.eamos"), fleet_file(*sitl, kHomes), dir_);
+  Flight f = fly(mission_path("three_hops.eamos"), fleet_file(*sitl, kHomes), dir_, {.extra = extra});
   ASSERT_EQ(f.run.status, 0) << f.run.out;
   for (int d = 1; d <= 3; ++d) EXPECT_EQ(f.actions["Drone" + std::to_string(d)], three_hops_of(d)) << f.run.out;
 
-  Flight wait = fly(mission_path("wait_armed.eamos"), fleet_file(*sitl, kHomes), dir_);
+  Flight wait = fly(mission_path("wait_armed.eamos"), fleet_file(*sitl, kHomes), dir_, {.extra = extra});
   ASSERT_EQ(wait.run.status, 0) << wait.run.out;
   std::vector<std::string> want = {"Drone2.Arm() succeeded", "Drone2.Takeoff(3) succeeded", "Drone2.Land() succeeded",
                                    "Drone2.Disarm() succeeded"};
@@ -251,12 +282,10 @@ TEST_P(Sitl, ASecondMissionRightAfterTheFirstWaitsArmedLongerThanTheAutoDisarm) 
   EXPECT_TRUE(any_contains(wait.vehicle["Drone2"], "auto-disarm")) << wait.run.out;
 }
 
-TEST_P(Sitl, ThreeDronesFlyWithOneDexPerDrone) {
-  auto sitl = start_fleet(kHomes);
-  if (HasFailure()) return;
-  Flight f = fly(mission_path("three_hops.eamos"), fleet_file(*sitl, kHomes), dir_, {.extra = "--distributed"});
-  ASSERT_EQ(f.run.status, 0) << f.run.out;
-  for (int d = 1; d <= 3; ++d) EXPECT_EQ(f.actions["Drone" + std::to_string(d)], three_hops_of(d)) << f.run.out;
+TEST_P(Sitl, ASecondMissionRightAfterTheFirstWaitsArmedLongerThanTheAutoDisarm) { fly_second_mission(""); }
+
+TEST_P(Sitl, ASecondMissionWithOneDexPerDroneWaitsArmedLongerThanTheAutoDisarm) {
+  fly_second_mission("--distributed");
 }
 
 // An action the autopilot itself refuses, for a reason only it knows: its answer and its own
@@ -265,17 +294,21 @@ TEST_P(Sitl, ThreeDronesFlyWithOneDexPerDrone) {
 // MAV_RESULT_FAILED. PX4 takes camera commands without answering when no camera_trigger runs
 // (that would be a timeout, not a refusal), so there Drone2 is set up as a user might leave
 // it, with COM_ARM_MIS_REQ 1 ("require a valid mission to arm") and no mission uploaded: its
-// Arm is refused by PX4's arming checks.
-TEST_P(Sitl, ARefusedActionFailsTheMissionWithTheAutopilotsAnswerInTheSummary) {
+// Arm is refused by PX4's arming checks. `extra`: --distributed, where the answer comes to
+// the ground's summary from the refused drone's DEX, a process of its own.
+void Sitl::fly_refused(const std::string& extra) {
   auto sitl = start_fleet(kHomes);
   if (HasFailure()) return;
   const bool px4 = GetParam() == Autopilot::px4;
   if (px4) {
     std::string error;
-    ASSERT_TRUE(sitl->set_param(1, "COM_ARM_MIS_REQ", 1, eamos::mavlink::param_type::INT32, 30, error)) << error;
+    // Not as a ground station: PX4's reason must come to eamos's own link.
+    ASSERT_TRUE(sitl->set_param(1, "COM_ARM_MIS_REQ", 1, eamos::mavlink::param_type::INT32, 30, error, false))
+        << error;
   }
-  Flight f = fly(listing2(), fleet_file(*sitl, kHomes, {{0, "Sensor1: 120"}}), dir_,
-                 {.extra = "--summary " + (dir_ / "summary.json").string()});
+  // PX4 sends its reasons (STATUSTEXT) only to a link with a ground station on it.
+  Flight f = fly(listing2(), fleet_file(*sitl, kHomes, {{0, "Sensor1: 120"}}, px4 ? ", announce_as_gcs: true" : ""), dir_,
+                 {.extra = extra + " --summary " + (dir_ / "summary.json").string()});
   EXPECT_NE(f.run.status, 0) << f.run.out;
   std::ifstream in(dir_ / "summary.json");
   std::string summary((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -298,15 +331,20 @@ TEST_P(Sitl, ARefusedActionFailsTheMissionWithTheAutopilotsAnswerInTheSummary) {
   EXPECT_TRUE(failsafes.contains("Drone1") && failsafes.contains("Drone3")) << f.run.out;
 }
 
+TEST_P(Sitl, ARefusedActionFailsTheMissionWithTheAutopilotsAnswerInTheSummary) { fly_refused(""); }
+
+TEST_P(Sitl, ARefusedActionOfOneDexPerDroneReachesTheSummaryWithTheAutopilotsAnswer) { fly_refused("--distributed"); }
+
 // The test stops Drone2's autopilot in flight: its link is lost, the mission fails saying
-// so, and the two others run their failsafe.
-TEST_P(Sitl, LinkLossFailsTheMissionAndEveryOtherDroneRunsItsFailsafe) {
+// so, and the two others run their failsafe. `extra`: --distributed, where the lost vehicle's
+// DEX is a process of its own that must tell the others.
+void Sitl::fly_link_loss(const std::string& extra) {
   auto sitl = start_fleet(kHomes);
   if (HasFailure()) return;
   bool killed = false;
   auto began = std::chrono::steady_clock::now();
   Flight f = fly(mission_path("three_hops.eamos"), fleet_file(*sitl, kHomes), dir_,
-                 {.on_line = [&](const std::string& line) {
+                 {.extra = extra, .on_line = [&](const std::string& line) {
                    if (!killed && line.find("Drone2.Takeoff(5)  succeeded") != std::string::npos) {
                      sitl->kill_instance(1);
                      killed = true;
@@ -328,6 +366,22 @@ TEST_P(Sitl, LinkLossFailsTheMissionAndEveryOtherDroneRunsItsFailsafe) {
   EXPECT_TRUE(failsafes.contains("Drone1") && failsafes.contains("Drone3")) << f.run.out;
 }
 
+TEST_P(Sitl, LinkLossFailsTheMissionAndEveryOtherDroneRunsItsFailsafe) { fly_link_loss(""); }
+
+TEST_P(Sitl, LinkLossWithOneDexPerDroneFailsTheMissionAndEveryOtherDroneRunsItsFailsafe) {
+  fly_link_loss("--distributed");
+}
+
+// The speed-up Listing 2 flies at (EAMOS_SITL_LISTING2_SPEED overrides it, for a measurement).
+// PX4 at 3: at 5, three PX4 instances and the eamos processes are more than two cores carry,
+// and the vehicles' clocks ran at 0.70-0.79 of mission time; the orbit's corrections and the
+// mission's timing (Drone2's orbit is cut short by the others' Land) came out worse
+// (docs/adapters.md). It costs about 8 s a run.
+double listing2_speed(Autopilot a) {
+  if (const char* v = std::getenv("EAMOS_SITL_LISTING2_SPEED")) return std::clamp(std::atof(v), 0.5, 10.0);
+  return a == Autopilot::px4 ? 3.0 : kSpeed;
+}
+
 // Listing 2 (Figure 3's run: Drone1 reads 120 and flies right) on instances with a camera
 // configured: every drone runs the same actions with the same outcomes as in the simulator,
 // Drone2's pictures are confirmed by its camera, and it orbits at 5 m within 5 %.
@@ -336,12 +390,13 @@ void Sitl::fly_listing2(const std::string& extra) {
   eamos_test::Output sim = eamos_test::run_eamos("run " + listing2() + " --fleet " + EAMOS_SOURCE_DIR +
                                                  "/examples/listing2-right.yaml --trace " + (dir_ / "sim.jsonl").string());
   ASSERT_EQ(sim.status, 0) << sim.out;
-  auto sitl = start_fleet(kHomes, /*camera=*/true);
+  const double speed = listing2_speed(GetParam());
+  auto sitl = start_fleet(kHomes, /*camera=*/true, speed);
   if (HasFailure()) return;
   eamos_test::SitlWatch watch(*sitl, 1);
   ASSERT_EQ(watch.error(), "");
   Flight f = fly(listing2(), fleet_file(*sitl, kHomes, {{0, "Sensor1: 120"}}), dir_,
-                 {.extra = extra + " --time-limit 150 --summary " + (dir_ / "summary.json").string()});
+                 {.extra = extra + " --time-limit 150 --summary " + (dir_ / "summary.json").string(), .speed = speed});
   // Bounded at 150 mission s (it takes 42-61 s): a run that never completes (once seen on PX4:
   // its end node reached, a drone still busy) fails here instead of at ctest's timeout.
   ASSERT_EQ(f.run.status, 0) << f.run.out;
@@ -358,26 +413,29 @@ void Sitl::fly_listing2(const std::string& extra) {
   uint32_t orbit_mode = GetParam() == Autopilot::ardupilot ? 4 /* GUIDED */ : eamos::mavlink::px4::ORBIT;
   std::string why;
   std::vector<double> radii;
-  std::optional<Circle> orbit = orbit_of(watch.samples(), orbit_mode, radii, why);
+  // The centre the adapter circles, in the mission's frame; Drone2's home is kHomes[1].
+  double cx = NAN, cy = NAN;
+  for (const std::string& text : f.vehicle["Drone2"])
+    if (std::sscanf(text.c_str(), "orbit of %*f m around x %lf, y %lf", &cx, &cy) == 2) break;
+  ASSERT_FALSE(std::isnan(cx)) << "no 'orbit of .. around' line in Drone2's trace\n" << f.run.out;
+  std::pair<double, double> centre{cy - kHomes[1].y, cx - kHomes[1].x};  // north, east of home
+  std::optional<Circle> orbit = orbit_of(watch.samples(), orbit_mode, centre, speed, radii, why);
   ASSERT_TRUE(orbit) << why;
   auto [low, high] = std::minmax_element(radii.begin(), radii.end());
-  std::cout << "Drone2 orbit: " << radii.size() << " samples, fitted radius " << orbit->radius << " m, from its centre "
+  std::cout << "Drone2 orbit: " << radii.size() << " samples, mean radius " << orbit->radius << " m, from its centre "
             << *low << " .. " << *high << " m\n";
   std::string trail;
   for (std::size_t k = 0; k < radii.size(); k += std::max<std::size_t>(1, radii.size() / 20))
     trail += std::to_string(radii[k]).substr(0, 4) + " ";
   std::cout << "  radii along the orbit: " << trail << "\n";
-  // Orbit() is 5 m, held within 5 % (issue 12) by the circle flown, and every sample within
-  // kSampleBound. PX4 flies its own ORBIT mode (DO_ORBIT), whose circle is smooth but whose
-  // radius was measured at 4.12-5.08 m fitted (docs/adapters.md, "Known failures"): held to
-  // 10 % there, and its samples to 20 %, until the adapter corrects PX4's radius (issue 12
-  // stays open for it). Not hidden: the radii are printed above.
-  const bool px4 = GetParam() == Autopilot::px4;
-  const double fitted_bound = px4 ? 0.5 : 0.25;
-  const double sample_bound = px4 ? 1.0 : kSampleBound;
-  EXPECT_NEAR(orbit->radius, 5.0, fitted_bound);
-  EXPECT_GE(*low, 5.0 - sample_bound);
-  EXPECT_LE(*high, 5.0 + sample_bound);
+  for (const std::string& text : f.vehicle["Drone2"])
+    if (text.find("DO_ORBIT radius") != std::string::npos) std::cout << "  " << text << "\n";
+  // Orbit() is 5 m, held within 5 % (issue 12) on average around where the Orbit started, and
+  // every sample within sample_bound(), on both autopilots: ArduCopter from setpoints, PX4 in its own ORBIT mode
+  // with the radius corrected by the one flown (docs/adapters.md). The radii are printed above.
+  EXPECT_NEAR(orbit->radius, 5.0, 0.25);
+  EXPECT_GE(*low, 5.0 - sample_bound(GetParam()));
+  EXPECT_LE(*high, 5.0 + sample_bound(GetParam()));
 }
 
 TEST_P(Sitl, Listing2FliesTheSimulatorsActionsWithConfirmedPicturesAndAFiveMetreOrbit) { fly_listing2(""); }
@@ -432,8 +490,7 @@ TEST_P(SitlExample, FliesToTheEndWithNoFailedAction) {
   EXPECT_EQ(f.run.status, 0) << f.run.out;
   for (const auto& [drone, actions] : f.actions)
     for (const std::string& a : actions) EXPECT_EQ(a.find(" failed"), std::string::npos) << a << "\n" << f.run.out;
-  std::error_code ec;
-  fs::remove_all(dir, ec);
+  remove_flight_dir(dir);
 }
 
 std::vector<ExampleFlight> example_flights() {
@@ -491,12 +548,12 @@ constexpr double kPatrolDrain_s = 2000;
 constexpr double kLeaveBound_s = 5.0 / kSpeed;
 
 // From the vehicles' own telemetry: the lead circled until its Orbit was cancelled, was in the
-// autopilot's RTL within kLeaveBound_s and landed at home; the wing stopped circling within
-// kLeaveBound_s of its Orbit's cancel (what it flies after stays within a 2 m span, a circle
-// of radius 4 m spans 8 m).
+// autopilot's RTL within kLeaveBound_s of its ReturnHome's start (after patrol's Hover(1)) and
+// landed at home; the wing stopped circling within kLeaveBound_s of its Orbit's cancel (what
+// it flies after stays within a 2 m span, a circle of radius 4 m spans 8 m).
 void expect_left_the_orbit(Autopilot autopilot, const std::vector<eamos_test::VehicleSample>& lead,
                            const std::vector<eamos_test::VehicleSample>& wing, double lead_cancelled_s,
-                           double wing_cancelled_s) {
+                           double lead_home_started_s, double wing_cancelled_s) {
   const uint32_t rtl = autopilot == Autopilot::ardupilot ? 6u : eamos::mavlink::px4::RTL;
   ASSERT_FALSE(lead.empty());
   ASSERT_FALSE(wing.empty());
@@ -515,8 +572,11 @@ void expect_left_the_orbit(Autopilot autopilot, const std::vector<eamos_test::Ve
       break;
     }
   ASSERT_GT(in_rtl_s, 0) << "the lead never showed RTL after its Orbit was cancelled";
-  std::cout << "Lead in RTL " << (in_rtl_s - lead_cancelled_s) * kSpeed << " mission s after its Orbit's cancel\n";
-  EXPECT_LT(in_rtl_s - lead_cancelled_s, kLeaveBound_s);
+  std::cout << "Lead in RTL " << (in_rtl_s - lead_cancelled_s) * kSpeed << " mission s after its Orbit's cancel, "
+            << (in_rtl_s - lead_home_started_s) * kSpeed << " after its ReturnHome's start\n";
+  // Not before the Hover(1) between them has ended: the autopilot flies what it is told.
+  EXPECT_GE(in_rtl_s, lead_home_started_s);
+  EXPECT_LT(in_rtl_s - lead_home_started_s, kLeaveBound_s);
   EXPECT_LT(std::hypot(lead.back().north, lead.back().east), 1.5) << "the lead did not land at home";
   EXPECT_LT(-lead.back().down, 0.5) << "the lead is not on the ground";
   EXPECT_GT(horizontal_span(before(wing, wing_cancelled_s)), 1.0);
@@ -531,13 +591,15 @@ class SitlPatrol : public ::testing::TestWithParam<Autopilot> {};
 
 // examples/patrol.eamos on the real autopilots, its Do* interruptions cancelling running
 // motions: the lead orbits until the vehicle's own battery reads 98 %, then its Orbit ends
-// `cancelled` and the vehicle leaves the circle for the autopilot's RTL and lands at home;
+// `cancelled`, it hovers for a second (the done-branch) and the vehicle leaves for the
+// autopilot's RTL and lands at home;
 // the wing photographs until the lead (in the autopilot's RTL) sinks below 9 m, then orbits
 // until the lead has landed, and that Orbit ends `cancelled` with the vehicle no longer
 // circling. The battery drains at a rate the test sets (SitlOptions::battery_drain_s), so
 // the lead orbits for some seconds, not minutes.
-TEST_P(SitlPatrol, TheBatteryAndTheLeadsHeightCancelTheRunningOrbitsOnTheAutopilot) {
-  const Autopilot autopilot = GetParam();
+// `extra`: --distributed, where the wing's conditions on the lead's height and landing come
+// over DDS from the lead's DEX.
+void fly_patrol(Autopilot autopilot, const std::string& extra) {
   if (SitlFleet::binary(autopilot).empty()) GTEST_SKIP() << SitlFleet::skip_message(autopilot);
   const std::string mission = std::string(EAMOS_SOURCE_DIR) + "/examples/patrol.eamos";
   fs::path dir = fs::temp_directory_path() / ("eamos-sitl-patrol-" + std::to_string(getpid()));
@@ -551,10 +613,11 @@ TEST_P(SitlPatrol, TheBatteryAndTheLeadsHeightCancelTheRunningOrbitsOnTheAutopil
   ASSERT_TRUE(sitl.start(error) && sitl.wait_ready(120, error)) << error;
   eamos_test::SitlWatch lead(sitl, 0), wing(sitl, 1);
   ASSERT_EQ(lead.error() + wing.error(), "");
-  double lead_cancelled_s = -1, wing_cancelled_s = -1;
+  double lead_cancelled_s = -1, lead_home_started_s = -1, wing_cancelled_s = -1;
   Flight f = fly(mission, named_fleet(sitl, {"Lead", "Wing"}, homes), dir,
-                 {.extra = "--time-limit 300", .on_line = [&](const std::string& line) {
+                 {.extra = extra + " --time-limit 300", .on_line = [&](const std::string& line) {
                     if (line.find("Lead.Orbit(8)  cancelled") != std::string::npos) lead_cancelled_s = wall_now_s();
+                    if (line.find("start     Lead.ReturnHome()") != std::string::npos) lead_home_started_s = wall_now_s();
                     if (line.find("Wing.Orbit(4)  cancelled") != std::string::npos) wing_cancelled_s = wall_now_s();
                   }});
   ASSERT_EQ(f.run.status, 0) << f.run.out;
@@ -565,7 +628,12 @@ TEST_P(SitlPatrol, TheBatteryAndTheLeadsHeightCancelTheRunningOrbitsOnTheAutopil
   double low = first_event_t(trace, "condition", "Lead.Battery() > 98 false");
   EXPECT_GE(low, 0) << f.run.out;
   EXPECT_NEAR(first_event_t(trace, "end", "Lead.Orbit(8) cancelled"), low, 0.5) << f.run.out;
-  EXPECT_GE(first_event_t(trace, "end", "Lead.ReturnHome() succeeded"), low) << f.run.out;
+  double braking = first_event_t(trace, "start", "Lead.Hover(1)");
+  EXPECT_NEAR(braking, low, 0.5) << f.run.out;
+  double braked = first_event_t(trace, "end", "Lead.Hover(1) succeeded");
+  EXPECT_NEAR(braked - braking, 1.0, 0.05) << f.run.out;
+  EXPECT_GE(first_event_t(trace, "start", "Lead.ReturnHome()"), braked) << f.run.out;
+  EXPECT_GE(first_event_t(trace, "end", "Lead.ReturnHome() succeeded"), braked) << f.run.out;
   // The wing's pictures stopped when the lead sank below 9 m, and its escort orbit began.
   double sank = first_event_t(trace, "condition", "Lead.Z() < 9 true");
   EXPECT_GT(sank, low) << f.run.out;
@@ -573,10 +641,17 @@ TEST_P(SitlPatrol, TheBatteryAndTheLeadsHeightCancelTheRunningOrbitsOnTheAutopil
   EXPECT_NEAR(first_event_t(trace, "end", "Wing.Orbit(4) cancelled"),
               first_event_t(trace, "condition", "Lead.Landed() true"), 0.5) << f.run.out;
   ASSERT_GT(lead_cancelled_s, 0) << f.run.out;
+  ASSERT_GT(lead_home_started_s, 0) << f.run.out;
   ASSERT_GT(wing_cancelled_s, 0) << f.run.out;
-  expect_left_the_orbit(autopilot, lead.samples(), wing.samples(), lead_cancelled_s, wing_cancelled_s);
-  std::error_code ec;
-  fs::remove_all(dir, ec);
+  expect_left_the_orbit(autopilot, lead.samples(), wing.samples(), lead_cancelled_s, lead_home_started_s,
+                        wing_cancelled_s);
+  remove_flight_dir(dir);
+}
+
+TEST_P(SitlPatrol, TheBatteryAndTheLeadsHeightCancelTheRunningOrbitsOnTheAutopilot) { fly_patrol(GetParam(), ""); }
+
+TEST_P(SitlPatrol, WithOneDexPerDroneTheBatteryAndTheLeadsHeightCancelTheRunningOrbits) {
+  fly_patrol(GetParam(), "--distributed");
 }
 
 INSTANTIATE_TEST_SUITE_P(Autopilots, SitlPatrol, ::testing::Values(Autopilot::ardupilot, Autopilot::px4),

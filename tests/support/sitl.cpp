@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <condition_variable>
 #include <cstdlib>
 #include <cstring>
@@ -43,6 +44,13 @@ constexpr uint32_t kPrearmCheck = 0x10000000;  // MAV_SYS_STATUS_PREARM_CHECK
 // hovering at 10 m (and as fast during the takeoff), 33 mAh per 4.1 s. Turns a drain time
 // into BATT_CAPACITY.
 constexpr double kArduCopterSitlHoverA = 29;
+// ArduCopter SITL boots (GPS lock, EKF alignment, the camera set-up's second boot) at this
+// simulation speed, and wait_ready() sets SIM_SPEEDUP back to the flight's speed-up before
+// eamos connects: standing on the ground, nothing a test judges depends on how fast the
+// boot ran (MAVProxy's sitl_autospeedup does the same). Measured (EAMOS_SITL_VERBOSE=1,
+// three instances on 2 cores, load average 7): start to ready 8.3 s at 5x, 2.7 s at 20x,
+// 2.0 s at 50x; 20x leaves the machine's other work some CPU.
+constexpr double kArduPilotBootSpeedup = 20;
 
 double now_s() {
   using namespace std::chrono;
@@ -55,6 +63,12 @@ void metres_per_degree(double lat_deg, double& per_lat, double& per_lon) {
   double p = lat_deg * M_PI / 180.0;
   per_lat = 111132.92 - 559.82 * std::cos(2 * p) + 1.175 * std::cos(4 * p);
   per_lon = 111412.84 * std::cos(p) - 93.5 * std::cos(3 * p);
+}
+
+// EAMOS_SITL_VERBOSE=1: where a fixture's wall time goes (boot, camera set-up, stop), one
+// line per step on stderr, for the suite's time budget (docs/adapters.md, "SITL tests").
+void report_time(const std::string& step, double since_s) {
+  if (std::getenv("EAMOS_SITL_VERBOSE")) std::fprintf(stderr, "[sitl] %s: %.2f s\n", step.c_str(), now_s() - since_s);
 }
 
 void geographic_home(const SitlHome& h, double& lat, double& lon) {
@@ -136,9 +150,16 @@ bool SitlFleet::start(std::string& error) {
             std::to_string(10 - static_cast<int>(options_.homes.size())) + " or less";
     return false;
   }
+  started_s_ = now_s();
   for (int i = 0; i < static_cast<int>(options_.homes.size()); ++i)
     if (!start_one(i, error)) return false;
   return true;
+}
+
+// ArduPilot's --speedup applies at every start (it overrides the SIM_SPEEDUP saved in the
+// instance's eeprom.bin), so the camera set-up's restart boots fast too.
+double SitlFleet::boot_speedup() const {
+  return std::max(options_.speedup, kArduPilotBootSpeedup);
 }
 
 std::vector<std::string> SitlFleet::command_line(int i, const std::string& bin) const {
@@ -147,7 +168,7 @@ std::vector<std::string> SitlFleet::command_line(int i, const std::string& bin) 
   if (options_.autopilot == Autopilot::ardupilot) {
     std::string parm = (fs::path(bin).parent_path() / "copter.parm").string();
     std::vector<std::string> args = {
-        bin, "-I", std::to_string(instance_number(i)), "--model", "+", "--speedup", fixed(options_.speedup, 2),
+        bin, "-I", std::to_string(instance_number(i)), "--model", "+", "--speedup", fixed(boot_speedup(), 2),
         "--sysid", std::to_string(sysid(i)), "--home", fixed(lat, 8) + "," + fixed(lon, 8) + "," + fixed(kOriginAlt, 1) + ",0",
         "--defaults", parm, "--serial0", "tcp:0"};
     // -w wipes the saved parameters. The folder is new and empty, so there is nothing to wipe
@@ -262,6 +283,7 @@ void SitlFleet::kill_instance(int i) {
 }
 
 void SitlFleet::stop() {
+  const double began = now_s();
   for (auto& inst : instances_)
     if (inst.pid > 0) kill(inst.pid, SIGTERM);
   double deadline = now_s() + 5.0;
@@ -274,6 +296,7 @@ void SitlFleet::stop() {
     std::error_code ec;
     if (!std::getenv("EAMOS_KEEP_SITL_DIRS")) fs::remove_all(inst.dir, ec);
   }
+  if (!instances_.empty()) report_time("stop", began);
   instances_.clear();
 }
 
@@ -381,7 +404,9 @@ bool SitlFleet::set_up_ardupilot_camera(int i, double deadline, std::string& err
   // the file to change (nothing else is saved a few seconds after boot).
   const std::string eeprom = instances_.at(i).dir + "/eeprom.bin";
   const std::string before = read_file(eeprom);
+  const double began = now_s();
   if (!set_param(i, "CAM1_TYPE", 1, ml::param_type::INT8, deadline - now_s(), error)) return false;
+  report_time("instance " + std::to_string(i) + " CAM1_TYPE echoed", began);
   const double saved_by = std::min(deadline, now_s() + 10.0);
   while (read_file(eeprom) == before) {
     if (now_s() > saved_by) {
@@ -390,7 +415,11 @@ bool SitlFleet::set_up_ardupilot_camera(int i, double deadline, std::string& err
     }
     usleep(20000);
   }
-  return restart_instance(i, error);
+  report_time("instance " + std::to_string(i) + " eeprom.bin saved", began);
+  const double restarting = now_s();
+  bool restarted = restart_instance(i, error);
+  report_time("instance " + std::to_string(i) + " stopped and started again", restarting);
+  return restarted;
 }
 
 bool SitlFleet::restart_instance(int i, std::string& error) {
@@ -404,6 +433,15 @@ bool SitlFleet::restart_instance(int i, std::string& error) {
 bool SitlFleet::wait_ready(double timeout_s, std::string& error) {
   const double deadline = now_s() + timeout_s;
   if (!wait_ready_with_camera(deadline, error)) return false;
+  report_time("start to ready", started_s_);
+  if (options_.autopilot == Autopilot::ardupilot && boot_speedup() != options_.speedup) {
+    const double slowing = now_s();
+    for (int i = 0; i < size(); ++i)
+      if (!set_param(i, "SIM_SPEEDUP", static_cast<float>(options_.speedup), ml::param_type::REAL32,
+                     deadline - now_s(), error))
+        return false;
+    report_time("SIM_SPEEDUP back to the flight's", slowing);
+  }
   // Remaining % is consumed mAh against BATT_CAPACITY: the capacity that lasts
   // battery_drain_s at the SITL copter's hover current (PX4: SIM_BAT_DRAIN at start).
   if (options_.battery_drain_s > 0 && options_.autopilot == Autopilot::ardupilot)
@@ -420,13 +458,16 @@ bool SitlFleet::wait_ready_with_camera(double deadline, std::string& error) {
   // its start-up was overwritten by ArduPilot's own start-up (CAM1_TYPE 0 after the restart).
   // Checked on the new boot; set again if it still did not take.
   if (!wait_all_ready(deadline, false, error)) return false;
+  report_time("start to first boot ready", started_s_);
   std::vector<int> todo;
   for (int i = 0; i < size(); ++i) todo.push_back(i);
   for (int attempt = 0; attempt < 3 && !todo.empty(); ++attempt) {
     for (int i : todo)
       if (!set_up_ardupilot_camera(i, deadline, error)) return false;
     todo.clear();
+    const double rebooting = now_s();
     if (!wait_all_ready(deadline, true, error, &todo)) return false;
+    report_time("restarted instances ready with the camera", rebooting);
   }
   if (todo.empty()) return true;
   error = "SITL instance " + std::to_string(todo.front()) + ": CAM1_TYPE still 0 after three restarts\n" +
@@ -445,7 +486,7 @@ static float wire_param(Autopilot autopilot, float value, uint8_t type) {
 }
 
 bool SitlFleet::set_param(int i, const std::string& name, float value, uint8_t type, double timeout_s,
-                          std::string& error) {
+                          std::string& error, bool as_ground_station) {
   ParamEchoes cs;
   const uint8_t vehicle = static_cast<uint8_t>(sysid(i));
   ml::OpenResult opened = ml::Link::open(
@@ -467,7 +508,7 @@ bool SitlFleet::set_param(int i, const std::string& name, float value, uint8_t t
   ml::Encoder encoder{250, 190, 0};
   auto send_set = [&] {
     ml::Heartbeat hb;
-    hb.type = 6;       // MAV_TYPE_GCS
+    hb.type = as_ground_station ? 6 : 18;  // MAV_TYPE_GCS or MAV_TYPE_ONBOARD_CONTROLLER
     hb.autopilot = 8;  // MAV_AUTOPILOT_INVALID
     opened.link->send(encoder.encode(ml::pack(hb)));
     opened.link->send(encoder.encode(ml::pack(ml::ParamSet{vehicle, 1, name, wire, type})));
@@ -560,8 +601,8 @@ SitlWatch::SitlWatch(const SitlFleet& fleet, int i) : state_(std::make_unique<St
     return;
   }
   st->link = std::move(opened.link);
-  // A ground station's HEARTBEAT (PX4 sends its GCS link to whoever spoke to it) and the rate
-  // of LOCAL_POSITION_NED, every second until the watch ends.
+  // A ground station's HEARTBEAT (PX4 sends its GCS link to whoever spoke to it) and the rates
+  // of LOCAL_POSITION_NED and HEARTBEAT, every second until the watch ends.
   st->asker = std::thread([st, vehicle] {
     ml::Encoder encoder{251, 190, 0};
     std::unique_lock lock(st->stop_mutex);
@@ -576,6 +617,11 @@ SitlWatch::SitlWatch(const SitlFleet& fleet, int i) : state_(std::make_unique<St
       c.command = ml::cmd::SET_MESSAGE_INTERVAL;
       c.param[0] = static_cast<float>(ml::msg::LOCAL_POSITION_NED);
       c.param[1] = 50000;  // 20 Hz of the vehicle's time
+      st->link->send(encoder.encode(ml::pack(c)));
+      // The mode at 10 Hz, as eamos asks for it: at PX4's default 1 Hz, samples up to a second
+      // after the vehicle left its Orbit mode (braking off the circle) still counted as orbit.
+      c.param[0] = static_cast<float>(ml::msg::HEARTBEAT);
+      c.param[1] = 100000;
       st->link->send(encoder.encode(ml::pack(c)));
       st->stop_cv.wait_for(lock, std::chrono::seconds(1), [st] { return st->stop; });
     }

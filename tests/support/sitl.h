@@ -24,7 +24,9 @@ struct SitlHome {
 struct SitlOptions {
   Autopilot autopilot = Autopilot::ardupilot;
   std::vector<SitlHome> homes;  ///< one instance per home; instance i has system id i + 1
-  double speedup = 1;           ///< simulation speed: ArduPilot --speedup, PX4_SIM_SPEED_FACTOR
+  /// Simulation speed of the flight: PX4_SIM_SPEED_FACTOR; ArduPilot boots faster
+  /// (--speedup, sitl.cpp kArduPilotBootSpeedup) and wait_ready() sets SIM_SPEEDUP to this.
+  double speedup = 1;
   /// The autopilot's instance number of instance 0: it picks the ports (ArduPilot TCP
   /// 5760 + 10 n, PX4 UDP 14540 + n), so two fleets on one machine do not meet. Unset, it is
   /// EAMOS_SITL_FIRST_INSTANCE or 0. PX4 instance n also listens on UDP 14580 + n and
@@ -60,12 +62,17 @@ class SitlFleet {
   /// Starts every instance; false with `error` set when one cannot be started.
   bool start(std::string& error);
   /// Waits (wall time, bounded) until every instance passes its pre-arm checks and reports a
-  /// position: the state in which a pilot would arm. False with the instances not ready.
+  /// position: the state in which a pilot would arm. ArduPilot: then SIM_SPEEDUP is set to
+  /// the options' speed-up (the boot ran faster). False with the instances not ready.
   bool wait_ready(double timeout_s, std::string& error);
   /// Sets one parameter of a ready instance the way a ground station does (PARAM_SET until
   /// the PARAM_VALUE echo carries the value; PX4's integers travel bytewise in the float).
   /// Call it before eamos opens the instance's port. False with `error` set on timeout.
-  bool set_param(int i, const std::string& name, float value, uint8_t type, double timeout_s, std::string& error);
+  /// `as_ground_station` false: its HEARTBEAT does not announce a GCS (PX4 would then send
+  /// STATUSTEXT on that port for 2.5 s, to whoever comes next: a test of what eamos itself
+  /// gets must not be helped by it).
+  bool set_param(int i, const std::string& name, float value, uint8_t type, double timeout_s, std::string& error,
+                 bool as_ground_station = true);
   /// Kills one instance at once (a vehicle whose link is lost mid-flight).
   void kill_instance(int i);
   /// SIGTERM, then SIGKILL after a grace period, for every instance still running.
@@ -91,6 +98,7 @@ class SitlFleet {
   bool restart_instance(int i, std::string& error);
   int instance_number(int i) const { return first_instance_ + i; }
   std::vector<std::string> command_line(int i, const std::string& binary) const;
+  double boot_speedup() const;
   void prepare_px4_bin(const std::string& dir, const std::string& binary) const;
   bool set_up_ardupilot_camera(int i, double deadline, std::string& error);
   bool wait_all_ready(double deadline, bool camera, std::string& error, std::vector<int>* no_camera = nullptr);
@@ -98,6 +106,7 @@ class SitlFleet {
 
   SitlOptions options_;
   int first_instance_ = 0;
+  double started_s_ = 0;  ///< steady clock at start(), for EAMOS_SITL_VERBOSE's timings
   std::vector<Instance> instances_;
 };
 
