@@ -365,6 +365,7 @@ class Reader {
     int failsafe = 0;
     if (f_.one_of(*d, "failsafe", "/drone", kFailsafes, failsafe)) s.failsafe = static_cast<fleet::Failsafe>(failsafe);
     limits(*d);
+    tolerance(*d);
     sensors(*d);
     if (const json* t = f_.member(*d, "timeouts", "/drone"); t && f_.object(*t, "/drone/timeouts"))
       for (const auto& [action, seconds] : t->items()) {
@@ -383,6 +384,17 @@ class Reader {
     f_.number(*l, "max_descent", w, out.max_descent_mps, 1e-9, kAny);
     f_.number(*l, "max_accel", w, out.max_accel_mps2, 1e-9, kAny);
     f_.number(*l, "max_altitude", w, out.max_altitude_m, 1e-9, kAny);
+  }
+
+  // Optional: a mission file written before the fleet file had `tolerance:` keeps the defaults.
+  void tolerance(const json& d) {
+    const json* t = f_.member(d, "tolerance", "/drone", false);
+    if (!t || !f_.object(*t, "/drone/tolerance")) return;
+    fleet::GoalTolerance& out = m_.settings.tolerance;
+    const std::string w = "/drone/tolerance";
+    f_.number(*t, "horizontal", w, out.horizontal_m, 1e-9, kAny);
+    f_.number(*t, "vertical", w, out.vertical_m, 1e-9, kAny);
+    f_.number(*t, "speed", w, out.settled_mps, 1e-9, kAny);
   }
 
   void sensors(const json& d) {

@@ -42,6 +42,14 @@ void write_limits(JsonWriter& w, const fleet::Limits& l) {
   w.end_object();
 }
 
+void write_tolerance(JsonWriter& w, const fleet::GoalTolerance& t) {
+  w.begin_object();
+  w.member("horizontal", t.horizontal_m);
+  w.member("vertical", t.vertical_m);
+  w.member("speed", t.settled_mps);
+  w.end_object();
+}
+
 void write_settings(JsonWriter& w, const fleet::DroneSettings& s, int index) {
   w.begin_object();
   w.member("name", s.name);
@@ -61,6 +69,8 @@ void write_settings(JsonWriter& w, const fleet::DroneSettings& s, int index) {
   w.member("failsafe", fleet::failsafe_name(s.failsafe));
   w.key("limits");
   write_limits(w, s.limits);
+  w.key("tolerance");
+  write_tolerance(w, s.tolerance);
   w.key("sensors");
   w.begin_object();
   for (const auto& [name, model] : s.sensors) {

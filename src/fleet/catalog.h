@@ -40,6 +40,16 @@ struct Limits {
   double max_altitude_m = 120.0;
 };
 
+/// When a motion's goal counts as reached on a real vehicle (fleet file `tolerance:` per
+/// type, docs/fleet.md): within `horizontal_m` in x/y, `vertical_m` in z and no faster than
+/// `settled_mps` (stopped there, not passing by). A vehicle never stops exactly on its
+/// setpoint; the simulator does, so it meets any tolerance.
+struct GoalTolerance {
+  double horizontal_m = 0.5;
+  double vertical_m = 0.3;
+  double settled_mps = 0.3;
+};
+
 struct DroneType {
   std::string name;              ///< as written after `var Drone NAME`
   std::string adapter = "sim";   ///< Adapter Space key: "sim" (built in) or "mavlink"
@@ -48,6 +58,7 @@ struct DroneType {
   int sensors = 8;               ///< Sensor1 … SensorN exist as properties and actions;
                                  ///< change it with set_sensors() so the specs follow
   Limits limits;
+  GoalTolerance tolerance;
   bool generic = true;           ///< true: the built-in multirotor (not described by a file)
 
   const ActionSpec* find_action(const std::string& name) const;

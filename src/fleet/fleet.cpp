@@ -80,6 +80,7 @@ DroneSettings Fleet::settings_for(const std::string& drone, const std::string& t
   if (!o || !o->home) s.home = {0.0, 5.0 * index, 0.0};
   if (!o || !o->adapter) s.adapter = type.adapter;
   s.limits = type.limits;
+  s.tolerance = type.tolerance;
   if (o) o->limits.apply(s.limits);
   // A sensor the type lacks can never be read (the checker rejects it); check_drone
   // reports it, and dropping it keeps the mission file to what the drone can do.

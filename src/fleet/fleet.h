@@ -34,6 +34,7 @@ struct DroneSettings {
   Vec3 home;                                 ///< local frame: x east, y north, z up (m)
   std::map<std::string, SensorModel> sensors;  ///< "Sensor1" → model; missing = 0
   Limits limits;                             ///< the type's limits, overridden per drone
+  GoalTolerance tolerance;                   ///< the type's
   Failsafe failsafe = Failsafe::land;
   std::string adapter = "sim";
   std::string connection;                    ///< adapter URL, e.g. udp://:14540; "" for sim

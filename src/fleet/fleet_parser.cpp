@@ -17,7 +17,8 @@ const std::vector<std::string> kSafetyKeys = {"min_separation", "battery_reserve
                                               "max_climb",      "max_descent",     "geofence"};
 const std::vector<std::string> kSeparationKeys = {"horizontal", "vertical"};
 const std::vector<std::string> kGeofenceKeys = {"polygon", "min_altitude", "max_altitude"};
-const std::vector<std::string> kTypeKeys = {"adapter", "capabilities", "sensors", "limits"};
+const std::vector<std::string> kTypeKeys = {"adapter", "capabilities", "sensors", "limits", "tolerance"};
+const std::vector<std::string> kToleranceKeys = {"horizontal", "vertical", "speed"};
 const std::vector<std::string> kDroneKeys = {"home",     "battery",  "sensors",
                                              "limits",   "failsafe", "adapter",
                                              "connection", "sysid",  "timeouts",
@@ -72,6 +73,7 @@ class FleetParser {
   void range(const YAML::Node& node, const std::string& what, std::optional<SensorRange>& out);
   void safety(const YAML::Node& node);
   void separation(const YAML::Node& node, Separation& out);
+  void tolerance(const YAML::Node& node, const std::string& where, GoalTolerance& out);
   bool positive(const YAML::Node& node, const std::string& what, double& out);
   void geofence(const YAML::Node& node, const std::string& where, std::optional<Geofence>& out);
   void polygon(const YAML::Node& node, const std::string& what, Geofence& out);
@@ -129,6 +131,7 @@ void FleetParser::type(const std::string& name, const YAML::Node& node) {
         limits(v, where, given);
         given.apply(t.limits);
       }
+      if (key == "tolerance") tolerance(v, where, t.tolerance);
       if (key == "sensors" && r_.whole_number(v, "sensors of " + where, sensor_count) &&
           (sensor_count < 0 || sensor_count > kMaxSensors)) {
         r_.error(v, "sensors of " + where + " must be from 0 to " + std::to_string(kMaxSensors) +
@@ -388,6 +391,22 @@ void FleetParser::separation(const YAML::Node& node, Separation& out) {
     double value = 0;
     if (key == "horizontal" && positive(kv.second, "horizontal of " + where, value)) out.horizontal_m = value;
     if (key == "vertical" && positive(kv.second, "vertical of " + where, value)) out.vertical_m = value;
+  }
+}
+
+void FleetParser::tolerance(const YAML::Node& node, const std::string& where, GoalTolerance& out) {
+  const std::string what = "tolerance of " + where;
+  if (!node.IsMap()) {
+    r_.error(node, what + " must be a map {horizontal: M, vertical: M, speed: M/S}; got " + describe(node));
+    return;
+  }
+  std::set<std::string> seen;
+  for (const auto& kv : node) {
+    std::string key = r_.field(kv.first, kToleranceKeys, seen, what);
+    double value = 0;
+    if (key == "horizontal" && positive(kv.second, "horizontal of " + what, value)) out.horizontal_m = value;
+    if (key == "vertical" && positive(kv.second, "vertical of " + what, value)) out.vertical_m = value;
+    if (key == "speed" && positive(kv.second, "speed of " + what, value)) out.settled_mps = value;
   }
 }
 

@@ -143,5 +143,25 @@ TEST(MissionFile, ADronesSigningKeySetupAndGcsAnnouncementComeBackFromItsFileOnl
   }
 }
 
+// A DEX judges its drone's goals by the type's tolerance: it must come back from the file.
+TEST(MissionFile, ATypesGoalToleranceComesBackFromEachOfItsDronesFiles) {
+  std::string fleet = "types:\n  DroneType2:\n    tolerance: {horizontal: 1.25, vertical: 0.75, speed: 0.5}\n" +
+                      std::string(test::kListing2Fleet);
+  auto c = test::compile_mission(test::listing2_text(), fleet);
+  ASSERT_TRUE(c);
+  std::string hash = deploy::mission_hash(*c);
+  for (int d = 0; d < c->drone_count(); ++d) {
+    std::ostringstream out;
+    ASSERT_TRUE(deploy::write_drone_mission(out, *c, d, hash));
+    dex::Mission m;
+    std::vector<std::string> errors;
+    ASSERT_TRUE(deploy::read_mission(out.str(), c->drone_name(d), m, errors)) << errors.front();
+    const bool typed = c->drone_name(d) == "Drone2";  // `var Drone2 DroneType2`
+    EXPECT_DOUBLE_EQ(m.settings.tolerance.horizontal_m, typed ? 1.25 : 0.5) << c->drone_name(d);
+    EXPECT_DOUBLE_EQ(m.settings.tolerance.vertical_m, typed ? 0.75 : 0.3) << c->drone_name(d);
+    EXPECT_DOUBLE_EQ(m.settings.tolerance.settled_mps, typed ? 0.5 : 0.3) << c->drone_name(d);
+  }
+}
+
 }  // namespace
 }  // namespace eamos

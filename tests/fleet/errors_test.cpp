@@ -27,6 +27,22 @@ TEST(Errors, UnknownKeyReportsLineColumnAndSuggestion) {
   EXPECT_TRUE(contains(d.message, "did you mean 'limits'?")) << d.message;
 }
 
+TEST(Errors, EveryBadGoalToleranceIsReportedAtItsValueInOnePass) {
+  auto p = parse("types:\n  Scout:\n    tolerance: {horizontal: 0, vertical: -1, sped: 0.2}\n"
+                 "  Lifter:\n    tolerance: 0.5\n");
+  EXPECT_FALSE(p.ok);
+  ASSERT_EQ(p.diags.error_count(), 4u) << p.diags.format();
+  const auto& d = p.diags.items();
+  EXPECT_TRUE(contains(d[0].message, "horizontal of tolerance of type 'Scout' must be positive; got '0'")) << d[0].message;
+  EXPECT_EQ(d[0].loc.line, 3);
+  EXPECT_EQ(d[0].loc.col, 29);
+  EXPECT_TRUE(contains(d[1].message, "vertical of tolerance of type 'Scout' must be positive")) << d[1].message;
+  EXPECT_TRUE(contains(d[2].message, "did you mean 'speed'?")) << d[2].message;
+  EXPECT_TRUE(contains(d[3].message, "tolerance of type 'Lifter' must be a map {horizontal: M, vertical: M, speed: M/S}"))
+      << d[3].message;
+  EXPECT_EQ(d[3].loc.line, 5);
+}
+
 // The CLI prints after the fleet's SourceFile is gone (compile_file returns, the Fleet and
 // its source die); a diagnostic pointing into the source printed freed memory or crashed.
 TEST(Errors, DiagnosticsStayPrintableAfterTheirSourceIsFreed) {

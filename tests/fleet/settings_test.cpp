@@ -164,5 +164,18 @@ TEST(Settings, AnnounceAsGcsIsOnlyForTheDronesThatAskAndTakesOnlyTrueOrFalse) {
   EXPECT_NE(d.message.find("announce_as_gcs of drone 'D1' must be true or false; got "), std::string::npos) << d.message;
 }
 
+TEST(Settings, ATypesGoalToleranceGoesToItsDronesAndOthersKeepTheDefault) {
+  auto p = parse("types:\n  Lifter:\n    tolerance: {horizontal: 1.5, vertical: 0.8}\n"
+                 "drones:\n  D1: {home: [0, 0, 0]}\n");
+  ASSERT_TRUE(p.ok) << p.diags.format();
+  DroneSettings lifter = p.fleet.settings_for("D1", "Lifter", 0);
+  EXPECT_DOUBLE_EQ(lifter.tolerance.horizontal_m, 1.5);
+  EXPECT_DOUBLE_EQ(lifter.tolerance.vertical_m, 0.8);
+  EXPECT_DOUBLE_EQ(lifter.tolerance.settled_mps, 0.3);  // not given: the default
+  DroneSettings quad = p.fleet.settings_for("D1", "Quad", 0);
+  EXPECT_DOUBLE_EQ(quad.tolerance.horizontal_m, 0.5);
+  EXPECT_DOUBLE_EQ(quad.tolerance.vertical_m, 0.3);
+}
+
 }  // namespace
 }  // namespace eamos::fleet

@@ -392,6 +392,23 @@ TEST(MavlinkFlight, FailsafeLandingEndsWithTheMotorsOffWhenTheAutopilotKeepsThem
   EXPECT_FALSE(f.drone->state().armed);
 }
 
+// A goal counts as reached within the tolerance the fleet file gives the drone's type
+// (`tolerance:`), not a fixed one: 3 m at any speed, a FlyByX(5) from a standstill ends while
+// the vehicle is still on its way, 2-3 m short of its target.
+TEST(MavlinkFlight, AGoalCountsAsReachedWithinTheToleranceTheFleetFileGivesTheType) {
+  test::VehicleThread vehicle(25397, 1, kSpeed);
+  Flight f(25397, {}, [](fleet::DroneSettings& s) { s.tolerance = {3.0, 0.3, 100.0}; });
+  ASSERT_TRUE(f.drone) << f.created.message;
+  ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
+  ASSERT_EQ(f.fly("Takeoff", {3}).outcome, mid::Outcome::succeeded);
+  const double from = f.drone->state().x;
+  mid::ActionEnd e = f.fly("FlyByX", {5});
+  ASSERT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
+  const double flown = f.drone->state().x - from;
+  EXPECT_GE(flown, 1.9);  // within 3 m of 5 m, one position report (0.1 s) late at most
+  EXPECT_LT(flown, 4.0);  // the default 0.5 m would have waited for 4.5 m
+}
+
 TEST(MavlinkAdapter, NoVehicleIsACreateErrorThatSaysWhatToCheck) {
   MavlinkOptions options;
   options.connect_timeout_s = 0.3;
