@@ -119,6 +119,29 @@ TEST(MissionHash, DoesNotDependOnTheSourcePath) {
 namespace eamos {
 namespace {
 
+/// Each drone's mission file as written for Listing 2 under `fleet`, read back: the text and
+/// what a DEX gets from it, per drone name.
+struct ReadBack {
+  std::string text;
+  dex::Mission mission;
+};
+std::map<std::string, ReadBack> read_back_each(const std::string& fleet) {
+  std::map<std::string, ReadBack> out;
+  auto c = test::compile_mission(test::listing2_text(), fleet);
+  EXPECT_TRUE(c);
+  if (!c) return out;
+  std::string hash = deploy::mission_hash(*c);
+  for (int d = 0; d < c->drone_count(); ++d) {
+    std::ostringstream text;
+    EXPECT_TRUE(deploy::write_drone_mission(text, *c, d, hash));
+    ReadBack& r = out[c->drone_name(d)];
+    r.text = text.str();
+    std::vector<std::string> errors;
+    EXPECT_TRUE(deploy::read_mission(r.text, c->drone_name(d), r.mission, errors)) << errors.front();
+  }
+  return out;
+}
+
 // A distributed run flies each drone from its mission file: a signing key the fleet file
 // gave must come back from it, or the DEX would fly that drone unsigned.
 TEST(MissionFile, ADronesSigningKeySetupAndGcsAnnouncementComeBackFromItsFileOnly) {
@@ -126,40 +149,28 @@ TEST(MissionFile, ADronesSigningKeySetupAndGcsAnnouncementComeBackFromItsFileOnl
   const std::string key = "0f1e2d3c4b5a69788796a5b4c3d2e1f000112233445566778899aabbccddeeff";
   fleet.replace(fleet.find("    failsafe: return_home\n"), 0,
                "    signing: {key: " + key + ", setup: true}\n    announce_as_gcs: true\n");
-  auto c = test::compile_mission(test::listing2_text(), fleet);
-  ASSERT_TRUE(c);
-  std::string hash = deploy::mission_hash(*c);
-  for (int d = 0; d < c->drone_count(); ++d) {
-    std::ostringstream out;
-    ASSERT_TRUE(deploy::write_drone_mission(out, *c, d, hash));
-    dex::Mission m;
-    std::vector<std::string> errors;
-    ASSERT_TRUE(deploy::read_mission(out.str(), c->drone_name(d), m, errors)) << errors.front();
-    bool is_drone2 = c->drone_name(d) == "Drone2";
-    EXPECT_EQ(m.settings.signing_key, is_drone2 ? key : "") << c->drone_name(d);
-    EXPECT_EQ(m.settings.signing_setup, is_drone2) << c->drone_name(d);
-    EXPECT_EQ(m.settings.announce_as_gcs, is_drone2) << c->drone_name(d);  // its DEX announces it too
-    EXPECT_EQ(out.str().find(key) != std::string::npos, is_drone2) << c->drone_name(d);
+  auto files = read_back_each(fleet);
+  ASSERT_EQ(files.size(), 3u);
+  for (const auto& [name, r] : files) {
+    bool is_drone2 = name == "Drone2";
+    EXPECT_EQ(r.mission.settings.signing_key, is_drone2 ? key : "") << name;
+    EXPECT_EQ(r.mission.settings.signing_setup, is_drone2) << name;
+    EXPECT_EQ(r.mission.settings.announce_as_gcs, is_drone2) << name;  // its DEX announces it too
+    EXPECT_EQ(r.text.find(key) != std::string::npos, is_drone2) << name;
   }
 }
 
 // A DEX judges its drone's goals by the type's tolerance: it must come back from the file.
 TEST(MissionFile, ATypesGoalToleranceComesBackFromEachOfItsDronesFiles) {
-  std::string fleet = "types:\n  DroneType2:\n    tolerance: {horizontal: 1.25, vertical: 0.75, speed: 0.5}\n" +
-                      std::string(test::kListing2Fleet);
-  auto c = test::compile_mission(test::listing2_text(), fleet);
-  ASSERT_TRUE(c);
-  std::string hash = deploy::mission_hash(*c);
-  for (int d = 0; d < c->drone_count(); ++d) {
-    std::ostringstream out;
-    ASSERT_TRUE(deploy::write_drone_mission(out, *c, d, hash));
-    dex::Mission m;
-    std::vector<std::string> errors;
-    ASSERT_TRUE(deploy::read_mission(out.str(), c->drone_name(d), m, errors)) << errors.front();
-    const bool typed = c->drone_name(d) == "Drone2";  // `var Drone2 DroneType2`
-    EXPECT_DOUBLE_EQ(m.settings.tolerance.horizontal_m, typed ? 1.25 : 0.5) << c->drone_name(d);
-    EXPECT_DOUBLE_EQ(m.settings.tolerance.vertical_m, typed ? 0.75 : 0.3) << c->drone_name(d);
-    EXPECT_DOUBLE_EQ(m.settings.tolerance.settled_mps, typed ? 0.5 : 0.3) << c->drone_name(d);
+  auto files = read_back_each("types:\n  DroneType2:\n    tolerance: {horizontal: 1.25, vertical: 0.75, speed: 0.5}\n" +
+                              std::string(test::kListing2Fleet));
+  ASSERT_EQ(files.size(), 3u);
+  for (const auto& [name, r] : files) {
+    const bool typed = name == "Drone2";  // `var Drone2 DroneType2`
+    const fleet::GoalTolerance& t = r.mission.settings.tolerance;
+    EXPECT_DOUBLE_EQ(t.horizontal_m, typed ? 1.25 : 0.5) << name;
+    EXPECT_DOUBLE_EQ(t.vertical_m, typed ? 0.75 : 0.3) << name;
+    EXPECT_DOUBLE_EQ(t.settled_mps, typed ? 0.5 : 0.3) << name;
   }
 }
 
