@@ -30,9 +30,6 @@ void register_adapter(mid::AdapterRegistry& registry, MavlinkOptions options) {
         scaled.mode_confirm_s *= options.speed;
         scaled.statustext_wait_s *= options.speed;
         scaled.picture_confirm_s *= options.speed;
-        // The type's goal tolerance from the fleet file (docs/fleet.md `tolerance:`).
-        scaled.tolerance = {settings.tolerance.horizontal_m, settings.tolerance.vertical_m};
-        scaled.settled_mps = settings.tolerance.settled_mps;
         auto drone = std::make_unique<MavlinkDrone>(settings, type, loop, scaled);
         if (std::string error = drone->connect(*url.endpoint); !error.empty()) return failed(error);
         return {mid::CreateStatus::success, std::move(drone), ""};

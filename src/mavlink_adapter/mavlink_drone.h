@@ -78,8 +78,6 @@ struct MavlinkOptions {
   /// CAMERA_IMAGE_CAPTURED), not when the command is accepted: an autopilot accepts the
   /// command with no camera behind it. How long after the ACK to wait (seconds; scaled).
   double picture_confirm_s = 2.0;
-  mid::Tolerance tolerance;        ///< when a goal counts as reached: this close ...
-  double settled_mps = 0.3;        ///< ... and no faster than this (stopped, not passing by)
 };
 
 class MavlinkDrone final : public mid::AdapterDrone {
@@ -226,6 +224,10 @@ class MavlinkDrone final : public mid::AdapterDrone {
   fleet::Vec3 position() const;
   fleet::Vec3 reference() const;  ///< where relative motions start: holding_ or position()
   double ground_z() const { return settings_.home.z; }
+  /// When a goal counts as reached: the type's tolerance from the fleet file (docs/fleet.md).
+  mid::Tolerance goal_tolerance() const {
+    return {settings_.tolerance.horizontal_m, settings_.tolerance.vertical_m};
+  }
   double sensor_value(int k) const;
   double remaining(fleet::Vec3 from) const;  ///< path still to fly for the running motion
 

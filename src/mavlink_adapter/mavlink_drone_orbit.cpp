@@ -183,7 +183,7 @@ void MavlinkDrone::advance_orbit(double dt) {
   if (!orbit_.on_circle) {
     // Out to the circle's east point first, like the simulator, then around it.
     setpoint_ = {orbit_.centre.x + r, orbit_.centre.y, orbit_.centre.z};
-    if (horizontal_norm(position() - setpoint_) > options_.tolerance.horizontal_m) return;
+    if (horizontal_norm(position() - setpoint_) > settings_.tolerance.horizontal_m) return;
     if (!autopilot_->do_orbit) {
       orbit_.on_circle = true;
       return;
@@ -196,7 +196,7 @@ void MavlinkDrone::advance_orbit(double dt) {
     orbit_.waited_at_start_s += dt;
     const bool still = norm(vehicle_.ned_velocity) <= kStartStillMps &&
                        std::fabs(horizontal_norm(position() - orbit_.centre) - r) <= kStartOnCircleM;
-    if (still || (orbit_.waited_at_start_s >= kStartWaitS && norm(vehicle_.ned_velocity) <= options_.settled_mps))
+    if (still || (orbit_.waited_at_start_s >= kStartWaitS && norm(vehicle_.ned_velocity) <= settings_.tolerance.settled_mps))
       send_do_orbit();
     return;
   }
