@@ -419,6 +419,13 @@ void Sitl::fly_listing2(const std::string& extra) {
     if (std::sscanf(text.c_str(), "orbit of %*f m around x %lf, y %lf", &cx, &cy) == 2) break;
   ASSERT_FALSE(std::isnan(cx)) << "no 'orbit of .. around' line in Drone2's trace\n" << f.run.out;
   std::pair<double, double> centre{cy - kHomes[1].y, cx - kHomes[1].x};  // north, east of home
+  if (std::getenv("EAMOS_KEEP_SITL_DIRS")) {  // the second ground station's view, for a look at the orbit
+    std::ofstream csv(dir_ / "watch.csv");
+    csv << "wall_s,north,east,down,speed,custom_mode\n";
+    for (const auto& s : watch.samples())
+      csv << s.wall_s << ',' << s.north << ',' << s.east << ',' << s.down << ',' << s.speed << ',' << s.custom_mode << '\n';
+    std::cout << "[sitl] centre north " << centre.first << ", east " << centre.second << "\n";
+  }
   std::optional<Circle> orbit = orbit_of(watch.samples(), orbit_mode, centre, speed, radii, why);
   ASSERT_TRUE(orbit) << why;
   auto [low, high] = std::minmax_element(radii.begin(), radii.end());
