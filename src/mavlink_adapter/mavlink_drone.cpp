@@ -359,6 +359,20 @@ void MavlinkDrone::stop_action(ActionId id) {
   hold_here();
 }
 
+std::string MavlinkDrone::timeout_detail(ActionId id) const {
+  // A goal missed is seldom missed by much: say by how much, against the type's tolerance,
+  // so the fleet file's `tolerance:` can be judged from the failure alone.
+  if (id != motion_owner_ || !goal_ || !vehicle_.have_position) return "";
+  const Vec3 off = position() - goal_->target();
+  const fleet::GoalTolerance& t = settings_.tolerance;
+  char text[192];
+  std::snprintf(text, sizeof text,
+                "%.2f m across, %.2f m %s its goal, at %.2f m/s; the type's tolerance: %.2f m, %.2f m, %.2f m/s",
+                horizontal_norm(off), std::fabs(off.z), off.z < 0 ? "below" : "above", norm(vehicle_.ned_velocity),
+                t.horizontal_m, t.vertical_m, t.settled_mps);
+  return text;
+}
+
 void MavlinkDrone::hold_here() {
   if (vehicle_.landed() || !vehicle_.armed) {
     streaming_ = false;

@@ -159,6 +159,7 @@ class MavlinkDrone final : public mid::AdapterDrone {
   /// (timed_out without an answer), its MAV_RESULT and STATUSTEXT the detail.
   void end_refused(mid::ActionId id, const CommandResult& result);
   void stop_action(mid::ActionId id) override;
+  std::string timeout_detail(mid::ActionId id) const override;
   void hold_here();
   /// Ends every running action `failed` for `why`, dropping the motion's goal and orbit.
   void fail_all(mid::FailureReason why, const std::string& reason);

@@ -13,8 +13,9 @@ std::string seconds_text(double s) {
 }
 }  // namespace
 
-ActionTracker::ActionTracker(EventLoop& loop, std::function<void(ActionId)> on_timeout)
-    : loop_(loop), on_timeout_(std::move(on_timeout)) {}
+ActionTracker::ActionTracker(EventLoop& loop, std::function<void(ActionId)> on_timeout,
+                             std::function<std::string(ActionId)> describe)
+    : loop_(loop), on_timeout_(std::move(on_timeout)), describe_(std::move(describe)) {}
 
 ActionTracker::~ActionTracker() {
   for (ActionId id : running_ids()) end(id, Outcome::cancelled, "drone shut down");
@@ -31,8 +32,10 @@ ActionId ActionTracker::begin(const ActionRequest& request, fleet::ActionClass a
       auto it = actions_.find(id);
       if (it == actions_.end()) return;
       it->second.deadline = kNoTimer;  // firing now; end() must not cancel it
+      const std::string where = describe_ ? describe_(id) : "";  // before the stop clears the goal
       on_timeout_(id);
-      fail(id, FailureReason::timed_out, "timed out after " + seconds_text(timeout_s),
+      fail(id, FailureReason::timed_out,
+           "timed out after " + seconds_text(timeout_s) + (where.empty() ? "" : " (" + where + ")"),
            "deadline " + seconds_text(timeout_s) + " after start");
     });
   }

@@ -3,10 +3,15 @@
 namespace eamos::mid {
 
 AdapterDrone::AdapterDrone(EventLoop& loop, fleet::DroneType type)
-    : loop_(loop), type_(std::move(type)), tracker_(loop, [this](ActionId id) {
-        clear_action_timer(id);
-        stop_action(id);
-      }) {}
+    : loop_(loop),
+      type_(std::move(type)),
+      tracker_(
+          loop,
+          [this](ActionId id) {
+            clear_action_timer(id);
+            stop_action(id);
+          },
+          [this](ActionId id) { return timeout_detail(id); }) {}
 
 AdapterDrone::~AdapterDrone() {
   for (auto& [id, timer] : action_timers_) loop_.cancel(timer);

@@ -45,6 +45,9 @@ class AdapterDrone : public Drone {
   /// What cancel() and a timeout do to the vehicle for a running action (its timer is
   /// already cleared); the action's end is reported by the caller.
   virtual void stop_action(ActionId id) = 0;
+  /// Where the vehicle stands against what a running action waits for, said when it times
+  /// out ("" when there is nothing to say).
+  virtual std::string timeout_detail(ActionId) const { return ""; }
 
   /// Runs `fn` after `delay_s` for a running action; cleared when the action stops.
   void after_for(ActionId id, double delay_s, std::function<void()> fn);

@@ -409,6 +409,24 @@ TEST(MavlinkFlight, AGoalCountsAsReachedWithinTheToleranceTheFleetFileGivesTheTy
   EXPECT_LT(flown, 4.0);  // the default 0.5 m would have waited for 4.5 m
 }
 
+// A motion that times out says where the vehicle stands against its goal and the type's
+// tolerance, so a fleet file's `tolerance:` can be judged from the failure alone. The
+// vehicle arrives; a speed bound no vehicle meets (no fleet file can give one) keeps the goal
+// from counting.
+TEST(MavlinkFlight, AMotionThatTimesOutSaysHowFarFromItsGoalTheVehicleStands) {
+  test::VehicleThread vehicle(25398, 1, kSpeed);
+  Flight f(25398, {}, [](fleet::DroneSettings& s) { s.tolerance = {0.5, 0.3, -1.0}; });
+  ASSERT_TRUE(f.drone) << f.created.message;
+  ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
+  mid::ActionEnd e = f.fly("Takeoff", {3}, 120);
+  ASSERT_EQ(e.outcome, mid::Outcome::failed) << e.reason;
+  EXPECT_EQ(e.failure, mid::FailureReason::timed_out);
+  EXPECT_NE(e.reason.find("timed out after"), std::string::npos) << e.reason;
+  EXPECT_NE(e.reason.find(" m across, 0.0"), std::string::npos) << e.reason;  // up there, within cm
+  EXPECT_NE(e.reason.find("its goal, at 0.0"), std::string::npos) << e.reason;
+  EXPECT_NE(e.reason.find("the type's tolerance: 0.50 m, 0.30 m, -1.00 m/s"), std::string::npos) << e.reason;
+}
+
 TEST(MavlinkAdapter, NoVehicleIsACreateErrorThatSaysWhatToCheck) {
   MavlinkOptions options;
   options.connect_timeout_s = 0.3;

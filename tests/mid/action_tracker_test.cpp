@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "mid/state_broker.h"
@@ -89,6 +90,24 @@ TEST(ActionTracker, DeadlineStopsThenFailsTheAction) {
   EXPECT_EQ(ends.seen[0].second.detail, "deadline 2.5 s after start");
   EXPECT_DOUBLE_EQ(loop.now(), 2.5);
   EXPECT_EQ(tracker.motion(), kNoAction);
+}
+
+TEST(ActionTracker, ATimeoutSaysWhereTheVehicleStandsWhenTheAdapterKnows) {
+  EventLoop loop;
+  std::vector<std::string> order;
+  ActionTracker tracker(
+      loop, [&](ActionId) { order.push_back("stopped"); },
+      [&](ActionId) {
+        order.push_back("described");
+        return std::string("0.40 m across");
+      });
+  Ends ends;
+  tracker.begin({"FlyTo", {1, 2, 3}}, ActionClass::motion, ends.tag(1), 2.5);
+  loop.run_until_idle();
+  ASSERT_EQ(ends.seen.size(), 1u);
+  EXPECT_EQ(ends.seen[0].second.reason, "timed out after 2.5 s (0.40 m across)");
+  // Described before the stop, which clears the goal the description measures from.
+  EXPECT_EQ(order, (std::vector<std::string>{"described", "stopped"}));
 }
 
 TEST(ActionTracker, EndedActionLeavesNoDeadlineBehind) {
