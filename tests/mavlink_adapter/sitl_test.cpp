@@ -249,7 +249,8 @@ class Sitl : public ::testing::TestWithParam<Autopilot> {
   /// The speed-up a flight runs at: 5, but PX4 with one DEX per drone at 3. At 5 three PX4
   /// instances and four eamos processes are more than two cores carry: the vehicles' clocks
   /// fell to 0.7 of mission time, and an Arm (mode switch, ARM, their ACKs) timed out after
-  /// 10 mission s in CI (it takes under 4; docs/adapters.md). Listing 2 has its own.
+  /// 10 mission s in CI (it takes under 4; docs/adapters.md). Listing 2 has its own; patrol,
+  /// whose timings are written for kSpeed, stays at 5.
   double flight_speed(const std::string& extra) const {
     return GetParam() == Autopilot::px4 && extra.find("--distributed") != std::string::npos ? 3.0 : kSpeed;
   }
