@@ -245,7 +245,7 @@ void MavlinkDrone::start_motion(ActionId id, const mid::ActionRequest& r) {
     return command_motion(id, ml::cmd::NAV_LAND, kLandHere);
   }
   if (auto goal = mid::goal_position(r, here, settings_.home)) {
-    goal_.emplace(*goal, goal_tolerance());
+    goal_.emplace(*goal, settings_.tolerance);
     until_ = Until::reached;
     setpoint_ = *goal;
     stream_setpoints();
@@ -272,7 +272,7 @@ void MavlinkDrone::start_takeoff(ActionId id, double altitude) {
   }
   armed_waiting_ = false;
   const Vec3 here = position();
-  goal_.emplace(Vec3{here.x, here.y, ground_z() + altitude}, goal_tolerance());
+  goal_.emplace(Vec3{here.x, here.y, ground_z() + altitude}, settings_.tolerance);
   until_ = Until::reached;
   if (!vehicle_.landed()) {
     // Already up: autopilots refuse NAV_TAKEOFF in the air, the simulator climbs or descends
@@ -437,7 +437,7 @@ std::optional<double> MavlinkDrone::progress(ActionId id) const {
 }
 
 Vec3 MavlinkDrone::reference() const {
-  if (holding_ && mid::LocationValidator(*holding_, goal_tolerance()).reached(position()))
+  if (holding_ && mid::LocationValidator(*holding_, settings_.tolerance).reached(position()))
     return *holding_;
   return position();
 }

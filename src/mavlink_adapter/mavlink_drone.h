@@ -225,10 +225,6 @@ class MavlinkDrone final : public mid::AdapterDrone {
   fleet::Vec3 position() const;
   fleet::Vec3 reference() const;  ///< where relative motions start: holding_ or position()
   double ground_z() const { return settings_.home.z; }
-  /// When a goal counts as reached: the type's tolerance from the fleet file (docs/fleet.md).
-  mid::Tolerance goal_tolerance() const {
-    return {settings_.tolerance.horizontal_m, settings_.tolerance.vertical_m};
-  }
   double sensor_value(int k) const;
   double remaining(fleet::Vec3 from) const;  ///< path still to fly for the running motion
 

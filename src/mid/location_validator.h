@@ -2,18 +2,15 @@
 // The LocationValidator (paper, section VI): has a drone reached a target location? Real
 // vehicles never stop exactly on a setpoint, so "reached" means within a tolerance, with
 // separate horizontal and vertical bounds (altitude estimates are noisier than position).
+// The bounds are the type's goal tolerance from the fleet file; its speed bound is the
+// caller's to judge (a position says nothing of it).
 #include "fleet/fleet.h"
 
 namespace eamos::mid {
 
-struct Tolerance {
-  double horizontal_m = 0.5;  ///< radius around the target in the x/y plane
-  double vertical_m = 0.3;    ///< band above and below the target's z
-};
-
 class LocationValidator {
  public:
-  explicit LocationValidator(fleet::Vec3 target, Tolerance tolerance = {})
+  explicit LocationValidator(fleet::Vec3 target, fleet::GoalTolerance tolerance = {})
       : target_(target), tolerance_(tolerance) {}
 
   /// True when `position` is within the tolerance of the target (bounds inclusive).
@@ -22,7 +19,7 @@ class LocationValidator {
 
  private:
   fleet::Vec3 target_;
-  Tolerance tolerance_;
+  fleet::GoalTolerance tolerance_;
 };
 
 }  // namespace eamos::mid
