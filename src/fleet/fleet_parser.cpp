@@ -74,6 +74,10 @@ class FleetParser {
   void safety(const YAML::Node& node);
   void separation(const YAML::Node& node, Separation& out);
   void tolerance(const YAML::Node& node, const std::string& where, GoalTolerance& out);
+  /// A map of positive numbers, `keys[k]` read into `*fields[k]` (`shape` shows the map in
+  /// the error for a node that is not one).
+  void positive_fields(const YAML::Node& node, const std::string& what, const std::string& shape,
+                       const std::vector<std::string>& keys, const std::vector<double*>& fields);
   bool positive(const YAML::Node& node, const std::string& what, double& out);
   void geofence(const YAML::Node& node, const std::string& where, std::optional<Geofence>& out);
   void polygon(const YAML::Node& node, const std::string& what, Geofence& out);
@@ -380,33 +384,27 @@ bool FleetParser::positive(const YAML::Node& node, const std::string& what, doub
 }
 
 void FleetParser::separation(const YAML::Node& node, Separation& out) {
-  const std::string where = "min_separation of safety";
-  if (!node.IsMap()) {
-    r_.error(node, where + " must be a map {horizontal: M, vertical: M}; got " + describe(node));
-    return;
-  }
-  std::set<std::string> seen;
-  for (const auto& kv : node) {
-    std::string key = r_.field(kv.first, kSeparationKeys, seen, where);
-    double value = 0;
-    if (key == "horizontal" && positive(kv.second, "horizontal of " + where, value)) out.horizontal_m = value;
-    if (key == "vertical" && positive(kv.second, "vertical of " + where, value)) out.vertical_m = value;
-  }
+  positive_fields(node, "min_separation of safety", "{horizontal: M, vertical: M}", kSeparationKeys,
+                  {&out.horizontal_m, &out.vertical_m});
 }
 
 void FleetParser::tolerance(const YAML::Node& node, const std::string& where, GoalTolerance& out) {
-  const std::string what = "tolerance of " + where;
+  positive_fields(node, "tolerance of " + where, "{horizontal: M, vertical: M, speed: M/S}", kToleranceKeys,
+                  {&out.horizontal_m, &out.vertical_m, &out.settled_mps});
+}
+
+void FleetParser::positive_fields(const YAML::Node& node, const std::string& what, const std::string& shape,
+                                  const std::vector<std::string>& keys, const std::vector<double*>& fields) {
   if (!node.IsMap()) {
-    r_.error(node, what + " must be a map {horizontal: M, vertical: M, speed: M/S}; got " + describe(node));
+    r_.error(node, what + " must be a map " + shape + "; got " + describe(node));
     return;
   }
   std::set<std::string> seen;
   for (const auto& kv : node) {
-    std::string key = r_.field(kv.first, kToleranceKeys, seen, what);
+    const std::string key = r_.field(kv.first, keys, seen, what);
+    const auto k = std::find(keys.begin(), keys.end(), key);
     double value = 0;
-    if (key == "horizontal" && positive(kv.second, "horizontal of " + what, value)) out.horizontal_m = value;
-    if (key == "vertical" && positive(kv.second, "vertical of " + what, value)) out.vertical_m = value;
-    if (key == "speed" && positive(kv.second, "speed of " + what, value)) out.settled_mps = value;
+    if (k != keys.end() && positive(kv.second, key + " of " + what, value)) *fields[k - keys.begin()] = value;
   }
 }
 
