@@ -13,25 +13,48 @@ if [ ! -f "$BUILD/build.ninja" ]; then
 fi
 cmake --build "$BUILD" -j "$(nproc)" --target fuzz_frontend fuzz_fleet fuzz_mavlink fuzz_mission fuzz_wire
 
+# One fuzzer per core at a time: each is one process on one core.
 run() {
   local target=$1 seeds=$2
   local corpus="$BUILD/corpus-$target"
   mkdir -p "$corpus"
   cp $seeds "$corpus"/ 2>/dev/null || true
-  echo "fuzz: $target for ${SECONDS_PER_TARGET}s"
   # -rss_limit_mb and -timeout turn memory blow-ups and hangs into failures.
   "$BUILD/tests/fuzz/$target" -max_total_time="$SECONDS_PER_TARGET" -timeout=10 \
-    -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 "$corpus" 2>"$BUILD/$target.log" || {
-      tail -40 "$BUILD/$target.log"
-      echo "fuzz: $target FAILED (log: $BUILD/$target.log)"
-      exit 1
-    }
+    -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 "$corpus" 2>"$BUILD/$target.log"
+}
+
+report() {
+  local target=$1 rc=$2
+  echo "fuzz: $target for ${SECONDS_PER_TARGET}s"
+  if [ "$rc" -ne 0 ]; then
+    tail -40 "$BUILD/$target.log"
+    echo "fuzz: $target FAILED (log: $BUILD/$target.log)"
+    return 1
+  fi
   grep -E "stat::number_of_executed_units|Done" "$BUILD/$target.log" | tail -2
 }
 
-run fuzz_frontend "examples/*.eamos tests/lang/diagnostics/*.eamos"
-run fuzz_fleet "tests/fleet/data/*.yaml examples/*.yaml"
-run fuzz_mavlink "tests/fuzz/mavlink-seeds/*"
-run fuzz_mission "tests/fuzz/mission-seeds/*"
-run fuzz_wire "tests/fuzz/wire-seeds/*"
+targets=(fuzz_frontend fuzz_fleet fuzz_mavlink fuzz_mission fuzz_wire)
+seeds=("examples/*.eamos tests/lang/diagnostics/*.eamos" "tests/fleet/data/*.yaml examples/*.yaml"
+       "tests/fuzz/mavlink-seeds/*" "tests/fuzz/mission-seeds/*" "tests/fuzz/wire-seeds/*")
+declare -A pid
+jobs_max=$(nproc)
+failed=0
+for i in "${!targets[@]}"; do
+  run "${targets[$i]}" "${seeds[$i]}" &
+  pid[$i]=$!
+  # Wait for the oldest still running once every core has one.
+  if [ $((i + 1)) -ge "$jobs_max" ]; then
+    j=$((i + 1 - jobs_max))
+    rc=0; wait "${pid[$j]}" || rc=$?
+    report "${targets[$j]}" "$rc" || failed=1
+  fi
+done
+start=$(( ${#targets[@]} - jobs_max + 1 )); [ "$start" -lt 0 ] && start=0  # the ones not yet waited for
+for j in $(seq "$start" $(( ${#targets[@]} - 1 ))); do
+  rc=0; wait "${pid[$j]}" || rc=$?
+  report "${targets[$j]}" "$rc" || failed=1
+done
+[ "$failed" -eq 0 ] || exit 1
 echo "fuzz: every target ran without a crash, hang or leak"
