@@ -20,7 +20,7 @@ build: deps $(BUILD)/build.ninja
 demo: build
 	@bash scripts/demo.sh $(BUILD)
 
-# The fuzzers run first and briefly (5 s per target: a smoke run; `make fuzz` runs 120 s each); ctest's summary closes the run.
+# The fuzzers run first and briefly (5 s per target, two at a time: a smoke run; `make fuzz` runs 120 s each); ctest's summary closes the run.
 # Real-time tests (DDS processes, SITL firmware, the browser) share two cores with each
 # other, so a failed test runs once more; one that fails twice fails the run, and the first
 # failure stays in the log.
