@@ -11,7 +11,10 @@ if [ ! -f "$BUILD/build.ninja" ]; then
   CC=clang CXX=clang++ cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DEAMOS_FUZZ=ON -DEAMOS_TESTS=OFF -DEAMOS_BENCH=OFF >/dev/null
 fi
-cmake --build "$BUILD" -j "$(nproc)" --target fuzz_frontend fuzz_fleet fuzz_mavlink fuzz_mission fuzz_wire
+targets=(fuzz_frontend fuzz_fleet fuzz_mavlink fuzz_mission fuzz_wire)
+seeds=("examples/*.eamos tests/lang/diagnostics/*.eamos" "tests/fleet/data/*.yaml examples/*.yaml"
+       "tests/fuzz/mavlink-seeds/*" "tests/fuzz/mission-seeds/*" "tests/fuzz/wire-seeds/*")
+cmake --build "$BUILD" -j "$(nproc)" --target "${targets[@]}"
 
 # One fuzzer per core at a time: each is one process on one core.
 run() {
@@ -35,26 +38,21 @@ report() {
   grep -E "stat::number_of_executed_units|Done" "$BUILD/$target.log" | tail -2
 }
 
-targets=(fuzz_frontend fuzz_fleet fuzz_mavlink fuzz_mission fuzz_wire)
-seeds=("examples/*.eamos tests/lang/diagnostics/*.eamos" "tests/fleet/data/*.yaml examples/*.yaml"
-       "tests/fuzz/mavlink-seeds/*" "tests/fuzz/mission-seeds/*" "tests/fuzz/wire-seeds/*")
-declare -A pid
-jobs_max=$(nproc)
+pid=()
 failed=0
+reported=0
+# Waits for the oldest fuzzer not yet reported, so the reports come in the targets' order.
+report_next() {
+  local rc=0
+  wait "${pid[$reported]}" || rc=$?
+  report "${targets[$reported]}" "$rc" || failed=1
+  reported=$((reported + 1))
+}
 for i in "${!targets[@]}"; do
   run "${targets[$i]}" "${seeds[$i]}" &
   pid[$i]=$!
-  # Wait for the oldest still running once every core has one.
-  if [ $((i + 1)) -ge "$jobs_max" ]; then
-    j=$((i + 1 - jobs_max))
-    rc=0; wait "${pid[$j]}" || rc=$?
-    report "${targets[$j]}" "$rc" || failed=1
-  fi
+  if [ $((i + 1 - reported)) -ge "$(nproc)" ]; then report_next; fi
 done
-start=$(( ${#targets[@]} - jobs_max + 1 )); [ "$start" -lt 0 ] && start=0  # the ones not yet waited for
-for j in $(seq "$start" $(( ${#targets[@]} - 1 ))); do
-  rc=0; wait "${pid[$j]}" || rc=$?
-  report "${targets[$j]}" "$rc" || failed=1
-done
+while [ "$reported" -lt "${#targets[@]}" ]; do report_next; done
 [ "$failed" -eq 0 ] || exit 1
 echo "fuzz: every target ran without a crash, hang or leak"
