@@ -20,13 +20,12 @@ build: deps $(BUILD)/build.ninja
 demo: build
 	@bash scripts/demo.sh $(BUILD)
 
-# The fuzzers run first and briefly (5 s per target, two at a time: a smoke run; `make fuzz` runs 120 s each); ctest's summary closes the run.
-# Real-time tests (DDS processes, SITL firmware, the browser) share two cores with each
-# other, so a failed test runs once more; one that fails twice fails the run, and the first
-# failure stays in the log.
+# The real-time tests (SITL firmware, DDS processes, the browser) run at normal priority;
+# beside them, at low priority, the fuzzers (built, then 5 s per target: a smoke run; `make
+# fuzz` runs 120 s each) and every other test (scripts/test.sh). A failed test runs once
+# more; one that fails twice fails the run, and the first failure stays in the log.
 test: build
-	@bash scripts/fuzz.sh $(BUILD)-fuzz 5
-	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) --repeat until-pass:2
+	@bash scripts/test.sh $(BUILD) $(BUILD)-fuzz 5
 
 bench: build
 	@bash scripts/bench.sh $(BUILD)

@@ -365,11 +365,12 @@ std::string MavlinkDrone::timeout_detail(ActionId id) const {
   if (id != motion_owner_ || !goal_ || !vehicle_.have_position) return "";
   const Vec3 off = position() - goal_->target();
   const fleet::GoalTolerance& t = settings_.tolerance;
-  char text[192];
+  char text[256];
   std::snprintf(text, sizeof text,
-                "%.2f m across, %.2f m %s its goal, at %.2f m/s; the type's tolerance: %.2f m, %.2f m, %.2f m/s",
-                horizontal_norm(off), std::fabs(off.z), off.z < 0 ? "below" : "above", norm(vehicle_.ned_velocity),
-                t.horizontal_m, t.vertical_m, t.settled_mps);
+                "%.2f m across, %.2f m %s its goal, at %.2f m/s (the estimator says %.2f m/s); the type's "
+                "tolerance: %.2f m, %.2f m, %.2f m/s",
+                horizontal_norm(off), std::fabs(off.z), off.z < 0 ? "below" : "above", vehicle_.settling_speed(),
+                norm(vehicle_.ned_velocity), t.horizontal_m, t.vertical_m, t.settled_mps);
   return text;
 }
 

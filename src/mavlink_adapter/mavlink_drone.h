@@ -135,6 +135,7 @@ class MavlinkDrone final : public mid::AdapterDrone {
     bool centre_known = false;
     int32_t centre_lat_e7 = 0, centre_lon_e7 = 0;
     bool do_orbit_sent = false;
+    bool centre_compared = false;  ///< the autopilot's centre has been traced beside ours
     double waited_at_start_s = 0.0;  ///< mission s at the east point, waiting to be still
   };
 
@@ -215,6 +216,7 @@ class MavlinkDrone final : public mid::AdapterDrone {
   /// DO_ORBIT: PX4 flies its circle a little off the radius asked for (docs/adapters.md);
   /// from each position report (vehicle s) the radius asked for is corrected by the one flown.
   void correct_orbit_radius();  ///< on a GLOBAL_POSITION_INT while the autopilot orbits
+  void trace_orbit_centre();
   void send_due_orbit_correction();  ///< on a HEARTBEAT: the correction, if one is due
   std::array<float, 7> do_orbit_params(double radius, double speed) const;
   void switch_to_setpoint_mode();

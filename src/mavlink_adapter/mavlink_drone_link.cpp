@@ -446,7 +446,7 @@ void MavlinkDrone::check_goal() {
   bool done = false;
   if (until_ == Until::reached)
     done = goal_ && vehicle_.have_position && goal_->reached(position()) &&
-           norm(vehicle_.ned_velocity) <= settings_.tolerance.settled_mps;
+           vehicle_.settling_speed() <= settings_.tolerance.settled_mps;
   if (until_ == Until::landed) done = vehicle_.landed();
   if (!done) return;
   ActionId id = motion_owner_;

@@ -82,12 +82,8 @@ void MavlinkDrone::start_orbit(Vec3 centre, double radius) {
   char text[128];
   std::snprintf(text, sizeof text, "orbit of %.2f m around x %.2f, y %.2f", radius, centre.x, centre.y);
   note(text);  // where the vehicle circles, for a reader of the trace (and the SITL tests)
-  if (autopilot_->do_orbit && vehicle_.have_altitude) {
-    const Vec3 off = centre - position();
-    std::tie(orbit_.centre_lat_e7, orbit_.centre_lon_e7) =
-        offset_lat_lon(vehicle_.lat_e7, vehicle_.lon_e7, off.y, off.x);
-    orbit_.centre_known = true;
-  }
+  // Named to PX4 in degrees, converted when DO_ORBIT goes (send_do_orbit).
+  orbit_.centre_known = autopilot_->do_orbit && vehicle_.have_altitude;
   // Without a global position the centre cannot be named to PX4: it orbits where the vehicle
   // is, from there (its own approach out to the circle overshoots it by up to 0.7 m).
   if (autopilot_->do_orbit && !orbit_.centre_known) return send_do_orbit();
@@ -122,6 +118,12 @@ void MavlinkDrone::send_do_orbit() {
   orbit_.up_to_speed = !orbit_.centre_known;
   if (!orbit_.centre_known)
     return send_mode_command(command(ml::cmd::DO_ORBIT, do_orbit_params(orbit_.radius, orbit_.sent_speed)), done);
+  // The centre in degrees from where the vehicle is now, standing still on its circle:
+  // GLOBAL_POSITION_INT and LOCAL_POSITION_NED are separate reports, and converted from a
+  // vehicle still moving (as when the Orbit starts after a FlyTo) their skew put PX4's circle
+  // 0.1-0.2 m off the centre in the vehicle's local frame.
+  const Vec3 off = orbit_.centre - position();
+  std::tie(orbit_.centre_lat_e7, orbit_.centre_lon_e7) = offset_lat_lon(vehicle_.lat_e7, vehicle_.lon_e7, off.y, off.x);
   const double r = orbit_.radius;
   const double here = horizontal_norm(position() - orbit_.centre);
   orbit_.sent_radius = std::clamp(here, std::max(1.0, r * (1.0 - kStartWithinM)), r * (1.0 + kStartWithinM));
@@ -238,6 +240,7 @@ void MavlinkDrone::correct_orbit_radius() {
   // The centre PX4 says it circles, else the one it was given.
   const bool said = vehicle_.have_orbit_centre;
   if (!said && !o.centre_known) return;
+  if (said && o.centre_known && !o.centre_compared) trace_orbit_centre();
   const Vec3 out = north_east_between(said ? vehicle_.orbit_centre_lat_e7 : o.centre_lat_e7,
                                       said ? vehicle_.orbit_centre_lon_e7 : o.centre_lon_e7, vehicle_.lat_e7,
                                       vehicle_.lon_e7);
@@ -269,6 +272,19 @@ void MavlinkDrone::correct_orbit_radius() {
   if (!o.up_to_speed || std::fabs(led - o.recent_flown_m) >= kAwayFromFlownM) return;
   o.commanded_radius =
       std::clamp(o.commanded_radius + kDoOrbitGain * dt * (o.radius - flown), 0.8 * o.radius, 1.5 * o.radius);
+}
+
+// Where PX4 circles may differ from the centre it was given (its own projection, a position
+// that moved between the two reports the centre was computed from): said once, for a reader
+// of the trace judging the circle flown.
+void MavlinkDrone::trace_orbit_centre() {
+  orbit_.centre_compared = true;
+  const Vec3 off = north_east_between(orbit_.centre_lat_e7, orbit_.centre_lon_e7, vehicle_.orbit_centre_lat_e7,
+                                      vehicle_.orbit_centre_lon_e7);
+  char text[128];
+  std::snprintf(text, sizeof text, "the autopilot circles %.2f m north, %.2f m east of the centre it was given",
+                off.x, off.y);
+  note(text);
 }
 
 // Sent only right after a HEARTBEAT that shows the Orbit mode: DO_ORBIT in any other mode

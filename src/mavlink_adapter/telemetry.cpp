@@ -4,6 +4,7 @@
 
 #include "mavlink/enums.h"
 #include "mavlink/payloads.h"
+#include "mid/vec.h"
 
 namespace eamos::mavlink_adapter {
 
@@ -13,6 +14,12 @@ bool VehicleState::landed() const {
   // Without EXTENDED_SYS_STATE: disarmed, or less than 0.3 m above the local origin.
   if (landed_state == ml::landed::UNDEFINED) return !armed || !have_position || -ned.z < 0.3;
   return landed_state == ml::landed::ON_GROUND;
+}
+
+double VehicleState::settling_speed() const {
+  if (track.size() < 2 || track.back().first - track.front().first < kTrackMinSpanMs) return norm(ned_velocity);
+  const double dt_s = (track.back().first - track.front().first) / 1000.0;
+  return norm(track.back().second - track.front().second) / dt_s;
 }
 
 namespace {
@@ -77,6 +84,10 @@ Changes apply_telemetry(VehicleState& v, const ml::Frame& frame) {
     v.have_position = true;
     v.ned = {p->x, p->y, p->z};
     v.ned_velocity = {p->vx, p->vy, p->vz};
+    // A time going back is a reboot of the autopilot (or a report out of order): start anew.
+    if (!v.track.empty() && p->time_boot_ms < v.track.back().first) v.track.clear();
+    v.track.emplace_back(p->time_boot_ms, v.ned);
+    while (p->time_boot_ms - v.track.front().first > kTrackWindowMs) v.track.pop_front();
   } else if (auto e = ml::unpack_extended_sys_state(m)) {
     v.landed_state = e->landed_state;
   } else if (auto s = ml::unpack_sys_status(m)) {

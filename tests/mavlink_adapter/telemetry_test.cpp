@@ -50,6 +50,36 @@ TEST(Telemetry, HeartbeatCarriesArmedAndModeAndLandedFollowsExtendedSysState) {
   EXPECT_FALSE(v.landed());
 }
 
+ml::LocalPositionNed at(uint32_t ms, float north, float vx) {
+  ml::LocalPositionNed p;
+  p.time_boot_ms = ms;
+  p.x = north;
+  p.z = -3;
+  p.vx = vx;
+  return p;
+}
+
+// PX4 SIH once held 0.3-0.6 m short of its setpoint for seconds while its estimator said it
+// moved towards it at 0.5 m/s: standing still is judged on where the position goes.
+TEST(Telemetry, SettlingSpeedIsThePositionsOwnOverHalfASecondOfTheVehiclesTime) {
+  VehicleState v;
+  apply_telemetry(v, frame(ml::pack(at(1000, 4.0f, 0.5f))));
+  EXPECT_DOUBLE_EQ(v.settling_speed(), 0.5);  // one report: the estimator's word only
+  apply_telemetry(v, frame(ml::pack(at(1200, 4.0f, 0.5f))));
+  EXPECT_DOUBLE_EQ(v.settling_speed(), 0.5);  // 200 ms: still too short a track
+  for (uint32_t ms = 1300; ms <= 2000; ms += 100) apply_telemetry(v, frame(ml::pack(at(ms, 4.0f, 0.5f))));
+  EXPECT_DOUBLE_EQ(v.settling_speed(), 0.0);  // it said 0.5 m/s, and stood
+  EXPECT_EQ(v.track.front().first, 1500u);    // only the last half second is kept
+  // Moving 1 m/s by its position, whatever it says of its velocity.
+  for (uint32_t ms = 2100; ms <= 2500; ms += 100)
+    apply_telemetry(v, frame(ml::pack(at(ms, 4.0f + (ms - 2000) / 1000.0f, 0.0f))));
+  EXPECT_NEAR(v.settling_speed(), 1.0, 1e-5);
+  // A reboot (time going back) starts the track anew.
+  apply_telemetry(v, frame(ml::pack(at(50, 0.0f, 0.2f))));
+  EXPECT_EQ(v.track.size(), 1u);
+  EXPECT_FLOAT_EQ(v.settling_speed(), 0.2f);
+}
+
 TEST(Telemetry, UnknownBatteryKeepsTheLastKnownCharge) {
   VehicleState v;
   ml::SysStatus s;

@@ -578,6 +578,8 @@ struct SitlWatch::State {
   std::mutex mutex;
   std::vector<VehicleSample> samples;
   uint32_t custom_mode = 0;
+  bool armed = false;
+  int32_t lat_e7 = 0, lon_e7 = 0, orbit_lat_e7 = 0, orbit_lon_e7 = 0;
   std::unique_ptr<ml::Link> link;
   std::thread asker;
   std::mutex stop_mutex;
@@ -594,9 +596,15 @@ SitlWatch::SitlWatch(const SitlFleet& fleet, int i) : state_(std::make_unique<St
   auto opened = ml::Link::open(*ml::parse_url(url).endpoint, [st, vehicle](ml::Frame f) {
     if (f.sysid != vehicle || f.compid != 1) return;
     std::lock_guard lock(st->mutex);
-    if (auto hb = ml::unpack_heartbeat(f.message)) st->custom_mode = hb->custom_mode;
+    if (auto hb = ml::unpack_heartbeat(f.message)) {
+      st->custom_mode = hb->custom_mode;
+      st->armed = (hb->base_mode & 128u) != 0;
+    }
+    if (auto g = ml::unpack_global_position_int(f.message)) st->lat_e7 = g->lat, st->lon_e7 = g->lon;
+    if (auto o = ml::unpack_orbit_execution_status(f.message)) st->orbit_lat_e7 = o->x, st->orbit_lon_e7 = o->y;
     if (auto p = ml::unpack_local_position_ned(f.message))
-      st->samples.push_back({now_s(), p->x, p->y, p->z, std::hypot(p->vx, p->vy), st->custom_mode});
+      st->samples.push_back({now_s(), p->x, p->y, p->z, std::hypot(p->vx, p->vy), st->custom_mode, st->armed,
+                             st->lat_e7, st->lon_e7, st->orbit_lat_e7, st->orbit_lon_e7});
   });
   if (!opened.link) {
     error_ = "cannot watch SITL instance " + std::to_string(i) + " on " + url + ": " + opened.error;
@@ -604,7 +612,7 @@ SitlWatch::SitlWatch(const SitlFleet& fleet, int i) : state_(std::make_unique<St
   }
   st->link = std::move(opened.link);
   // A ground station's HEARTBEAT (PX4 sends its GCS link to whoever spoke to it) and the rates
-  // of LOCAL_POSITION_NED and HEARTBEAT, every second until the watch ends.
+  // of LOCAL_POSITION_NED, GLOBAL_POSITION_INT and HEARTBEAT, every second until the watch ends.
   st->asker = std::thread([st, vehicle] {
     ml::Encoder encoder{251, 190, 0};
     std::unique_lock lock(st->stop_mutex);
@@ -619,6 +627,8 @@ SitlWatch::SitlWatch(const SitlFleet& fleet, int i) : state_(std::make_unique<St
       c.command = ml::cmd::SET_MESSAGE_INTERVAL;
       c.param[0] = static_cast<float>(ml::msg::LOCAL_POSITION_NED);
       c.param[1] = 50000;  // 20 Hz of the vehicle's time
+      st->link->send(encoder.encode(ml::pack(c)));
+      c.param[0] = static_cast<float>(ml::msg::GLOBAL_POSITION_INT);  // the frame PX4 orbits in
       st->link->send(encoder.encode(ml::pack(c)));
       // The mode at 10 Hz, as eamos asks for it: at PX4's default 1 Hz, samples up to a second
       // after the vehicle left its Orbit mode (braking off the circle) still counted as orbit.

@@ -116,6 +116,9 @@ struct VehicleSample {
   double north = 0, east = 0, down = 0;  ///< LOCAL_POSITION_NED, m from the vehicle's home
   double speed = 0;             ///< horizontal, m/s
   uint32_t custom_mode = 0;     ///< the flight mode of the newest HEARTBEAT before it
+  bool armed = false;           ///< the armed flag of the newest HEARTBEAT before it
+  int32_t lat_e7 = 0, lon_e7 = 0;  ///< the newest GLOBAL_POSITION_INT before it
+  int32_t orbit_lat_e7 = 0, orbit_lon_e7 = 0;  ///< the newest ORBIT_EXECUTION_STATUS's centre (PX4), else 0
 };
 
 /// A second ground station on one instance (ArduPilot SERIAL1, TCP 5762 + 10 n; PX4's GCS

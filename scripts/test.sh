@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Runs every test of a built tree. First the suites labelled `alone` (the browser's, which
+# hold a latency bound) with nothing beside them; then the real-time suites (label
+# `realtime`: SITL firmware, DDS processes, signals) at normal priority, and beside them, at
+# the lowest priority (nice 19), the fuzzers' build and smoke run, then every other test. The
+# real-time suites leave about one of two cores idle (SITL: 372 s wall, 379 CPU-s); the
+# low-priority work fills it without taking CPU the real-time ones ask for.
+# Usage: scripts/test.sh BUILD_DIR FUZZ_BUILD_DIR FUZZ_SECONDS_PER_TARGET
+set -uo pipefail
+BUILD=${1:-build}
+FUZZ_BUILD=${2:-$BUILD-fuzz}
+FUZZ_SECONDS=${3:-5}
+cd "$(dirname "$0")/.."
+JOBS=$(nproc)
+# A real-time test that fails runs once more; one that fails twice fails the run, and the
+# first failure stays in the log.
+CTEST=(ctest --test-dir "$BUILD" --output-on-failure -j "$JOBS" --repeat until-pass:2)
+BESIDE_LOG="$BUILD/Testing/beside-realtime.log"
+mkdir -p "$BUILD/Testing"
+
+"${CTEST[@]}" -L alone
+alone_rc=$?
+
+# Its own process group, so that an interrupted run stops it too (fuzzers, test processes).
+set -m
+nice -n 19 bash -c '
+  rc=0
+  bash scripts/fuzz.sh "$1" "$2" || rc=1
+  shift 2
+  "$@" -LE "realtime|alone" || rc=1
+  exit $rc' beside "$FUZZ_BUILD" "$FUZZ_SECONDS" "${CTEST[@]}" >"$BESIDE_LOG" 2>&1 &
+beside=$!
+set +m
+trap 'kill -TERM -- -"$beside" 2>/dev/null; exit 130' INT TERM
+
+echo "test: the fuzzers and the tests not labelled realtime run beside these, at low priority ($BESIDE_LOG)"
+"${CTEST[@]}" -L realtime -LE alone
+realtime_rc=$?
+wait "$beside"
+beside_rc=$?
+trap - INT TERM
+
+echo
+echo "test: the fuzzers and the tests not labelled realtime, as they ran beside the real-time ones:"
+cat "$BESIDE_LOG"
+echo
+verdict() { [ "$1" -eq 0 ] && echo "test: $2 passed" || echo "test: $2 FAILED (above)"; }
+verdict "$alone_rc" "tests run alone"
+verdict "$realtime_rc" "real-time tests"
+verdict "$beside_rc" "fuzzers and other tests"
+[ "$alone_rc" -eq 0 ] && [ "$realtime_rc" -eq 0 ] && [ "$beside_rc" -eq 0 ]
