@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 
 #include "mavlink/enums.h"
 #include "mid/requests.h"
@@ -302,14 +303,55 @@ void MavlinkDrone::start_takeoff(ActionId id, double altitude) {
     p[6] = static_cast<float>(vehicle_.amsl_m + goal_->target().z - here.z);
   }
   if (!autopilot_->takeoff_in_setpoint_mode || vehicle_.custom_mode == autopilot_->setpoint_mode)
-    return command_motion(id, ml::cmd::NAV_TAKEOFF, p);
+    return send_takeoff(id, altitude, p);
   auto params = set_mode_params(*autopilot_, autopilot_->setpoint_mode);
   send_mode_command(command(ml::cmd::DO_SET_MODE, {params[0], params[1], params[2]}),
-                    [this, id, p](const CommandResult& result) {
+                    [this, id, altitude, p](const CommandResult& result) {
                    if (!tracker_.running(id)) return;
                    if (!result.accepted) return end_refused(id, result);
-                   command_motion(id, ml::cmd::NAV_TAKEOFF, p);
+                   send_takeoff(id, altitude, p);
                  });
+}
+
+// One attempt of NAV_TAKEOFF. The auto-disarm can strike as it goes out: ArduCopter SITL's
+// DISARM_DELAY ran out 40 ms before Listing 2's Takeoff, while eamos' last HEARTBEAT still
+// said armed, and the takeoff was answered MAV_RESULT_FAILED. So a takeoff refused on the
+// ground is repeated, armed again first if the vehicle is disarmed by then, once for the
+// Takeoff (takeoff_disarmed_on_ground is the same repeat when a HEARTBEAT shows the disarm
+// first); refused again, it fails with the autopilot's answer. The answer to an attempt a
+// later one replaced is not this takeoff's, and such an attempt is not sent again.
+void MavlinkDrone::send_takeoff(ActionId id, double altitude, std::array<float, 7> p) {
+  const uint32_t attempt = ++takeoff_attempt_;
+  auto current = [this, id, attempt] { return attempt == takeoff_attempt_ && motion_owner_ == id; };
+  auto done = [this, id, altitude, attempt](const CommandResult& result) {
+    if (attempt != takeoff_attempt_ || !tracker_.running(id)) return;
+    if (result.accepted) {
+      streaming_ = false;  // the autopilot flies it in its own mode (command_motion)
+      in_control_ = false;
+      return check_goal();
+    }
+    if (!result.answered || !vehicle_.landed() || takeoff_rearmed_ == id) return end_refused(id, result);
+    takeoff_rearmed_ = id;
+    note(std::string(autopilot_->name) + " refused the takeoff on the ground (" + result.error +
+         "): its auto-disarm may have struck as it went out; eamos repeats it, once");
+    repeat_takeoff(id, altitude, heartbeats_, 0.0);
+  };
+  send_mode_command(command(ml::cmd::NAV_TAKEOFF, p), done, current);
+}
+
+// Once the vehicle's HEARTBEATs after the refusal show whether it is still armed (the second
+// one: the first may have left before the disarm), or after 1.5 s of its time without them:
+// start_takeoff arms it again first if it was disarmed.
+void MavlinkDrone::repeat_takeoff(ActionId id, double altitude, uint64_t heartbeats_before, double waited_s) {
+  constexpr double kStepS = 0.1, kLongestS = 1.5;
+  takeoff_repeating_ = id;  // a disarm seen meanwhile is this refusal's (takeoff_disarmed_on_ground)
+  if (heartbeats_ >= heartbeats_before + 2 || waited_s >= kLongestS) {
+    takeoff_repeating_ = mid::kNoAction;
+    return start_takeoff(id, altitude);
+  }
+  after_for(id, kStepS / std::clamp(vehicle_clock_rate(), 0.2, 1.0), [=, this] {
+    if (motion_owner_ == id) repeat_takeoff(id, altitude, heartbeats_before, waited_s + kStepS);
+  });
 }
 
 void MavlinkDrone::command_motion(ActionId id, uint16_t cmd, std::array<float, 7> params) {
@@ -357,6 +399,26 @@ void MavlinkDrone::stop_action(ActionId id) {
   orbit_ = {};
   if (autopilot_orbits) leave_orbit();
   hold_here();
+}
+
+// How far the vehicle still has to go, for a deadline that comes while it closes in (PX4 SIH
+// was seen creeping the last 0.3-0.6 m to a setpoint for seconds): to its goal; down to the
+// ground for Land; to the ground at home for ReturnHome.
+double MavlinkDrone::distance_left(ActionId id) const {
+  const mid::ActionRequest* r = tracker_.request(id);
+  if (id != motion_owner_ || !r || !vehicle_.have_position) return std::numeric_limits<double>::quiet_NaN();
+  const Vec3 here = position();
+  if (goal_) return norm(here - goal_->target());
+  if (r->name == "Land") return std::max(0.0, here.z - ground_z());
+  if (r->name == "ReturnHome") return norm(here - Vec3{settings_.home.x, settings_.home.y, ground_z()});
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+// In the vehicle's time, like the deadline itself (timeout_for); a deadline the fleet file
+// sets is taken as written.
+double MavlinkDrone::closing_window_s(const mid::ActionRequest& r) const {
+  if (settings_.timeouts_s.contains(r.name)) return 0.0;
+  return mid::kClosingWindow_s / std::clamp(vehicle_clock_rate(), 0.2, 1.0);
 }
 
 std::string MavlinkDrone::timeout_detail(ActionId id) const {

@@ -149,6 +149,8 @@ class MavlinkDrone final : public mid::AdapterDrone {
   void end_picture(mid::ActionId id);  ///< acknowledged and confirmed: taken
   void start_motion(mid::ActionId id, const mid::ActionRequest& r) override;
   void start_takeoff(mid::ActionId id, double altitude);
+  void send_takeoff(mid::ActionId id, double altitude, std::array<float, 7> p);
+  void repeat_takeoff(mid::ActionId id, double altitude, uint64_t heartbeats_before, double waited_s);
   /// Arms, first switching to a mode where arming is allowed when the vehicle is in one where
   /// it is not (ArduPilot cannot arm in LAND, where a landing leaves it); `armed` runs once
   /// the autopilot accepted.
@@ -161,6 +163,8 @@ class MavlinkDrone final : public mid::AdapterDrone {
   void end_refused(mid::ActionId id, const CommandResult& result);
   void stop_action(mid::ActionId id) override;
   std::string timeout_detail(mid::ActionId id) const override;
+  double distance_left(mid::ActionId id) const override;
+  double closing_window_s(const mid::ActionRequest& r) const override;
   void hold_here();
   /// Ends every running action `failed` for `why`, dropping the motion's goal and orbit.
   void fail_all(mid::FailureReason why, const std::string& reason);
@@ -220,7 +224,7 @@ class MavlinkDrone final : public mid::AdapterDrone {
   void send_due_orbit_correction();  ///< on a HEARTBEAT: the correction, if one is due
   std::array<float, 7> do_orbit_params(double radius, double speed) const;
   void switch_to_setpoint_mode();
-  void send_mode_command(mavlink::CommandLong c, CommandDone done);
+  void send_mode_command(mavlink::CommandLong c, CommandDone done, std::function<bool()> resend_while = nullptr);
   void send_mode_command(const mavlink::CommandInt& c, CommandDone done);
   CommandDone counted_mode_command(CommandDone done);  ///< mode_commands_pending_ while it is out
   void publish();
@@ -268,6 +272,9 @@ class MavlinkDrone final : public mid::AdapterDrone {
   bool armed_waiting_ = false;
   bool disarm_commanded_ = false;  ///< a disarm now is ours (Disarm, failsafe), not the autopilot's
   mid::ActionId takeoff_rearmed_ = mid::kNoAction;  ///< the Takeoff already re-armed once
+  uint32_t takeoff_attempt_ = 0;  ///< NAV_TAKEOFFs sent; an answer to an older one is stale
+  uint64_t heartbeats_ = 0;       ///< HEARTBEATs of the autopilot so far
+  mid::ActionId takeoff_repeating_ = mid::kNoAction;  ///< the Takeoff waiting to repeat a refused NAV_TAKEOFF
   /// (mission s, vehicle s) of recent position reports: a SITL on a loaded machine runs
   /// slower than --speed, and every deadline is stretched by how much (timeout_for()).
   std::deque<std::pair<double, double>> clock_samples_;

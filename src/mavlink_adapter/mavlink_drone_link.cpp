@@ -305,6 +305,7 @@ bool MavlinkDrone::takeoff_disarmed_on_ground() {
   const mid::ActionRequest* r = tracker_.request(motion_owner_);
   if (!r || r->name != "Takeoff" || !vehicle_.landed() || !tracker_.running(motion_owner_)) return false;
   mid::ActionId id = motion_owner_;
+  if (takeoff_repeating_ == id) return true;  // repeat_takeoff arms it again
   if (takeoff_rearmed_ == id) {
     fail_motion(mid::FailureReason::vehicle_fault,
                 std::string(autopilot_->name) + " disarmed the vehicle again before it took off" +
@@ -313,6 +314,7 @@ bool MavlinkDrone::takeoff_disarmed_on_ground() {
     return true;
   }
   takeoff_rearmed_ = id;
+  ++takeoff_attempt_;  // the NAV_TAKEOFF out now is not this takeoff's any more (send_takeoff)
   note(std::string(autopilot_->name) + " disarmed the vehicle on the ground during the takeoff (auto-disarm); "
        "eamos arms it again and repeats the takeoff");
   double altitude = r->args[0];
@@ -370,6 +372,7 @@ void MavlinkDrone::note_foreign() {
 }
 
 void MavlinkDrone::on_heartbeat() {
+  ++heartbeats_;
   note_foreign();
   if (link_lost_) {
     link_lost_ = false;
@@ -555,8 +558,8 @@ CommandDone MavlinkDrone::counted_mode_command(CommandDone done) {
   };
 }
 
-void MavlinkDrone::send_mode_command(ml::CommandLong c, CommandDone done) {
-  commands_.send(c, counted_mode_command(std::move(done)));
+void MavlinkDrone::send_mode_command(ml::CommandLong c, CommandDone done, std::function<bool()> resend_while) {
+  commands_.send(c, counted_mode_command(std::move(done)), std::move(resend_while));
 }
 
 void MavlinkDrone::send_mode_command(const ml::CommandInt& c, CommandDone done) {

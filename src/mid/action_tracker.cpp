@@ -2,6 +2,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
+
+#include "mid/timeouts.h"
 
 namespace eamos::mid {
 
@@ -14,34 +17,74 @@ std::string seconds_text(double s) {
 }  // namespace
 
 ActionTracker::ActionTracker(EventLoop& loop, std::function<void(ActionId)> on_timeout,
-                             std::function<std::string(ActionId)> describe)
-    : loop_(loop), on_timeout_(std::move(on_timeout)), describe_(std::move(describe)) {}
+                             std::function<std::string(ActionId)> describe,
+                             std::function<double(ActionId)> distance_left)
+    : loop_(loop),
+      on_timeout_(std::move(on_timeout)),
+      describe_(std::move(describe)),
+      distance_left_(std::move(distance_left)) {}
 
 ActionTracker::~ActionTracker() {
   for (ActionId id : running_ids()) end(id, Outcome::cancelled, "drone shut down");
 }
 
 ActionId ActionTracker::begin(const ActionRequest& request, fleet::ActionClass action_class,
-                              EndCallback on_end, double timeout_s) {
+                              EndCallback on_end, double timeout_s, double closing_window_s) {
   if (action_class == fleet::ActionClass::motion && motion_ != kNoAction)
     end(motion_, Outcome::preempted, "preempted by " + request.name);
   ActionId id = next_id_++;
-  TimerId deadline = kNoTimer;
-  if (std::isfinite(timeout_s)) {
-    deadline = loop_.after(timeout_s, [this, id, timeout_s] {
-      auto it = actions_.find(id);
-      if (it == actions_.end()) return;
-      it->second.deadline = kNoTimer;  // firing now; end() must not cancel it
-      const std::string where = describe_ ? describe_(id) : "";  // before the stop clears the goal
-      on_timeout_(id);
-      fail(id, FailureReason::timed_out,
-           "timed out after " + seconds_text(timeout_s) + (where.empty() ? "" : " (" + where + ")"),
-           "deadline " + seconds_text(timeout_s) + " after start");
-    });
-  }
-  actions_.emplace(id, Running{request, action_class, std::move(on_end), loop_.now(), deadline});
+  Running r{request, action_class, std::move(on_end), loop_.now(), kNoTimer};
+  r.timeout_s = timeout_s;
+  // A window as long as the deadline would start before the goal is set: none then.
+  if (distance_left_ && closing_window_s > 0.0 && closing_window_s < timeout_s) r.window_s = closing_window_s;
+  actions_.emplace(id, std::move(r));
   if (action_class == fleet::ActionClass::motion) motion_ = id;
+  if (std::isfinite(timeout_s)) {
+    const double window = actions_.at(id).window_s;
+    arm(id, timeout_s - window, window > 0.0);
+  }
   return id;
+}
+
+void ActionTracker::arm(ActionId id, double delay_s, bool probe) {
+  actions_.at(id).deadline = loop_.after(delay_s, [this, id, probe] {
+    auto it = actions_.find(id);
+    if (it == actions_.end()) return;
+    it->second.deadline = kNoTimer;  // firing now; end() must not cancel it
+    if (!probe) return deadline_passed(id);
+    it->second.window_from_m = distance_left(id);
+    arm(id, it->second.window_s, false);
+  });
+}
+
+// The deadline: moved on by a window while the vehicle still closes in, else the action fails.
+void ActionTracker::deadline_passed(ActionId id) {
+  Running& r = actions_.at(id);
+  const double now_m = distance_left(id);
+  const bool closed_in = r.window_s > 0.0 && std::isfinite(now_m) && std::isfinite(r.window_from_m) &&
+                         r.window_from_m - now_m >= kClosingMin_m;
+  if (!closed_in || r.granted_s + r.window_s > r.timeout_s + 1e-9) return time_out(id);
+  r.granted_s += r.window_s;
+  r.window_from_m = now_m;
+  arm(id, r.window_s, false);
+}
+
+void ActionTracker::time_out(ActionId id) {
+  const Running& r = actions_.at(id);
+  const double timeout_s = r.timeout_s, granted_s = r.granted_s;
+  const std::string where = describe_ ? describe_(id) : "";  // before the stop clears the goal
+  on_timeout_(id);
+  std::string reason = "timed out after " + seconds_text(timeout_s + granted_s);
+  std::string detail = "deadline " + seconds_text(timeout_s) + " after start";
+  if (granted_s > 0.0) {
+    reason += ", " + seconds_text(granted_s) + " of them given while it still closed in on its goal";
+    detail += ", extended by " + seconds_text(granted_s);
+  }
+  fail(id, FailureReason::timed_out, reason + (where.empty() ? "" : " (" + where + ")"), detail);
+}
+
+double ActionTracker::distance_left(ActionId id) const {
+  return distance_left_ ? distance_left_(id) : std::numeric_limits<double>::quiet_NaN();
 }
 
 ActionId ActionTracker::refuse(const ActionRequest&, EndCallback on_end, ActionEnd why) {

@@ -21,17 +21,23 @@ class ActionTracker {
   /// `failed`, so the adapter can stop what the vehicle is doing for it. `describe`, when
   /// given, says first where the vehicle stands against what the action waited for ("0.42 m
   /// across, 0.35 m below its goal, at 0.05 m/s"): it goes into the failure's reason.
+  /// `distance_left`, when given, says how far (m) a running action's vehicle still has to
+  /// go, NaN when it cannot tell: a deadline that comes while that shrinks is extended
+  /// (begin(), mid/timeouts.h).
   ActionTracker(EventLoop& loop, std::function<void(ActionId)> on_timeout,
-                std::function<std::string(ActionId)> describe = nullptr);
+                std::function<std::string(ActionId)> describe = nullptr,
+                std::function<double(ActionId)> distance_left = nullptr);
   /// Ends what still runs as `cancelled` ("drone shut down"): every end is reported once.
   ~ActionTracker();
   ActionTracker(const ActionTracker&) = delete;
   ActionTracker& operator=(const ActionTracker&) = delete;
 
   /// Registers a running action with a deadline `timeout_s` after now (infinity: none). A
-  /// motion action takes the motion slot; the one holding it ends `preempted`.
+  /// motion action takes the motion slot; the one holding it ends `preempted`. With a
+  /// `closing_window_s` (0: none), the deadline moves on by that window each time the
+  /// vehicle came kClosingMin_m nearer over the last one, up to `timeout_s` more in all.
   ActionId begin(const ActionRequest& request, fleet::ActionClass action_class,
-                 EndCallback on_end, double timeout_s);
+                 EndCallback on_end, double timeout_s, double closing_window_s = 0.0);
   /// Registers an action that is not started: it ends `failed` at once with `why` (its
   /// failure set: refused, link_lost, …), reported through the loop like every other end.
   ActionId refuse(const ActionRequest& request, EndCallback on_end, ActionEnd why);
@@ -61,13 +67,23 @@ class ActionTracker {
     EndCallback on_end;
     double started_at;
     TimerId deadline;  ///< kNoTimer when the action has none
+    double timeout_s = 0.0;
+    double window_s = 0.0;      ///< closing window; 0 = the deadline stays where it is
+    double granted_s = 0.0;     ///< time given beyond timeout_s while the vehicle closed in
+    double window_from_m = 0.0; ///< distance left when the current window began (NaN: unknown)
   };
 
+  /// Arms the timer for a window's start (`probe`) or for the deadline itself.
+  void arm(ActionId id, double delay_s, bool probe);
+  void deadline_passed(ActionId id);
+  void time_out(ActionId id);
+  double distance_left(ActionId id) const;
   void report(EndCallback on_end, ActionEnd end);
 
   EventLoop& loop_;
   std::function<void(ActionId)> on_timeout_;
   std::function<std::string(ActionId)> describe_;
+  std::function<double(ActionId)> distance_left_;
   ActionId next_id_ = 1;
   ActionId motion_ = kNoAction;
   std::map<ActionId, Running> actions_;  ///< ordered: ids grow with start order

@@ -11,7 +11,8 @@ AdapterDrone::AdapterDrone(EventLoop& loop, fleet::DroneType type)
             clear_action_timer(id);
             stop_action(id);
           },
-          [this](ActionId id) { return timeout_detail(id); }) {}
+          [this](ActionId id) { return timeout_detail(id); },
+          [this](ActionId id) { return distance_left(id); }) {}
 
 AdapterDrone::~AdapterDrone() {
   for (auto& [id, timer] : action_timers_) loop_.cancel(timer);
@@ -31,7 +32,7 @@ ActionId AdapterDrone::start(const ActionRequest& request, EndCallback on_end) {
   double timeout = timeout_for(request);
   fleet::ActionClass cls = check.spec->action_class;
   if (cls == fleet::ActionClass::motion) clear_action_timer(tracker_.motion());  // preempted
-  ActionId id = tracker_.begin(request, cls, std::move(on_end), timeout);
+  ActionId id = tracker_.begin(request, cls, std::move(on_end), timeout, closing_window_s(request));
   switch (cls) {
     case fleet::ActionClass::system: start_system(id, request); break;
     case fleet::ActionClass::payload: start_payload(id, request); break;

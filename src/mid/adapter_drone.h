@@ -6,6 +6,7 @@
 // how each class of action starts and how a running one stops. One place, so the simulator
 // and the MAVLink adapter cannot drift apart in what the DEX sees.
 #include <functional>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -48,6 +49,13 @@ class AdapterDrone : public Drone {
   /// Where the vehicle stands against what a running action waits for, said when it times
   /// out ("" when there is nothing to say).
   virtual std::string timeout_detail(ActionId) const { return ""; }
+  /// How far (m) the vehicle still has to go for a running action, NaN when the adapter
+  /// cannot tell; with closing_window_s(), a deadline that comes while it shrinks moves on
+  /// (mid/timeouts.h).
+  virtual double distance_left(ActionId) const { return std::numeric_limits<double>::quiet_NaN(); }
+  /// The closing window of `r`'s deadline in mission seconds; 0 (the default) keeps every
+  /// deadline where timeout_for() put it.
+  virtual double closing_window_s(const ActionRequest&) const { return 0.0; }
 
   /// Runs `fn` after `delay_s` for a running action; cleared when the action stops.
   void after_for(ActionId id, double delay_s, std::function<void()> fn);

@@ -203,6 +203,10 @@ uint8_t SimVehicle::execute(const ml::CommandLong& c) {
       return kAckLater;
     }
     case ml::cmd::NAV_TAKEOFF: {
+      if (options_.disarm_at_first_takeoff && !std::exchange(takeoff_seen_, true) && s.armed && s.landed) {
+        start("Disarm", {});
+        return ml::result::FAILED;
+      }
       if (!s.armed || !s.landed) return ml::result::DENIED;
       if (dialect_.takeoff_in_setpoint_mode && mode_ != Mode::setpoint) return ml::result::DENIED;
       double alt = std::isnan(c.param[6]) ? 2.5 : c.param[6];

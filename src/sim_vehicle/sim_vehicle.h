@@ -86,6 +86,10 @@ struct VehicleOptions {
   double orbit_shortfall = 0.0;
   /// DO_ORBIT denied whatever it asks (as PX4 denies one it cannot fly), to test the refusal.
   bool refuse_orbit = false;
+  /// The auto-disarm strikes as the first NAV_TAKEOFF arrives: the vehicle disarms and
+  /// answers MAV_RESULT_FAILED, as ArduCopter SITL did when its DISARM_DELAY (10 s) ran out
+  /// 40 ms before Listing 2's Takeoff, with eamos' HEARTBEAT still saying armed.
+  bool disarm_at_first_takeoff = false;
 };
 
 class SimVehicle {
@@ -164,6 +168,7 @@ class SimVehicle {
   double setpoint_at_ = -1e9;           ///< loop time of the newest setpoint
   fleet::Vec3 flying_to_;               ///< target of the running FlyTo
   bool flying_ = false;
+  bool takeoff_seen_ = false;  ///< a NAV_TAKEOFF came (disarm_at_first_takeoff)
   uint16_t last_command_ = 0;           ///< for resends: acknowledge again, do not redo
   uint8_t last_result_ = 0;
   bool has_last_ = false;

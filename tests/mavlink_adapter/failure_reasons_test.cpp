@@ -92,8 +92,8 @@ FlightRun fly(const std::string& mission, int port, const std::string& extra,
 }
 
 TEST(MavlinkFailureReasons, TheAutopilotsRefusalIsRefusedWithItsMavResultAsDetail) {
-  Vehicle v(25361, "120", "0");  // an empty battery: PX4 refuses to arm
-  FlightRun r = fly("arm-refused.eamos", 25361, "");
+  Vehicle v(25401, "120", "0");  // an empty battery: PX4 refuses to arm
+  FlightRun r = fly("arm-refused.eamos", 25401, "");
   EXPECT_EQ(r.status, 1) << r.out;
   ASSERT_TRUE(r.end.is_object()) << r.out;
   EXPECT_EQ(r.end["name"], "Arm");
@@ -104,8 +104,8 @@ TEST(MavlinkFailureReasons, TheAutopilotsRefusalIsRefusedWithItsMavResultAsDetai
 }
 
 TEST(MavlinkFailureReasons, AFlightPastItsDeadlineIsTimedOut) {
-  Vehicle v(25362, "200");
-  FlightRun r = fly("long-flight.eamos", 25362, ", timeouts: {FlyTo: 2}");
+  Vehicle v(25402, "200");
+  FlightRun r = fly("long-flight.eamos", 25402, ", timeouts: {FlyTo: 2}");
   EXPECT_EQ(r.status, 1) << r.out;
   ASSERT_TRUE(r.end.is_object()) << r.out;
   EXPECT_EQ(r.end["name"], "FlyTo");
@@ -118,8 +118,8 @@ TEST(MavlinkFailureReasons, AVehicleThatFallsSilentIsLinkLost) {
   // The vehicle process ends by itself 8 mission seconds in, while the drone waits armed on
   // the ground (in the air the run would wait for a landing it cannot see; a running action
   // failing on link loss is flight_test's LinkLossFailsTheRunningAction).
-  Vehicle v(25363, "8");
-  FlightRun r = fly("arm-and-wait.eamos", 25363, "");
+  Vehicle v(25403, "8");
+  FlightRun r = fly("arm-and-wait.eamos", 25403, "");
   EXPECT_EQ(r.status, 1) << r.out;
   ASSERT_TRUE(r.end.is_object()) << r.out;
   EXPECT_EQ(r.end["name"], "Takeoff");
@@ -131,12 +131,12 @@ TEST(MavlinkFailureReasons, AVehicleThatFallsSilentIsLinkLost) {
 TEST(MavlinkFailureReasons, APilotsModeSwitchIsPilotTookOverWithTheModeAsDetail) {
   // The vehicle says where it receives: a second ground station there plays the pilot.
   eamos_test::EamosProcess vehicle = eamos_test::start_eamos(
-      {"sim-vehicle", "--udp", "25364", "--sysid", "1", "--speed", "4", "--duration", "200"});
+      {"sim-vehicle", "--udp", "25404", "--sysid", "1", "--speed", "4", "--duration", "200"});
   ASSERT_TRUE(eamos_test::read_until(vehicle, "receiving on port ")) << vehicle.seen;
   int vehicle_port = std::stoi(vehicle.seen.substr(vehicle.seen.find("receiving on port ") + 18));
   std::atomic<bool> switched{false};
   std::thread pilot;
-  FlightRun r = fly("long-flight.eamos", 25364, "", [&] {
+  FlightRun r = fly("long-flight.eamos", 25404, "", [&] {
     // Switches to POSCTL, as a pilot's switch would, until the flight failed for it: one
     // switch that arrives before the adapter's own OFFBOARD request would be undone by it.
     pilot = std::thread([&switched, vehicle_port] {

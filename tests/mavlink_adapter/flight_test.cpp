@@ -427,6 +427,29 @@ TEST(MavlinkFlight, AMotionThatTimesOutSaysHowFarFromItsGoalTheVehicleStands) {
   EXPECT_NE(e.reason.find("the type's tolerance: 0.50 m, 0.30 m, -1.00 m/s"), std::string::npos) << e.reason;
 }
 
+// The auto-disarm striking as the takeoff goes out (ArduCopter SITL: DISARM_DELAY ran out
+// 40 ms before Listing 2's Takeoff, eamos' last HEARTBEAT still armed): the vehicle disarms
+// and refuses the NAV_TAKEOFF. The Takeoff arms again and repeats it, once, and flies.
+TEST(MavlinkFlight, ATakeoffRefusedAsTheAutoDisarmStrikesIsArmedAgainAndRepeatedOnce) {
+  sim_vehicle::VehicleOptions o = test::VehicleThread::options(sim_vehicle::ardupilot_dialect(), 1, 100.0, true);
+  o.disarm_at_first_takeoff = true;
+  test::VehicleThread vehicle(25399, kSpeed, o);
+  Flight f(25399);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  std::vector<std::string> said;
+  f.drone->set_message_sink([&](const std::string& text) { said.push_back(text); });
+  ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
+  mid::ActionEnd e = f.fly("Takeoff", {3});
+  std::string all;
+  for (const std::string& s : said) all += s + "\n";
+  ASSERT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason << "\n" << all;
+  EXPECT_NEAR(f.drone->state().z, 3.0, 0.3);
+  EXPECT_TRUE(f.drone->state().armed);
+  bool repeated = false;
+  for (const std::string& s : said) repeated = repeated || s.find("eamos repeats it, once") != std::string::npos;
+  EXPECT_TRUE(repeated);
+}
+
 TEST(MavlinkAdapter, NoVehicleIsACreateErrorThatSaysWhatToCheck) {
   MavlinkOptions options;
   options.connect_timeout_s = 0.3;

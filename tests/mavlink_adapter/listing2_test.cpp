@@ -158,7 +158,7 @@ TEST(MavlinkListing2, OneDexProcessPerDroneEachFlyingItsOwnVehicle) {
 }
 
 TEST(MavlinkRun, ARefusalFailsTheMissionWithTheAutopilotsReasonAndTheRunEnds) {
-  pid_t vehicle = spawn_vehicle(25332, 1, "120", "0");  // an empty battery: arming is refused
+  pid_t vehicle = spawn_vehicle(25405, 1, "120", "0");  // an empty battery: arming is refused
   std::string out;
   const std::string data = EAMOS_TEST_DATA;
   auto started = std::chrono::steady_clock::now();

@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -191,6 +193,76 @@ TEST(StateBroker, PublishesToSubscribersInOrderAndSurvivesUnsubscribeInCallback)
   broker.publish(s);
   broker.publish(s);
   EXPECT_EQ(calls, (std::vector<int>{1, 7, 7}));
+}
+
+
+// A tracker whose vehicle has `left(t)` metres to go at mission time t.
+struct Closing {
+  EventLoop loop;
+  std::function<double(double)> left;
+  ActionTracker tracker{loop, [](ActionId) {}, nullptr, [this](ActionId) { return left(loop.now()); }};
+  Ends ends;
+};
+
+TEST(ActionTracker, ADeadlineMovesOnWhileTheVehicleStillClosesInAndFailsOnceItStalls) {
+  Closing c;
+  c.left = [](double t) { return 10.0 - 0.5 * std::min(t, 7.5); };  // 0.5 m/s, stalls at 7.5 s
+  c.tracker.begin({"FlyTo", {1, 2, 3}}, ActionClass::motion, c.ends.tag(1), 5.0, 1.0);
+  c.loop.run_until_idle();
+  ASSERT_EQ(c.ends.seen.size(), 1u);
+  const ActionEnd& e = c.ends.seen[0].second;
+  // Windows 4-5, 5-6, 6-7 and 7-8 s each closed in by 0.25 m or more; 8-9 s by nothing.
+  EXPECT_DOUBLE_EQ(c.loop.now(), 9.0);
+  EXPECT_EQ(e.failure, FailureReason::timed_out);
+  EXPECT_EQ(e.reason, "timed out after 9.0 s, 4.0 s of them given while it still closed in on its goal");
+  EXPECT_EQ(e.detail, "deadline 5.0 s after start, extended by 4.0 s");
+}
+
+TEST(ActionTracker, AVehicleThatDoesNotCloseInFailsAtItsDeadline) {
+  Closing c;
+  c.left = [](double t) { return 3.0 - 0.05 * t; };  // 0.05 m a window: less than kClosingMin_m
+  c.tracker.begin({"FlyTo", {1, 2, 3}}, ActionClass::motion, c.ends.tag(1), 2.5, 1.0);
+  c.loop.run_until_idle();
+  ASSERT_EQ(c.ends.seen.size(), 1u);
+  EXPECT_DOUBLE_EQ(c.loop.now(), 2.5);
+  EXPECT_EQ(c.ends.seen[0].second.reason, "timed out after 2.5 s");
+}
+
+TEST(ActionTracker, ACrawlingVehicleGetsItsDeadlineAgainAtMost) {
+  Closing c;
+  c.left = [](double t) { return 100.0 - t; };  // never arrives
+  c.tracker.begin({"FlyTo", {1, 2, 3}}, ActionClass::motion, c.ends.tag(1), 3.0, 1.0);
+  c.loop.run_until_idle();
+  ASSERT_EQ(c.ends.seen.size(), 1u);
+  EXPECT_DOUBLE_EQ(c.loop.now(), 6.0);
+  EXPECT_EQ(c.ends.seen[0].second.detail, "deadline 3.0 s after start, extended by 3.0 s");
+}
+
+TEST(ActionTracker, WithoutAWindowOrADistanceTheDeadlineStaysWhereItWas) {
+  Closing c;
+  c.left = [](double t) { return 100.0 - t; };
+  c.tracker.begin({"FlyTo", {1, 2, 3}}, ActionClass::motion, c.ends.tag(1), 3.0);  // no window
+  c.loop.run_until_idle();
+  EXPECT_DOUBLE_EQ(c.loop.now(), 3.0);
+  Closing unknown;
+  unknown.left = [](double) { return std::nan(""); };  // the adapter cannot tell
+  unknown.tracker.begin({"Land", {}}, ActionClass::motion, unknown.ends.tag(1), 3.0, 1.0);
+  unknown.loop.run_until_idle();
+  EXPECT_DOUBLE_EQ(unknown.loop.now(), 3.0);
+  ASSERT_EQ(unknown.ends.seen.size(), 1u);
+  EXPECT_EQ(unknown.ends.seen[0].second.reason, "timed out after 3.0 s");
+}
+
+TEST(ActionTracker, AnActionThatEndsDuringAnExtensionEndsOnce) {
+  Closing c;
+  c.left = [](double t) { return 10.0 - t; };
+  ActionId id = c.tracker.begin({"FlyTo", {1, 2, 3}}, ActionClass::motion, c.ends.tag(1), 2.0, 1.0);
+  c.loop.run_until(2.5);  // extended once at 2 s
+  EXPECT_TRUE(c.tracker.running(id));
+  EXPECT_TRUE(c.tracker.end(id, Outcome::succeeded));
+  c.loop.run_until_idle();
+  ASSERT_EQ(c.ends.seen.size(), 1u);
+  EXPECT_EQ(c.ends.seen[0].second.outcome, Outcome::succeeded);
 }
 
 }  // namespace
