@@ -202,15 +202,21 @@ struct Closing {
   std::function<double(double)> left;
   ActionTracker tracker{loop, [](ActionId) {}, nullptr, [this](ActionId) { return left(loop.now()); }};
   Ends ends;
+
+  /// Starts a motion with this deadline and closing window (0: none), runs until it ends,
+  /// and returns its one end.
+  ActionEnd run(double timeout_s, double window_s) {
+    tracker.begin({"FlyTo", {1, 2, 3}}, ActionClass::motion, ends.tag(1), timeout_s, window_s);
+    loop.run_until_idle();
+    EXPECT_EQ(ends.seen.size(), 1u);
+    return ends.seen.empty() ? ActionEnd{} : ends.seen[0].second;
+  }
 };
 
 TEST(ActionTracker, ADeadlineMovesOnWhileTheVehicleStillClosesInAndFailsOnceItStalls) {
   Closing c;
   c.left = [](double t) { return 10.0 - 0.5 * std::min(t, 7.5); };  // 0.5 m/s, stalls at 7.5 s
-  c.tracker.begin({"FlyTo", {1, 2, 3}}, ActionClass::motion, c.ends.tag(1), 5.0, 1.0);
-  c.loop.run_until_idle();
-  ASSERT_EQ(c.ends.seen.size(), 1u);
-  const ActionEnd& e = c.ends.seen[0].second;
+  ActionEnd e = c.run(5.0, 1.0);
   // Windows 4-5, 5-6, 6-7 and 7-8 s each closed in by 0.25 m or more; 8-9 s by nothing.
   EXPECT_DOUBLE_EQ(c.loop.now(), 9.0);
   EXPECT_EQ(e.failure, FailureReason::timed_out);
@@ -221,36 +227,26 @@ TEST(ActionTracker, ADeadlineMovesOnWhileTheVehicleStillClosesInAndFailsOnceItSt
 TEST(ActionTracker, AVehicleThatDoesNotCloseInFailsAtItsDeadline) {
   Closing c;
   c.left = [](double t) { return 3.0 - 0.05 * t; };  // 0.05 m a window: less than kClosingMin_m
-  c.tracker.begin({"FlyTo", {1, 2, 3}}, ActionClass::motion, c.ends.tag(1), 2.5, 1.0);
-  c.loop.run_until_idle();
-  ASSERT_EQ(c.ends.seen.size(), 1u);
+  EXPECT_EQ(c.run(2.5, 1.0).reason, "timed out after 2.5 s");
   EXPECT_DOUBLE_EQ(c.loop.now(), 2.5);
-  EXPECT_EQ(c.ends.seen[0].second.reason, "timed out after 2.5 s");
 }
 
 TEST(ActionTracker, ACrawlingVehicleGetsItsDeadlineAgainAtMost) {
   Closing c;
   c.left = [](double t) { return 100.0 - t; };  // never arrives
-  c.tracker.begin({"FlyTo", {1, 2, 3}}, ActionClass::motion, c.ends.tag(1), 3.0, 1.0);
-  c.loop.run_until_idle();
-  ASSERT_EQ(c.ends.seen.size(), 1u);
+  EXPECT_EQ(c.run(3.0, 1.0).detail, "deadline 3.0 s after start, extended by 3.0 s");
   EXPECT_DOUBLE_EQ(c.loop.now(), 6.0);
-  EXPECT_EQ(c.ends.seen[0].second.detail, "deadline 3.0 s after start, extended by 3.0 s");
 }
 
 TEST(ActionTracker, WithoutAWindowOrADistanceTheDeadlineStaysWhereItWas) {
   Closing c;
   c.left = [](double t) { return 100.0 - t; };
-  c.tracker.begin({"FlyTo", {1, 2, 3}}, ActionClass::motion, c.ends.tag(1), 3.0);  // no window
-  c.loop.run_until_idle();
+  EXPECT_EQ(c.run(3.0, 0.0).reason, "timed out after 3.0 s");  // no window
   EXPECT_DOUBLE_EQ(c.loop.now(), 3.0);
   Closing unknown;
   unknown.left = [](double) { return std::nan(""); };  // the adapter cannot tell
-  unknown.tracker.begin({"Land", {}}, ActionClass::motion, unknown.ends.tag(1), 3.0, 1.0);
-  unknown.loop.run_until_idle();
+  EXPECT_EQ(unknown.run(3.0, 1.0).reason, "timed out after 3.0 s");
   EXPECT_DOUBLE_EQ(unknown.loop.now(), 3.0);
-  ASSERT_EQ(unknown.ends.seen.size(), 1u);
-  EXPECT_EQ(unknown.ends.seen[0].second.reason, "timed out after 3.0 s");
 }
 
 TEST(ActionTracker, AnActionThatEndsDuringAnExtensionEndsOnce) {
