@@ -450,6 +450,21 @@ TEST(MavlinkFlight, ATakeoffRefusedAsTheAutoDisarmStrikesIsArmedAgainAndRepeated
   EXPECT_TRUE(repeated);
 }
 
+// A takeoff the autopilot refuses for its own reason (here an altitude it will not fly) is
+// repeated once, as the auto-disarm race asks, and then fails with the autopilot's answer.
+TEST(MavlinkFlight, ATakeoffTheAutopilotRefusesTwiceFailsWithItsAnswer) {
+  test::VehicleThread vehicle(25406, 1, kSpeed);
+  Flight f(25406, {}, [](fleet::DroneSettings& s) { s.limits.max_altitude_m = 500; });
+  ASSERT_TRUE(f.drone) << f.created.message;
+  ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
+  mid::ActionEnd e = f.fly("Takeoff", {150});  // the vehicle takes off to 120 m at most
+  EXPECT_EQ(e.outcome, mid::Outcome::failed);
+  EXPECT_EQ(e.failure, mid::FailureReason::refused);
+  EXPECT_EQ(e.reason, "refused by PX4: MAV_CMD_NAV_TAKEOFF: MAV_RESULT_DENIED (denied by the autopilot)");
+  EXPECT_EQ(vehicle.inspect([](sim_vehicle::SimVehicle& v) { return v.received(mavlink::cmd::NAV_TAKEOFF); }), 2);
+  EXPECT_TRUE(f.drone->state().landed);
+}
+
 TEST(MavlinkAdapter, NoVehicleIsACreateErrorThatSaysWhatToCheck) {
   MavlinkOptions options;
   options.connect_timeout_s = 0.3;
