@@ -106,9 +106,8 @@ double MavlinkDrone::timeout_for(const mid::ActionRequest& r) const {
   if (r.name == "Takeoff" && !settings_.timeouts_s.contains("Takeoff"))
     timeout += limits_.takeoff_delay_s * mid::kTimeoutMargin;
   // Deadlines are the vehicle's time: a SITL that cannot keep up with --speed on a loaded
-  // machine flies as fast as ever in its own clock, only its clock runs slow. Never shorter
-  // (a vehicle clock ahead of ours is jitter), and at most 5 times longer.
-  return timeout / std::clamp(vehicle_clock_rate(), 0.2, 1.0);
+  // machine flies as fast as ever in its own clock, only its clock runs slow.
+  return mission_s(timeout);
 }
 
 void MavlinkDrone::start_system(ActionId id, const mid::ActionRequest& r) {
@@ -325,11 +324,7 @@ void MavlinkDrone::send_takeoff(ActionId id, double altitude, std::array<float, 
   auto current = [this, id, attempt] { return attempt == takeoff_attempt_ && motion_owner_ == id; };
   auto done = [this, id, altitude, attempt](const CommandResult& result) {
     if (attempt != takeoff_attempt_ || !tracker_.running(id)) return;
-    if (result.accepted) {
-      streaming_ = false;  // the autopilot flies it in its own mode (command_motion)
-      in_control_ = false;
-      return check_goal();
-    }
+    if (result.accepted) return autopilot_flies_it();
     if (!result.answered || !vehicle_.landed() || takeoff_rearmed_ == id) return end_refused(id, result);
     takeoff_rearmed_ = id;
     note(std::string(autopilot_->name) + " refused the takeoff on the ground (" + result.error +
@@ -349,7 +344,7 @@ void MavlinkDrone::repeat_takeoff(ActionId id, double altitude, uint64_t heartbe
     takeoff_repeating_ = mid::kNoAction;
     return start_takeoff(id, altitude);
   }
-  after_for(id, kStepS / std::clamp(vehicle_clock_rate(), 0.2, 1.0), [=, this] {
+  after_for(id, mission_s(kStepS), [=, this] {
     if (motion_owner_ == id) repeat_takeoff(id, altitude, heartbeats_before, waited_s + kStepS);
   });
 }
@@ -358,12 +353,16 @@ void MavlinkDrone::command_motion(ActionId id, uint16_t cmd, std::array<float, 7
   send_mode_command(command(cmd, params), [this, id](const CommandResult& result) {
     if (!tracker_.running(id)) return;
     if (!result.accepted) return end_refused(id, result);
-    // The autopilot flies this one in its own mode: stop the setpoints only now, so a
-    // refused command leaves the vehicle doing what it did.
-    streaming_ = false;
-    in_control_ = false;
-    check_goal();
+    autopilot_flies_it();
   });
+}
+
+void MavlinkDrone::autopilot_flies_it() {
+  // Its own mode now: the setpoints stop only once it took the command, so a refused one
+  // leaves the vehicle doing what it did.
+  streaming_ = false;
+  in_control_ = false;
+  check_goal();
 }
 
 void MavlinkDrone::end_refused(ActionId id, const CommandResult& result) {
@@ -418,7 +417,7 @@ double MavlinkDrone::distance_left(ActionId id) const {
 // sets is taken as written.
 double MavlinkDrone::closing_window_s(const mid::ActionRequest& r) const {
   if (settings_.timeouts_s.contains(r.name)) return 0.0;
-  return mid::kClosingWindow_s / std::clamp(vehicle_clock_rate(), 0.2, 1.0);
+  return mission_s(mid::kClosingWindow_s);
 }
 
 std::string MavlinkDrone::timeout_detail(ActionId id) const {

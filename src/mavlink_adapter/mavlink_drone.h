@@ -150,6 +150,8 @@ class MavlinkDrone final : public mid::AdapterDrone {
   void start_motion(mid::ActionId id, const mid::ActionRequest& r) override;
   void start_takeoff(mid::ActionId id, double altitude);
   void send_takeoff(mid::ActionId id, double altitude, std::array<float, 7> p);
+  /// A motion command the autopilot took: it flies it in its own mode now.
+  void autopilot_flies_it();
   void repeat_takeoff(mid::ActionId id, double altitude, uint64_t heartbeats_before, double waited_s);
   /// Arms, first switching to a mode where arming is allowed when the vehicle is in one where
   /// it is not (ArduPilot cannot arm in LAND, where a landing leaves it); `armed` runs once
@@ -184,6 +186,9 @@ class MavlinkDrone final : public mid::AdapterDrone {
   void on_vehicle_clock(uint32_t time_boot_ms);
   /// Vehicle seconds per mission second over the last few seconds (1 until known).
   double vehicle_clock_rate() const;
+  /// `vehicle_s` seconds of the vehicle's time in mission seconds, for a deadline or a wait:
+  /// never shorter (a vehicle clock ahead of ours is jitter), at most 5 times longer.
+  double mission_s(double vehicle_s) const;
   /// A disarm by the autopilot while our Takeoff waits on the ground: arm and take off again.
   bool takeoff_disarmed_on_ground();
   /// A motion still running on a vehicle down and disarmed (not by the mission): it fails.

@@ -350,6 +350,10 @@ double MavlinkDrone::vehicle_clock_rate() const {
   return (clock_samples_.back().second - clock_samples_.front().second) / mission;
 }
 
+double MavlinkDrone::mission_s(double vehicle_s) const {
+  return vehicle_s / std::clamp(vehicle_clock_rate(), 0.2, 1.0);
+}
+
 void MavlinkDrone::note_rejected(const char* what) {
   ++rejected_frames_;
   // The first few, then every thousandth: a flood of bad frames must not flood the log.
@@ -410,7 +414,7 @@ void MavlinkDrone::fail_motion(mid::FailureReason why, const std::string& reason
 void MavlinkDrone::link_watchdog() {
   loop_.cancel(watchdog_timer_);
   // Like the deadlines, in the vehicle's time: a slow SITL sends its heartbeats slower.
-  watchdog_timer_ = loop_.after(options_.link_timeout_s / std::clamp(vehicle_clock_rate(), 0.2, 1.0), [this] {
+  watchdog_timer_ = loop_.after(mission_s(options_.link_timeout_s), [this] {
     watchdog_timer_ = mid::kNoTimer;
     lose_link();
   });
