@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <limits>
 
 #include "mid/timeouts.h"
 
@@ -52,7 +51,7 @@ void ActionTracker::arm(ActionId id, double delay_s, bool probe) {
     if (it == actions_.end()) return;
     it->second.deadline = kNoTimer;  // firing now; end() must not cancel it
     if (!probe) return deadline_passed(id);
-    it->second.window_from_m = distance_left(id);
+    it->second.window_from_m = distance_left_(id);  // a window exists only with distance_left_
     arm(id, it->second.window_s, false);
   });
 }
@@ -60,10 +59,11 @@ void ActionTracker::arm(ActionId id, double delay_s, bool probe) {
 // The deadline: moved on by a window while the vehicle still closes in, else the action fails.
 void ActionTracker::deadline_passed(ActionId id) {
   Running& r = actions_.at(id);
-  const double now_m = distance_left(id);
-  const bool closed_in = r.window_s > 0.0 && std::isfinite(now_m) && std::isfinite(r.window_from_m) &&
-                         r.window_from_m - now_m >= kClosingMin_m;
-  if (!closed_in || r.granted_s + r.window_s > r.timeout_s + 1e-9) return time_out(id);
+  // Without a window (or with the whole extension spent) the adapter is not even asked.
+  if (r.window_s <= 0.0 || r.granted_s + r.window_s > r.timeout_s + 1e-9) return time_out(id);
+  const double now_m = distance_left_(id);
+  const bool closed_in = std::isfinite(now_m) && std::isfinite(r.window_from_m) && r.window_from_m - now_m >= kClosingMin_m;
+  if (!closed_in) return time_out(id);
   r.granted_s += r.window_s;
   r.window_from_m = now_m;
   arm(id, r.window_s, false);
@@ -81,10 +81,6 @@ void ActionTracker::time_out(ActionId id) {
     detail += ", extended by " + seconds_text(granted_s);
   }
   fail(id, FailureReason::timed_out, reason + (where.empty() ? "" : " (" + where + ")"), detail);
-}
-
-double ActionTracker::distance_left(ActionId id) const {
-  return distance_left_ ? distance_left_(id) : std::numeric_limits<double>::quiet_NaN();
 }
 
 ActionId ActionTracker::refuse(const ActionRequest&, EndCallback on_end, ActionEnd why) {

@@ -77,7 +77,6 @@ class ActionTracker {
   void arm(ActionId id, double delay_s, bool probe);
   void deadline_passed(ActionId id);
   void time_out(ActionId id);
-  double distance_left(ActionId id) const;
   void report(EndCallback on_end, ActionEnd end);
 
   EventLoop& loop_;
