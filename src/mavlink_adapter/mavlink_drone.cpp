@@ -414,7 +414,7 @@ double MavlinkDrone::distance_left(ActionId id) const {
 }
 
 // In the vehicle's time, like the deadline itself (timeout_for); a deadline the fleet file
-// sets is taken as written.
+// sets never moves on.
 double MavlinkDrone::closing_window_s(const mid::ActionRequest& r) const {
   if (settings_.timeouts_s.contains(r.name)) return 0.0;
   return mission_s(mid::kClosingWindow_s);

@@ -16,7 +16,7 @@
 // knows how far the vehicle still has to go (AdapterDrone::distance_left) then gives it
 // kClosingWindow_s more each time it came at least kClosingMin_m nearer in the last window,
 // at most the deadline again: a vehicle that stalls fails when its deadline comes, one that
-// crawls fails at twice it. A deadline the fleet file sets is taken as written.
+// crawls fails at twice it. A deadline the fleet file sets never moves on.
 #include "fleet/fleet.h"
 #include "mid/drone_api.h"
 
