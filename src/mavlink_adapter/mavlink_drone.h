@@ -167,6 +167,8 @@ class MavlinkDrone final : public mid::AdapterDrone {
   std::string timeout_detail(mid::ActionId id) const override;
   double distance_left(mid::ActionId id) const override;
   double closing_window_s(const mid::ActionRequest& r) const override;
+  /// vehicle_clock_rate() as mission_s() allows for it: within 0.2 … 1.
+  double deadline_clock_rate() const override;
   void hold_here();
   /// Ends every running action `failed` for `why`, dropping the motion's goal and orbit.
   void fail_all(mid::FailureReason why, const std::string& reason);

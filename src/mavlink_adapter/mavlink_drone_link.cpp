@@ -350,9 +350,9 @@ double MavlinkDrone::vehicle_clock_rate() const {
   return (clock_samples_.back().second - clock_samples_.front().second) / mission;
 }
 
-double MavlinkDrone::mission_s(double vehicle_s) const {
-  return vehicle_s / std::clamp(vehicle_clock_rate(), 0.2, 1.0);
-}
+double MavlinkDrone::deadline_clock_rate() const { return std::clamp(vehicle_clock_rate(), 0.2, 1.0); }
+
+double MavlinkDrone::mission_s(double vehicle_s) const { return vehicle_s / deadline_clock_rate(); }
 
 void MavlinkDrone::note_rejected(const char* what) {
   ++rejected_frames_;

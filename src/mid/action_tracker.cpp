@@ -28,12 +28,14 @@ ActionTracker::~ActionTracker() {
 }
 
 ActionId ActionTracker::begin(const ActionRequest& request, fleet::ActionClass action_class,
-                              EndCallback on_end, double timeout_s, double closing_window_s) {
+                              EndCallback on_end, double timeout_s, double closing_window_s,
+                              double vehicle_clock_rate) {
   if (action_class == fleet::ActionClass::motion && motion_ != kNoAction)
     end(motion_, Outcome::preempted, "preempted by " + request.name);
   ActionId id = next_id_++;
   Running r{request, action_class, std::move(on_end), loop_.now(), kNoTimer};
   r.timeout_s = timeout_s;
+  r.clock_rate = vehicle_clock_rate;
   // A window as long as the deadline would start before the goal is set: none then.
   if (distance_left_ && closing_window_s > 0.0 && closing_window_s < timeout_s) r.window_s = closing_window_s;
   actions_.emplace(id, std::move(r));
@@ -72,15 +74,26 @@ void ActionTracker::deadline_passed(ActionId id) {
 void ActionTracker::time_out(ActionId id) {
   const Running& r = actions_.at(id);
   const double timeout_s = r.timeout_s, granted_s = r.granted_s;
+  std::string detail = deadline_text(r);
   const std::string where = describe_ ? describe_(id) : "";  // before the stop clears the goal
   on_timeout_(id);
   std::string reason = "timed out after " + seconds_text(timeout_s + granted_s);
-  std::string detail = "deadline " + seconds_text(timeout_s) + " after start";
   if (granted_s > 0.0) {
     reason += ", " + seconds_text(granted_s) + " of them given while it still closed in on its goal";
     detail += ", extended by " + seconds_text(granted_s);
   }
   fail(id, FailureReason::timed_out, reason + (where.empty() ? "" : " (" + where + ")"), detail);
+}
+
+// In the fleet file's seconds first: a deadline stretched for a vehicle whose clock runs slow
+// (a SITL that cannot keep up) would otherwise read as a different deadline than was written.
+std::string ActionTracker::deadline_text(const Running& r) {
+  if (r.clock_rate >= 0.995 || r.clock_rate <= 0.0)
+    return "deadline " + seconds_text(r.timeout_s) + " after start";
+  char rate[16];
+  std::snprintf(rate, sizeof rate, "%.2f", r.clock_rate);
+  return "deadline " + seconds_text(r.timeout_s * r.clock_rate) + " of the vehicle's clock after start (" +
+         seconds_text(r.timeout_s) + " of mission time: the vehicle's clock ran at " + rate + " of it)";
 }
 
 ActionId ActionTracker::refuse(const ActionRequest&, EndCallback on_end, ActionEnd why) {

@@ -36,8 +36,11 @@ class ActionTracker {
   /// motion action takes the motion slot; the one holding it ends `preempted`. With a
   /// `closing_window_s` (0: none), the deadline moves on by that window each time the
   /// vehicle came kClosingMin_m nearer over the last one, up to `timeout_s` more in all.
+  /// `vehicle_clock_rate` (vehicle seconds per mission second, below 1 for a vehicle that
+  /// cannot keep up) is what `timeout_s` was stretched by: a timeout names both clocks.
   ActionId begin(const ActionRequest& request, fleet::ActionClass action_class,
-                 EndCallback on_end, double timeout_s, double closing_window_s = 0.0);
+                 EndCallback on_end, double timeout_s, double closing_window_s = 0.0,
+                 double vehicle_clock_rate = 1.0);
   /// Registers an action that is not started: it ends `failed` at once with `why` (its
   /// failure set: refused, link_lost, …), reported through the loop like every other end.
   ActionId refuse(const ActionRequest& request, EndCallback on_end, ActionEnd why);
@@ -71,12 +74,14 @@ class ActionTracker {
     double window_s = 0.0;      ///< closing window; 0 = the deadline stays where it is
     double granted_s = 0.0;     ///< time given beyond timeout_s while the vehicle closed in
     double window_from_m = 0.0; ///< distance left when the current window began (NaN: unknown)
+    double clock_rate = 1.0;    ///< vehicle seconds per mission second timeout_s allowed for
   };
 
   /// Arms the timer for a window's start (`probe`) or for the deadline itself.
   void arm(ActionId id, double delay_s, bool probe);
   void deadline_passed(ActionId id);
   void time_out(ActionId id);
+  static std::string deadline_text(const Running& r);
   void report(EndCallback on_end, ActionEnd end);
 
   EventLoop& loop_;

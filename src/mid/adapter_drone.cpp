@@ -32,7 +32,8 @@ ActionId AdapterDrone::start(const ActionRequest& request, EndCallback on_end) {
   double timeout = timeout_for(request);
   fleet::ActionClass cls = check.spec->action_class;
   if (cls == fleet::ActionClass::motion) clear_action_timer(tracker_.motion());  // preempted
-  ActionId id = tracker_.begin(request, cls, std::move(on_end), timeout, closing_window_s(request));
+  ActionId id = tracker_.begin(request, cls, std::move(on_end), timeout, closing_window_s(request),
+                                 deadline_clock_rate());
   switch (cls) {
     case fleet::ActionClass::system: start_system(id, request); break;
     case fleet::ActionClass::payload: start_payload(id, request); break;

@@ -56,6 +56,10 @@ class AdapterDrone : public Drone {
   /// The closing window of `r`'s deadline in mission seconds; 0 (the default) keeps every
   /// deadline where timeout_for() put it.
   virtual double closing_window_s(const ActionRequest&) const { return 0.0; }
+  /// Vehicle seconds per mission second that timeout_for() and closing_window_s() allowed
+  /// for (1: the vehicle keeps mission time, as the simulator does). A timeout says it, so a
+  /// deadline stretched for a slow vehicle clock still reads in the fleet file's seconds.
+  virtual double deadline_clock_rate() const { return 1.0; }
 
   /// Runs `fn` after `delay_s` for a running action; cleared when the action stops.
   void after_for(ActionId id, double delay_s, std::function<void()> fn);

@@ -11,6 +11,7 @@
 #include <atomic>
 #include <filesystem>
 #include <functional>
+#include <regex>
 #include <thread>
 #include <fstream>
 #include <string>
@@ -110,7 +111,13 @@ TEST(MavlinkFailureReasons, AFlightPastItsDeadlineIsTimedOut) {
   ASSERT_TRUE(r.end.is_object()) << r.out;
   EXPECT_EQ(r.end["name"], "FlyTo");
   EXPECT_EQ(r.end["failure"], "timed_out");
-  EXPECT_EQ(r.end["detail"], "deadline 2.0 s after start");
+  // The sim-vehicle's clock may run a little slow on a loaded machine (it runs at nice 19 in
+  // the suite): the deadline then stretches, and the detail still names the fleet's 2.0 s.
+  const std::string detail = r.end["detail"].is_string() ? r.end["detail"].get<std::string>() : "";
+  EXPECT_TRUE(detail == "deadline 2.0 s after start" ||
+              std::regex_match(detail, std::regex(R"(deadline 2\.0 s of the vehicle's clock after start \(2\.\d s of )"
+                                                  R"(mission time: the vehicle's clock ran at 0\.\d\d of it\))")))
+      << detail;
   EXPECT_EQ(r.summary["kind"], "timed_out");
 }
 

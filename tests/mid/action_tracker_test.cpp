@@ -94,6 +94,31 @@ TEST(ActionTracker, DeadlineStopsThenFailsTheAction) {
   EXPECT_EQ(tracker.motion(), kNoAction);
 }
 
+TEST(ActionTracker, ADeadlineStretchedForASlowVehicleClockNamesBothClocks) {
+  EventLoop loop;
+  ActionTracker tracker(loop, [](ActionId) {});
+  Ends ends;
+  // 2.0 s of a vehicle whose clock runs at 0.8 of mission time: 2.5 mission seconds.
+  tracker.begin({"FlyTo", {1, 2, 3}}, ActionClass::motion, ends.tag(1), 2.5, 0.0, 0.8);
+  loop.run_until_idle();
+  ASSERT_EQ(ends.seen.size(), 1u);
+  EXPECT_EQ(ends.seen[0].second.reason, "timed out after 2.5 s");
+  EXPECT_EQ(ends.seen[0].second.detail,
+            "deadline 2.0 s of the vehicle's clock after start (2.5 s of mission time: the vehicle's clock ran "
+            "at 0.80 of it)");
+  EXPECT_DOUBLE_EQ(loop.now(), 2.5);
+}
+
+TEST(ActionTracker, AVehicleClockWithinHalfAPercentIsMissionTime) {
+  EventLoop loop;
+  ActionTracker tracker(loop, [](ActionId) {});
+  Ends ends;
+  tracker.begin({"FlyTo", {1, 2, 3}}, ActionClass::motion, ends.tag(1), 2.0, 0.0, 0.996);
+  loop.run_until_idle();
+  ASSERT_EQ(ends.seen.size(), 1u);
+  EXPECT_EQ(ends.seen[0].second.detail, "deadline 2.0 s after start");
+}
+
 TEST(ActionTracker, ATimeoutSaysWhereTheVehicleStandsWhenTheAdapterKnows) {
   EventLoop loop;
   std::vector<std::string> order;
