@@ -15,6 +15,7 @@ inline constexpr uint16_t DO_SET_MODE = 176;
 inline constexpr uint16_t DO_DIGICAM_CONTROL = 203;
 inline constexpr uint16_t COMPONENT_ARM_DISARM = 400;
 inline constexpr uint16_t SET_MESSAGE_INTERVAL = 511;
+inline constexpr uint16_t REQUEST_MESSAGE = 512;
 inline constexpr uint16_t IMAGE_START_CAPTURE = 2000;
 }  // namespace cmd
 

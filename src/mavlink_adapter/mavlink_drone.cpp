@@ -43,7 +43,7 @@ MavlinkDrone::~MavlinkDrone() {
     std::cerr << "mavlink: " << settings_.name << ": " << link_->foreign_datagrams()
               << " datagram(s) from other addresses than the vehicle's were ignored in all\n";
   link_.reset();  // joins the receive thread: nothing new gets posted
-  for (mid::TimerId t : {stream_timer_, heartbeat_timer_, watchdog_timer_}) loop_.cancel(t);
+  for (mid::TimerId t : {stream_timer_, heartbeat_timer_, watchdog_timer_, heartbeat_poll_timer_}) loop_.cancel(t);
 }
 
 // --- starting actions ----------------------------------------------------------------------
@@ -146,7 +146,7 @@ void MavlinkDrone::send_arm(ActionId id, std::function<void()> armed) {
                  [this, id, armed = std::move(armed)](const CommandResult& result) {
                    if (!tracker_.running(id)) return;
                    if (!result.accepted) return end_refused(id, result);
-                   vehicle_.armed = true;  // the next HEARTBEAT (10 Hz) confirms it
+                   vehicle_.armed = true;  // the next HEARTBEAT (20 Hz) confirms it
                    publish();
                    armed();
                  });

@@ -63,8 +63,9 @@ struct MavlinkOptions {
   int setpoints_before_switch = 5; ///< PX4: setpoints sent before asking for OFFBOARD
   double position_hz = 10.0;       ///< LOCAL_POSITION_NED rate asked for
   /// HEARTBEAT rate asked for: the armed flag travels only there, and a disarm (the
-  /// autopilot's auto-disarm on the ground) must be seen within 100 ms.
-  double heartbeat_hz = 10.0;
+  /// autopilot's auto-disarm on the ground) must be seen within 100 ms, latency included.
+  /// PX4 refuses it (poll_heartbeat).
+  double heartbeat_hz = 20.0;
   /// Wall seconds at connect to read the autopilot's speed parameters (PARAM_REQUEST_READ,
   /// resent every half second); what has not come by then keeps the fleet's limit.
   double param_timeout_s = 3.0;
@@ -205,6 +206,9 @@ class MavlinkDrone final : public mid::AdapterDrone {
   /// logged (the first, then every thousandth) and the first one put in the trace.
   void note_foreign();
   void on_heartbeat();
+  /// MAV_CMD_REQUEST_MESSAGE(HEARTBEAT) at heartbeat_hz while on the ground, for an
+  /// autopilot that keeps its own HEARTBEAT rate.
+  void poll_heartbeat();
   void link_watchdog();
   void lose_link();
   void request_telemetry();
@@ -281,6 +285,7 @@ class MavlinkDrone final : public mid::AdapterDrone {
   mid::ActionId takeoff_rearmed_ = mid::kNoAction;  ///< the Takeoff already re-armed once
   uint32_t takeoff_attempt_ = 0;  ///< NAV_TAKEOFFs sent; an answer to an older one is stale
   uint64_t heartbeats_ = 0;       ///< HEARTBEATs of the autopilot so far
+  bool heartbeat_requested_ = false;  ///< a REQUEST_MESSAGE(HEARTBEAT) waits for its ACK
   mid::ActionId takeoff_repeating_ = mid::kNoAction;  ///< the Takeoff waiting to repeat a refused NAV_TAKEOFF
   /// (mission s, vehicle s) of recent position reports: a SITL on a loaded machine runs
   /// slower than --speed, and every deadline is stretched by how much (timeout_for()).
@@ -314,6 +319,7 @@ class MavlinkDrone final : public mid::AdapterDrone {
   mid::TimerId stream_timer_ = mid::kNoTimer;
   mid::TimerId heartbeat_timer_ = mid::kNoTimer;
   mid::TimerId watchdog_timer_ = mid::kNoTimer;
+  mid::TimerId heartbeat_poll_timer_ = mid::kNoTimer;  ///< poll_heartbeat's; none: the rate was granted
 };
 
 }  // namespace eamos::mavlink_adapter

@@ -270,6 +270,30 @@ void MavlinkDrone::on_statustext(const ml::Statustext& t) {
   note(std::string(autopilot_->name) + " " + severity_name(t.severity) + ": " + text);
 }
 
+// PX4 keeps its HEARTBEAT at 1 Hz (SET_MESSAGE_INTERVAL for it: MAV_RESULT_FAILED), armed
+// state comes only with a HEARTBEAT, and a link that is not a ground station's gets none of
+// its texts: a disarm would show up to a second late. On the ground, where its auto-disarms
+// strike (COM_DISARM_PRFLT, COM_DISARM_LAND), one is asked for at heartbeat_hz with
+// MAV_CMD_REQUEST_MESSAGE. In the air only a command or a crash disarms it, and the 1 Hz
+// HEARTBEAT there paces the orbit's corrections as it always did.
+void MavlinkDrone::poll_heartbeat() {
+  heartbeat_poll_timer_ = loop_.after(mission_s(1.0 / options_.heartbeat_hz), [this] {
+    heartbeat_poll_timer_ = mid::kNoTimer;
+    poll_heartbeat();
+  });
+  if (link_lost_ || heartbeat_requested_ || !vehicle_.landed()) return;
+  heartbeat_requested_ = true;
+  commands_.send(command(ml::cmd::REQUEST_MESSAGE, {static_cast<float>(ml::msg::HEARTBEAT)}),
+                 [this](const CommandResult& result) {
+                   heartbeat_requested_ = false;
+                   if (!result.answered || result.accepted) return;
+                   loop_.cancel(heartbeat_poll_timer_);  // an autopilot without REQUEST_MESSAGE
+                   heartbeat_poll_timer_ = mid::kNoTimer;
+                   note(std::string(autopilot_->name) + " refuses to send a HEARTBEAT when asked (" + result.error +
+                        "): a disarm on the ground shows with its next one");
+                 });
+}
+
 std::string MavlinkDrone::autopilot_says(double since) const {
   std::string said;
   for (const Text& t : texts_) {
@@ -441,10 +465,21 @@ void MavlinkDrone::request_telemetry() {
                  // At the position rate: an orbit's radius is measured from it (mavlink_drone_orbit.cpp).
                  Rate{ml::msg::GLOBAL_POSITION_INT, options_.position_hz}, Rate{ml::msg::ORBIT_EXECUTION_STATUS, 2.0},
                  Rate{ml::msg::SYS_STATUS, 1.0}, Rate{ml::msg::BATTERY_STATUS, 1.0}}) {
-    // An autopilot that refuses a rate still streams its defaults: nothing to do about it.
+    // An autopilot that refuses a rate still streams its defaults: HEARTBEAT is then asked
+    // for on the ground (poll_heartbeat), for the others nothing is to be done.
+    CommandDone done = nullptr;
+    if (r.id == ml::msg::HEARTBEAT)
+      done = [this](const CommandResult& result) {
+        if (!result.answered || result.accepted || heartbeat_poll_timer_ != mid::kNoTimer) return;
+        char hz[32];
+        std::snprintf(hz, sizeof hz, "%.0f Hz", options_.heartbeat_hz);
+        note(std::string(autopilot_->name) + " keeps its HEARTBEAT rate (" + result.error +
+             "): on the ground eamos asks for one at " + hz + ", so an auto-disarm shows at once");
+        poll_heartbeat();
+      };
     commands_.send(command(ml::cmd::SET_MESSAGE_INTERVAL,
                            {static_cast<float>(r.id), static_cast<float>(1e6 / r.hz)}),
-                   nullptr);
+                   std::move(done));
   }
 }
 

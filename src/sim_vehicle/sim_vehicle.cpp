@@ -49,7 +49,7 @@ const Dialect& px4_dialect() {
                          {px4::mode(px4::MAIN_POSCTL), px4::LOITER, px4::OFFBOARD, px4::TAKEOFF,
                           px4::LAND, px4::RTL, px4::ORBIT},
                          Mode::hold, true, true, false, true, true, Mode::hold, true,
-                         ml::cmd::DO_DIGICAM_CONTROL, ml::msg::CAMERA_TRIGGER};
+                         ml::cmd::DO_DIGICAM_CONTROL, ml::msg::CAMERA_TRIGGER, true};
   return d;
 }
 
@@ -58,7 +58,7 @@ const Dialect& ardupilot_dialect() {
   // stays GUIDED. CIRCLE is never entered here: no DO_ORBIT, and DO_SET_MODE cannot ask for it.
   static const Dialect d{"ArduPilot", ml::autopilot::ARDUPILOTMEGA, {0, 5, 4, 4, 9, 6, 7},
                          Mode::manual, false, false, true, false, false, Mode::setpoint, false,
-                         ml::cmd::IMAGE_START_CAPTURE, ml::msg::CAMERA_FEEDBACK};
+                         ml::cmd::IMAGE_START_CAPTURE, ml::msg::CAMERA_FEEDBACK, false};
   return d;
 }
 
@@ -88,8 +88,8 @@ std::string SimVehicle::open(const ml::Endpoint& endpoint) {
   });
   if (!opened.link) return opened.error;
   link_ = std::move(opened.link);
+  rates_hz_[ml::msg::HEARTBEAT] = options_.heartbeat_hz;
   send_stream(ml::msg::HEARTBEAT);
-  rates_hz_[ml::msg::HEARTBEAT] = 1.0;
   for (uint32_t id : kStreamed) set_rate(id, options_.default_rate_hz);
   return "";
 }
@@ -225,13 +225,22 @@ uint8_t SimVehicle::execute(const ml::CommandLong& c) {
     }
     case ml::cmd::SET_MESSAGE_INTERVAL: {
       auto id = static_cast<uint32_t>(c.param[0]);
-      bool known = false;
+      if (id == ml::msg::HEARTBEAT && dialect_.heartbeat_rate_fixed) return ml::result::FAILED;
+      bool known = id == ml::msg::HEARTBEAT;
       for (uint32_t m : kStreamed) known = known || m == id;
       // PX4's orbit status, sent while it orbits; ArduPilot Copter has no DO_ORBIT.
       known = known || (id == ml::msg::ORBIT_EXECUTION_STATUS && dialect_.do_orbit);
       if (!known) return ml::result::DENIED;
       double us = c.param[1];
       set_rate(id, us < 0 ? 0.0 : us == 0 ? options_.default_rate_hz : 1e6 / us);
+      return ml::result::ACCEPTED;
+    }
+    case ml::cmd::REQUEST_MESSAGE: {  // one now, as PX4 and ArduPilot answer it
+      auto id = static_cast<uint32_t>(c.param[0]);
+      bool known = id == ml::msg::HEARTBEAT;
+      for (uint32_t m : kStreamed) known = known || m == id;
+      if (!known) return ml::result::DENIED;
+      send(telemetry(id));
       return ml::result::ACCEPTED;
     }
   }
@@ -371,6 +380,30 @@ void SimVehicle::send_stream(uint32_t id) {
   if (id != ml::msg::ORBIT_EXECUTION_STATUS || mode_ == Mode::orbit) send(telemetry(id));
   double hz = rates_hz_.count(id) ? rates_hz_[id] : 1.0;
   streams_[id] = loop_.after(1.0 / hz, [this, id] { send_stream(id); });
+  if (id == ml::msg::HEARTBEAT) check_preflight_disarm();
+}
+
+void SimVehicle::check_preflight_disarm() {
+  mid::DroneState s = drone_.state();
+  if (!s.armed) {
+    armed_at_.reset();
+    flown_since_armed_ = false;
+    return;
+  }
+  if (!armed_at_) armed_at_ = loop_.now();
+  flown_since_armed_ = flown_since_armed_ || !s.landed;
+  if (options_.preflight_disarm_s <= 0.0 || flown_since_armed_ ||
+      loop_.now() - *armed_at_ < options_.preflight_disarm_s)
+    return;
+  armed_at_.reset();
+  std::weak_ptr<bool> alive = alive_;
+  drone_.start({"Disarm", {}}, [this, alive](const mid::ActionEnd& end) {
+    if (!alive.lock() || end.outcome != mid::Outcome::succeeded) return;
+    ml::Statustext t;
+    t.severity = 6;
+    t.text = "Disarmed by auto preflight disarming";
+    send(ml::pack(t));
+  });
 }
 
 ml::Message SimVehicle::telemetry(uint32_t id) const {

@@ -61,6 +61,9 @@ struct Dialect {
   /// CAMERA_FEEDBACK (each, in this vehicle, after the ACK).
   uint16_t picture_command;
   uint32_t picture_confirmation;
+  /// PX4 keeps its HEARTBEAT at 1 Hz (SET_MESSAGE_INTERVAL answered MAV_RESULT_FAILED, SITL
+  /// 1.18); ArduPilot streams it at the rate asked for.
+  bool heartbeat_rate_fixed;
 };
 const Dialect& px4_dialect();
 const Dialect& ardupilot_dialect();
@@ -90,6 +93,13 @@ struct VehicleOptions {
   /// answers MAV_RESULT_FAILED, as ArduCopter SITL did when its DISARM_DELAY (10 s) ran out
   /// 40 ms before Listing 2's Takeoff, with eamos' HEARTBEAT still saying armed.
   bool disarm_at_first_takeoff = false;
+  /// The auto-disarm of a vehicle armed on the ground that never took off (PX4's
+  /// COM_DISARM_PRFLT, ArduPilot's DISARM_DELAY) after this many seconds; 0: never. It
+  /// strikes right after a HEARTBEAT, the worst case for a ground station that waits for the
+  /// next one, and says so as PX4 does to a ground station: STATUSTEXT "Disarmed by auto
+  /// preflight disarming" (here to any link).
+  double preflight_disarm_s = 0.0;
+  double heartbeat_hz = 1.0;  ///< until SET_MESSAGE_INTERVAL changes it (not with PX4's dialect)
 };
 
 class SimVehicle {
@@ -151,6 +161,7 @@ class SimVehicle {
 
   void set_rate(uint32_t message_id, double hz);
   void send_stream(uint32_t message_id);
+  void check_preflight_disarm();
   mavlink::Message telemetry(uint32_t message_id) const;
   void send(const mavlink::Message& m);
 
@@ -169,6 +180,8 @@ class SimVehicle {
   fleet::Vec3 flying_to_;               ///< target of the running FlyTo
   bool flying_ = false;
   bool takeoff_seen_ = false;  ///< a NAV_TAKEOFF came (disarm_at_first_takeoff)
+  std::optional<double> armed_at_;  ///< seen armed since (at a HEARTBEAT); none while disarmed
+  bool flown_since_armed_ = false;  ///< preflight_disarm_s is for a vehicle that never took off
   uint16_t last_command_ = 0;           ///< for resends: acknowledge again, do not redo
   uint8_t last_result_ = 0;
   bool has_last_ = false;

@@ -12,6 +12,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <cmath>
 #include <optional>
 #include <set>
 
@@ -47,6 +48,7 @@ struct Flight {
   eamos_test::Output run;
   std::map<std::string, std::vector<std::string>> actions;  ///< drone -> "Action outcome"
   std::map<std::string, std::vector<std::string>> vehicle;  ///< drone -> the vehicle's own words
+  std::map<std::string, std::vector<double>> vehicle_t;     ///< drone -> when each was said (mission s)
   std::vector<std::string> failsafes;                       ///< drones whose failsafe ran
   double duration_s = 0;
 };
@@ -95,12 +97,30 @@ Flight fly(const std::string& mission, const std::string& fleet_yaml, const fs::
     std::string event = e.value("event", "");
     if (event == "end")
       f.actions[e.value("drone", "")].push_back(e.value("text", "") + " " + e.value("outcome", ""));
-    if (event == "vehicle") f.vehicle[e.value("drone", "")].push_back(e.value("text", ""));
+    if (event == "vehicle") {
+      f.vehicle[e.value("drone", "")].push_back(e.value("text", ""));
+      f.vehicle_t[e.value("drone", "")].push_back(e.value("t", 0.0));
+    }
     if (event == "failsafe") f.failsafes.push_back(e.value("drone", ""));
     if (e.contains("duration")) f.duration_s = e.value("duration", 0.0);
     if (event == "mission" || (event.empty() && e.contains("outcome"))) f.duration_s = e.value("t", f.duration_s);
   }
   return f;
+}
+
+// Mission seconds from the autopilot's own text about its auto-disarm (ArduPilot "Disarming
+// motors", PX4 "Disarmed by auto preflight disarming") to the adapter's word that it saw the
+// drone disarmed; NaN when either is missing.
+double auto_disarm_seen_after(const Flight& f, const std::string& drone) {
+  const std::vector<std::string>& said = f.vehicle.at(drone);
+  std::optional<double> text_at;
+  for (size_t i = 0; i < said.size(); ++i) {
+    if (said[i].find("Disarming motors") != std::string::npos ||
+        said[i].find("Disarmed by auto preflight disarming") != std::string::npos)
+      text_at = f.vehicle_t.at(drone)[i];
+    if (said[i].find("(auto-disarm)") != std::string::npos && text_at) return f.vehicle_t.at(drone)[i] - *text_at;
+  }
+  return NAN;
 }
 
 bool any_contains(const std::vector<std::string>& texts, const std::string& part) {
@@ -283,14 +303,23 @@ void Sitl::fly_second_mission(const std::string& extra) {
   ASSERT_EQ(f.run.status, 0) << f.run.out;
   for (int d = 1; d <= 3; ++d) EXPECT_EQ(f.actions["Drone" + std::to_string(d)], three_hops_of(d)) << f.run.out;
 
-  Flight wait =
-      fly(mission_path("wait_armed.eamos"), fleet_file(*sitl, kHomes), dir_, {.extra = extra, .speed = speed});
+  // As a ground station on PX4 too, so that its text about the disarm (sent to ground
+  // stations only) times how soon eamos saw it.
+  Flight wait = fly(mission_path("wait_armed.eamos"), fleet_file(*sitl, kHomes, {}, ", announce_as_gcs: true"), dir_,
+                    {.extra = extra, .speed = speed});
   ASSERT_EQ(wait.run.status, 0) << wait.run.out;
   std::vector<std::string> want = {"Drone2.Arm() succeeded", "Drone2.Takeoff(3) succeeded", "Drone2.Land() succeeded",
                                    "Drone2.Disarm() succeeded"};
   EXPECT_EQ(wait.actions["Drone2"], want) << wait.run.out;
   // The autopilot did disarm it meanwhile, and the adapter armed it again.
   EXPECT_TRUE(any_contains(wait.vehicle["Drone2"], "auto-disarm")) << wait.run.out;
+  // Seen at once: ArduPilot streams HEARTBEAT at 20 Hz, PX4 keeps its 1 Hz and is asked
+  // for one every 0.05 s on the ground (a HEARTBEAT waited for would be up to 1 s late).
+  // Measured 0.008-0.14 mission s; the bound leaves room for the wall latency of a loaded
+  // machine, which --speed 3-5 multiplies.
+  const double seen_after = auto_disarm_seen_after(wait, "Drone2");
+  std::cout << "[sitl] auto-disarm seen " << seen_after << " mission s after the autopilot's text\n";
+  EXPECT_LE(seen_after, 0.2) << wait.run.out;
 }
 
 TEST_P(Sitl, ASecondMissionRightAfterTheFirstWaitsArmedLongerThanTheAutoDisarm) { fly_second_mission(""); }
