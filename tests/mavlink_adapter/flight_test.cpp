@@ -452,19 +452,33 @@ TEST(MavlinkFlight, ATakeoffRefusedAsTheAutoDisarmStrikesIsArmedAgainAndRepeated
   EXPECT_TRUE(repeated);
 }
 
-// How long after the autopilot's auto-disarm on the ground the adapter shows the drone
-// disarmed. The vehicle disarms right after a HEARTBEAT, so one that waits for the next
-// HEARTBEAT sees it a whole period late. Returns NaN when no disarm is seen.
-double disarm_seen_after(Flight& f) {
+// The autopilot's auto-disarm on the ground, struck right after a HEARTBEAT: one that waits
+// for the next HEARTBEAT sees it a whole period late.
+struct DisarmSeen {
+  double after_s = NAN;  ///< from the vehicle's text to the adapter showing it disarmed; NaN: never
+  int heartbeat_requests = 0;  ///< MAV_CMD_REQUEST_MESSAGE the vehicle received
+  std::string why;             ///< what went wrong, when after_s is NaN
+};
+
+DisarmSeen auto_disarm_seen(const sim_vehicle::Dialect& dialect, int port) {
+  sim_vehicle::VehicleOptions o = test::VehicleThread::options(dialect, 1, 100.0, true);
+  o.preflight_disarm_s = 2.0;
+  test::VehicleThread vehicle(port, kSpeed, o);
+  Flight f(port);
+  DisarmSeen seen;
+  if (!f.drone) return {.why = f.created.message};
   std::optional<double> text_at;
   f.drone->set_message_sink([&](const std::string& text) {
     if (text.find("Disarmed by auto preflight disarming") != std::string::npos) text_at = f.loop.now();
   });
-  if (f.fly("Arm").outcome != mid::Outcome::succeeded) return NAN;
+  if (f.fly("Arm").outcome != mid::Outcome::succeeded) return {.why = "Arm failed"};
   double give_up = f.loop.now() + 10;
   while (f.drone->state().armed && f.loop.now() < give_up) f.loop.run_until(f.loop.now() + 0.01);
-  if (f.drone->state().armed || !text_at) return NAN;
-  return f.loop.now() - *text_at;
+  if (f.drone->state().armed || !text_at) return {.why = "no auto-disarm seen"};
+  seen.after_s = f.loop.now() - *text_at;
+  seen.heartbeat_requests =
+      vehicle.inspect([](sim_vehicle::SimVehicle& v) { return v.received(mavlink::cmd::REQUEST_MESSAGE); });
+  return seen;
 }
 
 // PX4 keeps its HEARTBEAT at 1 Hz (it answers SET_MESSAGE_INTERVAL for it MAV_RESULT_FAILED),
@@ -472,28 +486,18 @@ double disarm_seen_after(Flight& f) {
 // 20 Hz. (The vehicle's text is the test's clock of the disarm; PX4 sends it only to a
 // ground station's link.)
 TEST(MavlinkFlight, AnAutoDisarmIsSeenAtOnceFromAnAutopilotThatKeepsItsHeartbeatRate) {
-  sim_vehicle::VehicleOptions o = test::VehicleThread::options(sim_vehicle::px4_dialect(), 1, 100.0, true);
-  o.preflight_disarm_s = 2.0;
-  test::VehicleThread vehicle(25407, kSpeed, o);
-  Flight f(25407);
-  ASSERT_TRUE(f.drone) << f.created.message;
-  double after = disarm_seen_after(f);
-  ASSERT_FALSE(std::isnan(after)) << "no auto-disarm seen";
-  EXPECT_LT(after, 0.3) << "a HEARTBEAT waited for is 1 s late";
-  EXPECT_GE(vehicle.inspect([](sim_vehicle::SimVehicle& v) { return v.received(mavlink::cmd::REQUEST_MESSAGE); }), 1);
+  DisarmSeen seen = auto_disarm_seen(sim_vehicle::px4_dialect(), 25407);
+  ASSERT_FALSE(std::isnan(seen.after_s)) << seen.why;
+  EXPECT_LT(seen.after_s, 0.3) << "a HEARTBEAT waited for is 1 s late";
+  EXPECT_GE(seen.heartbeat_requests, 1);
 }
 
 // ArduPilot streams HEARTBEAT at the 20 Hz asked for: the disarm shows with the next one.
 TEST(MavlinkFlight, AnAutoDisarmIsSeenAtOnceFromAnAutopilotThatStreamsHeartbeatsFast) {
-  sim_vehicle::VehicleOptions o = test::VehicleThread::options(sim_vehicle::ardupilot_dialect(), 1, 100.0, true);
-  o.preflight_disarm_s = 2.0;
-  test::VehicleThread vehicle(25408, kSpeed, o);
-  Flight f(25408);
-  ASSERT_TRUE(f.drone) << f.created.message;
-  double after = disarm_seen_after(f);
-  ASSERT_FALSE(std::isnan(after)) << "no auto-disarm seen";
-  EXPECT_LT(after, 0.3);
-  EXPECT_EQ(vehicle.inspect([](sim_vehicle::SimVehicle& v) { return v.received(mavlink::cmd::REQUEST_MESSAGE); }), 0);
+  DisarmSeen seen = auto_disarm_seen(sim_vehicle::ardupilot_dialect(), 25408);
+  ASSERT_FALSE(std::isnan(seen.after_s)) << seen.why;
+  EXPECT_LT(seen.after_s, 0.3);
+  EXPECT_EQ(seen.heartbeat_requests, 0);
 }
 
 // A takeoff the autopilot refuses for its own reason (here an altitude it will not fly) is
