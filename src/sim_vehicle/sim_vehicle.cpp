@@ -39,6 +39,13 @@ const uint32_t kStreamed[] = {ml::msg::LOCAL_POSITION_NED, ml::msg::EXTENDED_SYS
                               ml::msg::SYS_STATUS, ml::msg::BATTERY_STATUS,
                               ml::msg::GLOBAL_POSITION_INT};
 
+/// HEARTBEAT or one of kStreamed: what SET_MESSAGE_INTERVAL and REQUEST_MESSAGE may ask for.
+bool streamed(uint32_t id) {
+  bool known = id == ml::msg::HEARTBEAT;
+  for (uint32_t m : kStreamed) known = known || m == id;
+  return known;
+}
+
 /// execute()'s answer for a command acknowledged when its action ends.
 constexpr uint8_t kAckLater = 255;
 
@@ -88,7 +95,7 @@ std::string SimVehicle::open(const ml::Endpoint& endpoint) {
   });
   if (!opened.link) return opened.error;
   link_ = std::move(opened.link);
-  rates_hz_[ml::msg::HEARTBEAT] = options_.heartbeat_hz;
+  rates_hz_[ml::msg::HEARTBEAT] = 1.0;
   send_stream(ml::msg::HEARTBEAT);
   for (uint32_t id : kStreamed) set_rate(id, options_.default_rate_hz);
   return "";
@@ -226,20 +233,15 @@ uint8_t SimVehicle::execute(const ml::CommandLong& c) {
     case ml::cmd::SET_MESSAGE_INTERVAL: {
       auto id = static_cast<uint32_t>(c.param[0]);
       if (id == ml::msg::HEARTBEAT && dialect_.heartbeat_rate_fixed) return ml::result::FAILED;
-      bool known = id == ml::msg::HEARTBEAT;
-      for (uint32_t m : kStreamed) known = known || m == id;
       // PX4's orbit status, sent while it orbits; ArduPilot Copter has no DO_ORBIT.
-      known = known || (id == ml::msg::ORBIT_EXECUTION_STATUS && dialect_.do_orbit);
-      if (!known) return ml::result::DENIED;
+      if (!streamed(id) && !(id == ml::msg::ORBIT_EXECUTION_STATUS && dialect_.do_orbit)) return ml::result::DENIED;
       double us = c.param[1];
       set_rate(id, us < 0 ? 0.0 : us == 0 ? options_.default_rate_hz : 1e6 / us);
       return ml::result::ACCEPTED;
     }
     case ml::cmd::REQUEST_MESSAGE: {  // one now, as PX4 and ArduPilot answer it
       auto id = static_cast<uint32_t>(c.param[0]);
-      bool known = id == ml::msg::HEARTBEAT;
-      for (uint32_t m : kStreamed) known = known || m == id;
-      if (!known) return ml::result::DENIED;
+      if (!streamed(id)) return ml::result::DENIED;
       send(telemetry(id));
       return ml::result::ACCEPTED;
     }

@@ -99,7 +99,6 @@ struct VehicleOptions {
   /// next one, and says so as PX4 does to a ground station: STATUSTEXT "Disarmed by auto
   /// preflight disarming" (here to any link).
   double preflight_disarm_s = 0.0;
-  double heartbeat_hz = 1.0;  ///< until SET_MESSAGE_INTERVAL changes it (not with PX4's dialect)
 };
 
 class SimVehicle {

@@ -465,7 +465,6 @@ DisarmSeen auto_disarm_seen(const sim_vehicle::Dialect& dialect, int port) {
   o.preflight_disarm_s = 2.0;
   test::VehicleThread vehicle(port, kSpeed, o);
   Flight f(port);
-  DisarmSeen seen;
   if (!f.drone) return {.why = f.created.message};
   std::optional<double> text_at;
   f.drone->set_message_sink([&](const std::string& text) {
@@ -475,10 +474,9 @@ DisarmSeen auto_disarm_seen(const sim_vehicle::Dialect& dialect, int port) {
   double give_up = f.loop.now() + 10;
   while (f.drone->state().armed && f.loop.now() < give_up) f.loop.run_until(f.loop.now() + 0.01);
   if (f.drone->state().armed || !text_at) return {.why = "no auto-disarm seen"};
-  seen.after_s = f.loop.now() - *text_at;
-  seen.heartbeat_requests =
-      vehicle.inspect([](sim_vehicle::SimVehicle& v) { return v.received(mavlink::cmd::REQUEST_MESSAGE); });
-  return seen;
+  return {.after_s = f.loop.now() - *text_at,
+          .heartbeat_requests =
+              vehicle.inspect([](sim_vehicle::SimVehicle& v) { return v.received(mavlink::cmd::REQUEST_MESSAGE); })};
 }
 
 // PX4 keeps its HEARTBEAT at 1 Hz (it answers SET_MESSAGE_INTERVAL for it MAV_RESULT_FAILED),
