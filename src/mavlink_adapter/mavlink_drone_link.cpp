@@ -8,6 +8,7 @@
 #include <iostream>
 #include <map>
 #include <mutex>
+#include <vector>
 
 #include "mavlink/enums.h"
 #include "mavlink_adapter/mavlink_drone.h"
@@ -460,11 +461,16 @@ void MavlinkDrone::lose_link() {
 void MavlinkDrone::request_telemetry() {
   telemetry_requested_ = true;
   struct Rate { uint32_t id; double hz; };
-  for (Rate r : {Rate{ml::msg::HEARTBEAT, options_.heartbeat_hz}, Rate{ml::msg::LOCAL_POSITION_NED, options_.position_hz},
-                 Rate{ml::msg::EXTENDED_SYS_STATE, 2.0},
-                 // At the position rate: an orbit's radius is measured from it (mavlink_drone_orbit.cpp).
-                 Rate{ml::msg::GLOBAL_POSITION_INT, options_.position_hz}, Rate{ml::msg::ORBIT_EXECUTION_STATUS, 2.0},
-                 Rate{ml::msg::SYS_STATUS, 1.0}, Rate{ml::msg::BATTERY_STATUS, 1.0}}) {
+  std::vector<Rate> rates{Rate{ml::msg::HEARTBEAT, options_.heartbeat_hz},
+                          Rate{ml::msg::LOCAL_POSITION_NED, options_.position_hz}, Rate{ml::msg::EXTENDED_SYS_STATE, 2.0},
+                          // At the position rate: an orbit's radius is measured from it (mavlink_drone_orbit.cpp).
+                          Rate{ml::msg::GLOBAL_POSITION_INT, options_.position_hz}};
+  // Only from an autopilot that flies DO_ORBIT: ArduCopter has no such stream and answers with
+  // a STATUSTEXT ("No ap_message for mavlink id (360)") in every trace.
+  if (autopilot_->do_orbit) rates.push_back(Rate{ml::msg::ORBIT_EXECUTION_STATUS, 2.0});
+  rates.push_back(Rate{ml::msg::SYS_STATUS, 1.0});
+  rates.push_back(Rate{ml::msg::BATTERY_STATUS, 1.0});
+  for (Rate r : rates) {
     // An autopilot that refuses a rate still streams its defaults: HEARTBEAT is then asked
     // for on the ground (poll_heartbeat), for the others nothing is to be done.
     CommandDone done = nullptr;

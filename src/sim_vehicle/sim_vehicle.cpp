@@ -232,6 +232,7 @@ uint8_t SimVehicle::execute(const ml::CommandLong& c) {
     }
     case ml::cmd::SET_MESSAGE_INTERVAL: {
       auto id = static_cast<uint32_t>(c.param[0]);
+      ++intervals_asked_[id];
       if (id == ml::msg::HEARTBEAT && dialect_.heartbeat_rate_fixed) return ml::result::FAILED;
       // PX4's orbit status, sent while it orbits; ArduPilot Copter has no DO_ORBIT.
       if (!streamed(id) && !(id == ml::msg::ORBIT_EXECUTION_STATUS && dialect_.do_orbit)) return ml::result::DENIED;

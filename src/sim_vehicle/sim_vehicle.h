@@ -121,6 +121,11 @@ class SimVehicle {
     auto it = received_.find(command);
     return it == received_.end() ? 0 : it->second;
   }
+  /// How many SET_MESSAGE_INTERVALs asked for this message id, taken or refused.
+  int intervals_asked(uint32_t message) const {
+    auto it = intervals_asked_.find(message);
+    return it == intervals_asked_.end() ? 0 : it->second;
+  }
   /// The DO_ORBITs it accepted (the last 1000), oldest first: what a test reads the
   /// corrections from.
   const std::vector<mavlink::CommandLong>& orbit_commands() const { return orbit_commands_; }
@@ -192,6 +197,7 @@ class SimVehicle {
   mid::TimerId offboard_timer_ = mid::kNoTimer;
   mid::TimerId disarm_timer_ = mid::kNoTimer;
   std::map<uint16_t, int> received_;
+  std::map<uint32_t, int> intervals_asked_;
   std::set<uint8_t> heartbeat_types_;  ///< see heard_heartbeat_of_type
   std::vector<mavlink::CommandLong> orbit_commands_;
 

@@ -107,6 +107,27 @@ TEST(MavlinkFlight, ArduPilotTakesOffInGuidedToAnAltitudeAboveHome) {
   EXPECT_NEAR(f.drone->state().x, 0.0, 0.5);
 }
 
+// PX4 reports its orbit (ORBIT_EXECUTION_STATUS) while it flies DO_ORBIT; ArduCopter has no
+// such stream and answers the rate with a STATUSTEXT each time: it is not asked.
+TEST(MavlinkFlight, TheOrbitStatusIsAskedForOnlyFromAnAutopilotThatFliesDoOrbit) {
+  for (const sim_vehicle::Dialect* d : {&sim_vehicle::px4_dialect(), &sim_vehicle::ardupilot_dialect()}) {
+    SCOPED_TRACE(d->name);
+    int port = d == &sim_vehicle::px4_dialect() ? 25409 : 25410;
+    test::VehicleThread vehicle(port, 1, kSpeed, *d);
+    Flight f(port);
+    ASSERT_TRUE(f.drone) << f.created.message;
+    auto asked = [&](uint32_t id) {
+      return vehicle.inspect([id](sim_vehicle::SimVehicle& v) { return v.intervals_asked(id); });
+    };
+    // BATTERY_STATUS is the last rate the adapter asks for, one command after the other.
+    double give_up = f.loop.now() + 5;
+    while (asked(mavlink::msg::BATTERY_STATUS) == 0 && f.loop.now() < give_up) f.loop.run_until(f.loop.now() + 0.01);
+    ASSERT_EQ(asked(mavlink::msg::BATTERY_STATUS), 1);
+    EXPECT_EQ(asked(mavlink::msg::LOCAL_POSITION_NED), 1);
+    EXPECT_EQ(asked(mavlink::msg::ORBIT_EXECUTION_STATUS), d->do_orbit ? 1 : 0);
+  }
+}
+
 // A picture is taken when the vehicle says so, not when it accepts the command: each
 // autopilot's own command (PX4 DO_DIGICAM_CONTROL, ArduPilot IMAGE_START_CAPTURE) and its
 // camera's confirmation (CAMERA_TRIGGER, CAMERA_FEEDBACK) make one picture.

@@ -574,6 +574,41 @@ bool SitlFleet::wait_all_ready(double deadline, bool camera, std::string& error,
 
 // --- a second ground station ---------------------------------------------------------------
 
+namespace {
+// The watch's HEARTBEAT poll: 20 ms of wall clock is 0.1 s of the vehicle's at --speedup 5.
+constexpr auto kWatchPoll = std::chrono::milliseconds(20);
+constexpr int kWatchPollsPerAsk = 50;  ///< the ground station's HEARTBEAT and the rates: each second
+
+void ask_for_rates(ml::Link& link, ml::Encoder& encoder, uint8_t vehicle) {
+  ml::Heartbeat hb;
+  hb.type = 6;
+  hb.autopilot = 8;
+  link.send(encoder.encode(ml::pack(hb)));
+  ml::CommandLong c;
+  c.target_system = vehicle;
+  c.target_component = 1;
+  c.command = ml::cmd::SET_MESSAGE_INTERVAL;
+  c.param[0] = static_cast<float>(ml::msg::LOCAL_POSITION_NED);
+  c.param[1] = 50000;  // 20 Hz of the vehicle's time
+  link.send(encoder.encode(ml::pack(c)));
+  c.param[0] = static_cast<float>(ml::msg::GLOBAL_POSITION_INT);  // the frame PX4 orbits in
+  link.send(encoder.encode(ml::pack(c)));
+  // The mode at 10 Hz, as eamos asks for it (ArduPilot takes it; PX4 does not).
+  c.param[0] = static_cast<float>(ml::msg::HEARTBEAT);
+  c.param[1] = 100000;
+  link.send(encoder.encode(ml::pack(c)));
+}
+
+void request_heartbeat(ml::Link& link, ml::Encoder& encoder, uint8_t vehicle) {
+  ml::CommandLong c;
+  c.target_system = vehicle;
+  c.target_component = 1;
+  c.command = ml::cmd::REQUEST_MESSAGE;
+  c.param[0] = static_cast<float>(ml::msg::HEARTBEAT);
+  link.send(encoder.encode(ml::pack(c)));
+}
+}  // namespace
+
 struct SitlWatch::State {
   std::mutex mutex;
   std::vector<VehicleSample> samples;
@@ -613,29 +648,17 @@ SitlWatch::SitlWatch(const SitlFleet& fleet, int i) : state_(std::make_unique<St
   st->link = std::move(opened.link);
   // A ground station's HEARTBEAT (PX4 sends its GCS link to whoever spoke to it) and the rates
   // of LOCAL_POSITION_NED, GLOBAL_POSITION_INT and HEARTBEAT, every second until the watch ends.
-  st->asker = std::thread([st, vehicle] {
+  const bool poll_heartbeat = fleet.autopilot() == Autopilot::px4;
+  st->asker = std::thread([st, vehicle, poll_heartbeat] {
     ml::Encoder encoder{251, 190, 0};
     std::unique_lock lock(st->stop_mutex);
-    while (!st->stop) {
-      ml::Heartbeat hb;
-      hb.type = 6;
-      hb.autopilot = 8;
-      st->link->send(encoder.encode(ml::pack(hb)));
-      ml::CommandLong c;
-      c.target_system = vehicle;
-      c.target_component = 1;
-      c.command = ml::cmd::SET_MESSAGE_INTERVAL;
-      c.param[0] = static_cast<float>(ml::msg::LOCAL_POSITION_NED);
-      c.param[1] = 50000;  // 20 Hz of the vehicle's time
-      st->link->send(encoder.encode(ml::pack(c)));
-      c.param[0] = static_cast<float>(ml::msg::GLOBAL_POSITION_INT);  // the frame PX4 orbits in
-      st->link->send(encoder.encode(ml::pack(c)));
-      // The mode at 10 Hz, as eamos asks for it: at PX4's default 1 Hz, samples up to a second
-      // after the vehicle left its Orbit mode (braking off the circle) still counted as orbit.
-      c.param[0] = static_cast<float>(ml::msg::HEARTBEAT);
-      c.param[1] = 100000;
-      st->link->send(encoder.encode(ml::pack(c)));
-      st->stop_cv.wait_for(lock, std::chrono::seconds(1), [st] { return st->stop; });
+    for (int round = 0; !st->stop; ++round) {
+      if (round % kWatchPollsPerAsk == 0) ask_for_rates(*st->link, encoder, vehicle);
+      // PX4 keeps its HEARTBEAT at 1 Hz (it answers the rate with MAV_RESULT_FAILED), so the
+      // mode is asked for each round: at 1 Hz, samples up to a vehicle second after it left its
+      // Orbit mode (braking off the circle) counted as orbit.
+      if (poll_heartbeat) request_heartbeat(*st->link, encoder, vehicle);
+      st->stop_cv.wait_for(lock, kWatchPoll, [st] { return st->stop; });
     }
   });
 }
