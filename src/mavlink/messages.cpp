@@ -87,6 +87,14 @@ std::vector<MessageDef> build_table() {
   // A picture's confirmations: PX4's camera trigger (camera_trigger module), ArduPilot's
   // camera feedback, and the camera protocol's captured image.
   t.push_back(make(msg::CAMERA_TRIGGER, "CAMERA_TRIGGER", {{T::u64, "time_usec"}, {T::u32, "seq"}}));
+  // A simulator's true state (PX4 SIH streams its ground truth under this name): what the
+  // vehicle really flew, beside its own estimate, for a test judging a flight.
+  t.push_back(make(msg::HIL_STATE_QUATERNION, "HIL_STATE_QUATERNION",
+                   {{T::u64, "time_usec"}, {T::f32, "attitude_quaternion", 4}, {T::f32, "rollspeed"},
+                    {T::f32, "pitchspeed"}, {T::f32, "yawspeed"}, {T::i32, "lat"}, {T::i32, "lon"},
+                    {T::i32, "alt"}, {T::i16, "vx"}, {T::i16, "vy"}, {T::i16, "vz"},
+                    {T::u16, "ind_airspeed"}, {T::u16, "true_airspeed"}, {T::i16, "xacc"},
+                    {T::i16, "yacc"}, {T::i16, "zacc"}}));
   t.push_back(make(msg::BATTERY_STATUS, "BATTERY_STATUS",
                    {{T::u8, "id"}, {T::u8, "battery_function"}, {T::u8, "type"},
                     {T::i16, "temperature"}, {T::u16, "voltages", 10},

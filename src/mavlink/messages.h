@@ -25,6 +25,7 @@ inline constexpr uint32_t COMMAND_LONG = 76;
 inline constexpr uint32_t COMMAND_ACK = 77;
 inline constexpr uint32_t SET_POSITION_TARGET_LOCAL_NED = 84;
 inline constexpr uint32_t CAMERA_TRIGGER = 112;
+inline constexpr uint32_t HIL_STATE_QUATERNION = 115;
 inline constexpr uint32_t BATTERY_STATUS = 147;
 inline constexpr uint32_t CAMERA_FEEDBACK = 180;
 inline constexpr uint32_t EXTENDED_SYS_STATE = 245;

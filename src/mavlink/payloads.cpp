@@ -164,6 +164,26 @@ std::optional<GlobalPositionInt> unpack_global_position_int(const Message& m) {
                            r.get<uint16_t>("hdg")};
 }
 
+Message pack(const HilStateQuaternion& m) {
+  FieldWriter w(def_of(msg::HIL_STATE_QUATERNION));
+  w.set("time_usec", m.time_usec);
+  w.set("lat", m.lat);
+  w.set("lon", m.lon);
+  w.set("alt", m.alt);
+  w.set("vx", m.vx);
+  w.set("vy", m.vy);
+  w.set("vz", m.vz);
+  return w.take();
+}
+
+std::optional<HilStateQuaternion> unpack_hil_state_quaternion(const Message& m) {
+  if (m.id != msg::HIL_STATE_QUATERNION) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  return HilStateQuaternion{r.get<uint64_t>("time_usec"), r.get<int32_t>("lat"), r.get<int32_t>("lon"),
+                            r.get<int32_t>("alt"),        r.get<int16_t>("vx"),  r.get<int16_t>("vy"),
+                            r.get<int16_t>("vz")};
+}
+
 Message pack(const OrbitExecutionStatus& m) {
   FieldWriter w(def_of(msg::ORBIT_EXECUTION_STATUS));
   w.set("time_usec", m.time_usec);

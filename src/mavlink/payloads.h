@@ -57,6 +57,15 @@ struct OrbitExecutionStatus {
   float z = 0;         ///< m, in `frame`
 };
 
+/// A simulator's true position and velocity (HIL_STATE_QUATERNION; PX4 SIH sends its ground
+/// truth as this when asked): the attitude and accelerations are not read.
+struct HilStateQuaternion {
+  uint64_t time_usec = 0;
+  int32_t lat = 0, lon = 0;        ///< degE7
+  int32_t alt = 0;                 ///< mm above mean sea level
+  int16_t vx = 0, vy = 0, vz = 0;  ///< cm/s, north east down
+};
+
 struct CommandLong {
   uint8_t target_system = 0;
   uint8_t target_component = 0;
@@ -176,6 +185,7 @@ Message pack(const ParamSet& m);
 Message pack(const SysStatus& m);
 Message pack(const LocalPositionNed& m);
 Message pack(const GlobalPositionInt& m);
+Message pack(const HilStateQuaternion& m);
 Message pack(const OrbitExecutionStatus& m);
 Message pack(const CommandLong& m);
 Message pack(const CommandInt& m);
@@ -205,6 +215,7 @@ std::optional<ParamSet> unpack_param_set(const Message& m);
 std::optional<SysStatus> unpack_sys_status(const Message& m);
 std::optional<LocalPositionNed> unpack_local_position_ned(const Message& m);
 std::optional<GlobalPositionInt> unpack_global_position_int(const Message& m);
+std::optional<HilStateQuaternion> unpack_hil_state_quaternion(const Message& m);
 std::optional<OrbitExecutionStatus> unpack_orbit_execution_status(const Message& m);
 std::optional<CommandLong> unpack_command_long(const Message& m);
 std::optional<CommandInt> unpack_command_int(const Message& m);

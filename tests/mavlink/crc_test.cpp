@@ -43,6 +43,7 @@ const std::map<uint32_t, uint8_t> kPublished = {
     {msg::BATTERY_STATUS, 154},     {msg::EXTENDED_SYS_STATE, 130},
     {msg::STATUSTEXT, 83},          {msg::SETUP_SIGNING, 71},
     {msg::CAMERA_TRIGGER, 174},     {msg::CAMERA_FEEDBACK, 52},
+    {msg::HIL_STATE_QUATERNION, 4},
     {msg::CAMERA_IMAGE_CAPTURED, 133}, {msg::ORBIT_EXECUTION_STATUS, 11},
 };
 

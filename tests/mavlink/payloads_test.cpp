@@ -99,6 +99,19 @@ TEST(RoundTrip, GlobalPositionInt) {
   EXPECT_EQ(out->hdg, 35999);
 }
 
+TEST(RoundTrip, HilStateQuaternionKeepsTheTruePositionAndVelocity) {
+  HilStateQuaternion in{1234567890123, 473977418, -85455939, 498000, -250, 310, -12};
+  auto out = unpack_hil_state_quaternion(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->time_usec, 1234567890123u);
+  EXPECT_EQ(out->lat, 473977418);
+  EXPECT_EQ(out->lon, -85455939);
+  EXPECT_EQ(out->alt, 498000);
+  EXPECT_EQ(out->vx, -250);
+  EXPECT_EQ(out->vy, 310);
+  EXPECT_EQ(out->vz, -12);
+}
+
 TEST(RoundTrip, CommandLong) {
   CommandLong in{1, 1, 400, 2, {1, 21196, 0, 0, 0, 0, 7.5f}};
   auto out = unpack_command_long(through_the_wire(pack(in)));

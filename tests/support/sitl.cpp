@@ -346,22 +346,31 @@ void on_probe_frame(Readiness& r, uint8_t sysid, const ml::Frame& f) {
   r.changed.notify_all();
 }
 
-// Asks for the two messages readiness is judged by, at 2 Hz, announcing a ground station;
-// `camera`: and for CAM1_TYPE (ArduPilot), which must be 1.
-void ask_for_status(ml::Link& link, ml::Encoder& encoder, uint8_t sysid, bool camera) {
+// A ground station's HEARTBEAT: PX4 sends its GCS link's streams to whoever sent one.
+void send_gcs_heartbeat(ml::Link& link, ml::Encoder& encoder) {
   ml::Heartbeat hb;
   hb.type = 6;       // MAV_TYPE_GCS
   hb.autopilot = 8;  // MAV_AUTOPILOT_INVALID
   link.send(encoder.encode(ml::pack(hb)));
-  for (uint32_t id : {ml::msg::SYS_STATUS, ml::msg::GLOBAL_POSITION_INT}) {
-    ml::CommandLong c;
-    c.target_system = sysid;
-    c.target_component = 1;
-    c.command = ml::cmd::SET_MESSAGE_INTERVAL;
-    c.param[0] = static_cast<float>(id);
-    c.param[1] = 500000;
-    link.send(encoder.encode(ml::pack(c)));
-  }
+}
+
+void send_command(ml::Link& link, ml::Encoder& encoder, uint8_t sysid, uint16_t command, float param0,
+                  float param1 = 0) {
+  ml::CommandLong c;
+  c.target_system = sysid;
+  c.target_component = 1;
+  c.command = command;
+  c.param[0] = param0;
+  c.param[1] = param1;
+  link.send(encoder.encode(ml::pack(c)));
+}
+
+// Asks for the two messages readiness is judged by, at 2 Hz, announcing a ground station;
+// `camera`: and for CAM1_TYPE (ArduPilot), which must be 1.
+void ask_for_status(ml::Link& link, ml::Encoder& encoder, uint8_t sysid, bool camera) {
+  send_gcs_heartbeat(link, encoder);
+  for (uint32_t id : {ml::msg::SYS_STATUS, ml::msg::GLOBAL_POSITION_INT})
+    send_command(link, encoder, sysid, ml::cmd::SET_MESSAGE_INTERVAL, static_cast<float>(id), 500000);
   if (camera) link.send(encoder.encode(ml::pack(ml::ParamRequestRead{sysid, 1, "CAM1_TYPE", -1})));
 }
 
@@ -579,33 +588,21 @@ namespace {
 constexpr auto kWatchPoll = std::chrono::milliseconds(20);
 constexpr int kWatchPollsPerAsk = 50;  ///< the ground station's HEARTBEAT and the rates: each second
 
-void ask_for_rates(ml::Link& link, ml::Encoder& encoder, uint8_t vehicle) {
-  ml::Heartbeat hb;
-  hb.type = 6;
-  hb.autopilot = 8;
-  link.send(encoder.encode(ml::pack(hb)));
-  ml::CommandLong c;
-  c.target_system = vehicle;
-  c.target_component = 1;
-  c.command = ml::cmd::SET_MESSAGE_INTERVAL;
-  c.param[0] = static_cast<float>(ml::msg::LOCAL_POSITION_NED);
-  c.param[1] = 50000;  // 20 Hz of the vehicle's time
-  link.send(encoder.encode(ml::pack(c)));
-  c.param[0] = static_cast<float>(ml::msg::GLOBAL_POSITION_INT);  // the frame PX4 orbits in
-  link.send(encoder.encode(ml::pack(c)));
+void ask_for_rates(ml::Link& link, ml::Encoder& encoder, uint8_t vehicle, bool truth) {
+  send_gcs_heartbeat(link, encoder);
+  // 20 Hz of the vehicle's time; GLOBAL_POSITION_INT is the frame PX4 orbits in.
+  for (uint32_t id : {ml::msg::LOCAL_POSITION_NED, ml::msg::GLOBAL_POSITION_INT})
+    send_command(link, encoder, vehicle, ml::cmd::SET_MESSAGE_INTERVAL, static_cast<float>(id), 50000);
+  // PX4 SIH's ground truth at the same rate: where the vehicle really flew, beside its estimate.
+  if (truth)
+    send_command(link, encoder, vehicle, ml::cmd::SET_MESSAGE_INTERVAL, static_cast<float>(ml::msg::HIL_STATE_QUATERNION),
+                 50000);
   // The mode at 10 Hz, as eamos asks for it (ArduPilot takes it; PX4 does not).
-  c.param[0] = static_cast<float>(ml::msg::HEARTBEAT);
-  c.param[1] = 100000;
-  link.send(encoder.encode(ml::pack(c)));
+  send_command(link, encoder, vehicle, ml::cmd::SET_MESSAGE_INTERVAL, static_cast<float>(ml::msg::HEARTBEAT), 100000);
 }
 
 void request_heartbeat(ml::Link& link, ml::Encoder& encoder, uint8_t vehicle) {
-  ml::CommandLong c;
-  c.target_system = vehicle;
-  c.target_component = 1;
-  c.command = ml::cmd::REQUEST_MESSAGE;
-  c.param[0] = static_cast<float>(ml::msg::HEARTBEAT);
-  link.send(encoder.encode(ml::pack(c)));
+  send_command(link, encoder, vehicle, ml::cmd::REQUEST_MESSAGE, static_cast<float>(ml::msg::HEARTBEAT));
 }
 }  // namespace
 
@@ -614,7 +611,7 @@ struct SitlWatch::State {
   std::vector<VehicleSample> samples;
   uint32_t custom_mode = 0;
   bool armed = false;
-  int32_t lat_e7 = 0, lon_e7 = 0, orbit_lat_e7 = 0, orbit_lon_e7 = 0;
+  int32_t lat_e7 = 0, lon_e7 = 0, orbit_lat_e7 = 0, orbit_lon_e7 = 0, true_lat_e7 = 0, true_lon_e7 = 0;
   std::unique_ptr<ml::Link> link;
   std::thread asker;
   std::mutex stop_mutex;
@@ -637,9 +634,11 @@ SitlWatch::SitlWatch(const SitlFleet& fleet, int i) : state_(std::make_unique<St
     }
     if (auto g = ml::unpack_global_position_int(f.message)) st->lat_e7 = g->lat, st->lon_e7 = g->lon;
     if (auto o = ml::unpack_orbit_execution_status(f.message)) st->orbit_lat_e7 = o->x, st->orbit_lon_e7 = o->y;
+    if (auto t = ml::unpack_hil_state_quaternion(f.message)) st->true_lat_e7 = t->lat, st->true_lon_e7 = t->lon;
     if (auto p = ml::unpack_local_position_ned(f.message))
       st->samples.push_back({now_s(), p->x, p->y, p->z, std::hypot(p->vx, p->vy), st->custom_mode, st->armed,
-                             st->lat_e7, st->lon_e7, st->orbit_lat_e7, st->orbit_lon_e7});
+                             st->lat_e7, st->lon_e7, st->orbit_lat_e7, st->orbit_lon_e7, st->true_lat_e7,
+                             st->true_lon_e7});
   });
   if (!opened.link) {
     error_ = "cannot watch SITL instance " + std::to_string(i) + " on " + url + ": " + opened.error;
@@ -653,7 +652,7 @@ SitlWatch::SitlWatch(const SitlFleet& fleet, int i) : state_(std::make_unique<St
     ml::Encoder encoder{251, 190, 0};
     std::unique_lock lock(st->stop_mutex);
     for (int round = 0; !st->stop; ++round) {
-      if (round % kWatchPollsPerAsk == 0) ask_for_rates(*st->link, encoder, vehicle);
+      if (round % kWatchPollsPerAsk == 0) ask_for_rates(*st->link, encoder, vehicle, poll_heartbeat);
       // PX4 keeps its HEARTBEAT at 1 Hz (it answers the rate with MAV_RESULT_FAILED), so the
       // mode is asked for each round: at 1 Hz, samples up to a vehicle second after it left its
       // Orbit mode (braking off the circle) counted as orbit.

@@ -119,6 +119,8 @@ struct VehicleSample {
   bool armed = false;           ///< the armed flag of the newest HEARTBEAT before it
   int32_t lat_e7 = 0, lon_e7 = 0;  ///< the newest GLOBAL_POSITION_INT before it
   int32_t orbit_lat_e7 = 0, orbit_lon_e7 = 0;  ///< the newest ORBIT_EXECUTION_STATUS's centre (PX4), else 0
+  /// Where the vehicle really was: the newest HIL_STATE_QUATERNION (PX4 SIH's ground truth), else 0.
+  int32_t true_lat_e7 = 0, true_lon_e7 = 0;
 };
 
 /// A second ground station on one instance (ArduPilot SERIAL1, TCP 5762 + 10 n; PX4's GCS
