@@ -123,6 +123,8 @@ class MavlinkDrone final : public mid::AdapterDrone {
     double sent_radius = 0.0;       ///< the radius the autopilot flies to, as last sent
     double sent_speed = 0.0;        ///< ... and its speed
     double flown_speed = 0.0;       ///< along the circle, smoothed like last_flown_m
+    double outward_mps = 0.0;       ///< how fast the radius flown grows, smoothed
+    double previous_flown_m = 0.0;  ///< the radius flown at the previous report
     bool up_to_speed = false;       ///< flown_speed no longer rises: the radius is corrected
     double speed_check_s = 0.0, speed_at_check = 0.0;
     double sent_at_s = 0.0;         ///< vehicle s the last correction was sent
@@ -232,6 +234,7 @@ class MavlinkDrone final : public mid::AdapterDrone {
   /// from each position report (vehicle s) the radius asked for is corrected by the one flown.
   void correct_orbit_radius();  ///< on a GLOBAL_POSITION_INT while the autopilot orbits
   void trace_orbit_centre();
+  double led_radius() const;     ///< the radius a correction sends, before its bounds
   void send_due_orbit_correction();  ///< on a HEARTBEAT: the correction, if one is due
   std::array<float, 7> do_orbit_params(double radius, double speed) const;
   void switch_to_setpoint_mode();

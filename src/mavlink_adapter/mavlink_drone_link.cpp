@@ -8,7 +8,6 @@
 #include <iostream>
 #include <map>
 #include <mutex>
-#include <vector>
 
 #include "mavlink/enums.h"
 #include "mavlink_adapter/mavlink_drone.h"
@@ -275,14 +274,16 @@ void MavlinkDrone::on_statustext(const ml::Statustext& t) {
 // state comes only with a HEARTBEAT, and a link that is not a ground station's gets none of
 // its texts: a disarm would show up to a second late. On the ground, where its auto-disarms
 // strike (COM_DISARM_PRFLT, COM_DISARM_LAND), one is asked for at heartbeat_hz with
-// MAV_CMD_REQUEST_MESSAGE. In the air only a command or a crash disarms it, and the 1 Hz
-// HEARTBEAT there paces the orbit's corrections as it always did.
+// MAV_CMD_REQUEST_MESSAGE. In the air only a command or a crash disarms it; there it is asked
+// for while PX4 flies an orbit, whose radius corrections go only right after a HEARTBEAT that
+// shows the Orbit mode (send_due_orbit_correction): at PX4's 1 Hz they trailed the swing they
+// correct.
 void MavlinkDrone::poll_heartbeat() {
   heartbeat_poll_timer_ = loop_.after(mission_s(1.0 / options_.heartbeat_hz), [this] {
     heartbeat_poll_timer_ = mid::kNoTimer;
     poll_heartbeat();
   });
-  if (link_lost_ || heartbeat_requested_ || !vehicle_.landed()) return;
+  if (link_lost_ || heartbeat_requested_ || !(vehicle_.landed() || orbit_.commanded)) return;
   heartbeat_requested_ = true;
   commands_.send(command(ml::cmd::REQUEST_MESSAGE, {static_cast<float>(ml::msg::HEARTBEAT)}),
                  [this](const CommandResult& result) {
@@ -461,16 +462,14 @@ void MavlinkDrone::lose_link() {
 void MavlinkDrone::request_telemetry() {
   telemetry_requested_ = true;
   struct Rate { uint32_t id; double hz; };
-  std::vector<Rate> rates{Rate{ml::msg::HEARTBEAT, options_.heartbeat_hz},
-                          Rate{ml::msg::LOCAL_POSITION_NED, options_.position_hz}, Rate{ml::msg::EXTENDED_SYS_STATE, 2.0},
-                          // At the position rate: an orbit's radius is measured from it (mavlink_drone_orbit.cpp).
-                          Rate{ml::msg::GLOBAL_POSITION_INT, options_.position_hz}};
-  // Only from an autopilot that flies DO_ORBIT: ArduCopter has no such stream and answers with
-  // a STATUSTEXT ("No ap_message for mavlink id (360)") in every trace.
-  if (autopilot_->do_orbit) rates.push_back(Rate{ml::msg::ORBIT_EXECUTION_STATUS, 2.0});
-  rates.push_back(Rate{ml::msg::SYS_STATUS, 1.0});
-  rates.push_back(Rate{ml::msg::BATTERY_STATUS, 1.0});
-  for (Rate r : rates) {
+  for (Rate r : {Rate{ml::msg::HEARTBEAT, options_.heartbeat_hz}, Rate{ml::msg::LOCAL_POSITION_NED, options_.position_hz},
+                 Rate{ml::msg::EXTENDED_SYS_STATE, 2.0},
+                 // At the position rate: an orbit's radius is measured from it (mavlink_drone_orbit.cpp).
+                 Rate{ml::msg::GLOBAL_POSITION_INT, options_.position_hz}, Rate{ml::msg::ORBIT_EXECUTION_STATUS, 2.0},
+                 Rate{ml::msg::SYS_STATUS, 1.0}, Rate{ml::msg::BATTERY_STATUS, 1.0}}) {
+    // Only from an autopilot that flies DO_ORBIT: ArduCopter has no such stream and answers
+    // with a STATUSTEXT ("No ap_message for mavlink id (360)") in every trace.
+    if (r.id == ml::msg::ORBIT_EXECUTION_STATUS && !autopilot_->do_orbit) continue;
     // An autopilot that refuses a rate still streams its defaults: HEARTBEAT is then asked
     // for on the ground (poll_heartbeat), for the others nothing is to be done.
     CommandDone done = nullptr;

@@ -29,15 +29,23 @@ constexpr double kSetpointLead = 1.08;
 // DO_ORBIT's correction. PX4 re-approaches its circle when a new radius is more than its
 // acceptance radius (FlightTaskOrbit: 1 m) from where the vehicle is: each step stays well
 // inside it, so the vehicle keeps circling while the radius moves.
-constexpr double kDoOrbitGain = 0.25;       ///< 1/s of vehicle time, on the radius error
-constexpr double kCorrectionEveryS = 0.5;   ///< at most two DO_ORBITs per vehicle second
+// The correction is a PD loop on top of PX4's own radial term (1 /s): PX4 flies
+// (sent − flown) outward, so sending r + 2 (r − flown) − 1 s × (outward speed) makes its
+// radial law three times as stiff and damped. The outward speed is the change of the distance
+// itself: GLOBAL_POSITION_INT's velocity, projected, read −0.25 m/s while the distance stood
+// still (the EKF's velocity and position disagree by that much as the vehicle speeds up). The
+// integral only takes out what is left over a turn: at 0.25 /s it lagged the once-a-turn
+// swing by a quarter turn and fed it. Five corrections a vehicle second (the HEARTBEAT is
+// polled for it, poll_heartbeat): at two, then at PX4's 1 Hz HEARTBEAT, the loop trailed the
+// swing it corrects. Measured in docs/adapters.md ("PX4's orbit, ninth session").
+constexpr double kDoOrbitGain = 0.1;        ///< 1/s of vehicle time, on the radius error
+constexpr double kCorrectionEveryS = 0.2;   ///< at most five DO_ORBITs per vehicle second
 constexpr double kSmallestStepM = 0.03;     ///< a smaller change is not worth a command
 constexpr double kLargestStepM = 0.3;
-// PX4's radial term on this SITL is slow (a vehicle 0.6 m out came back at 0.15 m/s) and its
-// circle swings +-0.4 m over 10 s while it speeds up: the integral alone, started once up to
-// speed, came too late for a short orbit. So the radius sent also leads by the recent error.
-constexpr double kDoOrbitLead = 1.0;        ///< m of radius sent per m flown off the circle
-constexpr double kRecentSmoothingS = 0.3;
+constexpr double kDoOrbitLead = 2.0;        ///< m of radius sent per m flown off the circle
+constexpr double kDoOrbitDampingS = 1.0;    ///< m of radius sent per m/s moving outward
+constexpr double kRecentSmoothingS = 0.15;
+constexpr double kOutwardSmoothingS = 0.3;
 constexpr double kAwayFromFlownM = 0.6;     ///< the radius sent stays this near the one flown
 constexpr double kOnCircleM = 1.0;          ///< PX4 circles from this close to the radius on
 constexpr double kSettledRadialMps = 0.3;   ///< ... and we correct once it no longer moves out
@@ -52,10 +60,7 @@ constexpr double kFlownSmoothingS = 2.0;    ///< the radius flown, as the trace 
 constexpr double kSpeedLeadMps = 1.0;
 constexpr double kSpeedSmoothingS = 0.5;
 constexpr double kSpeedCheckS = 2.0;  ///< up to speed: less than 0.1 m/s faster in this long
-// PX4's radial term is underdamped on a loaded SITL: started 0.28 m off its circle (OFFBOARD
-// holds the east point only that well), it swung 4.4 .. 5.6 m for 5 m. So it starts on the
-// circle the vehicle stands on, and the radius moves to the one asked for in small steps.
-constexpr double kStartWithinM = 0.2;       ///< ... of the radius asked for, at most
+// DO_ORBIT waits at the east point for the vehicle to come to rest there.
 constexpr double kStartStillMps = 0.08;     ///< DO_ORBIT once the vehicle is this still ...
 constexpr double kStartOnCircleM = 0.15;    ///< ... this close to the circle ...
 constexpr double kStartWaitS = 1.5;         ///< ... or has waited this long (mission s) there
@@ -124,9 +129,12 @@ void MavlinkDrone::send_do_orbit() {
   // 0.1-0.2 m off the centre in the vehicle's local frame.
   const Vec3 off = orbit_.centre - position();
   std::tie(orbit_.centre_lat_e7, orbit_.centre_lon_e7) = offset_lat_lon(vehicle_.lat_e7, vehicle_.lon_e7, off.y, off.x);
-  const double r = orbit_.radius;
-  const double here = horizontal_norm(position() - orbit_.centre);
-  orbit_.sent_radius = std::clamp(here, std::max(1.0, r * (1.0 - kStartWithinM)), r * (1.0 + kStartWithinM));
+  // The radius asked for, not the one the vehicle stands on. The move out winds PX4's velocity
+  // integrator up outward (SIH's drag, 1 /s, taken up on the way), and OFFBOARD holds the
+  // vehicle 0.2-0.4 m beyond the east point against it, its position term pulling inward.
+  // Given the circle it stood on, PX4's radial term pulled nothing and the integrator carried
+  // the vehicle 0.3-0.5 m further out; given the radius, the pull stays as it was.
+  orbit_.sent_radius = orbit_.radius;
   auto p = do_orbit_params(orbit_.sent_radius, orbit_.sent_speed);
   ml::CommandInt c;
   c.target_system = sysid_;
@@ -253,13 +261,16 @@ void MavlinkDrone::correct_orbit_radius() {
     if (std::fabs(flown - o.radius) > kOnCircleM || outward > kSettledRadialMps) return;
     o.on_circle = true;
     o.sent_at_s = o.speed_check_s = vehicle_s;
-    o.last_flown_m = o.recent_flown_m = flown;
+    o.last_flown_m = o.recent_flown_m = o.previous_flown_m = flown;
     return;
   }
+  const double previous_flown = o.previous_flown_m;
+  o.previous_flown_m = flown;
   if (dt <= 0.0 || dt > 1.0) return;  // a gap or a report out of order: nothing to integrate over
   o.last_flown_m += std::min(1.0, dt / kFlownSmoothingS) * (flown - o.last_flown_m);
   o.recent_flown_m += std::min(1.0, dt / kRecentSmoothingS) * (flown - o.recent_flown_m);
   o.flown_speed += std::min(1.0, dt / kSpeedSmoothingS) * (along - o.flown_speed);
+  o.outward_mps += std::min(1.0, dt / kOutwardSmoothingS) * ((flown - previous_flown) / dt - o.outward_mps);
   // Up to speed: the orbit's, or the one PX4 keeps to (it caps a speed it cannot turn at).
   if (!o.up_to_speed && vehicle_s - o.speed_check_s >= kSpeedCheckS) {
     o.up_to_speed = o.flown_speed >= 0.95 * orbit_speed(o.radius) || o.flown_speed - o.speed_at_check < 0.1;
@@ -268,10 +279,17 @@ void MavlinkDrone::correct_orbit_radius() {
   // Not while it speeds up: that error is the start's, and integrated it swings the circle out.
   // Nor while the lead is at its bound: integrated while the lead pulled the vehicle back from
   // 0.4 m off, the integral carried it 0.5 m past the circle.
-  const double led = o.commanded_radius + kDoOrbitLead * (o.radius - o.recent_flown_m);
+  const double led = led_radius();
   if (!o.up_to_speed || std::fabs(led - o.recent_flown_m) >= kAwayFromFlownM) return;
   o.commanded_radius =
       std::clamp(o.commanded_radius + kDoOrbitGain * dt * (o.radius - flown), 0.8 * o.radius, 1.5 * o.radius);
+}
+
+// The radius to send: the integral, led by how far off the circle the vehicle is and damped
+// by how fast it moves out.
+double MavlinkDrone::led_radius() const {
+  const Orbit& o = orbit_;
+  return o.commanded_radius + kDoOrbitLead * (o.radius - o.recent_flown_m) - kDoOrbitDampingS * o.outward_mps;
 }
 
 // Where PX4 circles may differ from the centre it was given (its own projection, a position
@@ -298,8 +316,7 @@ void MavlinkDrone::send_due_orbit_correction() {
   if (o.last_flown_m <= 0.0 || o.last_report_s - o.sent_at_s < kCorrectionEveryS) return;
   const double speed = std::min(orbit_speed(o.radius), std::max(o.sent_speed, o.flown_speed + kSpeedLeadMps));
   // Within PX4's acceptance radius of where the vehicle is, else it re-approaches its circle.
-  const double led = std::clamp(o.commanded_radius + kDoOrbitLead * (o.radius - o.recent_flown_m),
-                                o.recent_flown_m - kAwayFromFlownM, o.recent_flown_m + kAwayFromFlownM);
+  const double led = std::clamp(led_radius(), o.recent_flown_m - kAwayFromFlownM, o.recent_flown_m + kAwayFromFlownM);
   const double wanted = std::clamp(led, 0.8 * o.radius, 1.5 * o.radius);
   double step = std::clamp(wanted - o.sent_radius, -kLargestStepM, kLargestStepM);
   if (std::fabs(step) < kSmallestStepM) step = 0.0;

@@ -56,7 +56,9 @@ TEST(MavlinkOrbit, Px4FliesOrbitItselfAfterDoOrbitCirclingTheStartCounterClockwi
   // The first DO_ORBIT started it; any later one only corrected its radius (next test).
   auto sent = vehicle.inspect([](const sim_vehicle::SimVehicle& s) { return s.orbit_commands(); });
   ASSERT_GE(sent.size(), 1u);
-  EXPECT_NEAR(-sent[0].param[0], kRadius, 0.5);  // the circle it stands on, then the one asked for
+  // The radius asked for, not the circle it stands on: OFFBOARD's pull back to the east point
+  // (against PX4's wound-up velocity integrator, on SITL) stays as it was.
+  EXPECT_FLOAT_EQ(-sent[0].param[0], kRadius);
   EXPECT_EQ(vehicle_mode(vehicle), Mode::orbit);
   // Sent from the circle's east point, with the centre named (COMMAND_INT): PX4 then starts on
   // its circle instead of spiralling out to it from the centre.
@@ -102,13 +104,41 @@ TEST(MavlinkOrbit, APx4OrbitFlownShortIsCorrectedByDoOrbitsSentAgainWithTheCentr
       EXPECT_LE(std::fabs(sent[k].param[0] - sent[k - 1].param[0]), 0.3f + 1e-4f) << k;
     }
   }
-  EXPECT_NEAR(-sent[0].param[0], kRadius, 0.5);  // the circle it stands on, then the one asked for
+  EXPECT_FLOAT_EQ(-sent[0].param[0], kRadius);  // the radius asked for, then corrected
   // At least the shortfall made up (more: this vehicle also lags behind its moving point).
   EXPECT_GE(-sent.back().param[0], 0.98 * kRadius / 0.9);
   for (int i = 0; i < 4; ++i) {  // flown within 5 % of 3 m, around where it started
     f.loop.run_until(f.loop.now() + 0.5);
     EXPECT_NEAR(std::hypot(f.drone->state().x, f.drone->state().y), kRadius, 0.05 * kRadius);
   }
+}
+
+int heartbeat_requests(VehicleThread& v) {
+  return v.inspect([](const sim_vehicle::SimVehicle& s) { return s.received(ml::cmd::REQUEST_MESSAGE); });
+}
+
+// PX4 keeps its HEARTBEAT at 1 Hz, and a radius correction goes only right after a HEARTBEAT
+// that shows the Orbit mode: while PX4 orbits, the adapter asks for one with REQUEST_MESSAGE
+// (as on the ground), so the corrections keep up with the circle; hovering in the air it
+// does not.
+TEST(MavlinkOrbit, Px4sHeartbeatIsAskedForWhileItOrbitsAndNotWhileItHovers) {
+  VehicleThread vehicle(25368, 1, kSpeed);
+  Flight f(25368);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
+  ASSERT_EQ(f.fly("Takeoff", {3}).outcome, mid::Outcome::succeeded);
+  f.loop.run_until(f.loop.now() + 1.0);  // a poll from the ground may still be answered
+  const int airborne = heartbeat_requests(vehicle);
+  ASSERT_EQ(f.fly("Hover", {2}).outcome, mid::Outcome::succeeded);
+  EXPECT_EQ(heartbeat_requests(vehicle), airborne);
+  Orbiting o;
+  o.id = f.drone->start({"Orbit", {kRadius}}, [&o](const mid::ActionEnd& e) { o.end = e; });
+  f.loop.run_until(f.loop.now() + 8.0);
+  ASSERT_EQ(vehicle_mode(vehicle), Mode::orbit);
+  // heartbeat_hz is 20: one request in flight at a time, answered within the loopback's latency.
+  EXPECT_GE(heartbeat_requests(vehicle) - airborne, 40);
+  auto sent = vehicle.inspect([](const sim_vehicle::SimVehicle& s) { return s.orbit_commands(); });
+  EXPECT_GE(sent.size(), 10u);  // more than PX4's own 1 Hz HEARTBEAT would have let through
 }
 
 // A correction PX4 refuses (here: below its smallest orbit, 1 m, for an Orbit(1) flown wide)
