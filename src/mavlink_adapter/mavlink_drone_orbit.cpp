@@ -21,11 +21,14 @@ using mid::Outcome;
 
 namespace {
 constexpr float kYawFrontToCentre = 0;  ///< ORBIT_YAW_BEHAVIOUR_HOLD_FRONT_TO_CIRCLE_CENTER
-constexpr double kRadiusGain = 0.5;     ///< 1/s (2.0 was measured to oscillate, 4.5 .. 5.5 m)
-/// ArduCopter SITL followed setpoints going round 5 m at 4.5 m (a lagging follower cuts in by
-/// 1 / sqrt(1 + (w tau)^2)), and with kRadiusGain alone a half-turn orbit still averaged
-/// 4.73-4.82 m from its centre: its setpoints start this much wider.
-constexpr double kSetpointLead = 1.08;
+/// ArduCopter SITL followed setpoints going round 5 m at 4.5 m: a follower lagging by tau cuts
+/// a circle flown at angular rate w in by 1 / sqrt(1 + (w tau)^2), so the setpoints go round
+/// that much wider, w from the vehicle's own speed up to the orbit's (beyond, a vehicle that
+/// follows closely would be led ever wider by its own speed). A lead fixed from the start (1.08) carried
+/// the vehicle 0.2 m out while it sped up, and the integral it then wound down took it to
+/// 4.73 m half a turn later (docs/adapters.md, "ArduCopter's orbit within 5 %").
+constexpr double kFollowerLagS = 0.9;
+constexpr double kRadiusGain = 0.25;  ///< 1/s: what the lead leaves (0.5: 4.80 .. 5.14 m; 2.0 oscillated)
 // DO_ORBIT's correction. PX4 re-approaches its circle when a new radius is more than its
 // acceptance radius (FlightTaskOrbit: 1 m) from where the vehicle is: each step stays well
 // inside it, so the vehicle keeps circling while the radius moves.
@@ -81,9 +84,6 @@ void MavlinkDrone::start_orbit(Vec3 centre, double radius) {
   // ArduCopter goes round on our setpoints, PX4 by itself (send_do_orbit).
   orbit_ = {true, centre, radius, 0.0, false, false, false, radius};
   orbit_.sent_radius = radius;
-  // Our setpoints go round from the start at the radius they were measured to need, so the
-  // correction only fine-tunes it (a short orbit ends before it has integrated that much).
-  if (!autopilot_->do_orbit) orbit_.commanded_radius = radius * kSetpointLead;
   char text[128];
   std::snprintf(text, sizeof text, "orbit of %.2f m around x %.2f, y %.2f", radius, centre.x, centre.y);
   note(text);  // where the vehicle circles, for a reader of the trace (and the SITL tests)
@@ -194,20 +194,19 @@ void MavlinkDrone::advance_orbit(double dt) {
     // Out to the circle's east point first, like the simulator, then around it.
     setpoint_ = {orbit_.centre.x + r, orbit_.centre.y, orbit_.centre.z};
     if (horizontal_norm(position() - setpoint_) > settings_.tolerance.horizontal_m) return;
-    if (!autopilot_->do_orbit) {
-      orbit_.on_circle = true;
-      return;
-    }
-    // PX4 from a standstill there (send_do_orbit starts it on the circle it stands on): its
-    // radial term is slow, and a vehicle still drifting out at 0.15-0.3 m/s when DO_ORBIT came
-    // went on 0.3-0.6 m past its circle. A vehicle that does not come to rest (a gusty hold)
-    // starts after kStartWaitS all the same.
+    // Round from a standstill there. PX4 (send_do_orbit starts it on the circle): its radial
+    // term is slow, and a vehicle still drifting out at 0.15-0.3 m/s when DO_ORBIT came went on
+    // 0.3-0.6 m past its circle. ArduCopter, started as it came within the tolerance (still
+    // moving out at 0.7 m/s), went on 0.25 m past it. A vehicle that does not come to rest (a
+    // gusty hold) starts after kStartWaitS all the same.
     if (orbit_.do_orbit_sent) return;
     orbit_.waited_at_start_s += dt;
     const bool still = norm(vehicle_.ned_velocity) <= kStartStillMps &&
                        std::fabs(horizontal_norm(position() - orbit_.centre) - r) <= kStartOnCircleM;
-    if (still || (orbit_.waited_at_start_s >= kStartWaitS && norm(vehicle_.ned_velocity) <= settings_.tolerance.settled_mps))
-      send_do_orbit();
+    if (!still && (orbit_.waited_at_start_s < kStartWaitS || norm(vehicle_.ned_velocity) > settings_.tolerance.settled_mps))
+      return;
+    if (autopilot_->do_orbit) return send_do_orbit();
+    orbit_.on_circle = true;
     return;
   }
   // Moved by the vehicle's clock, which a SITL on a loaded machine runs slower than --speed:
@@ -216,16 +215,18 @@ void MavlinkDrone::advance_orbit(double dt) {
   orbit_.angle = std::fmod(orbit_.angle + orbit_speed(r) * vehicle_dt / r, 2.0 * M_PI);
   // A position setpoint moving around the circle is followed with a lag, along a chord:
   // ArduCopter circled at 4.5 m for 5 m. Feed-forward was tried and measured on ArduCopter
-  // SITL, at the accel-bounded speed too: with velocity the orbit grew to 6.9 m, with
-  // velocity and acceleration it shrank to 4.3 m and wobbled (3.6 .. 5.0 m), with velocity
-  // setpoints steered by the measured radius it swung 4.6 .. 5.1 m. Position setpoints stay
-  // the tightest. So the commanded radius is corrected by what the vehicle flies: an
-  // integral on the radius error, within r … 1.5 r.
+  // SITL, at the accel-bounded speed too: with velocity the orbit grew to 6.9 m (5.9 m in
+  // 2026-12), with velocity and acceleration it shrank to 4.3 m and wobbled (3.6 .. 5.0 m;
+  // 4.67 .. 5.29 m in 2026-12), with velocity setpoints steered by the measured radius it swung
+  // 4.6 .. 5.1 m. Position setpoints stay the tightest. So they go round wider by the lag the
+  // vehicle's speed gives, and an integral on the radius error takes out what is left.
   if (vehicle_.have_position) {
     double flown = horizontal_norm(position() - orbit_.centre);
-    orbit_.commanded_radius = std::clamp(orbit_.commanded_radius + kRadiusGain * dt * (r - flown), r, 1.5 * r);
+    orbit_.commanded_radius =
+        std::clamp(orbit_.commanded_radius + kRadiusGain * dt * (r - flown), 0.6 * r, 1.5 * r);
   }
-  const double rc = orbit_.commanded_radius;
+  const double w = std::min(horizontal_norm(vehicle_.ned_velocity), orbit_speed(r)) / r;
+  const double rc = orbit_.commanded_radius * std::sqrt(1.0 + w * w * kFollowerLagS * kFollowerLagS);
   setpoint_ = {orbit_.centre.x + rc * std::cos(orbit_.angle),
                orbit_.centre.y + rc * std::sin(orbit_.angle), orbit_.centre.z};
 }

@@ -126,6 +126,10 @@ class SimVehicle {
     auto it = intervals_asked_.find(message);
     return it == intervals_asked_.end() ? 0 : it->second;
   }
+  /// The newest position setpoint (x east, y north, z up), if any came.
+  std::optional<fleet::Vec3> setpoint() const {
+    return have_setpoint_ ? std::optional<fleet::Vec3>(setpoint_) : std::nullopt;
+  }
   /// The DO_ORBITs it accepted (the last 1000), oldest first: what a test reads the
   /// corrections from.
   const std::vector<mavlink::CommandLong>& orbit_commands() const { return orbit_commands_; }

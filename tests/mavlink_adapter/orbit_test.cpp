@@ -215,6 +215,29 @@ TEST(MavlinkOrbit, ArduPilotOrbitIsStillFlownFromSetpointsInGuided) {
   EXPECT_GT(turned(bearing(before), bearing(after)), 0.2);
 }
 
+// ArduCopter's setpoints go round wider by the lag its own speed gives: from the standstill at
+// the east point they start on the circle asked for (a lead fixed from the start held the
+// vehicle 0.2 m out while it sped up, on SITL), and they widen as the vehicle speeds up.
+TEST(MavlinkOrbit, ArduPilotsSetpointsGoRoundFromTheRadiusAskedForAndWidenWithTheVehiclesSpeed) {
+  VehicleThread vehicle(25370, 1, kSpeed, sim_vehicle::ardupilot_dialect());
+  Flight f(25370);
+  Orbiting o;
+  take_off_and_orbit(f, o, 0.0);
+  std::optional<double> first_round, widest;
+  for (int i = 0; i < 200 && !o.end; ++i) {
+    f.loop.run_until(f.loop.now() + 0.05);
+    auto sp = vehicle.inspect([](const sim_vehicle::SimVehicle& s) { return s.setpoint(); });
+    if (!sp || std::atan2(sp->y, sp->x) < 0.02) continue;  // still at (or out to) the east point
+    const double r = std::hypot(sp->x, sp->y);
+    if (!first_round) first_round = r;
+    widest = std::max(widest.value_or(0.0), r);
+  }
+  ASSERT_TRUE(first_round) << "the setpoints never went round";
+  EXPECT_NEAR(*first_round, kRadius, 0.05);
+  EXPECT_GT(*widest, *first_round + 0.05);
+  EXPECT_LE(*widest, 1.5 * kRadius);
+}
+
 // The vehicle flies out to the circle first; PX4 refuses DO_ORBIT there: the Orbit fails with
 // PX4's answer in words and the vehicle holds on our setpoints where it was refused.
 TEST(MavlinkOrbit, DoOrbitRefusedByPx4FailsWithTheResultInWordsAndKeepsHolding) {
