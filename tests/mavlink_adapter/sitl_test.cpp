@@ -114,8 +114,12 @@ double auto_disarm_seen_after(const Flight& f, const std::string& drone) {
   const std::vector<std::string>& said = f.vehicle.at(drone);
   std::optional<double> text_at;
   for (size_t i = 0; i < said.size(); ++i) {
+    // PX4 says "Disarmed by landing" instead when its land detector saw a takeoff of the
+    // vehicle standing armed (its estimate wandering) and then the landing: COM_DISARM_LAND
+    // disarmed it, as once in CI on 2026-12-05.
     if (said[i].find("Disarming motors") != std::string::npos ||
-        said[i].find("Disarmed by auto preflight disarming") != std::string::npos)
+        said[i].find("Disarmed by auto preflight disarming") != std::string::npos ||
+        said[i].find("Disarmed by landing") != std::string::npos)
       text_at = f.vehicle_t.at(drone)[i];
     if (said[i].find("(auto-disarm)") != std::string::npos && text_at) return f.vehicle_t.at(drone)[i] - *text_at;
   }
