@@ -24,9 +24,9 @@ constexpr float kYawFrontToCentre = 0;  ///< ORBIT_YAW_BEHAVIOUR_HOLD_FRONT_TO_C
 /// ArduCopter SITL followed setpoints going round 5 m at 4.5 m: a follower lagging by tau cuts
 /// a circle flown at angular rate w in by 1 / sqrt(1 + (w tau)^2), so the setpoints go round
 /// that much wider, w from the vehicle's own speed up to the orbit's (beyond, a vehicle that
-/// follows closely would be led ever wider by its own speed). A lead fixed from the start (1.08) carried
-/// the vehicle 0.2 m out while it sped up, and the integral it then wound down took it to
-/// 4.73 m half a turn later (docs/adapters.md, "ArduCopter's orbit within 5 %").
+/// follows closely would be led ever wider by its own speed). A lead fixed from the start
+/// (1.08) carried the vehicle 0.2 m out while it sped up, and the integral it then wound down
+/// took it to 4.73 m half a turn later (docs/adapters.md, "ArduCopter's orbit within 5 %").
 constexpr double kFollowerLagS = 0.9;
 constexpr double kRadiusGain = 0.25;  ///< 1/s: what the lead leaves (0.5: 4.80 .. 5.14 m; 2.0 oscillated)
 // DO_ORBIT's correction. PX4 re-approaches its circle when a new radius is more than its
