@@ -125,8 +125,6 @@ class MavlinkDrone final : public mid::AdapterDrone {
     double flown_speed = 0.0;       ///< along the circle, smoothed like last_flown_m
     double outward_mps = 0.0;       ///< how fast the radius flown grows, smoothed
     double previous_flown_m = 0.0;  ///< the radius flown at the previous report
-    bool up_to_speed = false;       ///< flown_speed no longer rises: the radius is corrected
-    double speed_check_s = 0.0, speed_at_check = 0.0;
     double sent_at_s = 0.0;         ///< vehicle s the last correction was sent
     double last_report_s = -1.0;    ///< vehicle s of the previous GLOBAL_POSITION_INT
     double last_flown_m = 0.0;      ///< the radius flown, smoothed over kFlownSmoothingS
@@ -230,6 +228,9 @@ class MavlinkDrone final : public mid::AdapterDrone {
   void leave_orbit();
   bool left_orbit_mode();  ///< the vehicle left DO_ORBIT's mode: the orbit failed
   void advance_orbit(double dt);
+  /// PX4, out to its circle on our setpoints: the heading (rad from north) that faces the centre.
+  std::optional<double> orbit_setpoint_yaw() const;
+  bool faces_orbit_centre() const;  ///< within kFacingDeg, or the heading is not known
   /// DO_ORBIT: PX4 flies its circle a little off the radius asked for (docs/adapters.md);
   /// from each position report (vehicle s) the radius asked for is corrected by the one flown.
   void correct_orbit_radius();  ///< on a GLOBAL_POSITION_INT while the autopilot orbits

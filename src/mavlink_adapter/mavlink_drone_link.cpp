@@ -564,6 +564,10 @@ void MavlinkDrone::stream_tick() {
   sp.x = static_cast<float>(ned.x);
   sp.y = static_cast<float>(ned.y);
   sp.z = static_cast<float>(ned.z);
+  if (std::optional<double> yaw = orbit_setpoint_yaw()) {
+    sp.type_mask = ml::kPositionAndYawMask;
+    sp.yaw = static_cast<float>(*yaw);
+  }
   send(ml::pack(sp));
   ++setpoints_sent_;
   if (!in_control_ && mode_commands_pending_ == 0 &&

@@ -301,6 +301,12 @@ void SimVehicle::on_setpoint(const ml::SetPositionTargetLocalNed& sp) {
   if (sp.target_system != options_.sysid || sp.coordinate_frame != ml::kFrameLocalNed) return;
   setpoint_ = {sp.y, sp.x, -sp.z};  // NED -> the simulator's east, north, up
   have_setpoint_ = true;
+  // Like PX4's OFFBOARD: a yaw is taken unless its ignore bit is set or it is not a number.
+  setpoint_yaw_deg_.reset();
+  if (!(sp.type_mask & 0x0400) && std::isfinite(sp.yaw)) {
+    const double deg = std::fmod(sp.yaw * 180.0 / M_PI, 360.0);
+    setpoint_yaw_deg_ = deg < 0 ? deg + 360.0 : deg;
+  }
   setpoint_at_ = loop_.now();
   fly_to_setpoint();
 }
@@ -452,8 +458,12 @@ ml::Message SimVehicle::telemetry(uint32_t id) const {
       g.vz = static_cast<int16_t>(std::lround(-v.z * 100.0));
       g.alt = static_cast<int32_t>(std::lround((options_.home_amsl_m + s.z) * 1000.0));
       g.relative_alt = static_cast<int32_t>(std::lround((s.z - options_.home_above_origin_m) * 1000.0));
-      // As a real autopilot: cdeg from north, UINT16_MAX when the vehicle does not know.
-      if (std::isfinite(s.heading)) g.hdg = static_cast<uint16_t>(std::lround(s.heading * 100.0) % 36000);
+      // As a real autopilot: cdeg from north, UINT16_MAX when the vehicle does not know. Flying
+      // setpoints that name a heading, this vehicle turns to it at once; otherwise the
+      // simulator's nose follows its velocity.
+      const bool yaw_set = mode_ == Mode::setpoint && setpoint_yaw_deg_;
+      const double heading = yaw_set ? *setpoint_yaw_deg_ : s.heading;
+      if (std::isfinite(heading)) g.hdg = static_cast<uint16_t>(std::lround(heading * 100.0) % 36000);
       return ml::pack(g);
     }
     case ml::msg::ORBIT_EXECUTION_STATUS: {

@@ -130,6 +130,8 @@ class SimVehicle {
   std::optional<fleet::Vec3> setpoint() const {
     return have_setpoint_ ? std::optional<fleet::Vec3>(setpoint_) : std::nullopt;
   }
+  /// The heading the newest position setpoint named (degrees from north), if it named one.
+  std::optional<double> setpoint_yaw_deg() const { return setpoint_yaw_deg_; }
   /// The DO_ORBITs it accepted (the last 1000), oldest first: what a test reads the
   /// corrections from.
   const std::vector<mavlink::CommandLong>& orbit_commands() const { return orbit_commands_; }
@@ -185,6 +187,7 @@ class SimVehicle {
   fleet::Vec3 setpoint_;                ///< mission frame of the simulator (x east, y north, z up)
   bool have_setpoint_ = false;
   double setpoint_at_ = -1e9;           ///< loop time of the newest setpoint
+  std::optional<double> setpoint_yaw_deg_;  ///< its yaw, when taken (type_mask bit 10 clear)
   fleet::Vec3 flying_to_;               ///< target of the running FlyTo
   bool flying_ = false;
   bool takeoff_seen_ = false;  ///< a NAV_TAKEOFF came (disarm_at_first_takeoff)

@@ -92,9 +92,9 @@ TEST(MavlinkOrbit, APx4OrbitFlownShortIsCorrectedByDoOrbitsSentAgainWithTheCentr
   VehicleThread vehicle(25367, kSpeed, options);
   Flight f(25367);
   Orbiting o;
-  // Up to speed first (the adapter raises it step by step), then corrected: the lead makes up
-  // half the shortfall at once, the integral (0.1 /s, set for PX4 SITL) the rest over about
-  // 30 s. At 24 s this vehicle still flew 2.83-2.90 m.
+  // The lead makes up half the shortfall at once, the integral (0.2 /s, set for PX4 SITL) the
+  // rest. At 24 s, under the integral of 0.1 /s it had before, this vehicle still flew
+  // 2.83-2.90 m.
   take_off_and_orbit(f, o, 40.0);
   EXPECT_FALSE(o.end);
   EXPECT_EQ(vehicle_mode(vehicle), Mode::orbit);
@@ -118,6 +118,26 @@ TEST(MavlinkOrbit, APx4OrbitFlownShortIsCorrectedByDoOrbitsSentAgainWithTheCentr
 
 int heartbeat_requests(VehicleThread& v) {
   return v.inspect([](const sim_vehicle::SimVehicle& s) { return s.received(ml::cmd::REQUEST_MESSAGE); });
+}
+
+// DO_ORBIT turns PX4's front to the centre. Turned there as the orbit began, on SITL, the
+// circle sank 0.2-0.3 m while the vehicle sped up: the setpoints out to the circle's east point
+// name the heading that faces the centre (west), and DO_ORBIT waits until the vehicle faces it.
+TEST(MavlinkOrbit, OnItsWayOutToAPx4OrbitTheVehicleTurnsToFaceTheCentreBeforeDoOrbit) {
+  VehicleThread vehicle(25376, 1, kSpeed);
+  Flight f(25376);
+  Orbiting o;
+  take_off_and_orbit(f, o, 0.0);
+  std::optional<double> named;
+  for (int i = 0; i < 800 && do_orbits(vehicle) == 0 && !o.end; ++i) {
+    auto yaw = vehicle.inspect([](const sim_vehicle::SimVehicle& s) { return s.setpoint_yaw_deg(); });
+    if (yaw) named = yaw;
+    f.loop.run_until(f.loop.now() + 0.05);
+  }
+  ASSERT_GT(do_orbits(vehicle), 0) << "DO_ORBIT never went";
+  ASSERT_TRUE(named) << "no heading in the setpoints out to the circle";
+  EXPECT_NEAR(*named, 270.0, 0.5);
+  EXPECT_NEAR(f.drone->state().heading, 270.0, 10.0);  // faced the centre as DO_ORBIT went
 }
 
 // PX4 keeps its HEARTBEAT at 1 Hz, and a radius correction goes only right after a HEARTBEAT
@@ -236,6 +256,8 @@ TEST(MavlinkOrbit, ArduPilotsSetpointsGoRoundFromTheRadiusAskedForAndWidenWithTh
     widest = std::max(widest.value_or(0.0), r);
   }
   ASSERT_TRUE(first_round) << "the setpoints never went round";
+  // Its heading is its own: no yaw in the setpoints.
+  EXPECT_FALSE(vehicle.inspect([](const sim_vehicle::SimVehicle& s) { return s.setpoint_yaw_deg(); }));
   EXPECT_NEAR(*first_round, kRadius, 0.05);
   EXPECT_GT(*widest, *first_round + 0.05);
   EXPECT_LE(*widest, 1.5 * kRadius);
