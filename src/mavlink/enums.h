@@ -69,8 +69,9 @@ inline constexpr uint8_t ONBOARD_COMPUTER = 191;
 /// POSITION_TARGET_TYPEMASK for "position only": velocity, acceleration, yaw and yaw rate
 /// ignored (bits 3-8, 10, 11).
 inline constexpr uint16_t kPositionOnlyMask = 0x0DF8;
-/// ... with the yaw taken (bit 10 clear): a position and the heading to hold there.
-inline constexpr uint16_t kPositionAndYawMask = 0x09F8;
+inline constexpr uint16_t kIgnoreYawBit = 0x0400;  ///< bit 10: the setpoint's yaw is not taken
+/// ... with the yaw taken: a position and the heading to hold there.
+inline constexpr uint16_t kPositionAndYawMask = kPositionOnlyMask & ~kIgnoreYawBit;
 inline constexpr uint8_t kFrameLocalNed = 1;  ///< MAV_FRAME_LOCAL_NED
 inline constexpr uint8_t kFrameGlobal = 0;    ///< MAV_FRAME_GLOBAL: x, y latitude, longitude
 /// MAV_FRAME_GLOBAL, _GLOBAL_RELATIVE_ALT, _GLOBAL_INT, _GLOBAL_RELATIVE_ALT_INT,

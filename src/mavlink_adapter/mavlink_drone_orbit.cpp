@@ -41,8 +41,8 @@ constexpr double kRadiusGain = 0.25;  ///< 1/s: what the lead leaves (0.5: 4.80 
 // swing by a quarter turn and fed it. Five corrections a vehicle second (the HEARTBEAT is
 // polled for it, poll_heartbeat): at two, then at PX4's 1 Hz HEARTBEAT, the loop trailed the
 // swing it corrects. Measured in docs/adapters.md ("PX4's orbit, ninth session"). The
-// integral runs from the start on: held back while the vehicle sped up (the eleventh session
-// and before), it left the mean 0.1 m off for most of a short orbit.
+// integral runs from the start: held back while the vehicle sped up (until the eleventh
+// session), it left the mean up to 0.2 m off for most of a short orbit.
 constexpr double kDoOrbitGain = 0.2;        ///< 1/s of vehicle time, on the radius error
 constexpr double kCorrectionEveryS = 0.2;   ///< at most five DO_ORBITs per vehicle second
 constexpr double kSmallestStepM = 0.03;     ///< a smaller change is not worth a command

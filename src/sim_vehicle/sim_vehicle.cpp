@@ -303,7 +303,7 @@ void SimVehicle::on_setpoint(const ml::SetPositionTargetLocalNed& sp) {
   have_setpoint_ = true;
   // Like PX4's OFFBOARD: a yaw is taken unless its ignore bit is set or it is not a number.
   setpoint_yaw_deg_.reset();
-  if (!(sp.type_mask & 0x0400) && std::isfinite(sp.yaw)) {
+  if (!(sp.type_mask & ml::kIgnoreYawBit) && std::isfinite(sp.yaw)) {
     const double deg = std::fmod(sp.yaw * 180.0 / M_PI, 360.0);
     setpoint_yaw_deg_ = deg < 0 ? deg + 360.0 : deg;
   }
