@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# Runs every test of a built tree. First the suites labelled `alone` (the browser's, which
-# hold a latency bound) with nothing beside them; then the real-time suites (label
-# `realtime`: SITL firmware, DDS processes, signals) at normal priority, and beside them, at
-# the lowest priority (nice 19), the fuzzers' build and smoke run, then every other test. The
-# real-time suites leave about one of two cores idle (SITL: 372 s wall, 379 CPU-s); the
-# low-priority work fills it without taking CPU the real-time ones ask for.
+# Runs every test of a built tree. First the cases labelled `alone` with nothing beside them:
+# the browser's, which hold a latency bound, and Listing 2 on SITL, which holds each position
+# report of an orbit to 5 %. Then the real-time suites (label `realtime`: SITL firmware, DDS
+# processes, signals) at normal priority, and beside them, at the lowest priority (nice 19),
+# the fuzzers' build and smoke run, then every other test. The real-time suites leave about
+# one of two cores idle (SITL: 372 s wall, 379 CPU-s); the low-priority work fills it without
+# taking CPU the real-time ones ask for.
 # Usage: scripts/test.sh BUILD_DIR FUZZ_BUILD_DIR FUZZ_SECONDS_PER_TARGET
 set -uo pipefail
 BUILD=${1:-build}
