@@ -213,6 +213,7 @@ class MavlinkDrone final : public mid::AdapterDrone {
   void lose_link();
   void request_telemetry();
   void check_goal();
+  void bring_takeoff_back_over_its_start();
   void send(const mavlink::Message& m);
   void send_heartbeat();
   mavlink::CommandLong command(uint16_t id, std::array<float, 7> params = {}) const;

@@ -354,6 +354,10 @@ void SimVehicle::start(const std::string& action, std::vector<double> args,
     if (end.outcome != mid::Outcome::succeeded) return;
     if (mode_after) mode_ = *mode_after;
     if (action == "Land" || action == "ReturnHome") after_touchdown();
+    if (action == "Takeoff" && options_.hover_wander_east_m != 0.0) {
+      const mid::DroneState s = drone_.state();
+      start("FlyTo", {s.x + options_.hover_wander_east_m, s.y, s.z});  // until a mode or setpoint preempts it
+    }
   });
 }
 

@@ -99,6 +99,9 @@ struct VehicleOptions {
   /// next one, and says so as PX4 does to a ground station: STATUSTEXT "Disarmed by auto
   /// preflight disarming" (here to any link).
   double preflight_disarm_s = 0.0;
+  /// Its own hover after a takeoff wanders this far east (m) at once, as PX4 SITL's did (up to
+  /// 1 m within 5 s, its estimate moving); 0: it stays over where it took off.
+  double hover_wander_east_m = 0.0;
 };
 
 class SimVehicle {
