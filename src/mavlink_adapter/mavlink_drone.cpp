@@ -272,7 +272,14 @@ void MavlinkDrone::start_takeoff(ActionId id, double altitude) {
   }
   armed_waiting_ = false;
   const Vec3 here = position();
-  goal_.emplace(Vec3{here.x, here.y, ground_z() + altitude}, settings_.tolerance);
+  // A Takeoff asks for a height: done once settled at it, wherever across the autopilot's own
+  // climb and hover put the vehicle. PX4 SITL's hover after its takeoff wandered up to 1 m (its
+  // estimate moving); judged over where it began, Listing 2's Takeoff(10) waited up to 5 s for
+  // the wander to come back, and Drone2's orbit was then too short to judge (docs/adapters.md,
+  // "PX4's orbit, twelfth session"). The hold after every goal brings it back over its start.
+  fleet::GoalTolerance height_only = settings_.tolerance;
+  height_only.horizontal_m = std::numeric_limits<double>::infinity();
+  goal_.emplace(Vec3{here.x, here.y, ground_z() + altitude}, height_only);
   until_ = Until::reached;
   if (!vehicle_.landed()) {
     // Already up: autopilots refuse NAV_TAKEOFF in the air, the simulator climbs or descends

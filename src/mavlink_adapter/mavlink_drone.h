@@ -213,7 +213,6 @@ class MavlinkDrone final : public mid::AdapterDrone {
   void lose_link();
   void request_telemetry();
   void check_goal();
-  void bring_takeoff_back_over_its_start();
   void send(const mavlink::Message& m);
   void send_heartbeat();
   mavlink::CommandLong command(uint16_t id, std::array<float, 7> params = {}) const;
@@ -231,6 +230,7 @@ class MavlinkDrone final : public mid::AdapterDrone {
   void advance_orbit(double dt);
   /// PX4, out to its circle on our setpoints: the heading (rad from north) that faces the centre.
   std::optional<double> orbit_setpoint_yaw() const;
+  double near_orbit_start_m() const;
   bool faces_orbit_centre() const;  ///< within kFacingDeg, or the heading is not known
   /// DO_ORBIT: PX4 flies its circle a little off the radius asked for (docs/adapters.md);
   /// from each position report (vehicle s) the radius asked for is corrected by the one flown.

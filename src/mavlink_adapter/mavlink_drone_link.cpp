@@ -495,7 +495,6 @@ void MavlinkDrone::check_goal() {
     done = goal_ && vehicle_.have_position && goal_->reached(position()) &&
            vehicle_.settling_speed() <= settings_.tolerance.settled_mps;
   if (until_ == Until::landed) done = vehicle_.landed();
-  if (!done && until_ == Until::reached) bring_takeoff_back_over_its_start();
   if (!done) return;
   ActionId id = motion_owner_;
   motion_owner_ = mid::kNoAction;
@@ -507,26 +506,6 @@ void MavlinkDrone::check_goal() {
   // PX4 needs the stream before OFFBOARD, and an already running stream lets the next
   // FlyTo start at once instead of half a second later.
   holding_ = setpoint_ = goal_target;
-  stream_setpoints();
-}
-
-// A Takeoff from the ground is flown in the autopilot's own mode (streaming_ is false only
-// then while a goal is pending), and at its height the autopilot hovers by itself. PX4 SITL's
-// hover wandered up to 1 m from where it took off (its estimate moving), and the Takeoff,
-// judged over where it began, waited for the wander to come back: 5 s in one Listing 2 run
-// (Drone2's orbit was then too short to judge), for ever in another (a Takeoff(3) timed out
-// 0.71 m across). So at its height, beyond the goal's horizontal tolerance, the vehicle is
-// brought back with our setpoints, as the hold after any Takeoff does.
-void MavlinkDrone::bring_takeoff_back_over_its_start() {
-  if (streaming_ || !goal_ || !vehicle_.have_position || mode_commands_pending_ > 0) return;
-  const Vec3 off = position() - goal_->target();
-  if (std::fabs(off.z) > settings_.tolerance.vertical_m || horizontal_norm(off) <= settings_.tolerance.horizontal_m)
-    return;
-  char text[128];
-  std::snprintf(text, sizeof text, "at its height %.2f m across from where it took off: brought back with setpoints",
-                horizontal_norm(off));
-  note(text);
-  setpoint_ = goal_->target();
   stream_setpoints();
 }
 
