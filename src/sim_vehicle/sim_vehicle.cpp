@@ -329,9 +329,9 @@ void SimVehicle::start_then_ack(uint16_t command, const std::string& action, std
 void SimVehicle::fly_to_setpoint() {
   if (mode_ != Mode::setpoint || !have_setpoint_) return;
   if (flying_ && flying_to_ == setpoint_) return;
-  flying_to_ = setpoint_;
+  flying_to_ = setpoint_;  // the setpoint, not where the hold stands (a stand-off is no new setpoint)
   flying_ = true;
-  start("FlyTo", {setpoint_.x, setpoint_.y, setpoint_.z});
+  start("FlyTo", {setpoint_.x + options_.setpoint_standoff_east_m, setpoint_.y, setpoint_.z});
 }
 
 void SimVehicle::check_offboard() {

@@ -102,6 +102,9 @@ struct VehicleOptions {
   /// Its own hover after a takeoff wanders this far east (m) at once, as PX4 SITL's did (up to
   /// 1 m within 5 s, its estimate moving); 0: it stays over where it took off.
   double hover_wander_east_m = 0.0;
+  /// Its setpoint hold stands this far east of the setpoint (m), as PX4 SITL's OFFBOARD stood
+  /// 0.6-0.7 m off the circle's east point for seconds; 0: it holds on the setpoint.
+  double setpoint_standoff_east_m = 0.0;
 };
 
 class SimVehicle {

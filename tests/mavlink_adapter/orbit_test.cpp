@@ -145,6 +145,30 @@ TEST(MavlinkOrbit, OnItsWayOutToAPx4OrbitTheVehicleTurnsToFaceTheCentreBeforeDoO
   EXPECT_NEAR(heading_before, 270.0, 10.0);  // faced the centre as DO_ORBIT went
 }
 
+// PX4 SITL's OFFBOARD hold stood 0.6-0.7 m off the circle's east point for seconds. Judged by
+// the goal tolerance (0.5 m), the wait for the orbit's start never began and DO_ORBIT went
+// 10.6 s late on SITL: PX4's wait begins within its own acceptance radius of its circle (1 m),
+// and after the wait's fallback (1.5 s) the orbit starts from where the vehicle stands.
+TEST(MavlinkOrbit, APx4HoldStandingOffTheEastPointStillStartsTheOrbitAfterTheWait) {
+  sim_vehicle::VehicleOptions options = VehicleThread::options(sim_vehicle::px4_dialect(), 1, 100.0, true);
+  options.setpoint_standoff_east_m = 0.7;
+  VehicleThread vehicle(25411, kSpeed, options);
+  Flight f(25411);
+  Orbiting o;
+  take_off_and_orbit(f, o, 0.0);
+  double stood_off = 0.0;
+  for (int i = 0; i < 200 && do_orbits(vehicle) == 0 && !o.end; ++i) {  // 10 mission s at most
+    stood_off = std::max(stood_off, f.drone->state().x - kRadius);
+    f.loop.run_until(f.loop.now() + 0.05);
+  }
+  EXPECT_GT(stood_off, 0.6) << "the hold never stood off: the test tests nothing";
+  ASSERT_GT(do_orbits(vehicle), 0) << "DO_ORBIT never went";
+  EXPECT_FALSE(o.end);
+  auto start = vehicle.inspect([](const sim_vehicle::SimVehicle& s) { return s.orbit_start(); });
+  EXPECT_NEAR(start.vehicle.x, kRadius + 0.7, 0.15);  // from where it stood
+  EXPECT_NEAR(start.centre.x, 0.0, 0.1);               // around the centre asked for
+}
+
 // PX4 keeps its HEARTBEAT at 1 Hz, and a radius correction goes only right after a HEARTBEAT
 // that shows the Orbit mode: while PX4 orbits, the adapter asks for one with REQUEST_MESSAGE
 // (as on the ground), so the corrections keep up with the circle; hovering in the air it
