@@ -56,6 +56,10 @@ std::vector<MessageDef> build_table() {
   t.push_back(make(msg::PARAM_SET, "PARAM_SET",
                    {{T::u8, "target_system"}, {T::u8, "target_component"},
                     {T::char_, "param_id", 16}, {T::f32, "param_value"}, {T::u8, "param_type"}}));
+  // The vehicle's estimate of its attitude: a test compares its heading with a simulator's truth.
+  t.push_back(make(msg::ATTITUDE, "ATTITUDE",
+                   {{T::u32, "time_boot_ms"}, {T::f32, "roll"}, {T::f32, "pitch"}, {T::f32, "yaw"},
+                    {T::f32, "rollspeed"}, {T::f32, "pitchspeed"}, {T::f32, "yawspeed"}}));
   t.push_back(make(msg::LOCAL_POSITION_NED, "LOCAL_POSITION_NED",
                    {{T::u32, "time_boot_ms"}, {T::f32, "x"}, {T::f32, "y"}, {T::f32, "z"},
                     {T::f32, "vx"}, {T::f32, "vy"}, {T::f32, "vz"}}));

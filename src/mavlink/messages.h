@@ -18,6 +18,7 @@ inline constexpr uint32_t SYS_STATUS = 1;
 inline constexpr uint32_t PARAM_REQUEST_READ = 20;
 inline constexpr uint32_t PARAM_VALUE = 22;
 inline constexpr uint32_t PARAM_SET = 23;
+inline constexpr uint32_t ATTITUDE = 30;
 inline constexpr uint32_t LOCAL_POSITION_NED = 32;
 inline constexpr uint32_t GLOBAL_POSITION_INT = 33;
 inline constexpr uint32_t COMMAND_INT = 75;

@@ -167,6 +167,7 @@ std::optional<GlobalPositionInt> unpack_global_position_int(const Message& m) {
 Message pack(const HilStateQuaternion& m) {
   FieldWriter w(def_of(msg::HIL_STATE_QUATERNION));
   w.set("time_usec", m.time_usec);
+  for (int k = 0; k < 4; ++k) w.set("attitude_quaternion", m.attitude_quaternion[k], k);
   w.set("lat", m.lat);
   w.set("lon", m.lon);
   w.set("alt", m.alt);
@@ -179,9 +180,25 @@ Message pack(const HilStateQuaternion& m) {
 std::optional<HilStateQuaternion> unpack_hil_state_quaternion(const Message& m) {
   if (m.id != msg::HIL_STATE_QUATERNION) return std::nullopt;
   FieldReader r(def_of(m.id), m);
-  return HilStateQuaternion{r.get<uint64_t>("time_usec"), r.get<int32_t>("lat"), r.get<int32_t>("lon"),
-                            r.get<int32_t>("alt"),        r.get<int16_t>("vx"),  r.get<int16_t>("vy"),
-                            r.get<int16_t>("vz")};
+  HilStateQuaternion out{r.get<uint64_t>("time_usec"), {}, r.get<int32_t>("lat"), r.get<int32_t>("lon"),
+                         r.get<int32_t>("alt"), r.get<int16_t>("vx"), r.get<int16_t>("vy"), r.get<int16_t>("vz")};
+  for (int k = 0; k < 4; ++k) out.attitude_quaternion[k] = r.get<float>("attitude_quaternion", k);
+  return out;
+}
+
+Message pack(const Attitude& m) {
+  FieldWriter w(def_of(msg::ATTITUDE));
+  w.set("time_boot_ms", m.time_boot_ms);
+  w.set("roll", m.roll);
+  w.set("pitch", m.pitch);
+  w.set("yaw", m.yaw);
+  return w.take();
+}
+
+std::optional<Attitude> unpack_attitude(const Message& m) {
+  if (m.id != msg::ATTITUDE) return std::nullopt;
+  FieldReader r(def_of(m.id), m);
+  return Attitude{r.get<uint32_t>("time_boot_ms"), r.get<float>("roll"), r.get<float>("pitch"), r.get<float>("yaw")};
 }
 
 Message pack(const OrbitExecutionStatus& m) {

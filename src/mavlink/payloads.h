@@ -57,10 +57,17 @@ struct OrbitExecutionStatus {
   float z = 0;         ///< m, in `frame`
 };
 
-/// A simulator's true position and velocity (HIL_STATE_QUATERNION; PX4 SIH sends its ground
-/// truth as this when asked): the attitude and accelerations are not read.
+/// The vehicle's estimated attitude (ATTITUDE).
+struct Attitude {
+  uint32_t time_boot_ms = 0;
+  float roll = 0, pitch = 0, yaw = 0;  ///< rad; yaw from north, clockwise
+};
+
+/// A simulator's true attitude, position and velocity (HIL_STATE_QUATERNION; PX4 SIH sends its
+/// ground truth as this when asked): the rates and accelerations are not read.
 struct HilStateQuaternion {
   uint64_t time_usec = 0;
+  std::array<float, 4> attitude_quaternion{1, 0, 0, 0};  ///< w, x, y, z
   int32_t lat = 0, lon = 0;        ///< degE7
   int32_t alt = 0;                 ///< mm above mean sea level
   int16_t vx = 0, vy = 0, vz = 0;  ///< cm/s, north east down
@@ -183,6 +190,7 @@ Message pack(const ParamRequestRead& m);
 Message pack(const ParamValue& m);
 Message pack(const ParamSet& m);
 Message pack(const SysStatus& m);
+Message pack(const Attitude& m);
 Message pack(const LocalPositionNed& m);
 Message pack(const GlobalPositionInt& m);
 Message pack(const HilStateQuaternion& m);
@@ -216,6 +224,7 @@ std::optional<SysStatus> unpack_sys_status(const Message& m);
 std::optional<LocalPositionNed> unpack_local_position_ned(const Message& m);
 std::optional<GlobalPositionInt> unpack_global_position_int(const Message& m);
 std::optional<HilStateQuaternion> unpack_hil_state_quaternion(const Message& m);
+std::optional<Attitude> unpack_attitude(const Message& m);
 std::optional<OrbitExecutionStatus> unpack_orbit_execution_status(const Message& m);
 std::optional<CommandLong> unpack_command_long(const Message& m);
 std::optional<CommandInt> unpack_command_int(const Message& m);

@@ -36,7 +36,7 @@ TEST(Crc, CalculateContinuesFromAGivenCrc) {
 const std::map<uint32_t, uint8_t> kPublished = {
     {msg::HEARTBEAT, 50},           {msg::SYS_STATUS, 124},
     {msg::PARAM_REQUEST_READ, 214}, {msg::PARAM_VALUE, 220},
-    {msg::PARAM_SET, 168},
+    {msg::PARAM_SET, 168},          {msg::ATTITUDE, 39},
     {msg::LOCAL_POSITION_NED, 185}, {msg::GLOBAL_POSITION_INT, 104},
     {msg::COMMAND_INT, 158},        {msg::COMMAND_LONG, 152},
     {msg::COMMAND_ACK, 143},        {msg::SET_POSITION_TARGET_LOCAL_NED, 143},

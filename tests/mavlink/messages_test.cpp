@@ -31,7 +31,7 @@ TEST(MessageTable, ExtensionsStayLastAndUnsorted) {
 
 TEST(MessageTable, LengthsMatchCommonXml) {
   struct Want { uint32_t id; int base; int full; };
-  for (Want w : {Want{msg::HEARTBEAT, 9, 9}, Want{msg::SYS_STATUS, 31, 43},
+  for (Want w : {Want{msg::HEARTBEAT, 9, 9}, Want{msg::SYS_STATUS, 31, 43}, Want{msg::ATTITUDE, 28, 28},
                  Want{msg::LOCAL_POSITION_NED, 28, 28}, Want{msg::GLOBAL_POSITION_INT, 28, 28},
                  Want{msg::COMMAND_INT, 35, 35}, Want{msg::COMMAND_LONG, 33, 33},
                  Want{msg::COMMAND_ACK, 3, 10}, Want{msg::SET_POSITION_TARGET_LOCAL_NED, 53, 53},

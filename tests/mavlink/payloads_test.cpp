@@ -99,17 +99,28 @@ TEST(RoundTrip, GlobalPositionInt) {
   EXPECT_EQ(out->hdg, 35999);
 }
 
-TEST(RoundTrip, HilStateQuaternionKeepsTheTruePositionAndVelocity) {
-  HilStateQuaternion in{1234567890123, 473977418, -85455939, 498000, -250, 310, -12};
+TEST(RoundTrip, HilStateQuaternionKeepsTheTrueAttitudePositionAndVelocity) {
+  HilStateQuaternion in{1234567890123, {0.5f, -0.5f, 0.25f, -0.75f}, 473977418, -85455939, 498000, -250, 310, -12};
   auto out = unpack_hil_state_quaternion(through_the_wire(pack(in)));
   ASSERT_TRUE(out);
   EXPECT_EQ(out->time_usec, 1234567890123u);
+  EXPECT_EQ(out->attitude_quaternion, in.attitude_quaternion);
   EXPECT_EQ(out->lat, 473977418);
   EXPECT_EQ(out->lon, -85455939);
   EXPECT_EQ(out->alt, 498000);
   EXPECT_EQ(out->vx, -250);
   EXPECT_EQ(out->vy, 310);
   EXPECT_EQ(out->vz, -12);
+}
+
+TEST(RoundTrip, AttitudeKeepsTimeAndAngles) {
+  Attitude in{4321, 0.125f, -0.25f, 3.0f};
+  auto out = unpack_attitude(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->time_boot_ms, 4321u);
+  EXPECT_EQ(out->roll, 0.125f);
+  EXPECT_EQ(out->pitch, -0.25f);
+  EXPECT_EQ(out->yaw, 3.0f);
 }
 
 TEST(RoundTrip, CommandLong) {

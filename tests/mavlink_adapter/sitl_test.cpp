@@ -472,11 +472,11 @@ void Sitl::fly_listing2(const std::string& extra) {
   std::pair<double, double> centre{cy - kHomes[1].y, cx - kHomes[1].x};  // north, east of home
   if (std::getenv("EAMOS_KEEP_SITL_DIRS")) {  // the second ground station's view, for a look at the orbit
     std::ofstream csv(dir_ / "watch.csv");
-    csv << "wall_s,north,east,down,speed,custom_mode,lat_e7,lon_e7,orbit_lat_e7,orbit_lon_e7,true_lat_e7,true_lon_e7\n";
+    csv << "wall_s,north,east,down,speed,custom_mode,lat_e7,lon_e7,orbit_lat_e7,orbit_lon_e7,true_lat_e7,true_lon_e7,yaw,true_yaw\n";
     for (const auto& s : watch.samples())
       csv << s.wall_s << ',' << s.north << ',' << s.east << ',' << s.down << ',' << s.speed << ',' << s.custom_mode << ','
           << s.lat_e7 << ',' << s.lon_e7 << ',' << s.orbit_lat_e7 << ',' << s.orbit_lon_e7 << ',' << s.true_lat_e7 << ','
-          << s.true_lon_e7 << '\n';
+          << s.true_lon_e7 << ',' << s.yaw << ',' << s.true_yaw << '\n';
     std::cout << "[sitl] centre north " << centre.first << ", east " << centre.second << "\n";
   }
   std::optional<Circle> orbit = orbit_of(watch.samples(), orbit_mode, centre, speed, radii, why);

@@ -591,7 +591,7 @@ constexpr int kWatchPollsPerAsk = 50;  ///< the ground station's HEARTBEAT and t
 void ask_for_rates(ml::Link& link, ml::Encoder& encoder, uint8_t vehicle, bool truth) {
   send_gcs_heartbeat(link, encoder);
   // 20 Hz of the vehicle's time; GLOBAL_POSITION_INT is the frame PX4 orbits in.
-  for (uint32_t id : {ml::msg::LOCAL_POSITION_NED, ml::msg::GLOBAL_POSITION_INT})
+  for (uint32_t id : {ml::msg::LOCAL_POSITION_NED, ml::msg::GLOBAL_POSITION_INT, ml::msg::ATTITUDE})
     send_command(link, encoder, vehicle, ml::cmd::SET_MESSAGE_INTERVAL, static_cast<float>(id), 50000);
   // PX4 SIH's ground truth at the same rate: where the vehicle really flew, beside its estimate.
   if (truth)
@@ -599,6 +599,11 @@ void ask_for_rates(ml::Link& link, ml::Encoder& encoder, uint8_t vehicle, bool t
                  50000);
   // The mode at 10 Hz, as eamos asks for it (ArduPilot takes it; PX4 does not).
   send_command(link, encoder, vehicle, ml::cmd::SET_MESSAGE_INTERVAL, static_cast<float>(ml::msg::HEARTBEAT), 100000);
+}
+
+// The heading of a w, x, y, z quaternion (body to north-east-down), rad from north.
+double yaw_of(const std::array<float, 4>& q) {
+  return std::atan2(2.0 * (q[0] * q[3] + q[1] * q[2]), 1.0 - 2.0 * (q[2] * q[2] + q[3] * q[3]));
 }
 
 void request_heartbeat(ml::Link& link, ml::Encoder& encoder, uint8_t vehicle) {
@@ -612,6 +617,7 @@ struct SitlWatch::State {
   uint32_t custom_mode = 0;
   bool armed = false;
   int32_t lat_e7 = 0, lon_e7 = 0, orbit_lat_e7 = 0, orbit_lon_e7 = 0, true_lat_e7 = 0, true_lon_e7 = 0;
+  double yaw = 0, true_yaw = 0;
   std::unique_ptr<ml::Link> link;
   std::thread asker;
   std::mutex stop_mutex;
@@ -634,11 +640,15 @@ SitlWatch::SitlWatch(const SitlFleet& fleet, int i) : state_(std::make_unique<St
     }
     if (auto g = ml::unpack_global_position_int(f.message)) st->lat_e7 = g->lat, st->lon_e7 = g->lon;
     if (auto o = ml::unpack_orbit_execution_status(f.message)) st->orbit_lat_e7 = o->x, st->orbit_lon_e7 = o->y;
-    if (auto t = ml::unpack_hil_state_quaternion(f.message)) st->true_lat_e7 = t->lat, st->true_lon_e7 = t->lon;
+    if (auto t = ml::unpack_hil_state_quaternion(f.message)) {
+      st->true_lat_e7 = t->lat, st->true_lon_e7 = t->lon;
+      st->true_yaw = yaw_of(t->attitude_quaternion);
+    }
+    if (auto a = ml::unpack_attitude(f.message)) st->yaw = a->yaw;
     if (auto p = ml::unpack_local_position_ned(f.message))
       st->samples.push_back({now_s(), p->x, p->y, p->z, std::hypot(p->vx, p->vy), st->custom_mode, st->armed,
                              st->lat_e7, st->lon_e7, st->orbit_lat_e7, st->orbit_lon_e7, st->true_lat_e7,
-                             st->true_lon_e7});
+                             st->true_lon_e7, st->yaw, st->true_yaw});
   });
   if (!opened.link) {
     error_ = "cannot watch SITL instance " + std::to_string(i) + " on " + url + ": " + opened.error;

@@ -121,6 +121,9 @@ struct VehicleSample {
   int32_t orbit_lat_e7 = 0, orbit_lon_e7 = 0;  ///< the newest ORBIT_EXECUTION_STATUS's centre (PX4), else 0
   /// Where the vehicle really was: the newest HIL_STATE_QUATERNION (PX4 SIH's ground truth), else 0.
   int32_t true_lat_e7 = 0, true_lon_e7 = 0;
+  /// Heading, rad from north: the newest ATTITUDE (the vehicle's estimate) and the newest
+  /// HIL_STATE_QUATERNION (PX4 SIH's truth, else 0).
+  double yaw = 0, true_yaw = 0;
 };
 
 /// A second ground station on one instance (ArduPilot SERIAL1, TCP 5762 + 10 n; PX4's GCS
