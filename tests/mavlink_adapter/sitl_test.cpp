@@ -36,15 +36,15 @@ using Sequences = std::map<std::string, std::vector<std::string>>;
 constexpr double kSpeed = 5;
 
 // How far a single position report on the orbit may be from 5 m (distance from the orbit's
-// centre), beside the 5 % that the samples' mean must hold. A single report carries the EKF's
-// noise and the controller's swing, and the SITL's physics and estimator run on the wall
-// clock: these tests run with nothing beside them (label `alone`, CMakeLists.txt). ArduCopter,
-// on our setpoints led by the vehicle's lag: 5 %, as issue 12 asks (4.82 .. 5.15 m in 13
-// runs). PX4, in its own ORBIT mode, facing the centre before DO_ORBIT and corrected five
-// times a vehicle second: 10 %. On this machine 106 of 112 runs held 5 %, but in CI one long
-// orbit sank to 4.47 m, the estimator parting from the truth (docs/adapters.md, "PX4's
-// orbit, twelfth session"): issue 12's 5 % is not reliable there.
-double sample_bound(Autopilot a) { return a == Autopilot::ardupilot ? 0.25 : 0.5; }
+// centre): 5 %, as issue 12 asks, on both autopilots, beside the 5 % that the samples' mean
+// must hold. ArduCopter, on our setpoints led by the vehicle's lag: 4.82 .. 5.15 m in 13
+// runs. PX4, in its own ORBIT mode, facing the centre before DO_ORBIT and corrected five times
+// a vehicle second: 31 of 32 runs held it on 2026-12-05, 144 of 152 since the eleventh
+// session. Its misses, by 0.1-10 cm, come from PX4 SIH's estimator parting from the truth
+// (docs/adapters.md, "PX4's orbit, thirteenth session"); ctest runs a failed case once more.
+// The SITL's physics and estimator run on the wall clock: these tests run with nothing beside
+// them (label `alone`, CMakeLists.txt).
+constexpr double kSampleBound = 0.25;
 
 struct Flight {
   eamos_test::Output run;
@@ -491,12 +491,12 @@ void Sitl::fly_listing2(const std::string& extra) {
   for (const std::string& text : f.vehicle["Drone2"])
     if (text.find("DO_ORBIT radius") != std::string::npos) std::cout << "  " << text << "\n";
   // Orbit() is 5 m, held within 5 % (issue 12) on average around where the Orbit started, and
-  // every sample within sample_bound(), on both autopilots: ArduCopter from setpoints, PX4 in its
+  // every sample within kSampleBound, on both autopilots: ArduCopter from setpoints, PX4 in its
   // own ORBIT mode with the radius corrected by the one flown (docs/adapters.md). The radii are
   // printed above.
   EXPECT_NEAR(orbit->radius, 5.0, 0.25);
-  EXPECT_GE(*low, 5.0 - sample_bound(GetParam()));
-  EXPECT_LE(*high, 5.0 + sample_bound(GetParam()));
+  EXPECT_GE(*low, 5.0 - kSampleBound);
+  EXPECT_LE(*high, 5.0 + kSampleBound);
 }
 
 TEST_P(Sitl, Listing2FliesTheSimulatorsActionsWithConfirmedPicturesAndAFiveMetreOrbit) { fly_listing2(""); }
