@@ -228,6 +228,7 @@ class MavlinkDrone final : public mid::AdapterDrone {
   void leave_orbit();
   bool left_orbit_mode();  ///< the vehicle left DO_ORBIT's mode: the orbit failed
   void advance_orbit(double dt);
+  bool done_moving_out() const;
   /// PX4, out to its circle on our setpoints: the heading (rad from north) that faces the centre.
   std::optional<double> orbit_setpoint_yaw() const;
   double near_orbit_start_m() const;

@@ -68,7 +68,9 @@ constexpr double kSpeedSmoothingS = 0.5;
 constexpr double kStartStillMps = 0.08;     ///< DO_ORBIT once the vehicle is this still ...
 constexpr double kStartOnCircleM = 0.15;    ///< ... this close to the circle ...
 constexpr double kFacingDeg = 10.0;         ///< ... turned this near to the centre ...
-constexpr double kStartWaitS = 1.5;         ///< ... or has waited this long (mission s) there
+constexpr double kStartWaitS = 1.5;         ///< ... or has waited this long (mission s) there,
+constexpr double kStartOutwardMps = 0.08;   ///< ... and on PX4 no longer moves out this fast,
+constexpr double kStartWaitMostS = 5.0;     ///< ... or has waited this long
 }  // namespace
 
 // How near the east point the wait for the orbit's start begins. PX4 circles from where it
@@ -213,6 +215,7 @@ void MavlinkDrone::advance_orbit(double dt) {
     // gusty hold) starts after kStartWaitS all the same.
     if (orbit_.do_orbit_sent) return;
     orbit_.waited_at_start_s += dt;
+    if (autopilot_->do_orbit && !done_moving_out()) return;
     const bool still = norm(vehicle_.ned_velocity) <= kStartStillMps &&
                        std::fabs(horizontal_norm(position() - orbit_.centre) - r) <= kStartOnCircleM &&
                        faces_orbit_centre();
@@ -242,6 +245,24 @@ void MavlinkDrone::advance_orbit(double dt) {
   const double rc = orbit_.commanded_radius * std::sqrt(1.0 + w * w * kFollowerLagS * kFollowerLagS);
   setpoint_ = {orbit_.centre.x + rc * std::cos(orbit_.angle),
                orbit_.centre.y + rc * std::sin(orbit_.angle), orbit_.centre.z};
+}
+
+// PX4 SITL arrives at the east point overshooting it by 0.2-0.45 m (its velocity integrator,
+// wound up against SIH's drag on the move out, carries it on while it brakes), and its
+// estimator's velocity read under the goal's 0.3 m/s while the position still moved out at
+// 0.3-0.7 m/s: DO_ORBIT went within the overshoot, the vehicle carried on outward, and in CI
+// it was still 0.31 m out 2 s later (docs/adapters.md, "PX4's orbit, thirteenth session").
+// So the start waits, by the vehicle's positions over the last half second, until the
+// distance from the centre no longer grows, at most kStartWaitMostS.
+bool MavlinkDrone::done_moving_out() const {
+  if (orbit_.waited_at_start_s >= kStartWaitMostS) return true;
+  const auto& track = vehicle_.track;
+  if (track.size() < 2 || track.back().first - track.front().first < kTrackMinSpanMs) return true;
+  auto distance = [this](const Vec3& ned) {
+    return horizontal_norm(ned_to_mission(ned, settings_.home) - orbit_.centre);
+  };
+  const double span_s = (track.back().first - track.front().first) / 1000.0;
+  return (distance(track.back().second) - distance(track.front().second)) / span_s <= kStartOutwardMps;
 }
 
 // DO_ORBIT turns PX4's front to the centre (kYawFrontToCentre). Turned there from the takeoff's

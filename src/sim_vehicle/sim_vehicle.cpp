@@ -69,10 +69,18 @@ const Dialect& ardupilot_dialect() {
   return d;
 }
 
+namespace {
+fleet::DroneType vehicle_type(const fleet::Limits& limits) {
+  fleet::DroneType type = fleet::generic_multirotor("Quad");
+  type.limits = limits;
+  return type;
+}
+}  // namespace
+
 SimVehicle::SimVehicle(mid::EventLoop& loop, VehicleOptions options)
     : loop_(loop),
       options_(options),
-      drone_(vehicle_settings(options.sysid, options.battery_percent), fleet::generic_multirotor("Quad"), loop),
+      drone_(vehicle_settings(options.sysid, options.battery_percent), vehicle_type(options.limits), loop),
       encoder_{options.sysid, ml::comp::AUTOPILOT1, 0},
       dialect_(*options.dialect),
       mode_(dialect_.boot) {}
@@ -134,13 +142,13 @@ void SimVehicle::on_setup_signing(const ml::SetupSigning& s) {
   link_->verify_with(key, true);
 }
 
-// The speed parameters the real autopilot has, valued as the simulator flies (its default
-// limits: 10 m/s across, 3 up, 2 down, 4 m/s²; it takes off without spool-up or ramp, and returns
-// home at its altitude without waiting); a name it
-// does not know gets no answer, like on the real ones.
+// The speed parameters the real autopilot has, valued as this vehicle flies (options.limits,
+// by default the simulator's: 10 m/s across, 3 up, 2 down, 4 m/s²; it takes off without
+// spool-up or ramp, and returns home at its altitude without waiting); a name it does not
+// know gets no answer, like on the real ones.
 void SimVehicle::on_param_request(const ml::ParamRequestRead& r) {
   if ((r.target_system != options_.sysid && r.target_system != 0) || r.param_index != -1) return;
-  const fleet::Limits l;
+  const fleet::Limits& l = options_.limits;
   bool px4 = dialect_.mav_autopilot == ml::autopilot::PX4;
   const std::map<std::string, double> params =
       px4 ? std::map<std::string, double>{{"MPC_XY_CRUISE", l.max_speed_mps}, {"MPC_Z_VEL_MAX_UP", l.max_climb_mps},
@@ -424,6 +432,7 @@ ml::Message SimVehicle::telemetry(uint32_t id) const {
   Vec3 v = drone_.velocity();
   switch (id) {
     case ml::msg::LOCAL_POSITION_NED: {
+      v = v * options_.reported_velocity_scale;
       ml::LocalPositionNed p;
       p.time_boot_ms = static_cast<uint32_t>(s.t * 1000.0);
       p.x = static_cast<float>(s.y);

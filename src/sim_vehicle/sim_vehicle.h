@@ -105,6 +105,11 @@ struct VehicleOptions {
   /// Its setpoint hold stands this far east of the setpoint (m), as PX4 SITL's OFFBOARD stood
   /// 0.6-0.7 m off the circle's east point for seconds; 0: it holds on the setpoint.
   double setpoint_standoff_east_m = 0.0;
+  /// The velocity its LOCAL_POSITION_NED reports, as a fraction of the one it flies: PX4
+  /// SITL's estimator read under 0.3 m/s while the vehicle still moved at 0.3-0.7 m/s; 1: true.
+  double reported_velocity_scale = 1.0;
+  /// How fast it flies, and the speed parameters it answers with (the simulator's by default).
+  fleet::Limits limits;
 };
 
 class SimVehicle {

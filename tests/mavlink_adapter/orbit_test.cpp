@@ -169,6 +169,26 @@ TEST(MavlinkOrbit, APx4HoldStandingOffTheEastPointStillStartsTheOrbitAfterTheWai
   EXPECT_NEAR(start.centre.x, 0.0, 0.1);               // around the centre asked for
 }
 
+// PX4 SITL arrived at the east point overshooting it, and its estimator's velocity read under
+// 0.3 m/s while the vehicle still moved out at 0.3-0.7 m/s: DO_ORBIT went within the overshoot
+// and the vehicle carried on outward. The start waits, by the vehicle's positions, until it
+// no longer moves out, whatever its velocity report says.
+TEST(MavlinkOrbit, APx4OrbitStartsOnceTheVehicleNoLongerMovesOutWhateverItsVelocityReportSays) {
+  sim_vehicle::VehicleOptions options = VehicleThread::options(sim_vehicle::px4_dialect(), 1, 100.0, true);
+  options.setpoint_standoff_east_m = 0.7;  // it comes to rest 0.7 m beyond the east point ...
+  options.limits.max_speed_mps = 0.5;      // ... slowly ...
+  options.reported_velocity_scale = 0.0;   // ... reporting itself still all the way
+  VehicleThread vehicle(25412, kSpeed, options);
+  Flight f(25412);
+  Orbiting o;
+  take_off_and_orbit(f, o, 0.0);
+  for (int i = 0; i < 400 && do_orbits(vehicle) == 0 && !o.end; ++i) f.loop.run_until(f.loop.now() + 0.05);
+  ASSERT_GT(do_orbits(vehicle), 0) << "DO_ORBIT never went";
+  EXPECT_FALSE(o.end);
+  auto start = vehicle.inspect([](const sim_vehicle::SimVehicle& s) { return s.orbit_start(); });
+  EXPECT_NEAR(start.vehicle.x, kRadius + 0.7, 0.1);  // at rest where it stood off, not on its way there
+}
+
 // PX4 keeps its HEARTBEAT at 1 Hz, and a radius correction goes only right after a HEARTBEAT
 // that shows the Orbit mode: while PX4 orbits, the adapter asks for one with REQUEST_MESSAGE
 // (as on the ground), so the corrections keep up with the circle; hovering in the air it
