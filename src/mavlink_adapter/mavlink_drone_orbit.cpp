@@ -256,12 +256,12 @@ void MavlinkDrone::advance_orbit(double dt) {
 // distance from the centre no longer grows, at most kStartWaitMostS.
 bool MavlinkDrone::done_moving_out() const {
   if (orbit_.waited_at_start_s >= kStartWaitMostS) return true;
-  const auto& track = vehicle_.track;
-  if (track.size() < 2 || track.back().first - track.front().first < kTrackMinSpanMs) return true;
+  const double span_s = vehicle_.track_span_s();
+  if (span_s <= 0.0) return true;
   auto distance = [this](const Vec3& ned) {
     return horizontal_norm(ned_to_mission(ned, settings_.home) - orbit_.centre);
   };
-  const double span_s = (track.back().first - track.front().first) / 1000.0;
+  const auto& track = vehicle_.track;
   return (distance(track.back().second) - distance(track.front().second)) / span_s <= kStartOutwardMps;
 }
 

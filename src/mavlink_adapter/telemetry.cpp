@@ -16,10 +16,15 @@ bool VehicleState::landed() const {
   return landed_state == ml::landed::ON_GROUND;
 }
 
+double VehicleState::track_span_s() const {
+  if (track.size() < 2 || track.back().first - track.front().first < kTrackMinSpanMs) return 0.0;
+  return (track.back().first - track.front().first) / 1000.0;
+}
+
 double VehicleState::settling_speed() const {
-  if (track.size() < 2 || track.back().first - track.front().first < kTrackMinSpanMs) return norm(ned_velocity);
-  const double dt_s = (track.back().first - track.front().first) / 1000.0;
-  return norm(track.back().second - track.front().second) / dt_s;
+  const double span_s = track_span_s();
+  if (span_s <= 0.0) return norm(ned_velocity);
+  return norm(track.back().second - track.front().second) / span_s;
 }
 
 namespace {

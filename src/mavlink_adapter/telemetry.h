@@ -45,6 +45,9 @@ struct VehicleState {
   /// m/s over the track (its oldest to its newest position, in the vehicle's time); the
   /// estimator's ned_velocity while the track spans less than kTrackMinSpanMs.
   double settling_speed() const;
+  /// Vehicle seconds from the track's oldest to its newest position; 0 while it spans less
+  /// than kTrackMinSpanMs (too short to judge a motion by).
+  double track_span_s() const;
 };
 
 /// PX4 SIH on a loaded machine was seen holding 0.3-0.6 m short of a setpoint for seconds
