@@ -273,10 +273,10 @@ void MavlinkDrone::start_takeoff(ActionId id, double altitude) {
   armed_waiting_ = false;
   const Vec3 here = position();
   // A Takeoff asks for a height: done once settled at it, wherever across the autopilot's own
-  // climb and hover put the vehicle. PX4 SITL's hover after its takeoff wandered up to 1 m (its
-  // estimate moving); judged over where it began, Listing 2's Takeoff(10) waited up to 5 s for
-  // the wander to come back, and Drone2's orbit was then too short to judge (docs/adapters.md,
-  // "PX4's orbit, twelfth session"). The hold after every goal brings it back over its start.
+  // climb and hover put the vehicle. PX4 SITL's hover after its takeoff wanders up to 1 m (its
+  // estimate moving); judged over where it began, a Takeoff would wait seconds for the wander
+  // to come back, and everything the mission starts after it would start that much later. The
+  // hold after every goal brings the vehicle back over its start.
   fleet::GoalTolerance height_only = settings_.tolerance;
   height_only.horizontal_m = std::numeric_limits<double>::infinity();
   goal_.emplace(Vec3{here.x, here.y, ground_z() + altitude}, height_only);

@@ -24,9 +24,10 @@ constexpr float kYawFrontToCentre = 0;  ///< ORBIT_YAW_BEHAVIOUR_HOLD_FRONT_TO_C
 /// ArduCopter SITL followed setpoints going round 5 m at 4.5 m: a follower lagging by tau cuts
 /// a circle flown at angular rate w in by 1 / sqrt(1 + (w tau)^2), so the setpoints go round
 /// that much wider, w from the vehicle's own speed up to the orbit's (beyond, a vehicle that
-/// follows closely would be led ever wider by its own speed). A lead fixed from the start
-/// (1.08) carried the vehicle 0.2 m out while it sped up, and the integral it then wound down
-/// took it to 4.73 m half a turn later (docs/adapters.md, "ArduCopter's orbit within 5 %").
+/// follows closely would be led ever wider by its own speed). The lead grows with the
+/// vehicle's speed rather than being fixed from the start: a fixed lead holds the vehicle out
+/// while it speeds up, and the integral, wound down against that, then carries it inside the
+/// circle half a turn later.
 constexpr double kFollowerLagS = 0.9;
 constexpr double kRadiusGain = 0.25;  ///< 1/s: what the lead leaves (0.5: 4.80 .. 5.14 m; 2.0 oscillated)
 // DO_ORBIT's correction. PX4 re-approaches its circle when a new radius is more than its
@@ -37,12 +38,11 @@ constexpr double kRadiusGain = 0.25;  ///< 1/s: what the lead leaves (0.5: 4.80 
 // radial law three times as stiff and damped. The outward speed is the change of the distance
 // itself: GLOBAL_POSITION_INT's velocity, projected, read −0.25 m/s while the distance stood
 // still (the EKF's velocity and position disagree by that much as the vehicle speeds up). The
-// integral only takes out what is left over a turn: at 0.25 /s it lagged the once-a-turn
-// swing by a quarter turn and fed it. Five corrections a vehicle second (the HEARTBEAT is
-// polled for it, poll_heartbeat): at two, then at PX4's 1 Hz HEARTBEAT, the loop trailed the
-// swing it corrects. Measured in docs/adapters.md ("PX4's orbit, ninth session"). The
-// integral runs from the start: held back while the vehicle sped up (until the eleventh
-// session), it left the mean up to 0.2 m off for most of a short orbit.
+// integral only takes out what is left over a turn: a faster one (0.25 /s) lags PX4's
+// once-a-turn swing by a quarter turn and feeds it. Five corrections a vehicle second (the
+// HEARTBEAT is polled for it, poll_heartbeat): fewer, the loop trails the swing it corrects.
+// The integral runs from the start: held back while the vehicle speeds up, it would leave the
+// mean up to 0.2 m off for most of a short orbit.
 constexpr double kDoOrbitGain = 0.2;        ///< 1/s of vehicle time, on the radius error
 constexpr double kCorrectionEveryS = 0.2;   ///< at most five DO_ORBITs per vehicle second
 constexpr double kSmallestStepM = 0.03;     ///< a smaller change is not worth a command
@@ -74,11 +74,11 @@ constexpr double kStartWaitMostS = 5.0;     ///< ... or has waited this long
 }  // namespace
 
 // How near the east point the wait for the orbit's start begins. PX4 circles from where it
-// is, and its OFFBOARD hold stood 0.6-0.7 m off the east point for seconds (its estimate of
-// velocity and position disagreeing): judged by the goal tolerance (0.5 m), the wait had not
-// begun 10 s after the Orbit started, and Listing 2's orbit was too short to judge
-// (docs/adapters.md, "PX4's orbit, twelfth session"). Within PX4's own acceptance radius
-// (kOnCircleM) it begins; our setpoint orbit (ArduCopter) starts at the goal tolerance.
+// is, and its OFFBOARD hold can stand 0.6-0.7 m off the east point for seconds (its estimate of
+// velocity and position disagreeing): judged by the goal tolerance (0.5 m), the wait might not
+// begin for 10 s, and a short orbit (Listing 2's, ended by the others' landing) would be mostly
+// spent waiting. Within PX4's own acceptance radius (kOnCircleM) it begins; our setpoint orbit
+// (ArduCopter) starts at the goal tolerance.
 double MavlinkDrone::near_orbit_start_m() const {
   return autopilot_->do_orbit ? std::max(kOnCircleM, settings_.tolerance.horizontal_m)
                               : settings_.tolerance.horizontal_m;
@@ -230,12 +230,13 @@ void MavlinkDrone::advance_orbit(double dt) {
   const double vehicle_dt = dt * std::clamp(vehicle_clock_rate(), 0.2, 2.0);
   orbit_.angle = std::fmod(orbit_.angle + orbit_speed(r) * vehicle_dt / r, 2.0 * M_PI);
   // A position setpoint moving around the circle is followed with a lag, along a chord:
-  // ArduCopter circled at 4.5 m for 5 m. Feed-forward was tried and measured on ArduCopter
-  // SITL, at the accel-bounded speed too: with velocity the orbit grew to 6.9 m (5.9 m in
-  // 2026-12), with velocity and acceleration it shrank to 4.3 m and wobbled (3.6 .. 5.0 m;
-  // 4.67 .. 5.29 m in 2026-12), with velocity setpoints steered by the measured radius it swung
-  // 4.6 .. 5.1 m. Position setpoints stay the tightest. So they go round wider by the lag the
-  // vehicle's speed gives, and an integral on the radius error takes out what is left.
+  // ArduCopter circled at 4.5 m for 5 m. No feed-forward: on ArduCopter SITL, at the
+  // accel-bounded speed, velocity feed-forward grows the orbit to 6.9 m, velocity and
+  // acceleration shrink it to 4.3 m with a wobble of 3.6 .. 5.0 m, and velocity setpoints
+  // steered by the measured radius swing 4.6 .. 5.1 m (GUIDED integrates its own target between
+  // our setpoints and its jerk-limited shaping chases each new one). Position setpoints are the
+  // tightest, so they go round wider by the lag the vehicle's speed gives, and an integral on
+  // the radius error takes out what is left.
   if (vehicle_.have_position) {
     double flown = horizontal_norm(position() - orbit_.centre);
     orbit_.commanded_radius =
@@ -249,11 +250,11 @@ void MavlinkDrone::advance_orbit(double dt) {
 
 // PX4 SITL arrives at the east point overshooting it by 0.2-0.45 m (its velocity integrator,
 // wound up against SIH's drag on the move out, carries it on while it brakes), and its
-// estimator's velocity read under the goal's 0.3 m/s while the position still moved out at
-// 0.3-0.7 m/s: DO_ORBIT went within the overshoot, the vehicle carried on outward, and in CI
-// it was still 0.31 m out 2 s later (docs/adapters.md, "PX4's orbit, thirteenth session").
-// So the start waits, by the vehicle's positions over the last half second, until the
-// distance from the centre no longer grows, at most kStartWaitMostS.
+// estimator's velocity can read under the goal's 0.3 m/s while the position still moves out
+// at 0.3-0.7 m/s. DO_ORBIT sent within the overshoot lets the vehicle carry on outward, still
+// 0.3 m out of its circle 2 s later. So the start waits, by the vehicle's positions over the
+// last half second, until the distance from the centre no longer grows, at most
+// kStartWaitMostS.
 bool MavlinkDrone::done_moving_out() const {
   if (orbit_.waited_at_start_s >= kStartWaitMostS) return true;
   const double span_s = vehicle_.track_span_s();
@@ -266,10 +267,9 @@ bool MavlinkDrone::done_moving_out() const {
 }
 
 // DO_ORBIT turns PX4's front to the centre (kYawFrontToCentre). Turned there from the takeoff's
-// heading as the orbit began, a quarter turn at PX4's yaw rate limit while the vehicle sped
-// up, the circle sank 0.2-0.3 m in its first seconds (to 4.68-4.81 m for 5 in the runs that
-// missed 5 %); turned on the way out, it did not (docs/adapters.md, "PX4's orbit, eleventh
-// session"). ArduCopter's setpoint orbit keeps its heading: no yaw is sent there.
+// heading as the orbit begins, a quarter turn at PX4's yaw rate limit while the vehicle speeds
+// up, the circle sinks 0.2-0.3 m in its first seconds (to 4.68-4.81 m for 5); turned on the
+// way out, it does not. ArduCopter's setpoint orbit keeps its heading: no yaw is sent there.
 std::optional<double> MavlinkDrone::orbit_setpoint_yaw() const {
   if (!orbit_.active || !autopilot_->do_orbit) return std::nullopt;
   const Vec3 to_centre = orbit_.centre - setpoint_;  // mission frame: x east, y north
@@ -288,8 +288,8 @@ bool MavlinkDrone::faces_orbit_centre() const {
 // different from run to run and with the machine's load. As on ArduCopter, the radius asked
 // for is corrected by the one flown, an integral on the error, here sent as DO_ORBIT again
 // with the centre left NaN. The radius flown is the distance from the centre PX4 reports
-// (ORBIT_EXECUTION_STATUS), measured in GLOBAL_POSITION_INT's frame: a circle fitted to the
-// last half turn, tried first, swung 4.3 .. 6.1 m while the vehicle flew 4.6 .. 5.4 m.
+// (ORBIT_EXECUTION_STATUS), measured in GLOBAL_POSITION_INT's frame, not a circle fitted to
+// the last half turn: such a fit swings 4.3 .. 6.1 m while the vehicle flies 4.6 .. 5.4 m.
 // Without the autopilot's centre, the one it was given (start_orbit); without either, no
 // correction: PX4's own circle is better than one corrected by a wrong measure.
 void MavlinkDrone::correct_orbit_radius() {
