@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs every test of a built tree. First the cases labelled `alone` with nothing beside them:
 # the browser's, which hold a latency bound, and Listing 2 on SITL, which holds each position
-# report of an orbit to 5-10 %. Then the real-time suites (label `realtime`: SITL firmware, DDS
+# report of an orbit to 5 %. Then the real-time suites (label `realtime`: SITL firmware, DDS
 # processes, signals) at normal priority, and beside them, at the lowest priority (nice 19),
 # the fuzzers' build and smoke run, then every other test. The real-time suites leave about
 # one of two cores idle (SITL: 372 s wall, 379 CPU-s); the low-priority work fills it without

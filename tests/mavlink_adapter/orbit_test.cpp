@@ -93,8 +93,7 @@ TEST(MavlinkOrbit, APx4OrbitFlownShortIsCorrectedByDoOrbitsSentAgainWithTheCentr
   Flight f(25367);
   Orbiting o;
   // The lead makes up half the shortfall at once, the integral (0.2 /s, set for PX4 SITL) the
-  // rest. At 24 s, under the integral of 0.1 /s it had before, this vehicle still flew
-  // 2.83-2.90 m.
+  // rest; with an integral of 0.1 /s this vehicle still flies 2.83-2.90 m at 24 s.
   take_off_and_orbit(f, o, 40.0);
   EXPECT_FALSE(o.end);
   EXPECT_EQ(vehicle_mode(vehicle), Mode::orbit);
@@ -130,8 +129,8 @@ TEST(MavlinkOrbit, OnItsWayOutToAPx4OrbitTheVehicleTurnsToFaceTheCentreBeforeDoO
   take_off_and_orbit(f, o, 0.0);
   std::optional<double> named;
   // The heading the adapter knew while the vehicle had no DO_ORBIT yet: once in its Orbit mode,
-  // this vehicle reports its own heading again (under load that report was in before the
-  // check, and the test failed once in CI reading 90).
+  // this vehicle reports its own heading again (90), and under load that report can come in
+  // before the check.
   double heading_before = NAN;
   for (int i = 0; i < 800 && do_orbits(vehicle) == 0 && !o.end; ++i) {
     auto yaw = vehicle.inspect([](const sim_vehicle::SimVehicle& s) { return s.setpoint_yaw_deg(); });

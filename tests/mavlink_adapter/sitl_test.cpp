@@ -36,15 +36,12 @@ using Sequences = std::map<std::string, std::vector<std::string>>;
 constexpr double kSpeed = 5;
 
 // How far a single position report on the orbit may be from 5 m (distance from the orbit's
-// centre): 5 %, as issue 12 asks, on both autopilots, beside the 5 % that the samples' mean
-// must hold. ArduCopter, on our setpoints led by the vehicle's lag: 4.82 .. 5.15 m in 13
-// runs. PX4, in its own ORBIT mode, facing the centre before DO_ORBIT and corrected five times
-// a vehicle second: 85 of 87 runs held it on 2026-12-05, 198 of 207 since the eleventh
-// session. Its misses, by 0.1-10 cm, come from PX4 SIH's estimator parting from the truth
-// (and, before the thirteenth session, from starts while the vehicle still moved out;
-// docs/adapters.md, "PX4's orbit, thirteenth session"); ctest runs a failed case once more.
-// The SITL's physics and estimator run on the wall clock: these tests run with nothing beside
-// them (label `alone`, CMakeLists.txt).
+// centre): 5 %, on both autopilots, beside the 5 % that the samples' mean must hold.
+// ArduCopter, on our setpoints led by the vehicle's lag, holds it in every run; PX4, in its
+// own ORBIT mode with the radius corrected, in about 31 of 32 (docs/adapters.md, "Orbit"): its
+// misses, by a few centimetres, come from PX4 SIH's estimator parting from the truth, and
+// ctest runs a failed case once more. The SITL's physics and estimator run on the wall clock:
+// these tests run with nothing beside them (label `alone`, CMakeLists.txt).
 constexpr double kSampleBound = 0.25;
 
 struct Flight {
@@ -87,7 +84,8 @@ Flight fly(const std::string& mission, const std::string& fleet_yaml, const fs::
   f.run = eamos_test::run_eamos("run " + mission + " --fleet " + (dir / "fleet.yaml").string() + speed + " " +
                                     o.extra + " --trace " + (dir / "trace.jsonl").string(),
                                 o.on_line);
-  // EAMOS_SITL_VERBOSE=1: every flight's log, for docs/adapters.md's timings or a diagnosis.
+  // EAMOS_SITL_VERBOSE=1: every flight's log, for the mission times docs/adapters.md gives or
+  // for a diagnosis.
   // Its wall time always (ctest shows it for a failed case, beside the fixture's).
   if (std::getenv("EAMOS_SITL_VERBOSE")) std::cout << f.run.out;
   std::cout << "[sitl] eamos run: " << std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count()
@@ -120,7 +118,7 @@ double auto_disarm_seen_after(const Flight& f, const std::string& drone) {
   for (size_t i = 0; i < said.size(); ++i) {
     // PX4 says "Disarmed by landing" instead when its land detector saw a takeoff of the
     // vehicle standing armed (its estimate wandering) and then the landing: COM_DISARM_LAND
-    // disarmed it, as once in CI on 2026-12-05.
+    // disarms it then.
     const bool text = said[i].find("Disarming motors") != std::string::npos ||
                       said[i].find("Disarmed by auto preflight disarming") != std::string::npos ||
                       said[i].find("Disarmed by landing") != std::string::npos;
@@ -278,9 +276,9 @@ class Sitl : public ::testing::TestWithParam<Autopilot> {
   }
   /// The speed-up a flight runs at: 5, but PX4 with one DEX per drone at 3. At 5 three PX4
   /// instances and four eamos processes are more than two cores carry: the vehicles' clocks
-  /// fell to 0.7 of mission time, and an Arm (mode switch, ARM, their ACKs) timed out after
-  /// 10 mission s in CI (it takes under 4; docs/adapters.md). Listing 2 has its own; patrol,
-  /// whose timings are written for kSpeed, stays at 5.
+  /// fall to 0.7 of mission time, and an Arm (mode switch, ARM, their ACKs), which takes under
+  /// 4 mission s, can time out after 10. Listing 2 has its own; patrol, whose timings are
+  /// written for kSpeed, stays at 5.
   double flight_speed(const std::string& extra) const {
     return GetParam() == Autopilot::px4 && extra.find("--distributed") != std::string::npos ? 3.0 : kSpeed;
   }
@@ -426,9 +424,9 @@ TEST_P(Sitl, LinkLossWithOneDexPerDroneFailsTheMissionAndEveryOtherDroneRunsItsF
 
 // The speed-up Listing 2 flies at (EAMOS_SITL_LISTING2_SPEED overrides it, for a measurement).
 // PX4 at 3: at 5, three PX4 instances and the eamos processes are more than two cores carry,
-// and the vehicles' clocks ran at 0.70-0.79 of mission time; the orbit's corrections and the
-// mission's timing (Drone2's orbit is cut short by the others' Land) came out worse
-// (docs/adapters.md). It costs about 8 s a run.
+// and the vehicles' clocks run at 0.70-0.79 of mission time, which spoils the orbit's
+// corrections and the mission's timing (Drone2's orbit is cut short by the others' Land).
+// It costs about 8 s a run.
 double listing2_speed(Autopilot a) {
   if (const char* v = std::getenv("EAMOS_SITL_LISTING2_SPEED")) return std::clamp(std::atof(v), 0.5, 10.0);
   return a == Autopilot::px4 ? 3.0 : kSpeed;
@@ -535,8 +533,6 @@ std::string named_fleet(const SitlFleet& sitl, const std::vector<std::string>& n
 TEST_P(SitlExample, FliesToTheEndWithNoFailedAction) {
   const ExampleFlight& p = GetParam();
   if (SitlFleet::binary(p.autopilot).empty()) GTEST_SKIP() << SitlFleet::skip_message(p.autopilot);
-  // Known failures, seen on PX4 (docs/adapters.md, "SITL tests"): not hidden, but not run
-  // until fixed, so the suite stays a signal.
   const std::string mission = std::string(EAMOS_SOURCE_DIR) + "/examples/" + p.example + ".eamos";
   std::vector<std::string> names = declared_drones(mission);
   ASSERT_EQ(names.size(), 2u) << mission;

@@ -67,8 +67,8 @@ void metres_per_degree(double lat_deg, double& per_lat, double& per_lon) {
 
 // Where a fixture's wall time goes (boot, camera set-up, stop), one line per step, for the
 // suite's time budget (docs/adapters.md, "SITL tests"). Always on stderr, which ctest shows
-// only for a failed test: a CI run once spent 117 s of a failed case outside its 10 s flight,
-// and nothing said where.
+// only for a failed test: a failed case can spend far longer outside its flight than in it,
+// and this says where.
 void report_time(const std::string& step, double since_s) {
   std::fprintf(stderr, "[sitl] %s: %.2f s\n", step.c_str(), now_s() - since_s);
 }
