@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# The main job until mission execution exists: compile Listing 2 into deployment folders
-# and render its AMT, MEG and each drone's MDG as SVG (out/listing2/).
+# The main job (make demo): Listing 2 through every stage, into out/listing2/. Check and
+# compile it into deployment folders, render its AMT, MEG and each drone's MDG as SVG, fly it
+# in the simulator (trace, summary, picture), verify every example, fly the deployment as one
+# DEX process per drone over Cyclone DDS, and print how to replay the run in the browser.
 set -euo pipefail
 BUILD=${1:-build}
 EAMOS="$BUILD/src/cli/eamos"

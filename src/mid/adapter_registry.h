@@ -3,7 +3,7 @@
 // BehaviorTree.CPP factory registers node types. A drone type's (or drone's) `adapter:` in
 // the fleet file names the entry; an unknown name is an error value listing the known ones,
 // found when the mission is set up, never in flight. Registries are values, not globals:
-// a program registers what it links (sim::register_adapter, later the MAVLink adapter).
+// a program registers what it links (sim::register_adapter, mavlink_adapter::register_adapter).
 #include <functional>
 #include <map>
 #include <memory>

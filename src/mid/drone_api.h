@@ -1,7 +1,8 @@
 #pragma once
 // The Uniform Space's drone API (paper, section VI): one interface for every vehicle,
 // whatever flies it. The DEX starts actions and reads properties through it only; each
-// Adapter Space implementation (the simulator, later MAVLink) hides its platform behind it.
+// Adapter Space implementation (the simulator, src/sim; PX4 and ArduPilot over MAVLink,
+// src/mavlink_adapter) hides its platform behind it.
 //
 // Rules every adapter keeps (the DEX relies on them):
 //  - Every started action ends exactly once, as one Outcome, and its EndCallback always runs
