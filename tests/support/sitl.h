@@ -15,7 +15,7 @@ namespace eamos_test {
 
 enum class Autopilot { ardupilot, px4 };
 
-/// A drone's home in the mission frame (docs/adapters.md "Frames": x east, y north, metres).
+/// A drone's home in the mission frame (docs/adapters.md, "Connecting": x east, y north, metres).
 struct SitlHome {
   double x = 0;
   double y = 0;
