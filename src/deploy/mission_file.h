@@ -14,8 +14,9 @@
 namespace eamos::deploy {
 
 /// Version of the mission file format; a DEX refuses files of another version.
-/// 2: every file ends with its `file_hash`.
-constexpr int kMissionFormatVersion = 2;
+/// 2: every file ends with its `file_hash`. 3: sync points are barriers over `drone_sets`
+/// (`waits`, `notify`) instead of an external node and arc per peer.
+constexpr int kMissionFormatVersion = 3;
 
 /// The last member of every mission file: SHA-256 (hex) of every byte before it.
 inline constexpr const char* kFileHashMember = "file_hash";

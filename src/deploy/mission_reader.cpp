@@ -8,6 +8,7 @@
 #include <iterator>
 #include <limits>
 #include <sstream>
+#include <unordered_map>
 
 #include <nlohmann/json.hpp>
 
@@ -253,6 +254,7 @@ class Reader {
     settings(file);
     type(file);
     drone_list(file, "reads", "", m_.reads);
+    drone_sets(file);
     nodes(file);
     arcs(file);
     node_references();
@@ -294,25 +296,69 @@ class Reader {
         ok = false;
         continue;
       }
-      if (name.empty() || contains(m_.fleet, name)) {
+      if (name.empty() || fleet_index_.count(name) > 0) {
         d_.add(at("/fleet", i), name.empty() ? "empty drone name" : "drone \"" + name + "\" is listed twice");
         ok = false;
       }
+      fleet_index_.emplace(name, static_cast<int>(m_.fleet.size()));
       m_.fleet.push_back(name);
     }
     return ok;
+  }
+
+  /// `drone_sets`: each a list of [first, last] drone index ranges, ascending and apart.
+  void drone_sets(const json& file) {
+    const json* list = f_.member(file, "drone_sets", "", false);
+    if (!list || !f_.array(*list, "/drone_sets")) return;
+    for (std::size_t i = 0; i < list->size(); ++i) {
+      std::string where = at("/drone_sets", i);
+      std::vector<int> set;
+      const json& ranges = (*list)[i];
+      if (f_.array(ranges, where))
+        for (std::size_t r = 0; r < ranges.size(); ++r) drone_range(ranges[r], at(where, r), set);
+      m_.drone_sets.push_back(std::move(set));
+    }
+  }
+
+  void drone_range(const json& j, const std::string& where, std::vector<int>& set) {
+    if (!f_.array(j, where)) return;
+    if (j.size() != 2) return d_.add(where, "a drone range is [first, last]");
+    int last_drone = static_cast<int>(m_.fleet.size()) - 1;
+    int first = 0, last = 0;
+    if (!f_.integer_value(j[0], at(where, 0), first, 0, last_drone) ||
+        !f_.integer_value(j[1], at(where, 1), last, first, last_drone))
+      return;
+    if (!set.empty() && first <= set.back() + 1)
+      return d_.add(where, "ranges must ascend with a gap between them");
+    for (int d = first; d <= last; ++d) set.push_back(d);
+  }
+
+  /// A sync point's `waits` (internal clones) and `notify` (its drone's arrival).
+  bool barrier(const json& j, const std::string& where, dex::Node& n) {
+    int last_set = static_cast<int>(m_.drone_sets.size()) - 1;
+    bool ok = f_.integer(j, "waits", where, n.waits, -1, last_set, false);
+    ok &= f_.integer(j, "notify", where, n.notify, -1, last_set, false);
+    if (!ok) return false;
+    if ((n.waits >= 0 || n.notify >= 0) && !graph::is_sync_point(n.kind))
+      return d_.add(where, "only a sync point (init or fork) waits for or notifies drones"), false;
+    if (n.waits >= 0 && !n.internal) return d_.add(at(where, "waits"), "an external node waits for nothing"), false;
+    if (n.waits >= 0) {
+      const std::vector<int>& set = m_.drone_sets[n.waits];
+      n.waits_count = static_cast<int>(set.size()) - (std::binary_search(set.begin(), set.end(), m_.self) ? 1 : 0);
+    }
+    return true;
   }
 
   /// The index in the fleet of the drone named by `j`, or -1 (and a defect).
   int drone_index(const json& j, const Loc& where) {
     std::string name;
     if (!f_.string_value(j, where, name)) return -1;
-    auto it = std::find(m_.fleet.begin(), m_.fleet.end(), name);
-    if (it == m_.fleet.end()) {
+    auto it = fleet_index_.find(name);
+    if (it == fleet_index_.end()) {
       d_.add(where, "drone \"" + name + "\" is not in the mission's fleet");
       return -1;
     }
-    return static_cast<int>(it - m_.fleet.begin());
+    return it->second;
   }
 
   void drone_list(const json& obj, const char* key, const std::string& where, std::vector<int>& out) {
@@ -539,7 +585,7 @@ class Reader {
     ok &= f_.integer(j, "line", where, n.line, 0, std::numeric_limits<int>::max());
     ok &= f_.integer(j, "col", where, n.col, 0, std::numeric_limits<int>::max());
     ok &= f_.integer(j, "scope", where, n.scope, -1, std::numeric_limits<int>::max(), false);
-    if (!ok) return false;
+    if (!ok || !barrier(j, where, n)) return false;
     return node_content(j, where, n);
   }
 
@@ -639,6 +685,7 @@ class Reader {
   Fields f_;
   Defects& d_;
   dex::Mission& m_;
+  std::unordered_map<std::string, int> fleet_index_;  ///< drone name → its index in the fleet
 };
 
 /// Where the file hash member starts (at its comma) and its value, or npos when the file

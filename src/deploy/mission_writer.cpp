@@ -195,8 +195,28 @@ void write_arc(JsonWriter& w, int from, int to, graph::ArcKind kind, graph::Bran
   if (branch != graph::Branch::any) w.member("branch", graph::branch_name(branch));
 }
 
+/// A sorted drone set as [first, last] ranges: a fleet-wide set is one pair.
+void write_drone_ranges(JsonWriter& w, const std::vector<int>& set) {
+  w.begin_array();
+  for (std::size_t i = 0; i < set.size();) {
+    std::size_t j = i;
+    while (j + 1 < set.size() && set[j + 1] == set[j] + 1) ++j;
+    w.begin_array();
+    w.value(set[i]);
+    w.value(set[j]);
+    w.end_array();
+    i = j + 1;
+  }
+  w.end_array();
+}
+
 /// The drone's MDG: graph::mdg_json's nodes and arcs, node by node.
 void write_mdg(JsonWriter& w, const Compilation& c, const graph::Mdg& g) {
+  w.key("drone_sets");
+  w.begin_array();
+  for (const std::vector<int>& set : g.drone_sets) write_drone_ranges(w, set);
+  w.end_array();
+
   // A terminal names its condition by index in this MDG. Conditions are never cloned, so
   // their MEG id finds them.
   std::unordered_map<int, int> condition_index;
@@ -215,6 +235,8 @@ void write_mdg(JsonWriter& w, const Compilation& c, const graph::Mdg& g) {
     w.member("drone", c.drone_name(mn.drone));
     w.member("internal", mn.internal);
     if (graph::is_sync_point(n.kind)) w.member("clone", true);
+    if (mn.waits >= 0) w.member("waits", mn.waits);
+    if (mn.notify >= 0) w.member("notify", mn.notify);
     write_node_content(w, c, n, true);
     if (n.kind == MegKind::condition) w.member("evaluated_by", c.drone_name(n.drone));
     if (!mn.cancels.empty()) {

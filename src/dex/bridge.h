@@ -1,8 +1,10 @@
 #pragma once
 // What crosses drone boundaries (paper, section V): when an internal node ends, the
 // OutBridge tells every drone holding a node it links to; the InBridge of that drone
-// applies the links of its external copy of the node. A Do condition's flip is broadcast
-// so every drone cancels its part of the do-branch.
+// applies the links of its external copy of the node. A drone that reaches a sync point
+// announces it once to every drone holding a clone, which counts the arrivals it needs.
+// A Do condition's flip is broadcast so every drone cancels its part of the do-branch.
+#include <vector>
 #include <memory>
 #include <string>
 
@@ -15,6 +17,7 @@ struct Message {
   enum class Kind {
     ended,   ///< node `meg` held by `from` ended with `branch`
     cancel,  ///< Do condition `meg` held by `from` flipped: cancel its do-branch
+    arrived, ///< `from` reached sync point `meg`: its own arcs into it have all fired
   };
   Kind kind = Kind::ended;
   std::string mission_hash;  ///< receivers ignore messages of another mission
@@ -45,6 +48,12 @@ class Transport {
   virtual ~Transport() = default;
   /// Delivers `m` to drone `to` later (never inside send), in send order per sender.
   virtual void send(int to, const Message& m) = 0;
+  /// Delivers `m` to every drone of `to` but its sender, as `send` does. Over DDS one
+  /// sample reaches them all; the default sends one message each.
+  virtual void send_to_set(const std::vector<int>& to, const Message& m) {
+    for (int d : to)
+      if (d != m.from) send(d, m);
+  }
   /// Delivers `t` to every other drone later, newest value wins. Shared, not copied: a
   /// drone publishes at 20 Hz to every other drone.
   virtual void publish(std::shared_ptr<const Telemetry> t) = 0;

@@ -33,10 +33,7 @@ using lang::ControlKind;
 Engine::Engine(const Mission& mission, mid::Drone& drone, mid::EventLoop& loop, EngineHooks hooks)
     : m_(mission), drone_(drone), loop_(loop), hooks_(std::move(hooks)), state_(mission.nodes.size()),
       board_(mission.fleet.size()) {
-  for (std::size_t i = 0; i < m_.nodes.size(); ++i) {
-    state_[i].exec_pending = m_.nodes[i].exec_in;
-    state_[i].back_pending = m_.nodes[i].back_in;
-  }
+  for (std::size_t i = 0; i < m_.nodes.size(); ++i) reset_counters(static_cast<int>(i));
   if (hooks_.trace) {
     drone_.set_message_sink([this](const std::string& text) {
       TraceEvent e;
@@ -114,8 +111,16 @@ void Engine::refresh(int node) {
   long long e = epoch_of(n.scope);
   if (s.epoch == e) return;
   s.epoch = e;
+  reset_counters(node);
+}
+
+void Engine::reset_counters(int node) {
+  const Node& n = m_.nodes[node];
+  State& s = state_[node];
   s.exec_pending = n.exec_in;
   s.back_pending = n.back_in;
+  s.local_ready = n.exec_in == 0;
+  s.arrivals_pending = n.waits_count;
 }
 
 void Engine::drain() {
@@ -127,11 +132,17 @@ void Engine::drain() {
     refresh(d.node);
     State& s = state_[d.node];
     const Node& n = m_.nodes[d.node];
+    if (d.arrival) {
+      --s.arrivals_pending;
+      pass_barrier_when_complete(d.node);
+      continue;
+    }
     switch (d.kind) {
       case ArcKind::exec:
         if (--s.exec_pending <= 0) {
           s.exec_pending = n.exec_in;  // ready for the next activation (loops)
-          activate(d.node, false);
+          if (graph::is_sync_point(n.kind)) arrive(d.node);
+          else activate(d.node, false);
         }
         break;
       case ArcKind::back:
@@ -178,9 +189,46 @@ void Engine::schedule_iteration(int node) {
   });
 }
 
+// This drone's own arcs into a sync point have all fired: it has arrived. It tells the
+// other clone holders once, and its own clone, if it holds one, passes once every other
+// drone it waits for has arrived too.
+void Engine::arrive(int node) {
+  const Node& n = m_.nodes[node];
+  if (n.notify >= 0) announce(node);
+  if (!n.internal) return;  // a drone without a clone only announces
+  state_[node].local_ready = true;
+  pass_barrier_when_complete(node);
+}
+
+void Engine::pass_barrier_when_complete(int node) {
+  State& s = state_[node];
+  if (!s.local_ready || s.arrivals_pending > 0) return;
+  s.local_ready = m_.nodes[node].exec_in == 0;  // counters ready for the next activation (loops)
+  s.arrivals_pending = m_.nodes[node].waits_count;
+  activate(node, false);
+}
+
+void Engine::announce(int node) {
+  const Node& n = m_.nodes[node];
+  Message msg{Message::Kind::arrived, m_.hash, m_.self, n.meg, Branch::any};
+  msg.sent = loop_.now();
+  if (n.scope >= 0) {
+    msg.scope = n.scope;
+    msg.epoch = epoch_of(n.scope);
+  }
+  if (hooks_.transport) hooks_.transport->send_to_set(m_.drone_sets[n.notify], msg);
+}
+
+void Engine::receive_arrival(const Message& msg) {
+  int node = m_.find(msg.meg, m_.self);
+  if (node < 0 || m_.nodes[node].waits_count == 0) return;  // a sync point this drone does not wait at
+  queue_.push_back({node, ArcKind::exec, false, true});
+  drain();
+}
+
 void Engine::receive(const Message& msg) {
   if (halted_ || msg.mission_hash != m_.hash) return;
-  int from = m_.find(msg.meg, msg.from);
+  int from = msg.kind == Message::Kind::arrived ? m_.find(msg.meg, m_.self) : m_.find(msg.meg, msg.from);
   if (from < 0) return;
   if (msg.scope >= 0) {
     long long& known = epoch_[msg.scope];
@@ -198,6 +246,7 @@ void Engine::receive(const Message& msg) {
     drain();  // settles: the cancel may have left this drone idle
     return;
   }
+  if (msg.kind == Message::Kind::arrived) return receive_arrival(msg);
   for (int a : m_.nodes[from].out) {
     const Arc& arc = m_.arcs[a];
     if (arc.branch != Branch::any && arc.branch != msg.branch) continue;
@@ -497,8 +546,7 @@ void Engine::cancel_local(const std::vector<int>& nodes) {
       --active_;
     }
     stop_watching(node);
-    s.exec_pending = n.exec_in;
-    s.back_pending = n.back_in;
+    reset_counters(node);
   }
   // Triggers already queued for cancelled nodes must not start them.
   queue_.erase(std::remove_if(queue_.begin(), queue_.end(),
@@ -533,7 +581,8 @@ void Engine::end(int node, Branch branch, bool released_by_partner, bool release
     const Arc& arc = m_.arcs[a];
     if (arc.branch != Branch::any && arc.branch != branch) continue;
     if (released_by_partner && arc.kind == ArcKind::partner) continue;
-    if (m_.nodes[arc.to].internal) {
+    // A sync point counts this drone's own arcs into it, on every drone (dex::Engine::arrive).
+    if (m_.nodes[arc.to].internal || graph::is_sync_point(m_.nodes[arc.to].kind)) {
       queue_.push_back({arc.to, arc.kind, n.kind == MegKind::terminal});
     } else if (std::find(remote.begin(), remote.end(), m_.nodes[arc.to].drone) == remote.end()) {
       remote.push_back(m_.nodes[arc.to].drone);

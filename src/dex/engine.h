@@ -96,11 +96,16 @@ class Engine {
     long long iterations = 0;
     int last_value = -1;  ///< watched conditions: last traced value (-1 none), to log changes only
     long long epoch = 0;  ///< run of the node's body (Mission::Node::scope) its counters belong to
+    /// Sync-point clones: this drone's own arcs into it have all fired (or it has none),
+    /// and the other drones' arrivals still to come.
+    bool local_ready = false;
+    int arrivals_pending = 0;
   };
   struct Delivery {
     int node;
     graph::ArcKind kind;
-    bool from_terminal;  ///< a partner release sent by a terminal (not by a condition)
+    bool from_terminal;    ///< a partner release sent by a terminal (not by a condition)
+    bool arrival = false;  ///< another drone arrived at this sync point (not an arc)
   };
 
   void deliver(int node, graph::ArcKind kind, bool from_terminal);
@@ -113,6 +118,11 @@ class Engine {
   void schedule_iteration(int node);
   bool take_instance(int node, std::uint64_t id);
   void cancel_do_run(int node);
+  void arrive(int node);
+  void pass_barrier_when_complete(int node);
+  void announce(int node);
+  void receive_arrival(const Message& m);
+  void reset_counters(int node);
   void activate_condition(int node, bool by_back_arc);
   /// `released`: a partner arc released it (it ends without its branch having run).
   void end(int node, graph::Branch branch, bool released_by_partner = false, bool released = false);

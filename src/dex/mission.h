@@ -31,6 +31,9 @@ struct Node {
   double seconds = 0.0;        ///< PauseFor
   int scope = -1;              ///< MEG id of the innermost Repeat/Do condition whose body holds it
   std::vector<int> cancels;    ///< Do conditions: local nodes a flip cancels
+  int waits = -1;              ///< sync-point clones: drones whose arrival it needs (Mission::drone_sets)
+  int waits_count = 0;         ///< of those, the other drones: arrivals that must come in
+  int notify = -1;             ///< sync points: drones told when this drone arrives (Mission::drone_sets)
   std::vector<int> out;        ///< indices into Mission::arcs
   int exec_in = 0;             ///< number of exec arcs into this node
   int back_in = 0;             ///< number of back arcs into this node
@@ -53,6 +56,7 @@ struct Mission {
   std::vector<int> reads;              ///< drones whose telemetry this drone needs
   std::vector<Node> nodes;
   std::vector<Arc> arcs;
+  std::vector<std::vector<int>> drone_sets;  ///< sorted drone lists named by Node::waits and notify
 
   /// Index of the node with MEG id `meg` held by `drone`, or -1.
   int find(int meg, int drone) const;

@@ -78,8 +78,8 @@ TraceEvent message_event(const Mission& receiver, const Message& m, int to, doub
   e.from = m.from;
   e.to = to;
   e.node = m.meg;
-  int held = receiver.find(m.meg, m.from);
-  if (held >= 0 && graph::is_sync_point(receiver.nodes[held].kind)) e.instance = m.from;
+  // A drone's arrival at a sync point triggers the receiver's own clone of it.
+  if (m.kind == Message::Kind::arrived) e.instance = to;
   e.sent = m.sent;
   if (to >= 0 && to < static_cast<int>(receiver.fleet.size())) e.drone = receiver.fleet[to];
   return e;

@@ -71,9 +71,10 @@ std::string arc_style(ArcKind kind, Branch branch, bool external) {
 }
 
 void meg_node_line(std::ostringstream& out, const Compilation& c, const std::string& id,
-                   const MegNode& n, int holder, bool external) {
+                   const MegNode& n, int holder, bool external, const std::string& barrier = "") {
   std::string label = escape("n" + std::to_string(n.id) + "  " + meg_node_label(c, n));
-  if (is_sync_point(n.kind) && holder >= 0) label += " @" + c.drone_name(holder);
+  if (is_sync_point(n.kind) && holder >= 0) label += external ? " (arrival)" : " @" + c.drone_name(holder);
+  if (!barrier.empty()) label += "\\n" + escape(barrier);
   std::string tag = line_tag(n.loc);
   if (!tag.empty() && n.kind != MegKind::end) label += "\\n" + tag;
   int colour_drone = n.drone >= 0 ? n.drone : holder;
@@ -195,6 +196,28 @@ std::string meg_dot(const Compilation& c) {
   return out.str();
 }
 
+/// "Drone1, Drone2" or, past four, "Drone1 … Drone9 (9 drones)".
+std::string drone_set_text(const Compilation& c, const std::vector<int>& set, int self) {
+  std::vector<int> others;
+  for (int d : set)
+    if (d != self) others.push_back(d);
+  if (others.size() > 4)
+    return c.drone_name(others.front()) + " … " + c.drone_name(others.back()) + " (" +
+           std::to_string(others.size()) + " drones)";
+  std::string text;
+  for (int d : others) text += (text.empty() ? "" : ", ") + c.drone_name(d);
+  return text;
+}
+
+/// A sync point's barrier in words: whose arrival its clone waits for, whom this drone tells.
+std::string barrier_text(const Compilation& c, const Mdg& g, const MdgNode& mn) {
+  std::string text;
+  if (mn.waits >= 0) text += "waits for " + drone_set_text(c, g.drone_sets[mn.waits], g.drone);
+  if (mn.notify >= 0)
+    text += (text.empty() ? "" : "\n") + std::string("tells ") + drone_set_text(c, g.drone_sets[mn.notify], g.drone);
+  return text;
+}
+
 std::string mdg_dot(const Compilation& c, int drone) {
   const Mdg& g = c.mdgs[drone];
   std::ostringstream out;
@@ -203,7 +226,8 @@ std::string mdg_dot(const Compilation& c, int drone) {
       << "  label=\"MDG of " << c.drone_name(drone) << "\";\n";
   for (std::size_t i = 0; i < g.nodes.size(); ++i) {
     const MdgNode& mn = g.nodes[i];
-    meg_node_line(out, c, "m" + std::to_string(i), c.meg.nodes[mn.meg], mn.drone, !mn.internal);
+    meg_node_line(out, c, "m" + std::to_string(i), c.meg.nodes[mn.meg], mn.drone, !mn.internal,
+                  barrier_text(c, g, mn));
   }
   for (const MdgArc& a : g.arcs)
     out << "  m" << a.from << " -> m" << a.to << " [" << arc_style(a.kind, a.branch, g.external(a))

@@ -99,6 +99,24 @@ json meg_json(const Compilation& c) {
           {"nodes", nodes}, {"arcs", arcs}};
 }
 
+namespace {
+/// Each sorted drone set as [first, last] index ranges, as mission files write them.
+json drone_ranges(const std::vector<std::vector<int>>& sets) {
+  json all = json::array();
+  for (const std::vector<int>& set : sets) {
+    json ranges = json::array();
+    for (std::size_t i = 0; i < set.size();) {
+      std::size_t j = i;
+      while (j + 1 < set.size() && set[j + 1] == set[j] + 1) ++j;
+      ranges.push_back({set[i], set[j]});
+      i = j + 1;
+    }
+    all.push_back(std::move(ranges));
+  }
+  return all;
+}
+}  // namespace
+
 json mdg_json(const Compilation& c, int drone) {
   const Mdg& g = c.mdgs[drone];
   json nodes = json::array();
@@ -112,6 +130,8 @@ json mdg_json(const Compilation& c, int drone) {
     j["drone"] = c.drone_name(mn.drone);
     j["internal"] = mn.internal;
     if (is_sync_point(n.kind)) j["clone"] = true;
+    if (mn.waits >= 0) j["waits"] = mn.waits;
+    if (mn.notify >= 0) j["notify"] = mn.notify;
     if (n.kind == MegKind::condition) j["evaluated_by"] = c.drone_name(n.drone);
     j.erase("terminals");
     j.erase("cancels");
@@ -130,7 +150,7 @@ json mdg_json(const Compilation& c, int drone) {
     arcs.push_back(std::move(j));
   }
   return {{"graph", "mdg"}, {"drone", c.drone_name(drone)}, {"reads", drone_list(c, g.reads)},
-          {"nodes", nodes}, {"arcs", arcs}};
+          {"drone_sets", drone_ranges(g.drone_sets)}, {"nodes", nodes}, {"arcs", arcs}};
 }
 
 json stats_json(const Compilation& c) {

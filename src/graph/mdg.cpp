@@ -1,6 +1,7 @@
 #include "graph/mdg.h"
 
 #include <algorithm>
+#include <map>
 #include <unordered_map>
 
 namespace eamos::graph {
@@ -53,12 +54,26 @@ std::vector<std::vector<int>> sync_clones(const Meg& meg) {
   return clones;
 }
 
+std::vector<std::vector<int>> sync_arrivers(const Meg& meg) {
+  std::vector<std::vector<int>> arrivers(meg.nodes.size());
+  for (const MegArc& a : meg.arcs) {
+    const MegNode& u = meg.nodes[a.from];
+    if (is_sync_point(meg.nodes[a.to].kind) && !is_sync_point(u.kind)) arrivers[a.to].push_back(u.drone);
+  }
+  for (auto& set : arrivers) {
+    std::sort(set.begin(), set.end());
+    set.erase(std::unique(set.begin(), set.end()), set.end());
+  }
+  return arrivers;
+}
+
 namespace {
 
 class MdgBuilder {
  public:
-  explicit MdgBuilder(const Meg& meg) : meg_(meg), clones_(sync_clones(meg)) {
+  explicit MdgBuilder(const Meg& meg) : meg_(meg), clones_(sync_clones(meg)), arrivers_(sync_arrivers(meg)) {
     mdgs_.resize(meg.drone_count);
+    set_index_.resize(meg.drone_count);
     for (int d = 0; d < meg.drone_count; ++d) mdgs_[d].drone = d;
     first_instance_.resize(meg.nodes.size());
     int instances = 0;
@@ -79,6 +94,7 @@ class MdgBuilder {
         node(n.drone, {n.id, n.drone});
     }
     for (const MegArc& a : meg_.arcs) expand(a);
+    add_barrier_waits();
     add_cancel_scopes();
     add_reads();
     return std::move(mdgs_);
@@ -125,12 +141,58 @@ class MdgBuilder {
     if (!su && !sv) {
       arc({u.id, u.drone}, {v.id, v.drone}, a);
     } else if (!su && sv) {
-      for (int k : clones_[v.id]) arc({u.id, u.drone}, {v.id, k}, a);
+      arrival_arc(u, v, a);
     } else if (su && !sv) {
       arc({u.id, v.drone}, {v.id, v.drone}, a);
     } else {
       for (int k : clones_[v.id]) arc({u.id, k}, {v.id, k}, a);
     }
+  }
+
+  /// An arc from a drone's own node into a sync point stays on that drone: into its own
+  /// clone if it holds one, else into one external copy. Either announces the drone's
+  /// arrival to the other holders once all of the drone's arcs into it have fired.
+  void arrival_arc(const MegNode& u, const MegNode& s, const MegArc& a) {
+    const std::vector<int>& holders = clones_[s.id];
+    int d = u.drone;
+    bool holds = std::binary_search(holders.begin(), holders.end(), d);
+    int to = node(d, {s.id, holds ? d : holders.front()});
+    Mdg& g = mdgs_[d];
+    g.arcs.push_back({node(d, {u.id, d}), to, a.kind, a.branch});
+    if (holders.size() > (holds ? 1u : 0u)) g.nodes[to].notify = drone_set(d, global_set(holders_set_, s.id, holders));
+  }
+
+  /// Each clone waits for the arrival of every drone whose work leads into it.
+  void add_barrier_waits() {
+    for (const MegNode& n : meg_.nodes) {
+      if (!is_sync_point(n.kind)) continue;
+      const std::vector<int>& arrivers = arrivers_[n.id];
+      for (int d : clones_[n.id]) {
+        bool self_only = arrivers.size() == 1 && arrivers.front() == d;
+        if (arrivers.empty() || self_only) continue;
+        mdgs_[d].nodes[node(d, {n.id, d})].waits = drone_set(d, global_set(arrivers_set_, n.id, arrivers));
+      }
+    }
+  }
+
+  /// The global id of a sync point's set, looked up once per sync point (`cache`), so a
+  /// barrier of k drones compares its set once, not once per arc.
+  int global_set(std::vector<int>& cache, int meg, const std::vector<int>& set) {
+    if (cache.empty()) cache.assign(meg_.nodes.size(), -1);
+    if (cache[meg] < 0) {
+      auto [it, added] = global_ids_.emplace(set, static_cast<int>(global_sets_.size()));
+      if (added) global_sets_.push_back(&it->first);
+      cache[meg] = it->second;
+    }
+    return cache[meg];
+  }
+
+  /// Index of global set `global` in the table of drone `d`'s MDG, added if new: a
+  /// fleet-wide barrier costs one table entry per MDG, however many sync points share it.
+  int drone_set(int d, int global) {
+    auto [it, added] = set_index_[d].emplace(global, static_cast<int>(mdgs_[d].drone_sets.size()));
+    if (added) mdgs_[d].drone_sets.push_back(*global_sets_[global]);
+    return it->second;
   }
 
   void add_cancel_scopes() {
@@ -160,7 +222,13 @@ class MdgBuilder {
 
   const Meg& meg_;
   std::vector<std::vector<int>> clones_;
+  std::vector<std::vector<int>> arrivers_;
   std::vector<Mdg> mdgs_;
+  std::map<std::vector<int>, int> global_ids_;      ///< every drone set → its global id
+  std::vector<const std::vector<int>*> global_sets_;  ///< global id → the set (keys of global_ids_)
+  std::vector<int> holders_set_;   ///< per MEG node: global id of its clone holders, -1 not yet
+  std::vector<int> arrivers_set_;  ///< per MEG node: global id of its arrivers, -1 not yet
+  std::vector<std::unordered_map<int, int>> set_index_;  ///< per MDG: global set id → its index
   // Where each instance sits in the MDGs that hold it. Every instance is internal to its
   // holder's MDG, so that index is a plain array; the other drones' instances an MDG
   // holds (its external nodes) are found in a small hash map per MDG.

@@ -3,6 +3,7 @@
 // key was stolen, a DEX with a bug) must not make this drone do what its own mission does
 // not say. docs/security.md lists the rules. A sample that breaks one is ignored and
 // logged once per sender and rule; it never stops the DEX.
+#include <algorithm>
 #include <iostream>
 
 #include "launch/dex_state.h"
@@ -25,6 +26,11 @@ bool DexProcess::trigger_allowed(const TriggerSample& s, std::string& why) const
   const dex::Message& m = s.message;
   if (m.from == mission_.self) {
     why = "it names this drone as its sender";
+    return false;
+  }
+  if (m.kind == dex::Message::Kind::arrived) {
+    if (s.to == transport::kEveryDrone) return true;  // on_trigger took it only from a drone its clone waits for
+    why = "an arrival at sync point " + std::to_string(m.meg) + " is sent to every drone, not to one";
     return false;
   }
   int node = mission_.find(m.meg, m.from);
@@ -101,6 +107,16 @@ void DexProcess::check_pending_finished() {
   if (finish_agreed(pending_finished_->drone, why)) return complete();
   // Statuses arrive within a few ticks; one not agreed with after the lease is refused.
   if (wall_s() - pending_since_ > o_.dds.lease_s) reject(pending_finished_->drone, "finished", why);
+}
+
+// Every drone reads every arrival; one it does not wait for (another sync point, or a
+// drone its clone does not wait for) is not for it.
+bool DexProcess::waits_for_arrival(const dex::Message& m) const {
+  if (m.kind != dex::Message::Kind::arrived) return false;
+  int node = mission_.find(m.meg, mission_.self);
+  if (node < 0 || mission_.nodes[node].waits < 0) return false;
+  const std::vector<int>& set = mission_.drone_sets[mission_.nodes[node].waits];
+  return m.from != mission_.self && std::binary_search(set.begin(), set.end(), m.from);
 }
 
 }  // namespace eamos::launch

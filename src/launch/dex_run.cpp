@@ -49,7 +49,10 @@ void DexProcess::note_foreign(const std::string& hash) {
 }
 
 void DexProcess::on_trigger(const TriggerSample& s) {
-  if (!ours(s.message.mission_hash, s.run_id) || s.to != mission_.self) return;
+  if (!ours(s.message.mission_hash, s.run_id) || (s.to != mission_.self && s.to != transport::kEveryDrone)) return;
+  // An arrival at a sync point goes to every drone; only the clone holders that wait for
+  // its sender take it.
+  if (s.to == transport::kEveryDrone && !waits_for_arrival(s.message)) return;
   std::string why;
   if (!trigger_allowed(s, why)) return reject(s.message.from, "trigger", why);
   // Reliable delivery never repeats a sample: a second one with the same number is a replay.
@@ -57,7 +60,7 @@ void DexProcess::on_trigger(const TriggerSample& s) {
     return reject(s.message.from, "trigger", "sequence number " + std::to_string(s.seq) + " was already received");
   // Only what was accepted is counted: a dropped sample counted as received would leave
   // Σsent ≠ Σreceived and the mission waiting for ever.
-  if (s.message.kind == dex::Message::Kind::ended) ++received_;
+  if (s.message.kind != dex::Message::Kind::cancel) ++received_;
   if (phase_ == Phase::running) {
     dex::TraceEvent event = dex::message_event(mission_, s.message, mission_.self, loop_->now());
     if (too_late(event)) return;

@@ -99,6 +99,8 @@ class DexProcess {
   void on_lost(const std::string& hash, int drone, std::uint64_t nonce);
   // --- checks of what arrives, even from an authenticated peer (dex_checks.cpp) ---
   bool trigger_allowed(const TriggerSample& s, std::string& why) const;
+  /// An arrival broadcast at a sync point whose clone here waits for its sender.
+  bool waits_for_arrival(const dex::Message& m) const;
   bool abort_allowed(const LifecycleSample& s, std::string& why) const;
   bool finish_agreed(int lead, std::string& why) const;
   void on_finished(const LifecycleSample& s);

@@ -21,6 +21,13 @@ class DdsTransport : public dex::Transport {
     if (m.kind == dex::Message::Kind::ended) ++sent_;
     if (!node_.write(s)) ++write_errors_;
   }
+  /// One sample for the whole set: DDS hands it to every reader (one multicast packet on a
+  /// network that has multicast). Counted once per drone that will take it.
+  void send_to_set(const std::vector<int>& to, const dex::Message& m) override {
+    TriggerSample s{run_id_, kEveryDrone, ++seq_, m};
+    for (int d : to) sent_ += d != m.from ? 1 : 0;
+    if (!node_.write(s)) ++write_errors_;
+  }
   void publish(std::shared_ptr<const dex::Telemetry> t) override {
     if (!node_.write(TelemetrySample{run_id_, *t})) ++write_errors_;
   }

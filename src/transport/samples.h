@@ -15,9 +15,12 @@ namespace eamos::transport {
 
 inline constexpr int kGround = -1;  ///< the `drone` of what the ground process writes
 
+/// TriggerSample::to of a sample for every drone it concerns (an arrival at a sync point).
+inline constexpr int kEveryDrone = -1;
+
 struct TriggerSample {
   std::uint64_t run_id = 0;
-  int to = 0;
+  int to = 0;  ///< receiving drone, or kEveryDrone
   std::uint64_t seq = 0;  ///< per sender, from 1
   dex::Message message;   ///< carries the mission hash and the sender
 };

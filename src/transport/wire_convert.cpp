@@ -153,7 +153,9 @@ eamos_wire_Trigger to_wire(const TriggerSample& s) {
   w.from = m.from;
   w.to = s.to;
   w.seq = s.seq;
-  w.kind = m.kind == dex::Message::Kind::cancel ? eamos_wire_TRIGGER_CANCEL : eamos_wire_TRIGGER_ENDED;
+  w.kind = m.kind == dex::Message::Kind::cancel    ? eamos_wire_TRIGGER_CANCEL
+           : m.kind == dex::Message::Kind::arrived ? eamos_wire_TRIGGER_ARRIVED
+                                                   : eamos_wire_TRIGGER_ENDED;
   w.meg = m.meg;
   w.branch = static_cast<int32_t>(m.branch);
   w.scope = m.scope;
@@ -167,13 +169,16 @@ bool from_wire(const eamos_wire_Trigger& w, const WireLimits& limits, TriggerSam
   Check check(limits, why);
   s = {};
   s.run_id = w.run_id;
-  check.drone("to", w.to);
-  s.to = w.to;
   s.seq = w.seq;
   dex::Message& m = s.message;
   uint32_t kind = raw_enum(w.kind);
-  check.one_of("kind", kind, 2);
-  m.kind = kind == eamos_wire_TRIGGER_CANCEL ? dex::Message::Kind::cancel : dex::Message::Kind::ended;
+  check.one_of("kind", kind, 3);
+  m.kind = kind == eamos_wire_TRIGGER_CANCEL    ? dex::Message::Kind::cancel
+           : kind == eamos_wire_TRIGGER_ARRIVED ? dex::Message::Kind::arrived
+                                                : dex::Message::Kind::ended;
+  // An arrival goes to every drone at once (kEveryDrone), anything else to one.
+  check.drone("to", w.to, m.kind == dex::Message::Kind::arrived);
+  s.to = w.to;
   m.mission_hash = check.text("mission_hash", w.mission_hash, kMaxWireHash);
   check.drone("from", w.from);
   m.from = w.from;

@@ -81,7 +81,7 @@ TEST_F(Cli, CompileWritesManifestAndOneMissionFilePerDrone) {
   for (const char* drone : {"Drone1", "Drone2", "Drone3"}) {
     auto m = nlohmann::json::parse(read_file(dir_ / "deploy" / drone / "mission.json"));
     EXPECT_EQ(m["format"], "eamos-mission");
-    EXPECT_EQ(m["format_version"], 2);
+    EXPECT_EQ(m["format_version"], 3);
     EXPECT_EQ(m["mission_hash"], hash);
     EXPECT_EQ(m["drone"]["name"], drone);
     EXPECT_FALSE(m["nodes"].empty());

@@ -26,6 +26,7 @@ void expect_streamed_files_equal_documents(const graph::Compilation& c) {
     EXPECT_EQ(streamed["nodes"], mdg["nodes"]) << "drone " << c.drone_name(d);
     EXPECT_EQ(streamed["arcs"], mdg["arcs"]) << "drone " << c.drone_name(d);
     EXPECT_EQ(streamed["reads"], mdg["reads"]) << "drone " << c.drone_name(d);
+    EXPECT_EQ(streamed["drone_sets"], mdg["drone_sets"]) << "drone " << c.drone_name(d);
     dex::Mission m;
     std::vector<std::string> errors;
     EXPECT_TRUE(deploy::read_mission(out.str(), c.drone_name(d), m, errors)) << errors.front();

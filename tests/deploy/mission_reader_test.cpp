@@ -156,9 +156,9 @@ TEST_F(MissionReader, RefusesANumberTooLargeForADouble) {
 }
 
 TEST_F(MissionReader, RefusesAFileOfAnotherFormatVersion) {
-  std::string edited = reseal(replace_once(text_, "\"format_version\":2", "\"format_version\":1"));
+  std::string edited = reseal(replace_once(text_, "\"format_version\":3", "\"format_version\":1"));
   EXPECT_EQ(defects(edited),
-            "Drone1/mission.json: error: /format_version: format version 1 is not supported by this DEX (knows 2); "
+            "Drone1/mission.json: error: /format_version: format version 1 is not supported by this DEX (knows 3); "
             "compile the mission with a matching eamos\n");
 }
 
