@@ -205,8 +205,11 @@ int cmd_stats(const CommonOptions& o, const std::string& output) {
   return write_output(output, graph::stats_json(c).dump(2) + "\n") ? 0 : 1;
 }
 
-int cmd_gen_stress(long long nodes, int drones, unsigned seed, const std::string& output) {
+int cmd_gen_stress(const std::string& shape, long long nodes, int drones, int work_per_step, unsigned seed,
+                   const std::string& output) {
   stress::StressOptions opt;
+  stress::shape_from_name(shape, opt.shape);  // the option accepts only the shapes' names
+  opt.work_per_step = work_per_step;
   opt.target_nodes = nodes;
   opt.drones = drones;
   opt.seed = seed;

@@ -86,7 +86,8 @@ struct SimVehicleCommandOptions {
   double duration = 0.0;    ///< stop after this many mission seconds; 0 = until SIGINT/SIGTERM
 };
 int cmd_sim_vehicle(const SimVehicleCommandOptions& o);
-int cmd_gen_stress(long long nodes, int drones, unsigned seed, const std::string& output);
+int cmd_gen_stress(const std::string& shape, long long nodes, int drones, int work_per_step, unsigned seed,
+                   const std::string& output);
 
 struct MonitorCommandOptions {
   std::string trace;   ///< the JSONL trace to replay

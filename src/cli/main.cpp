@@ -196,9 +196,16 @@ int main(int argc, char** argv) {
 
   auto* gen = app.add_subcommand("gen-stress", "Generate a large valid mission for scaling tests");
   long long nodes = 5000;
+  int work_per_step = 4;
   int drones = 20;
   unsigned seed = 1;
   std::string gen_out;
+  std::string shape = "squads";
+  gen->add_option("--shape", shape,
+                  "squads: squads of ten, each its own barriers; show: every drone in every PAR; cross: squads that "
+                  "wait on, branch on and fly to other squads' drones")
+      ->check(CLI::IsMember({"squads", "show", "cross"}));
+  gen->add_option("--work", work_per_step, "Work items per drone between two barriers")->check(CLI::Range(1, 1000));
   gen->add_option("--nodes", nodes, "Approximate number of MEG nodes")->check(CLI::Range(10LL, 50'000'000LL));
   gen->add_option("--drones", drones, "Number of drones")->check(CLI::Range(1, 100000));
   gen->add_option("--seed", seed, "Seed of the generator (same seed, same mission)");
@@ -246,7 +253,7 @@ int main(int argc, char** argv) {
     if (*dexcmd) return eamos::cli::cmd_dex(dex_opts);
     if (*simv) return eamos::cli::cmd_sim_vehicle(simv_opts);
     if (*monitor) return eamos::cli::cmd_monitor(monitor_opts);
-    if (*gen) return eamos::cli::cmd_gen_stress(nodes, drones, seed, gen_out);
+    if (*gen) return eamos::cli::cmd_gen_stress(shape, nodes, drones, work_per_step, seed, gen_out);
   } catch (const std::exception& e) {
     std::cerr << "eamos: error: " << e.what() << "\n";
     return 1;

@@ -29,6 +29,7 @@ class ProgressDisplay : public dex::TraceSink {
   /// `missions`: every drone's, for its action count (fleet order).
   ProgressDisplay(std::ostream& out, const std::vector<dex::Mission>& missions);
   void record(const dex::TraceEvent& e) override;
+  bool takes_messages() const override { return false; }
   /// Draws the final state and leaves the cursor below it (call once, after the run).
   void finish();
 

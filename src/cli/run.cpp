@@ -149,6 +149,7 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   if (live_monitor) tee.add(live_monitor.get());
   dex::RunOptions options;
   options.time_limit_s = r.time_limit;
+  options.keep_tracks = !r.plot.empty();  // only the plot draws them
   options.interrupt = &interrupt;
   // Samples cost a copy of every drone's state per tick: only when a trace file or the
   // terminal's status lines (their clock) take them.

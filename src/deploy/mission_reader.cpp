@@ -559,7 +559,7 @@ class Reader {
       std::string where = at("/nodes", i);
       dex::Node& n = m_.nodes[i];
       if (!f_.object((*list)[i], where) || !node((*list)[i], where, i, n)) continue;
-      if (!m_.index.emplace(std::pair{n.meg, n.drone}, static_cast<int>(i)).second)
+      if (!m_.index.emplace(dex::Mission::key(n.meg, n.drone), static_cast<int>(i)).second)
         d_.add(where, "a second node with MEG id " + std::to_string(n.meg) + " held by " + m_.fleet[n.drone]);
     }
   }

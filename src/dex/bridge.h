@@ -49,7 +49,8 @@ class Transport {
   /// Delivers `m` to drone `to` later (never inside send), in send order per sender.
   virtual void send(int to, const Message& m) = 0;
   /// Delivers `m` to every drone of `to` but its sender, as `send` does. Over DDS one
-  /// sample reaches them all; the default sends one message each.
+  /// sample reaches them all; the default sends one message each. `to` is a set of the
+  /// mission (Mission::drone_sets) and outlives the delivery.
   virtual void send_to_set(const std::vector<int>& to, const Message& m) {
     for (int d : to)
       if (d != m.from) send(d, m);

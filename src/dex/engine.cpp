@@ -219,34 +219,39 @@ void Engine::announce(int node) {
   if (hooks_.transport) hooks_.transport->send_to_set(m_.drone_sets[n.notify], msg);
 }
 
-void Engine::receive_arrival(const Message& msg) {
-  int node = m_.find(msg.meg, m_.self);
-  if (node < 0 || m_.nodes[node].waits_count == 0) return;  // a sync point this drone does not wait at
+void Engine::receive_arrival(int node, const Message& msg) {
+  if (halted_ || node < 0 || m_.nodes[node].waits_count == 0) return;  // not a sync point it waits at
+  if (!current(msg)) return;
   queue_.push_back({node, ArcKind::exec, false, true});
   drain();
 }
 
-void Engine::receive(const Message& msg) {
-  if (halted_ || msg.mission_hash != m_.hash) return;
-  int from = msg.kind == Message::Kind::arrived ? m_.find(msg.meg, m_.self) : m_.find(msg.meg, msg.from);
-  if (from < 0) return;
+// Learns the runs `msg` names; false when it belongs to a run that is over here (stale).
+bool Engine::current(const Message& msg) {
   if (msg.scope >= 0) {
     long long& known = epoch_[msg.scope];
     // A cancel belongs to one iteration; a trigger to its run (see kIterationBits).
     bool stale = msg.kind == Message::Kind::cancel ? msg.epoch < known : run_of(msg.epoch) < run_of(known);
-    if (stale) return;
+    if (stale) return false;
     known = std::max(known, msg.epoch);
   }
   if (msg.body_epoch > 0) {
     long long& known = epoch_[msg.meg];
     known = std::max(known, msg.body_epoch);
   }
+  return true;
+}
+
+void Engine::receive(const Message& msg) {
+  if (halted_ || msg.mission_hash != m_.hash) return;
+  if (msg.kind == Message::Kind::arrived) return receive_arrival(m_.find(msg.meg, m_.self), msg);
+  int from = m_.find(msg.meg, msg.from);
+  if (from < 0 || !current(msg)) return;
   if (msg.kind == Message::Kind::cancel) {
     cancel_local(m_.nodes[from].cancels);
     drain();  // settles: the cancel may have left this drone idle
     return;
   }
-  if (msg.kind == Message::Kind::arrived) return receive_arrival(msg);
   for (int a : m_.nodes[from].out) {
     const Arc& arc = m_.arcs[a];
     if (arc.branch != Branch::any && arc.branch != msg.branch) continue;

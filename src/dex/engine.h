@@ -61,6 +61,10 @@ class Engine {
   void start();
   /// InBridge: a message from another drone.
   void receive(const Message& m);
+  /// InBridge: another drone's arrival at this drone's sync-point clone `node` (its index
+  /// in the Mission), found by a transport that delivers many: receive() finds it itself.
+  /// The caller has checked the mission hash.
+  void receive_arrival(int node, const Message& m);
   /// InBridge: another drone's telemetry; re-evaluates the conditions that read it.
   void receive(std::shared_ptr<const Telemetry> t);
   /// A property of `drone` changed: re-evaluate the conditions that wait on it.
@@ -121,7 +125,7 @@ class Engine {
   void arrive(int node);
   void pass_barrier_when_complete(int node);
   void announce(int node);
-  void receive_arrival(const Message& m);
+  bool current(const Message& m);
   void reset_counters(int node);
   void activate_condition(int node, bool by_back_arc);
   /// `released`: a partner arc released it (it ends without its branch having run).

@@ -3,8 +3,10 @@
 // arcs, expressions ready to evaluate, and the drone's settings. Loaded once at start-up
 // (the paper's "setup part", IV.D.1) by deploy::read_mission, which checks every index
 // and enum in it; the engine relies on that and never changes it.
+#include <cstdint>
 #include <map>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "dex/expr.h"
@@ -60,7 +62,11 @@ struct Mission {
 
   /// Index of the node with MEG id `meg` held by `drone`, or -1.
   int find(int meg, int drone) const;
-  std::map<std::pair<int, int>, int> index;  ///< (meg, drone) → node index
+  /// Key of (meg, drone) in `index`.
+  static std::uint64_t key(int meg, int drone) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(meg)) << 32) | static_cast<std::uint32_t>(drone);
+  }
+  std::unordered_map<std::uint64_t, int> index;  ///< key(meg, drone) → node index
 };
 
 }  // namespace eamos::dex

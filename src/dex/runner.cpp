@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <unordered_map>
 
 namespace eamos::dex {
 
@@ -20,7 +21,8 @@ class InProcessTransport : public Transport {
  public:
   InProcessTransport(mid::EventLoop& loop, std::vector<std::unique_ptr<Engine>>& engines,
                      const std::vector<Mission>& missions, TraceSink* trace, std::function<void()> on_delivered)
-      : loop_(loop), engines_(engines), missions_(missions), trace_(trace), readers_(missions.size()),
+      : loop_(loop), engines_(engines), missions_(missions), trace_(trace),
+        trace_messages_(trace && trace->takes_messages()), readers_(missions.size()),
         on_delivered_(std::move(on_delivered)) {
     for (std::size_t to = 0; to < missions.size(); ++to)
       for (int d : missions[to].reads)
@@ -30,8 +32,23 @@ class InProcessTransport : public Transport {
     ++in_flight_;
     loop_.after(0.0, [this, to, m] {
       --in_flight_;
-      if (trace_) trace_->record(message_event(missions_[to], m, to, loop_.now()));
-      engines_[to]->receive(m);
+      deliver(to, m);
+      on_delivered_();
+    });
+  }
+  /// One event for the whole set, in the set's order: a fleet-wide barrier schedules k
+  /// events, not k².
+  void send_to_set(const std::vector<int>& to, const Message& m) override {
+    ++in_flight_;
+    loop_.after(0.0, [this, &to, m] {
+      --in_flight_;
+      const std::vector<int>& clones = clones_of(m.meg, to);
+      for (std::size_t i = 0; i < to.size(); ++i) {
+        int d = to[i];
+        if (d == m.from) continue;
+        if (trace_messages_) trace_->record(message_event(missions_[d], m, d, loop_.now()));
+        engines_[d]->receive_arrival(clones[i], m);  // one mission, one hash: checked at the start
+      }
       on_delivered_();
     });
   }
@@ -42,12 +59,32 @@ class InProcessTransport : public Transport {
     }
   }
   int in_flight() const { return in_flight_; }
+  /// The drones whose mission reads drone `d`'s telemetry.
+  const std::vector<int>& readers_of(int d) const { return readers_[d]; }
 
  private:
+  /// Where each drone of `to` holds its clone of sync point `meg`, found once per sync point:
+  /// a fleet-wide barrier delivers every arrival to every drone.
+  const std::vector<int>& clones_of(int meg, const std::vector<int>& to) {
+    std::vector<int>& clones = clones_[meg];
+    if (clones.size() != to.size()) {
+      clones.clear();
+      for (int d : to) clones.push_back(missions_[d].find(meg, d));
+    }
+    return clones;
+  }
+
+  void deliver(int to, const Message& m) {
+    if (trace_messages_) trace_->record(message_event(missions_[to], m, to, loop_.now()));
+    engines_[to]->receive(m);
+  }
+
   mid::EventLoop& loop_;
   std::vector<std::unique_ptr<Engine>>& engines_;
   const std::vector<Mission>& missions_;
   TraceSink* trace_;
+  bool trace_messages_;
+  std::unordered_map<int, std::vector<int>> clones_;  ///< sync point → clone index per drone of its set
   std::vector<std::vector<int>> readers_;  ///< per drone: the drones that read its telemetry
   std::function<void()> on_delivered_;
   int in_flight_ = 0;  ///< triggers and cancels sent, not yet handled
@@ -279,15 +316,17 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
   // transport (the OutBridge side of telemetry); a first publication seeds every board.
   // Before anything runs, every engine holds every drone's initial state, as a DEX would
   // after the start barrier: a condition at t = 0 never reads a value that is not there yet.
-  for (int d = 0; d < n; ++d)
-    for (int to = 0; to < n; ++to)
-      if (to != d)
-        engines[to]->receive(std::make_shared<const Telemetry>(Telemetry{missions[d].hash, d, drones[d]->state()}));
+  for (int d = 0; d < n; ++d) {
+    auto initial = std::make_shared<const Telemetry>(Telemetry{missions[d].hash, d, drones[d]->state()});
+    for (int to : transport.readers_of(d))
+      if (to != d) engines[to]->receive(initial);
+  }
   for (int d = 0; d < n; ++d) {
     drones[d]->subscribe([&, d](const mid::DroneState& s) {
-      record_sample(tracks[d], s);
+      if (options.keep_tracks) record_sample(tracks[d], s);
       engines[d]->properties_changed(d);
-      transport.publish(std::make_shared<const Telemetry>(Telemetry{missions[d].hash, d, s}));
+      if (!transport.readers_of(d).empty())
+        transport.publish(std::make_shared<const Telemetry>(Telemetry{missions[d].hash, d, s}));
     });
   }
   if (options.interrupt) options.interrupt->attach(loop, stop_mission);
@@ -325,6 +364,7 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
   if (options.interrupt) options.interrupt->detach();
   result.duration = finished_at;
   for (int d = 0; d < n; ++d) {
+    if (!options.keep_tracks) record_sample(tracks[d], drones[d]->state());
     result.drones.push_back({missions[d].settings.name, drones[d]->state(), std::move(tracks[d])});
     result.activations += engines[d]->activations();
   }

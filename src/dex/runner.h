@@ -49,6 +49,10 @@ struct RunOptions {
   RunInterrupt* interrupt = nullptr;
   RunObserver* observer = nullptr;  ///< `eamos verify` only (dex/observer.h)
   double telemetry_hz = 0.0;  ///< telemetry events in the trace per mission second; 0 = none
+  /// Keep each drone's track (a sample per change of position or phase: 20 per second of
+  /// flight) in the result, for verify's checks and the plot. Off, a track holds the
+  /// drone's first and last state only: a 1,000-drone show flies 18 million samples.
+  bool keep_tracks = true;
 };
 
 /// One drone's position and phase at a moment its broker published a change of them.

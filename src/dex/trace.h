@@ -38,6 +38,9 @@ class TraceSink {
  public:
   virtual ~TraceSink() = default;
   virtual void record(const TraceEvent& e) = 0;
+  /// Whether this sink keeps `message` events: in one process a fleet-wide barrier of k
+  /// drones is k² of them, built only when someone keeps them.
+  virtual bool takes_messages() const { return true; }
 };
 
 }  // namespace eamos::dex

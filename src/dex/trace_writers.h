@@ -33,6 +33,7 @@ class LiveLog : public TraceSink {
  public:
   explicit LiveLog(std::ostream& out) : out_(out) {}
   void record(const TraceEvent& e) override;
+  bool takes_messages() const override { return false; }  // a person reads actions, not triggers
 
  private:
   std::ostream& out_;
@@ -43,6 +44,11 @@ class TeeTrace : public TraceSink {
   void add(TraceSink* sink) { sinks_.push_back(sink); }
   void record(const TraceEvent& e) override {
     for (TraceSink* s : sinks_) s->record(e);
+  }
+  bool takes_messages() const override {
+    for (TraceSink* s : sinks_)
+      if (s->takes_messages()) return true;
+    return false;
   }
 
  private:

@@ -23,6 +23,11 @@ SimDrone::SimDrone(fleet::DroneSettings settings, fleet::DroneType type, mid::Ev
       options_(options),
       battery_(settings_.battery_percent, loop.now()) {
   kin_.position = settings_.home;
+  for (int k = 1; k <= type_.sensors; ++k) {
+    std::string name = "Sensor" + std::to_string(k);
+    auto it = settings_.sensors.find(name);
+    sensor_models_.push_back({name, it == settings_.sensors.end() ? nullptr : &it->second});
+  }
 }
 
 SimDrone::~SimDrone() {
@@ -291,9 +296,12 @@ void SimDrone::update_timers() {
 // --- properties ----------------------------------------------------------------------------
 
 double SimDrone::sensor_value(int k) const {
-  auto it = settings_.sensors.find("Sensor" + std::to_string(k));
-  if (it == settings_.sensors.end()) return 0.0;
-  return it->second.base + dot(it->second.gradient, kin_.position);
+  if (k < 1 || k > static_cast<int>(sensor_models_.size())) {
+    auto it = settings_.sensors.find("Sensor" + std::to_string(k));
+    return it == settings_.sensors.end() ? 0.0 : it->second.base + dot(it->second.gradient, kin_.position);
+  }
+  const fleet::SensorModel* m = sensor_models_[k - 1].second;
+  return m ? m->base + dot(m->gradient, kin_.position) : 0.0;
 }
 
 mid::DroneState SimDrone::state() const {
@@ -305,7 +313,8 @@ mid::DroneState SimDrone::state() const {
   s.battery = battery_.at(loop_.now());
   s.armed = armed_;
   s.landed = landed_;
-  for (int k = 1; k <= type_.sensors; ++k) s.sensors["Sensor" + std::to_string(k)] = sensor_value(k);
+  for (std::size_t k = 0; k < sensor_models_.size(); ++k)
+    s.sensors.emplace_hint(s.sensors.end(), sensor_models_[k].first, sensor_value(static_cast<int>(k) + 1));
   s.pictures = pictures_;
   s.heading = heading_;
   s.mode = mode_name();

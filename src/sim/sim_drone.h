@@ -74,6 +74,9 @@ class SimDrone final : public mid::AdapterDrone {
   double ground_z() const { return settings_.home.z; }
 
   fleet::DroneSettings settings_;
+  /// "Sensor1" … "SensorN" of the type and the fleet file's model of each (null: reads 0),
+  /// looked up once: a state is built on every step of every drone.
+  std::vector<std::pair<std::string, const fleet::SensorModel*>> sensor_models_;
   SimOptions options_;
 
   mid::Kinematics kin_;
