@@ -21,9 +21,6 @@ struct DexProcessOptions {
   double speed = 1.0;             ///< mission seconds per wall second; must match the ground's
   double start_timeout_s = 0.0;   ///< give up when no start came by then; 0 = wait for ever
   double time_limit_s = 3600.0;   ///< a mission still running then fails
-  /// Wall seconds the lead watches every drone idle with nothing in flight before it calls
-  /// the mission finished: covers status samples still on their way.
-  double settle_s = 0.15;
   std::string trace_file;         ///< the drone's own JSONL trace; "" = none
   /// The `eamos launch` that started this DEX: its READY says so and it takes a START only
   /// from that launch. 0: started on its own; any launch may start it (once).

@@ -133,7 +133,13 @@ void DexProcess::on_status(const StatusSample& s) {
   if (s.drone >= static_cast<int>(start_.nonces.size()) || start_.nonces[s.drone] != s.nonce)
     return reject(s.drone, "status", "it comes from another process than the one this run was started with");
   statuses_[s.drone] = s;
-  ++status_changes_;
+  // The lead (the one drone that reached the end) asks for a termination wave: answer
+  // once with this drone's counters as they are now.
+  if (s.end_reached && s.wave > wave_answered_) {
+    wave_answered_ = s.wave;
+    publish_status(true);
+  }
+  if (termination_) termination_->report({s.drone, s.wave, s.busy, s.sent, s.received});
 }
 
 void DexProcess::on_lost(const std::string& hash, int drone, std::uint64_t nonce) {
@@ -162,6 +168,7 @@ StatusSample DexProcess::status_now(Phase phase) const {
   s.sent = transport_ ? transport_->sent() : 0;
   s.received = received_;
   s.activations = engine_ ? engine_->activations() : 0;
+  s.wave = termination_ ? termination_->wave() : wave_answered_;
   s.since = last_status_ && last_status_->busy == s.busy ? last_status_->since : (loop_ ? loop_->now() : 0.0);
   s.state = drone_->state();
   return s;
@@ -171,33 +178,32 @@ void DexProcess::publish_status(bool force) {
   StatusSample s = status_now(phase_);
   if (!force && last_status_ && last_status_->phase == s.phase && last_status_->busy == s.busy &&
       last_status_->end_reached == s.end_reached && last_status_->sent == s.sent &&
-      last_status_->received == s.received)
+      last_status_->received == s.received && last_status_->wave == s.wave)
     return;
   node_->write(s);
   last_status_ = s;
 }
 
+// Only the lead (it ran the end node) decides, by termination waves (launch/termination.h);
+// everyone else follows its FINISHED. Waves start once the newest statuses look over, so an
+// active fleet is not asked at every tick.
 void DexProcess::check_finished() {
-  // Only the lead (it ran the end node) decides; everyone else follows its FINISHED.
-  if (phase_ != Phase::running || !end_reached_ || engine_->busy()) {
-    quiet_ticks_ = 0;
-    return;
-  }
+  if (phase_ != Phase::running || !end_reached_) return;
+  if (!termination_) termination_.emplace(static_cast<int>(mission_.fleet.size()));
   FleetCounters c;
   std::string why;
-  if (!others_idle(true, c, why)) {
-    quiet_ticks_ = 0;
+  if (engine_->busy() || !others_idle(true, c, why) || c.sent != c.received) {
+    termination_->reset();
+    return;
+  }
+  if (termination_->collecting()) return;
+  if (!termination_->terminated()) {
+    std::uint64_t wave = termination_->start_wave();
+    termination_->report({mission_.self, wave, false, transport_->sent(), received_});
+    publish_status(true);  // asks every drone for its answer
     return;
   }
   double idle_since = std::max(last_status_ ? last_status_->since : loop_->now(), c.others_idle_since);
-  auto signature = std::make_tuple(c.sent, c.received, status_changes_);
-  if (c.sent != c.received || (quiet_ticks_ > 0 && signature != quiet_signature_)) {
-    quiet_ticks_ = 0;
-    return;
-  }
-  quiet_signature_ = signature;
-  ++quiet_ticks_;
-  if (quiet_ticks_ * tick_s() < o_.settle_s) return;
   LifecycleSample finished{mission_.hash, mission_.self, LifecycleKind::finished, start_.run_id};
   // The mission ended when its last drone went idle, not when the lead noticed.
   finished.t = idle_since;

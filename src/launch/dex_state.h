@@ -18,6 +18,7 @@
 #include "dex/mission.h"
 #include "dex/trace_writers.h"
 #include "launch/dex_process.h"
+#include "launch/termination.h"
 #include "launch/inbox.h"
 #include "transport/dds_transport.h"
 
@@ -164,10 +165,9 @@ class DexProcess {
   bool end_reached_ = false;
   std::uint64_t received_ = 0;
   std::map<int, StatusSample> statuses_;  ///< other drones' newest status of this run
-  std::uint64_t status_changes_ = 0;
   std::optional<StatusSample> last_status_;
-  int quiet_ticks_ = 0;
-  std::tuple<std::uint64_t, std::uint64_t, std::uint64_t> quiet_signature_{};
+  std::optional<TerminationDetector> termination_;  ///< the lead's waves (made at the start)
+  std::uint64_t wave_answered_ = 0;                 ///< the newest wave this drone answered
   std::string error_;
   std::set<std::string> foreign_;
   std::set<std::uint64_t> stale_runs_;

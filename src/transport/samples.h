@@ -63,6 +63,9 @@ struct StatusSample {
   std::uint64_t sent = 0;      ///< triggers sent
   std::uint64_t received = 0;  ///< triggers of this run received
   std::uint64_t activations = 0;
+  /// Termination waves (launch/termination.h): the lead's asks for this wave, another
+  /// drone's answers it.
+  std::uint64_t wave = 0;
   double since = 0.0;          ///< mission time the drone entered its current busy/idle state
   mid::DroneState state;       ///< sensors not included
 };

@@ -302,6 +302,7 @@ eamos_wire_Status to_wire(const StatusSample& s) {
   w.sent = s.sent;
   w.received = s.received;
   w.activations = s.activations;
+  w.wave = s.wave;
   w.since = s.since;
   state_to_wire(s.state, w.t, w.x, w.y, w.z, w.battery, w.armed, w.landed, w.pictures);
   return w;
@@ -323,6 +324,7 @@ bool from_wire(const eamos_wire_Status& w, const WireLimits& limits, StatusSampl
   s.sent = w.sent;
   s.received = w.received;
   s.activations = w.activations;
+  s.wave = w.wave;
   check.finite("since", w.since);
   s.since = w.since;
   s.state = state_from_wire(w, check);
