@@ -1,6 +1,8 @@
 // The editor files of editors/: the TextMate grammar (run by a small TextMate tokenizer over
 // a mission that has every kind of token), the VS Code extension's manifest and script,
-// and the Vim syntax file (loaded in the real `vim -es` and asked for each word's group).
+// the Vim syntax file (loaded in the real `vim -es` and asked for each word's group), and
+// `eamos lsp` in two real clients: Vim with Debian's ALE and Neovim's built-in client, each
+// through the configuration editors/vim ships.
 // The grammar and the Vim file name the language's control structures and the catalog
 // documents every standard capability: both are checked against the compiler's own tables.
 #include <gtest/gtest.h>
@@ -200,7 +202,8 @@ TEST(VsCodeExtension, DeclaresTheLanguageItsGrammarAndStartsEamosLsp) {
   EXPECT_FALSE(read_json(dir / language["configuration"].get<std::string>()).is_discarded());
   const json& grammar = manifest["contributes"]["grammars"][0];
   EXPECT_EQ(grammar["scopeName"], "source.eamos");
-  // The extension's grammar is the one grammar of editors/textmate, not a copy.
+  // The extension's grammar is a copy of editors/textmate's (a link would not survive a
+  // Windows checkout or every packager), and must stay the same.
   EXPECT_EQ(eamos_test::slurp((dir / grammar["path"].get<std::string>()).string()),
             eamos_test::slurp((kEditors / "textmate" / "eamos.tmLanguage.json").string()));
   EXPECT_TRUE(manifest["dependencies"].contains("vscode-languageclient"));
@@ -239,6 +242,67 @@ TEST(VimSyntax, LoadsInVimAndGivesEachWordItsGroup) {
         "15:3 async eamosAsync",         "16:12 2 eamosNumber",         "18:22 Takeoff eamosCapability",
         "18:47 - eamosOperator",         "18:48 4e1 eamosNumber"})
     EXPECT_TRUE(has(expected)) << expected << "\n" << text;
+}
+
+// Runs a shell command with EAMOS_BIN, EAMOS_OUT and `env` in its environment; returns
+// its exit status (-1 when it did not exit) and what it wrote to EAMOS_OUT, line by line.
+std::pair<int, std::vector<std::string>> run_client(const std::string& command,
+                                                    std::map<std::string, std::string> env = {}) {
+  std::string out = (fs::temp_directory_path() / ("eamos-client-" + std::to_string(getpid()))).string();
+  env["EAMOS_BIN"] = EAMOS_BINARY;
+  env["EAMOS_OUT"] = out;
+  std::string prefix;
+  for (const auto& [k, v] : env) prefix += k + "='" + v + "' ";
+  int raw = std::system((prefix + command + " </dev/null >/dev/null 2>&1").c_str());
+  std::string text = eamos_test::slurp(out);
+  std::remove(out.c_str());
+  return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, lines_of(text)};
+}
+
+const fs::path kSessionData = fs::path(EAMOS_TEST_DATA) / "data";
+const std::string kFlyByXError =
+    "drone 'Lead' of type 'Scout' has no capability 'FlyByX'; see `eamos check --list-capabilities`";
+
+TEST(VimWithAle, ShowsTheDiagnosticsOfEamosLspWithTheFleetFile) {
+  if (std::system("command -v vim >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "vim is not installed (Debian: apt-get install vim)";
+  if (!fs::exists("/usr/share/vim/vimfiles/pack/dist-bundle/opt/ale"))
+    GTEST_SKIP() << "ALE is not installed (Debian: apt-get install vim-ale); editors/vim/ale_linters not checked";
+  std::string command = "vim -N -u NONE -i NONE -es --cmd 'set rtp^=" + (kEditors / "vim").string() +
+                        "' -c 'packadd ale' -c 'filetype plugin on' -c 'edit " +
+                        (kSessionData / "mission.eamos").string() + "' -c 'source " +
+                        (fs::path(EAMOS_TEST_DATA) / "ale_probe.vim").string() + "' -c 'qa!'";
+  auto [status, got] = run_client(command, {{"EAMOS_FLEET", (kSessionData / "fleet.yaml").string()}});
+  ASSERT_EQ(status, 0) << command;
+  // The fleet file took effect: Scout has no FlyByX there (the generic type has).
+  std::vector<std::string> expected = {"22:23 E " + kFlyByXError};
+  fs::path source(EAMOS_SOURCE_DIR);
+  expected.push_back("root " + (fs::exists(source / ".git") ? source : kSessionData).string());
+  EXPECT_EQ(got, expected) << command;
+}
+
+TEST(NeovimLsp, ShowsDiagnosticsHoverAndDefinitionFromEamosLsp) {
+  if (std::system("command -v nvim >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "Neovim is not installed (Debian: apt-get install neovim); editors/vim/lua/eamos.lua not checked";
+  std::string setup =
+      "lua require(\"eamos\").setup({cmd = {os.getenv(\"EAMOS_BIN\"), \"lsp\"}, fleet = os.getenv(\"EAMOS_FLEET\")})";
+  std::string command = "nvim --headless -u NONE -i NONE --cmd 'set rtp^=" + (kEditors / "vim").string() + "' -c '" +
+                        setup + "' -c 'filetype plugin on' -c 'edit " + (kSessionData / "mission.eamos").string() +
+                        "' -c 'luafile " + (fs::path(EAMOS_TEST_DATA) / "nvim_probe.lua").string() + "' -c 'qa!'";
+  // Hover on FlyTo (line 12), definition of the PAR_up called on line 10 (0-based below).
+  auto [status, got] = run_client(command, {{"EAMOS_FLEET", (kSessionData / "fleet.yaml").string()},
+                                            {"HOVER_LINE", "11"},
+                                            {"HOVER_CHAR", "8"},
+                                            {"DEF_LINE", "9"},
+                                            {"DEF_CHAR", "3"}});
+  ASSERT_EQ(status, 0) << command;
+  ASSERT_EQ(got.size(), 3u) << command;
+  EXPECT_EQ(got[0], "diagnostic 21:22 " + kFlyByXError);
+  EXPECT_EQ(got[1],
+            "hover ```eamos Lead.FlyTo(x, y, z) ``` Motion action of `Scout`: fly to a position in the mission frame.  "
+            "- `x`: east of the frame's origin, in metres - `y`: north of the frame's origin, in metres - `z`: up "
+            "from home ground level, in metres ");
+  EXPECT_EQ(got[2], "definition 16:5");
 }
 
 }  // namespace
