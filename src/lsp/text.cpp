@@ -1,5 +1,6 @@
 #include "lsp/text.h"
 
+#include <algorithm>
 #include <cctype>
 
 namespace eamos::lsp {
