@@ -14,6 +14,7 @@ packages=(
   nodejs
   chromium
   iproute2  # ip netns and veth pairs for tests/launch/netns_test.cpp
+  vim vim-ale neovim  # tests/lsp: editors/vim in vim -es, eamos lsp through ALE and Neovim's LSP client
 )
 
 missing=()

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "cli/commands.h"
+#include "lsp/server.h"
 #include "version.h"
 
 namespace {
@@ -226,6 +227,15 @@ int main(int argc, char** argv) {
   simv->add_option("--duration", simv_opts.duration, "Stop after this many mission seconds (default: until interrupted)")
       ->check(CLI::NonNegativeNumber);
 
+  auto* lsp = app.add_subcommand("lsp", "Serve the Language Server Protocol on standard input and output, for editors "
+                                       "(docs/editors.md): diagnostics as you type, hover, go-to-definition, completion, outline");
+  eamos::lsp::ServerOptions lsp_opts;
+  lsp->add_option("--fleet", lsp_opts.fleet,
+                  "Fleet file (YAML) to check every mission against, as `eamos check --fleet`; the client's "
+                  "initializationOptions {\"fleet\": PATH} replace it");
+  bool lsp_stdio = true;
+  lsp->add_flag("--stdio", lsp_stdio, "Talk over standard input and output (the only transport; editors pass it)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -254,6 +264,7 @@ int main(int argc, char** argv) {
     if (*simv) return eamos::cli::cmd_sim_vehicle(simv_opts);
     if (*monitor) return eamos::cli::cmd_monitor(monitor_opts);
     if (*gen) return eamos::cli::cmd_gen_stress(shape, nodes, drones, work_per_step, seed, gen_out);
+    if (*lsp) return eamos::lsp::serve_stdio(lsp_opts);
   } catch (const std::exception& e) {
     std::cerr << "eamos: error: " << e.what() << "\n";
     return 1;

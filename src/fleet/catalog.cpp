@@ -92,6 +92,48 @@ std::vector<std::string> DroneType::capability_names() const {
   return names;
 }
 
+// Units in words, one table: the catalog above fixes names and arities, this says what the
+// numbers mean. The frame is the mission's local one: x east, y north, z up, metres, z = 0
+// at home ground level (docs/language.md §5).
+const std::vector<CapabilityDoc>& capability_docs() {
+  static const std::vector<CapabilityDoc> docs = {
+      {"Arm", "arm the motors", {}, ""},
+      {"Disarm", "disarm the motors", {}, ""},
+      {"Takeoff", "take off and climb to an altitude", {{"alt", "metres", "altitude above home ground level"}}, ""},
+      {"Land", "land where the drone is", {}, ""},
+      {"FlyTo", "fly to a position in the mission frame",
+       {{"x", "metres", "east of the frame's origin"},
+        {"y", "metres", "north of the frame's origin"},
+        {"z", "metres", "up from home ground level"}}, ""},
+      {"FlyBy", "fly by an offset from where the drone is",
+       {{"dx", "metres", "east"}, {"dy", "metres", "north"}, {"dz", "metres", "up"}}, ""},
+      {"FlyByX", "fly by an offset east (negative: west)", {{"dx", "metres", "east"}}, ""},
+      {"FlyByY", "fly by an offset north (negative: south)", {{"dy", "metres", "north"}}, ""},
+      {"FlyByZ", "fly by an offset up (negative: down)", {{"dz", "metres", "up"}}, ""},
+      {"Hover", "hold position; without an argument until a later motion action preempts it",
+       {{"s", "seconds", "how long to hold (optional)"}}, ""},
+      {"Orbit", "circle around where the drone is", {{"r", "metres", "radius of the circle (optional)"}}, ""},
+      {"ReturnHome", "fly back to home", {}, ""},
+      {"TakePicture", "take a picture", {}, ""},
+      {"SensorK", "as a statement, take a reading with sensor K; in an expression, its last reading, "
+                  "in the sensor's own unit (K = 1 ... the type's sensor count)", {}, ""},
+      {"X", "position east of the mission frame's origin", {}, "metres"},
+      {"Y", "position north of the mission frame's origin", {}, "metres"},
+      {"Z", "height above home ground level", {}, "metres"},
+      {"Battery", "charge left", {}, "percent"},
+      {"Armed", "true while the motors are armed", {}, ""},
+      {"Landed", "true while the drone is on the ground", {}, ""},
+  };
+  return docs;
+}
+
+const CapabilityDoc* capability_doc(const std::string& name) {
+  const std::string key = is_sensor_name(name) ? "SensorK" : name;
+  for (const auto& d : capability_docs())
+    if (d.name == key) return &d;
+  return nullptr;
+}
+
 int sensor_index(const std::string& name, int sensors) {
   const std::string prefix = "Sensor";
   if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) return 0;

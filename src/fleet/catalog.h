@@ -80,4 +80,27 @@ DroneType generic_multirotor(const std::string& type_name);
 /// "SensorK" with 1 <= K <= sensors: returns K, else 0.
 int sensor_index(const std::string& name, int sensors);
 
+/// One argument of a standard action in words, with its unit: what editors show on hover
+/// (eamos lsp) and what docs/language.md §5 and docs/fleet.md state.
+struct ParamDoc {
+  std::string name;     ///< as the signature writes it, e.g. "x"
+  std::string unit;     ///< "metres", "seconds", ...; "" for a plain number
+  std::string meaning;  ///< e.g. "position east of the mission frame's origin"
+};
+
+/// A standard capability in words. For an action, `params` lists its arguments in order
+/// (an optional last one when the action accepts one fewer); for a property, `unit` is the
+/// unit of the value it reads.
+struct CapabilityDoc {
+  std::string name;     ///< "FlyTo"; "SensorK" stands for every Sensor1 ... SensorN
+  std::string summary;  ///< what the action does or the property reads
+  std::vector<ParamDoc> params;
+  std::string unit;     ///< a property's unit in words; "" for an action or a boolean
+};
+
+/// The standard capabilities in words, one entry per action and property name (SensorK once).
+const std::vector<CapabilityDoc>& capability_docs();
+/// The entry for an action or property name ("Sensor3" finds "SensorK"); null when none.
+const CapabilityDoc* capability_doc(const std::string& name);
+
 }  // namespace eamos::fleet

@@ -25,31 +25,53 @@ struct Signature {
   ControlKind kind;
   std::vector<Param> params;
   const char* usage;
+  const char* meaning;  ///< docs/language.md §8 in one sentence, for editors (eamos lsp)
 };
 
 const std::vector<Signature>& signatures() {
   using P = Param;
   static const std::vector<Signature> table = {
-      {ControlKind::If, {P::condition, P::block, P::block}, "If(condition, SEQ_then, SEQ_else)"},
-      {ControlKind::WaitUntil, {P::condition, P::block}, "WaitUntil(condition, SEQ_then)"},
-      {ControlKind::WaitWhile, {P::condition, P::block}, "WaitWhile(condition, SEQ_then)"},
+      {ControlKind::If, {P::condition, P::block, P::block}, "If(condition, SEQ_then, SEQ_else)",
+       "evaluates the condition once and runs SEQ_then if it is true, else SEQ_else; the next "
+       "statement waits for the branch"},
+      {ControlKind::WaitUntil, {P::condition, P::block}, "WaitUntil(condition, SEQ_then)",
+       "blocks until the condition is true, then runs SEQ_then"},
+      {ControlKind::WaitWhile, {P::condition, P::block}, "WaitWhile(condition, SEQ_then)",
+       "blocks while the condition is true, then runs SEQ_then"},
       {ControlKind::RepeatUntil, {P::condition, P::block, P::block},
-       "RepeatUntil(condition, SEQ_repeat, SEQ_after)"},
+       "RepeatUntil(condition, SEQ_repeat, SEQ_after)",
+       "tests the condition before each iteration: while it is false, runs SEQ_repeat; once it is "
+       "true, runs SEQ_after once"},
       {ControlKind::RepeatWhile, {P::condition, P::block, P::block},
-       "RepeatWhile(condition, SEQ_repeat, SEQ_after)"},
+       "RepeatWhile(condition, SEQ_repeat, SEQ_after)",
+       "tests the condition before each iteration: while it is true, runs SEQ_repeat; once it is "
+       "false, runs SEQ_after once"},
       {ControlKind::RepeatFor, {P::condition, P::block, P::block, P::count},
-       "RepeatFor(condition, SEQ_repeat, SEQ_after, count)"},
-      {ControlKind::PauseUntil, {P::condition}, "PauseUntil(condition)"},
-      {ControlKind::PauseWhile, {P::condition}, "PauseWhile(condition)"},
-      {ControlKind::PauseFor, {P::seconds}, "PauseFor(seconds)"},
+       "RepeatFor(condition, SEQ_repeat, SEQ_after, count)",
+       "runs SEQ_repeat while the condition is true and at most count times (a whole-number "
+       "literal), then SEQ_after once"},
+      {ControlKind::PauseUntil, {P::condition}, "PauseUntil(condition)",
+       "halts the enclosing sequence until the condition is true"},
+      {ControlKind::PauseWhile, {P::condition}, "PauseWhile(condition)",
+       "halts the enclosing sequence while the condition is true"},
+      {ControlKind::PauseFor, {P::seconds}, "PauseFor(seconds)",
+       "halts the enclosing sequence for a number of seconds (a literal)"},
       {ControlKind::DoUntilAsync, {P::condition, P::block, P::block},
-       "DoUntilAsync(condition, SEQ_do, SEQ_done)"},
+       "DoUntilAsync(condition, SEQ_do, SEQ_done)",
+       "like DoUntilSync, but the sequence goes on at once and the branches run detached"},
       {ControlKind::DoWhileAsync, {P::condition, P::block, P::block},
-       "DoWhileAsync(condition, SEQ_do, SEQ_done)"},
+       "DoWhileAsync(condition, SEQ_do, SEQ_done)",
+       "like DoWhileSync, but the sequence goes on at once and the branches run detached"},
       {ControlKind::DoUntilSync, {P::condition, P::block, P::block},
-       "DoUntilSync(condition, SEQ_do, SEQ_done)"},
+       "DoUntilSync(condition, SEQ_do, SEQ_done)",
+       "if the condition is false, runs SEQ_do while watching it (else nothing); should it turn true "
+       "first, SEQ_do is cancelled on every drone and SEQ_done runs; the sequence goes on when SEQ_do or "
+       "SEQ_done has ended"},
       {ControlKind::DoWhileSync, {P::condition, P::block, P::block},
-       "DoWhileSync(condition, SEQ_do, SEQ_done)"},
+       "DoWhileSync(condition, SEQ_do, SEQ_done)",
+       "if the condition is true, runs SEQ_do while watching it (else nothing); should it turn false "
+       "first, SEQ_do is cancelled on every drone and SEQ_done runs; the sequence goes on when SEQ_do or "
+       "SEQ_done has ended"},
   };
   return table;
 }
@@ -59,6 +81,20 @@ const Signature* signature_of(ControlKind kind) {
     if (s.kind == kind) return &s;
   return nullptr;
 }
+
+}  // namespace
+
+const char* control_usage(ControlKind kind) {
+  const Signature* s = signature_of(kind);
+  return s ? s->usage : "";
+}
+
+const char* control_meaning(ControlKind kind) {
+  const Signature* s = signature_of(kind);
+  return s ? s->meaning : "";
+}
+
+namespace {
 
 const char* type_name(ValueType t) {
   switch (t) {

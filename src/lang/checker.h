@@ -30,4 +30,10 @@ CheckedMission check_mission(Mission& mission, const fleet::Fleet& fleet, Diagno
 /// True for names the language reserves for blocks.
 bool is_block_name(const std::string& name);
 
+/// A control structure's signature as docs/language.md §8 writes it, e.g.
+/// "If(condition, SEQ_then, SEQ_else)"; "" for ControlKind::none.
+const char* control_usage(ControlKind kind);
+/// What it does, in one sentence (docs/language.md §8 has the whole story); "" for none.
+const char* control_meaning(ControlKind kind);
+
 }  // namespace eamos::lang

@@ -1,0 +1,2 @@
+" eamos missions: *.eamos files are of filetype eamos.
+autocmd BufRead,BufNewFile *.eamos setfiletype eamos
