@@ -14,6 +14,10 @@ packages=(
   nodejs
   chromium
   iproute2  # ip netns and veth pairs for tests/launch/netns_test.cpp
+  help2man  # the man pages, made from --help at build time (packaging/man_pages.cmake)
+  # tests/install: the .deb's Depends (dpkg-shlibdeps, in dpkg-dev), the rendered man pages,
+  # the zsh completion, the DEX's unit (systemd-analyze verify)
+  dpkg-dev man-db zsh systemd
 )
 
 missing=()
