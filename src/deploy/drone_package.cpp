@@ -38,8 +38,9 @@ std::string dex_env(const std::string& drone, const PackageOptions& o) {
                      "# The network interface DDS uses to reach the other drones and the ground; `ip -br link`\n"
                      "# lists this computer's. Without it the DEX does not start and says why in the journal.\n";
   text += o.interface.empty() ? "#EAMOS_DDS_INTERFACE=wlan0\n" : "EAMOS_DDS_INTERFACE=" + o.interface + "\n";
-  text += "# More options of `eamos dex` (eamos dex --help); the domain must be the ground's.\n";
-  text += "EAMOS_DEX_ARGS=--domain " + std::to_string(o.domain) + (o.insecure ? " --insecure" : "") + "\n";
+  text += "# More options of `eamos dex` (eamos dex --help); the domain must be the ground's. Quoted, so\n"
+          "# that a shell can read this file too: set -a; . ./dex.env; set +a\n";
+  text += "EAMOS_DEX_ARGS=\"--domain " + std::to_string(o.domain) + (o.insecure ? " --insecure" : "") + "\"\n";
   return text;
 }
 
@@ -59,7 +60,7 @@ std::string deploy_notes(const graph::Compilation& c, int d, const std::string& 
       "  eamos-dex@.service  the systemd unit (the eamos .deb installs the same one)\n\n"
       "On the companion computer, with eamos installed, this folder copied to ~/" + n + ":\n"
       "  sudo useradd --system --user-group --home-dir /var/lib/eamos --shell /usr/sbin/nologin eamos"
-      "   # the .deb made it\n"
+      "   # only without the .deb, which made it\n"
       "  sudo rm -rf /var/lib/eamos/" + n + " && sudo mkdir -p /var/lib/eamos && sudo cp -r ~/" + n +
       " /var/lib/eamos/\n"
       "  sudo chown -R eamos:eamos /var/lib/eamos/" + n + "\n"

@@ -45,7 +45,7 @@ TEST_F(DronePackage, EveryDroneGetsTheUnitTheNetworkConfigurationItsEnvironmentA
     EXPECT_EQ(file(drone, "cyclonedds.xml"), network);
     std::string env = file(drone, "dex.env");
     EXPECT_NE(env.find("\nEAMOS_DDS_INTERFACE=wlan0\n"), std::string::npos) << env;
-    EXPECT_NE(env.find("\nEAMOS_DEX_ARGS=--domain 7\n"), std::string::npos) << env;
+    EXPECT_NE(env.find("\nEAMOS_DEX_ARGS=\"--domain 7\"\n"), std::string::npos) << env;
     std::string notes = file(drone, "DEPLOY.txt");
     EXPECT_NE(notes.find("systemctl enable --now eamos-dex@" + std::string(drone)), std::string::npos) << notes;
     EXPECT_NE(notes.find("chown -R eamos:eamos /var/lib/eamos/" + std::string(drone)), std::string::npos) << notes;
@@ -67,12 +67,12 @@ TEST_F(DronePackage, WithoutAnInterfaceTheEnvironmentLeavesItForTheUserToSet) {
   std::string env = deploy::dex_env("Drone1", {});
   EXPECT_NE(env.find("\n#EAMOS_DDS_INTERFACE=wlan0\n"), std::string::npos) << env;
   EXPECT_EQ(env.find("\nEAMOS_DDS_INTERFACE="), std::string::npos) << env;
-  EXPECT_NE(env.find("\nEAMOS_DEX_ARGS=--domain 0\n"), std::string::npos) << env;
+  EXPECT_NE(env.find("\nEAMOS_DEX_ARGS=\"--domain 0\"\n"), std::string::npos) << env;
 }
 
 TEST_F(DronePackage, InsecureMissionRunsItsDexesInsecure) {
   std::string env = deploy::dex_env("Drone1", {.insecure = true});
-  EXPECT_NE(env.find("\nEAMOS_DEX_ARGS=--domain 0 --insecure\n"), std::string::npos) << env;
+  EXPECT_NE(env.find("\nEAMOS_DEX_ARGS=\"--domain 0 --insecure\"\n"), std::string::npos) << env;
 }
 
 TEST_F(DronePackage, InterfaceThatIsNoInterfaceNameIsRefusedAndNothingIsWritten) {

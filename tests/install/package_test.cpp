@@ -1,8 +1,5 @@
 // `eamos compile --package`: each drone's folder holds a systemd unit that systemd itself
 // accepts, and a DDS configuration on which the real `eamos dex` joins the network.
-#include <ifaddrs.h>
-#include <net/if.h>
-
 #include "install/shell.h"
 
 namespace eamos {
@@ -25,19 +22,6 @@ class CompilePackage : public eamos_test::TempDir {
   }
 };
 
-/// An interface that is up, not loopback and has multicast and an IPv4 address: "" if none.
-std::string network_interface() {
-  ifaddrs* list = nullptr;
-  if (getifaddrs(&list) != 0) return "";
-  std::string name;
-  for (ifaddrs* a = list; a && name.empty(); a = a->ifa_next)
-    if (a->ifa_addr && a->ifa_addr->sa_family == AF_INET && (a->ifa_flags & IFF_UP) &&
-        (a->ifa_flags & IFF_MULTICAST) && !(a->ifa_flags & IFF_LOOPBACK))
-      name = a->ifa_name;
-  freeifaddrs(list);
-  return name;
-}
-
 TEST_F(CompilePackage, UnitPassesSystemdAnalyzeVerify) {
   if (sh("command -v systemd-analyze").status != 0) GTEST_SKIP() << "systemd-analyze not installed (Debian: systemd)";
   eamos_test::Shell r = compile("--package --interface wlan0");
@@ -57,7 +41,7 @@ TEST_F(CompilePackage, UnitPassesSystemdAnalyzeVerify) {
 }
 
 TEST_F(CompilePackage, DexJoinsDdsOnTheInterfaceItsEnvironmentNamesAndRefusesWithoutOne) {
-  std::string interface = network_interface();
+  std::string interface = eamos_test::network_interface();
   if (interface.empty()) GTEST_SKIP() << "no network interface up with multicast and IPv4 besides loopback";
   ASSERT_EQ(compile("--package --domain 229").status, 0);
   fs::path drone = dir_ / "deploy/Drone1";

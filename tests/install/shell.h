@@ -1,6 +1,8 @@
 #pragma once
 // Running shell commands and reading files for the install tests, which use the installed
 // eamos as a user would: through cmake, cpack, dpkg, bash and systemd-analyze.
+#include <ifaddrs.h>
+#include <net/if.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -65,6 +67,20 @@ inline void install_into(const std::filesystem::path& prefix) {
   Shell r = sh(std::string(EAMOS_CMAKE) + " --install " + shell_quote(EAMOS_BUILD_DIR) + " --prefix " +
                shell_quote(prefix.string()));
   ASSERT_EQ(r.status, 0) << r.out;
+}
+
+/// An interface that is up, not loopback and has multicast and an IPv4 address, as a drone's
+/// WLAN would be; "" when this machine has none.
+inline std::string network_interface() {
+  ifaddrs* list = nullptr;
+  if (getifaddrs(&list) != 0) return "";
+  std::string name;
+  for (ifaddrs* a = list; a && name.empty(); a = a->ifa_next)
+    if (a->ifa_addr && a->ifa_addr->sa_family == AF_INET && (a->ifa_flags & IFF_UP) &&
+        (a->ifa_flags & IFF_MULTICAST) && !(a->ifa_flags & IFF_LOOPBACK))
+      name = a->ifa_name;
+  freeifaddrs(list);
+  return name;
 }
 
 }  // namespace eamos_test
