@@ -15,6 +15,10 @@ packages=(
   chromium
   iproute2  # ip netns and veth pairs for tests/launch/netns_test.cpp
   vim vim-ale neovim  # tests/lsp: editors/vim in vim -es, eamos lsp through ALE and Neovim's LSP client
+  help2man  # the man pages, made from --help at build time (packaging/man_pages.cmake)
+  # tests/install: the .deb's Depends (dpkg-shlibdeps, in dpkg-dev), the rendered man pages,
+  # the zsh completion, the DEX's unit (systemd-analyze verify)
+  dpkg-dev man-db zsh systemd
 )
 
 missing=()

@@ -115,8 +115,16 @@ bool write_security(const graph::Compilation& c, const std::string& dir, const S
   return true;
 }
 
-int cmd_compile(const CommonOptions& o, const std::string& out_dir, const SecurityOptions& security) {
+int cmd_compile(const CommonOptions& o, const std::string& out_dir, const SecurityOptions& security,
+                const deploy::PackageOptions* package) {
   if (security.insecure) warn_insecure("compile");
+  // An option that cannot be packaged is refused before anything is written.
+  if (package) {
+    if (std::string error = deploy::package_options_error(*package); !error.empty()) {
+      std::cerr << "eamos: error: " << error << "\n";
+      return 1;
+    }
+  }
   graph::Compilation c;
   if (!compile_and_report(o, c, graph::Keep::deployment_graphs)) return 1;
   Diagnostics diags;
@@ -125,8 +133,21 @@ int cmd_compile(const CommonOptions& o, const std::string& out_dir, const Securi
     return 1;
   }
   if (!write_security(c, out_dir, security)) return 1;
+  if (package) {
+    deploy::PackageOptions p = *package;
+    p.insecure = security.insecure;
+    p.ground_folder = security::kGroundFolder;
+    if (!deploy::write_packages(c, out_dir, p, diags)) {
+      std::cerr << diags.format();
+      return 1;
+    }
+  }
   std::cout << "compiled " << o.mission << " → " << out_dir << "/ (" << c.drone_count()
             << " drones, " << c.meg.nodes.size() << " MEG nodes)\n";
+  if (package)
+    std::cout << "packaged each drone's DEX as a systemd service: " << out_dir << "/<drone>/DEPLOY.txt says what to "
+              << "copy where" << (package->interface.empty() ? "; set EAMOS_DDS_INTERFACE in each dex.env" : "")
+              << " (docs/deploy.md)\n";
   return 0;
 }
 

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "deploy/drone_package.h"
 #include "dex/runner.h"
 #include "graph/pipeline.h"
 #include "launch/dex_process.h"
@@ -34,7 +35,9 @@ struct SecurityOptions {
 };
 
 int cmd_check(const CommonOptions& o, bool list_capabilities);
-int cmd_compile(const CommonOptions& o, const std::string& out_dir, const SecurityOptions& security);
+/// With `package`: also each drone's service files (deploy/drone_package.h, docs/deploy.md).
+int cmd_compile(const CommonOptions& o, const std::string& out_dir, const SecurityOptions& security,
+                const deploy::PackageOptions* package = nullptr);
 /// Writes (or, insecure, removes) the credentials of the deployment in `dir`; false with
 /// the error printed.
 bool write_security(const graph::Compilation& c, const std::string& dir, const SecurityOptions& security);

@@ -86,6 +86,17 @@ int main(int argc, char** argv) {
   compile->add_option("-o,--output", out_dir, "Output folder")->required();
   eamos::cli::SecurityOptions security;
   add_security(compile, security);
+  eamos::deploy::PackageOptions package;
+  bool packaged = false;
+  auto* package_flag = compile->add_flag(
+      "--package", packaged, "Also write what each drone's companion computer needs to run its DEX as a systemd service: "
+                   "cyclonedds.xml for a real network, dex.env, eamos-dex@.service, DEPLOY.txt (docs/deploy.md)");
+  compile->add_option("--interface", package.interface,
+                      "With --package: the network interface the drones' DDS uses, written into each dex.env "
+                      "(default: left for you to set there)")
+      ->needs(package_flag);
+  compile->add_option("--domain", package.domain, "With --package: the DDS domain id (0-230) every DEX joins")
+      ->default_val(0)->check(CLI::Range(0, 230))->needs(package_flag);
 
   auto* graph = app.add_subcommand("graph", "Write the AMT, MEG or a drone's MDG as DOT, JSON or SVG");
   add_common(graph, o);
@@ -249,7 +260,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*check) return eamos::cli::cmd_check(o, list_caps);
-    if (*compile) return eamos::cli::cmd_compile(o, out_dir, security);
+    if (*compile) return eamos::cli::cmd_compile(o, out_dir, security, packaged ? &package : nullptr);
     if (*graph) return eamos::cli::cmd_graph(o, kind, drone, format, graph_out);
     if (*stats) return eamos::cli::cmd_stats(o, stats_out);
     if (*run && distributed) {

@@ -1,0 +1,112 @@
+# What `cmake --install` puts where, and the CMake package a C++ program finds with
+# find_package(eamos). Included from the top-level CMakeLists.txt after every component, so the
+# components' own CMakeLists stay about building; this file is the one list of what is public.
+#
+# Layout under the prefix (GNUInstallDirs):
+#   bin/eamos                                  the command
+#   include/eamos/<component>/*.h              public headers, included as "dex/runner.h"
+#   lib/libeamos_*.a, lib/cmake/eamos/         the libraries and the package (eamos::dex, ...)
+#   lib/systemd/system/eamos-dex@.service      the DEX as a service (docs/deploy.md)
+#   share/man/man1/eamos*.1                    man pages made from --help (packaging/man_pages.cmake)
+#   share/bash-completion/completions/eamos, share/zsh/.../_eamos
+#   share/eamos/examples/, share/doc/eamos/
+# Two install components: `runtime` (the command and what a drone or a ground station needs)
+# and `dev` (headers, libraries, CMake package); cpack makes one .deb of each (packaging/cpack.cmake).
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+set(EAMOS_INCLUDE_DIR ${CMAKE_INSTALL_INCLUDEDIR}/eamos)
+set(EAMOS_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/eamos)
+
+# eamos_export(TARGET NAME DIR HEADERS...): TARGET becomes eamos::NAME for a program that
+# links it, here (an alias) and installed; HEADERS (in src/DIR) are the ones its users may
+# include: everything an installed header includes must be installed too (InstallTree.*
+# checks). The source folder is an include directory only while building.
+function(eamos_export target name dir)
+  set(headers ${ARGN})
+  list(TRANSFORM headers PREPEND ${PROJECT_SOURCE_DIR}/src/${dir}/)
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${name}
+                        INTERFACE_INCLUDE_DIRECTORIES "$<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src>")
+  target_compile_features(${target} PUBLIC cxx_std_20)
+  target_sources(${target} PUBLIC FILE_SET HEADERS BASE_DIRS ${PROJECT_SOURCE_DIR}/src FILES ${headers})
+  add_library(eamos::${name} ALIAS ${target})
+  set_property(GLOBAL APPEND PROPERTY EAMOS_EXPORTED_TARGETS ${target})
+endfunction()
+
+eamos_export(eamos_diag diag diag source.h diagnostics.h)
+eamos_export(eamos_fleet fleet fleet catalog.h fleet.h)
+eamos_export(eamos_lang lang lang ast.h token.h lexer.h parser.h checker.h)
+eamos_export(eamos_graph graph graph amt.h meg.h mdg.h pipeline.h export.h)
+eamos_export(eamos_deploy deploy deploy mission_file.h synthesize.h drone_package.h)
+eamos_export(eamos_mid mid mid drone_api.h event_loop.h adapter_registry.h adapter_drone.h action_tracker.h
+             requests.h mover.h state_broker.h location_validator.h timeouts.h vec.h)
+eamos_export(eamos_dex dex dex bridge.h engine.h expr.h latency.h mission.h observer.h plot.h runner.h trace.h
+             trace_schema.h trace_writers.h)
+eamos_export(eamos_sim sim sim battery.h motion.h sim_adapter.h sim_drone.h)
+eamos_export(eamos_mavlink mavlink mavlink crc.h enums.h field_def.h fields.h frame.h link.h messages.h payloads.h
+             signing.h url.h)
+eamos_export(eamos_mavlink_adapter mavlink_adapter mavlink_adapter adapter.h autopilot.h autopilot_params.h
+             command_sender.h mavlink_drone.h telemetry.h)
+# version.h (EAMOS_VERSION) is generated into the build tree.
+set_target_properties(eamos_version PROPERTIES EXPORT_NAME version
+                      INTERFACE_INCLUDE_DIRECTORIES "$<BUILD_INTERFACE:${PROJECT_BINARY_DIR}/generated>")
+target_sources(eamos_version INTERFACE FILE_SET HEADERS BASE_DIRS ${PROJECT_BINARY_DIR}/generated
+               FILES ${PROJECT_BINARY_DIR}/generated/version.h)
+add_library(eamos::version ALIAS eamos_version)
+get_property(exported GLOBAL PROPERTY EAMOS_EXPORTED_TARGETS)
+
+install(TARGETS eamos RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+install(TARGETS ${exported} eamos_version EXPORT eamosTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev
+        FILE_SET HEADERS DESTINATION ${EAMOS_INCLUDE_DIR} COMPONENT dev
+        INCLUDES DESTINATION ${EAMOS_INCLUDE_DIR})
+install(EXPORT eamosTargets NAMESPACE eamos:: DESTINATION ${EAMOS_CMAKE_DIR} COMPONENT dev)
+configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/eamosConfig.cmake.in
+                              ${PROJECT_BINARY_DIR}/packaging/eamosConfig.cmake
+                              INSTALL_DESTINATION ${EAMOS_CMAKE_DIR})
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/packaging/eamosConfigVersion.cmake
+                                 COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/packaging/eamosConfig.cmake ${PROJECT_BINARY_DIR}/packaging/eamosConfigVersion.cmake
+        DESTINATION ${EAMOS_CMAKE_DIR} COMPONENT dev)
+
+# The DEX as a systemd service; the same text `eamos compile --package` writes (src/deploy).
+install(FILES ${PROJECT_SOURCE_DIR}/config/eamos-dex@.service
+        DESTINATION lib/systemd/system COMPONENT runtime)
+install(FILES ${PROJECT_SOURCE_DIR}/config/cyclonedds-network.xml ${PROJECT_SOURCE_DIR}/config/cyclonedds-loopback.xml
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/eamos/config COMPONENT runtime)
+
+# Completions: bash-completion loads completions/eamos on demand; zsh finds _eamos on its
+# fpath, which on Debian has vendor-completions under /usr and site-functions under
+# /usr/local. Decided when installing: cpack installs under a staging folder ending in /usr.
+install(FILES ${CMAKE_CURRENT_LIST_DIR}/eamos.bash RENAME eamos
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/bash-completion/completions COMPONENT runtime)
+install(CODE "
+  if(CMAKE_INSTALL_PREFIX MATCHES \"/usr$\")
+    set(eamos_zsh_dir vendor-completions)
+  else()
+    set(eamos_zsh_dir site-functions)
+  endif()
+  file(INSTALL DESTINATION \"\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_DATADIR}/zsh/\${eamos_zsh_dir}\" TYPE FILE
+       FILES \"${CMAKE_CURRENT_LIST_DIR}/_eamos\")" COMPONENT runtime)
+
+# Man pages: help2man over `eamos --help` and every `eamos SUBCOMMAND --help`, at build time.
+find_program(EAMOS_HELP2MAN help2man)
+if(NOT EAMOS_HELP2MAN)
+  message(FATAL_ERROR "help2man not found: install help2man (scripts/install-deps.sh does)")
+endif()
+set(man_dir ${PROJECT_BINARY_DIR}/man)
+add_custom_command(OUTPUT ${man_dir}/eamos.1
+  COMMAND ${CMAKE_COMMAND} -DEAMOS=$<TARGET_FILE:eamos> -DHELP2MAN=${EAMOS_HELP2MAN} -DOUT=${man_dir}
+          -DVERSION=${PROJECT_VERSION} -DINCLUDE=${CMAKE_CURRENT_LIST_DIR}/eamos.h2m
+          -P ${CMAKE_CURRENT_LIST_DIR}/man_pages.cmake
+  DEPENDS eamos ${CMAKE_CURRENT_LIST_DIR}/man_pages.cmake ${CMAKE_CURRENT_LIST_DIR}/eamos.h2m
+  COMMENT "Writing the man pages from eamos --help"
+  VERBATIM)
+add_custom_target(eamos_man ALL DEPENDS ${man_dir}/eamos.1)
+install(DIRECTORY ${man_dir}/ DESTINATION ${CMAKE_INSTALL_MANDIR}/man1 COMPONENT runtime
+        FILES_MATCHING PATTERN "*.1")
+
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/ DESTINATION ${CMAKE_INSTALL_DATADIR}/eamos/examples
+        COMPONENT runtime)
+install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT runtime)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/docs COMPONENT runtime)
