@@ -14,6 +14,8 @@ packages=(
   nodejs
   chromium
   iproute2  # ip netns and veth pairs for tests/launch/netns_test.cpp
+  python3-dev python3-pybind11  # the Python module (src/python), built against Debian's /usr/bin/python3
+  python3-pytest python3-matplotlib python3-pandas  # test side: tests/python (the module needs neither at run time)
 )
 
 missing=()
