@@ -27,6 +27,18 @@ struct RunArgs {
   std::optional<std::string> trace;
 };
 
+/// "KeyError: 'x'": the exception's type and words, without the traceback err.what() adds.
+std::string exception_text(const py::error_already_set& err) {
+  try {
+    std::string text = py::str(err.type().attr("__name__"));
+    std::string words = py::str(err.value());
+    return words.empty() ? text : text + ": " + words;
+  } catch (const std::exception&) {  // an exception whose str() raises
+    PyErr_Clear();
+    return "an exception";
+  }
+}
+
 /// Gives each event to the callback as the trace line's dict. The run goes on without the
 /// GIL; each event takes it. A callback that raises (or Ctrl-C, seen here as
 /// KeyboardInterrupt) ends the mission as `eamos run` ends an interrupted one: every drone
@@ -44,10 +56,12 @@ class PythonSink : public dex::TraceSink {
       if (PyErr_CheckSignals() != 0) throw py::error_already_set();
     } catch (py::error_already_set& err) {
       error_ = err;
-      interrupt_.request(std::string("the Python callback raised ") + err.what());
+      // Ctrl-C comes as KeyboardInterrupt, seen here or inside the callback.
+      interrupt_.request(err.matches(PyExc_KeyboardInterrupt) ? std::string("interrupted (KeyboardInterrupt)")
+                                                              : "the on_event callback raised " + exception_text(err));
     } catch (const std::exception& err) {
       failed_ = err.what();
-      interrupt_.request(std::string("the Python callback failed: ") + err.what());
+      interrupt_.request(std::string("the on_event callback failed: ") + err.what());
     }
   }
 

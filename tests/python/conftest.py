@@ -43,3 +43,7 @@ def cli_listing2(eamos_bin, tmp_path_factory):
     trace, summary = out / "trace.jsonl", out / "summary.json"
     run_eamos(eamos_bin, "run", "-q", LISTING2, "--trace", trace, "--summary", summary)
     return {"trace": trace, "summary": json.loads(summary.read_text())}
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "realtime: flies on the wall clock (ctest runs these under the label realtime)")

@@ -2,11 +2,15 @@
 callback per trace event."""
 
 import json
+import os
+import signal
+import subprocess
+import sys
 
 import pytest
 
 import eamos
-from conftest import LISTING2
+from conftest import LISTING2, run_eamos
 
 
 def trace_lines(path):
@@ -55,7 +59,7 @@ def test_without_telemetry_the_callback_gets_no_telemetry_and_the_run_is_the_sam
     assert events and not [e for e in events if e["event"] == "telemetry"]
 
 
-def test_a_callback_that_raises_ends_the_mission_and_its_exception_comes_back():
+def test_a_callback_that_raises_ends_the_mission_and_its_exception_comes_back(tmp_path):
     seen = []
 
     class Stop(Exception):
@@ -66,8 +70,13 @@ def test_a_callback_that_raises_ends_the_mission_and_its_exception_comes_back():
         if e["event"] == "start" and e["name"] == "Takeoff":
             raise Stop("enough")
 
+    trace = tmp_path / "t.jsonl"
     with pytest.raises(Stop, match="enough"):
-        eamos.run(LISTING2, on_event=on_event)
+        eamos.run(LISTING2, on_event=on_event, trace=trace)
+    # The mission was abandoned at that event, and says why.
+    end = eamos.load_trace(trace).events[-1]
+    assert (end["outcome"], end["reason"]) == ("failed", "the on_event callback raised Stop: enough")
+    assert end["t"] == seen[-1]["t"]
     # Not called again after it raised: the mission was abandoned at that event.
     assert seen[-1]["event"] == "start" and seen[-1]["name"] == "Takeoff"
     assert not [e for e in seen if e["event"] == "mission"]
@@ -83,7 +92,7 @@ def test_a_failed_action_fails_the_run_with_the_responsible_line():
     assert r.failure is not None
     assert (r.failure.drone, r.failure.action, r.failure.line, r.failure.kind) == ("Drone1", "Takeoff", 3, "refused")
     assert "Takeoff (line 3) failed" in r.error
-    assert events[-1] == {**events[-1], "event": "mission", "outcome": "failed"}
+    assert (events[-1]["event"], events[-1]["outcome"]) == ("mission", "failed")
 
 
 def test_a_mission_still_flying_at_the_time_limit_fails_and_says_so():
@@ -108,3 +117,53 @@ def test_bad_options_are_refused_before_anything_flies(options, error, words):
     with pytest.raises(error, match=words):
         eamos.run(LISTING2, on_event=on_event, **options)
     assert events == []
+
+
+def test_a_fleet_file_changes_the_flight_as_it_does_for_eamos_run(tmp_path, eamos_bin):
+    fleet = LISTING2.parent / "listing2-right.yaml"
+    summary = tmp_path / "s.json"
+    run_eamos(eamos_bin, "run", "-q", LISTING2, "--fleet", fleet, "--summary", summary)
+    cli = json.loads(summary.read_text())
+    r = eamos.run(LISTING2, fleet=fleet)
+    assert r.completed and r.duration == cli["duration"]
+    # Sensor1 reads 120 here: Drone1 takes the right branch, 5 m east of its home.
+    assert r.drones["Drone1"].state["x"] == cli["drones"]["Drone1"]["x"] == pytest.approx(5, abs=0.5)
+
+
+@pytest.mark.realtime
+def test_ctrl_c_during_a_run_lands_every_drone_and_raises_keyboard_interrupt(tmp_path):
+    # A real-time run at 20x, without a callback, in its own process, writing its trace into a
+    # pipe: the signal is sent once the first part of the trace has come through (the flight
+    # is under way), as a notebook's Interrupt would be. The rest of the trace then shows how
+    # the run ended.
+    pipe = tmp_path / "trace.pipe"
+    os.mkfifo(pipe)
+    code = (
+        "import eamos\n"
+        "try:\n"
+        f"    eamos.run({str(LISTING2)!r}, speed=20, trace={str(pipe)!r})\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted')\n"
+    )
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        with open(pipe) as f:
+            text = f.readline()
+            p.send_signal(signal.SIGINT)
+            text += f.read()
+        out, err = p.communicate(timeout=60)
+    finally:
+        p.kill()
+    assert p.returncode == 0, err
+    assert out == "interrupted\n"
+    trace = tmp_path / "trace.jsonl"
+    trace.write_text(text)
+    t = eamos.load_trace(trace)
+    end = t.events[-1]
+    assert end["outcome"] == "failed" and end["reason"] == "interrupted (KeyboardInterrupt)"
+    assert end["t"] < 16.7
+    # The drones in the air ran their failsafe (land) and were down when run() returned.
+    assert t.of("failsafe") and {e["name"] for e in t.of("failsafe")} == {"land"}
+    for name in t.drones:
+        last = t.of("telemetry", name)[-1]
+        assert last["landed"] and last["z"] == pytest.approx(0, abs=0.05)
