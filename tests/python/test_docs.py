@@ -73,3 +73,14 @@ def check_picture(path):
         assert matches.sum() > 200, f"hardly any pixels of colour {colour}: a drone's line is missing"
         # On both panels: left half (tracks) and right half (altitude).
         assert matches[:, : width // 2].sum() > 50 and matches[:, width // 2 :].sum() > 50
+
+
+def test_the_python_lines_in_the_readme_run(tmp_path):
+    (code,) = [body for lang, body in re.findall(r"^```(\w+)\n(.*?)^```$", (ROOT / "README.md").read_text(), re.M | re.S)
+               if lang == "python"]
+    (tmp_path / "examples").symlink_to(ROOT / "examples")
+    code += "print(result.completed, len(df) == len(eamos.load_trace('run.jsonl').of('telemetry')))\n"
+    p = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.splitlines()[-1] == "True True"
+    assert "mission" in p.stdout  # the callback printed the mission's end
