@@ -105,3 +105,14 @@ def test_unknown_drone_names_are_refused_with_the_fleet():
         c.mdg("Drone7")
     with pytest.raises(IndexError):
         c.mdg(3)
+
+
+def test_a_file_of_bytes_that_are_not_text_gives_diagnostics_not_an_exception(tmp_path):
+    path = tmp_path / "garbage.eamos"
+    path.write_bytes(b"var Drone1 Quad\nfunc INIT() { Drone1.Takeoff(\xff\xfe) }\n\x00\x01garbage\n")
+    c = eamos.compile(path)
+    assert not c.ok
+    assert [(d.line, d.column) for d in c.errors] == [(2, 30), (3, 1)]
+    assert "unexpected byte 0xff" in c.errors[0].message
+    # The source line's bytes that are not UTF-8 come as U+FFFD.
+    assert "Takeoff(\ufffd\ufffd)" in c.errors[0].text
