@@ -11,7 +11,7 @@ def test_installed_module_compiles_and_runs_a_mission(tmp_path, build_dir):
     prefix = tmp_path / "prefix"
     subprocess.run(["cmake", "--install", str(build_dir), "--component", "python", "--prefix", str(prefix)],
                    check=True, capture_output=True, timeout=120)
-    site = prefix / os.environ["EAMOS_PYTHON_INSTALL_DIR"]
+    site = prefix / os.environ["EAMOS_PYTHON_PACKAGE_DIR"]
     assert (site / "eamos" / "__init__.py").is_file()
     code = (
         "import eamos\n"
