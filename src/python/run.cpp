@@ -25,6 +25,7 @@ struct RunArgs {
   double telemetry_hz = 5.0;
   std::optional<double> speed;  ///< none: virtual time
   std::optional<std::string> trace;
+  bool tracks = true;  ///< keep every drone's whole track in the result
 };
 
 /// "KeyError: 'x'": the exception's type and words, without the traceback err.what() adds.
@@ -64,6 +65,9 @@ class PythonSink : public dex::TraceSink {
       interrupt_.request(std::string("the on_event callback failed: ") + err.what());
     }
   }
+
+  /// Without a callback it only watches for Ctrl-C: no message events need be built for it.
+  bool takes_messages() const override { return !callback_.is_none(); }
 
   /// With the GIL held, after the run: raises what the callback raised, if anything.
   void rethrow() {
@@ -203,6 +207,7 @@ py::dict run(const CompiledMission& m, const RunArgs& a) {
   options.time_limit_s = a.time_limit;
   options.interrupt = &interrupt;
   options.telemetry_hz = a.telemetry_hz;
+  options.keep_tracks = a.tracks;
   if (a.speed) {
     options.clock.mode = mid::ClockMode::real_time;
     options.clock.speed = *a.speed;
@@ -226,11 +231,12 @@ void bind_run(py::module_& m) {
   m.def(
       "run",
       [](const CompiledMission& c, py::object on_event, double time_limit, double telemetry_hz,
-         std::optional<double> speed, std::optional<std::string> trace) {
-        return run(c, {std::move(on_event), time_limit, telemetry_hz, speed, std::move(trace)});
+         std::optional<double> speed, std::optional<std::string> trace, bool tracks) {
+        return run(c, {std::move(on_event), time_limit, telemetry_hz, speed, std::move(trace), tracks});
       },
       py::arg("mission"), py::arg("on_event") = py::none(), py::arg("time_limit") = 3600.0,
-      py::arg("telemetry_hz") = 5.0, py::arg("speed") = py::none(), py::arg("trace") = py::none());
+      py::arg("telemetry_hz") = 5.0, py::arg("speed") = py::none(), py::arg("trace") = py::none(),
+      py::arg("tracks") = true);
 }
 
 }  // namespace eamos::python

@@ -82,6 +82,15 @@ def test_a_callback_that_raises_ends_the_mission_and_its_exception_comes_back(tm
     assert not [e for e in seen if e["event"] == "mission"]
 
 
+def test_without_tracks_each_drone_keeps_its_first_and_last_state_and_the_run_is_the_same():
+    whole = eamos.run(LISTING2)
+    short = eamos.run(LISTING2, tracks=False)
+    assert short.completed and short.duration == whole.duration
+    for name, d in short.drones.items():
+        full = whole.drones[name].track
+        assert d.track == {k: [v[0], v[-1]] for k, v in full.items()} and len(full["t"]) > 50
+
+
 def test_a_failed_action_fails_the_run_with_the_responsible_line():
     # Takeoff without Arm: the simulated drone refuses it.
     c = eamos.compile_text("var Drone1 Quad\nfunc INIT() { SEQ_fly() }\nfunc SEQ_fly() { Drone1.Takeoff(3) }\n",

@@ -123,7 +123,7 @@ class Compilation:
 
     def run(self, on_event: Optional[Callable[[Dict[str, Any]], None]] = None, *, time_limit: float = 3600.0,
             telemetry_hz: float = 5.0, speed: Optional[float] = None,
-            trace: Optional[str | os.PathLike] = None) -> "RunResult":
+            trace: Optional[str | os.PathLike] = None, tracks: bool = True) -> "RunResult":
         """Flies the mission in the built-in simulator, as `eamos run` does.
 
         on_event: called with each trace event (a dict with the fields of docs/trace.md) as it
@@ -133,11 +133,13 @@ class Compilation:
         speed: None flies on virtual time (as fast as the machine goes); a number flies in real
         time at that factor (needed for drones on the mavlink adapter).
         trace: also write the trace (JSON Lines) to this file, header first, as `--trace` does.
+        tracks: keep each drone's whole track in the result (a row per change, 20 per second of
+        flight); False keeps its first and last state only (fleets of hundreds of drones).
         """
         self.check()
         raw = _core.run(self._core, on_event, time_limit=float(time_limit), telemetry_hz=float(telemetry_hz),
                         speed=None if speed is None else float(speed),
-                        trace=None if trace is None else os.fspath(trace))
+                        trace=None if trace is None else os.fspath(trace), tracks=bool(tracks))
         return RunResult._from_core(raw)
 
     def _drone_name(self, drone: str | int) -> str:
