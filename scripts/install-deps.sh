@@ -19,6 +19,8 @@ packages=(
   # tests/install: the .deb's Depends (dpkg-shlibdeps, in dpkg-dev), the rendered man pages,
   # the zsh completion, the DEX's unit (systemd-analyze verify)
   dpkg-dev man-db zsh systemd
+  python3-dev python3-pybind11  # the Python module (src/python), built against Debian's /usr/bin/python3
+  python3-pytest python3-matplotlib python3-pandas  # test side: tests/python (the module needs neither at run time)
 )
 
 missing=()

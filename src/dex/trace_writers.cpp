@@ -12,12 +12,12 @@ namespace {
 double rounded(double t) { return std::round(t * 1e6) / 1e6; }
 }  // namespace
 
-std::string JsonlTrace::drone_name(int index) const {
-  if (index < static_cast<int>(fleet_.size())) return fleet_[index];
+namespace {
+std::string fleet_name(const std::vector<std::string>& fleet, int index) {
+  if (index < static_cast<int>(fleet.size())) return fleet[index];
   return std::to_string(index);
 }
 
-namespace {
 /// Telemetry is for people and pictures: millimetres, a tenth of a degree and a hundredth
 /// of a percent are finer than any vehicle reports, and keep the trace small.
 /// `v` to 1/`per_unit` (1000: millimetres); divided, not multiplied by the step, so that
@@ -37,7 +37,8 @@ void put_telemetry(nlohmann::ordered_json& j, const mid::DroneState& s) {
 }
 }  // namespace
 
-void JsonlTrace::record(const TraceEvent& e) {
+nlohmann::ordered_json trace_event_json(const TraceEvent& e, const std::vector<std::string>& fleet) {
+  auto drone_name = [&fleet](int index) { return fleet_name(fleet, index); };
   nlohmann::ordered_json j;
   j["t"] = rounded(e.t);
   if (e.event == "telemetry" && e.state) {
@@ -75,8 +76,10 @@ void JsonlTrace::record(const TraceEvent& e) {
     if (e.node >= 0) j["node"] = e.node;
     if (e.instance >= 0) j["instance"] = e.instance;
   }
-  write(j);
+  return j;
 }
+
+void JsonlTrace::record(const TraceEvent& e) { write(trace_event_json(e, fleet_)); }
 
 void JsonlTrace::write_header(const nlohmann::ordered_json& header) { write(header); }
 

@@ -11,6 +11,11 @@
 
 namespace eamos::dex {
 
+/// One event as a line of the JSON Lines trace (docs/trace.md): what JsonlTrace writes and what
+/// the Python module hands to a run's callback. `fleet` names the drones of message events'
+/// from/to (an index past its end is written as the number).
+nlohmann::ordered_json trace_event_json(const TraceEvent& e, const std::vector<std::string>& fleet);
+
 /// {"t":1.25,"drone":"Drone1","event":"start","name":"Takeoff","line":51,...} per line, in
 /// the schema of docs/trace.md. `fleet` names the drones of message events' from/to.
 class JsonlTrace : public TraceSink {
@@ -22,7 +27,6 @@ class JsonlTrace : public TraceSink {
 
  private:
   void write(const nlohmann::ordered_json& j);
-  std::string drone_name(int index) const;
   std::ostream& out_;
   std::vector<std::string> fleet_;
 };
