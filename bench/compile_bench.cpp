@@ -66,10 +66,12 @@ std::size_t compile_all(const std::string& text) {
   return counter.bytes;
 }
 
-std::string stress_mission(long long nodes, int drones) {
+/// A gen-stress mission; `shape` is a stress::Shape as a number (0 squads, 1 show, 2 cross).
+std::string stress_mission(long long nodes, int drones, long long shape = 0) {
   eamos::stress::StressOptions o;
   o.target_nodes = nodes;
   o.drones = drones;
+  o.shape = static_cast<eamos::stress::Shape>(shape);
   return eamos::stress::generate_mission(o);
 }
 
@@ -79,8 +81,10 @@ void BM_CompileListing2(benchmark::State& state) {
 }
 BENCHMARK(BM_CompileListing2)->Unit(benchmark::kMicrosecond);
 
+// Args: nodes, drones, shape (0 squads, 1 show: every drone in every PAR, 2 cross: waits,
+// Ifs and arguments on other squads' drones).
 void BM_CompileStress(benchmark::State& state) {
-  std::string text = stress_mission(state.range(0), static_cast<int>(state.range(1)));
+  std::string text = stress_mission(state.range(0), static_cast<int>(state.range(1)), state.range(2));
   // The generator aims at a node count; per-node figures use the MEG's real size.
   double meg_nodes = 0;
   {
@@ -95,9 +99,14 @@ void BM_CompileStress(benchmark::State& state) {
       meg_nodes, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_CompileStress)
-    ->Args({5000, 20})
-    ->Args({50000, 100})
-    ->Args({500000, 1000})
+    ->ArgNames({"nodes", "drones", "shape"})
+    ->Args({5000, 20, 0})
+    ->Args({50000, 100, 0})
+    ->Args({500000, 1000, 0})
+    ->Args({50000, 100, 1})
+    ->Args({500000, 1000, 1})
+    ->Args({50000, 100, 2})
+    ->Args({500000, 1000, 2})
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
     ->UseRealTime();
@@ -143,7 +152,7 @@ void BM_ProcessPeakRss(benchmark::State& state) {
   std::string mission = std::string(EAMOS_SOURCE_DIR) + "/examples/listing2.eamos";
   if (state.range(0) > 0) {
     mission = (dir / "stress.eamos").string();
-    std::ofstream(mission) << stress_mission(state.range(0), static_cast<int>(state.range(1)));
+    std::ofstream(mission) << stress_mission(state.range(0), static_cast<int>(state.range(1)), state.range(2));
   }
   std::string self = fs::read_symlink("/proc/self/exe").string();
   std::string command = "'" + self + "' " + kMeasureFlag + " '" + EAMOS_BINARY + "' compile '" +
@@ -165,9 +174,12 @@ void BM_ProcessPeakRss(benchmark::State& state) {
   fs::remove_all(dir);
 }
 BENCHMARK(BM_ProcessPeakRss)
-    ->Args({0, 0})
-    ->Args({5000, 20})
-    ->Args({500000, 1000})
+    ->ArgNames({"nodes", "drones", "shape"})
+    ->Args({0, 0, 0})
+    ->Args({5000, 20, 0})
+    ->Args({500000, 1000, 0})
+    ->Args({500000, 1000, 1})
+    ->Args({500000, 1000, 2})
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime()
     ->Iterations(3);
