@@ -143,6 +143,15 @@ class LoopTime {
 
 }  // namespace
 
+namespace {
+/// A RepeatFor whose literal count stays below the DEX's guard: it cannot hang.
+bool bounded_below_guard(const Statement& s) {
+  if (s.control != ControlKind::RepeatFor || s.args.size() < 4 || !s.args[3]) return false;
+  const Expr& n = *s.args[3];
+  return n.kind == ExprKind::number && n.number >= 0 && n.number < static_cast<double>(kMaxInstantIterations);
+}
+}  // namespace
+
 void check_loops_take_time(const Mission& mission, Diagnostics& diags) {
   LoopTime loops(mission);
   for (const Function& f : mission.functions)
@@ -150,11 +159,18 @@ void check_loops_take_time(const Mission& mission, Diagnostics& diags) {
       if (s.kind != StatementKind::call || !is_repeat(s.control) || s.branch_functions.empty()) continue;
       int body = s.branch_functions[0];
       if (body < 0 || loops.block_waits(body)) continue;
-      diags.error(mission.file, s.loc,
-                  std::string(control_name(s.control)) + " can repeat without mission time passing: " +
-                      loops.why_instant(body) + ", so an iteration can end at the instant it began; " +
-                      "add an action or a PauseFor(seconds) to '" + mission.functions[body].name +
-                      "', or wait with PauseUntil/PauseWhile instead of looping");
+      std::string why = std::string(control_name(s.control)) + " can repeat without mission time passing: " +
+                        loops.why_instant(body) + ", so an iteration can end at the instant it began; ";
+      std::string fix = "add an action or a PauseFor(seconds) to '" + mission.functions[body].name +
+                        "', or wait with PauseUntil/PauseWhile instead of looping";
+      if (bounded_below_guard(s)) {
+        diags.warning(mission.file, s.loc,
+                      why + "it ends after its count (below the " + std::to_string(kMaxInstantIterations) +
+                          " instant iterations the DEX allows), but its iterations may all fall in one instant; " +
+                          fix);
+        continue;
+      }
+      diags.error(mission.file, s.loc, why + fix);
     }
 }
 

@@ -7,9 +7,16 @@
 
 namespace eamos::lang {
 
-/// Reports an error at each Repeat* whose repeat branch can end, on some path, without
-/// running an action, a PauseFor of more than 0 s, or a wait on a condition. Tolerates
-/// unresolved names and recursion (other checks report those), so it runs on any mission.
+/// Iterations in a row a Repeat may run without mission time passing before the DEX fails
+/// the mission (dex::kMaxInstantIterations; a test keeps the two equal).
+inline constexpr long long kMaxInstantIterations = 10000;
+
+/// Reports each Repeat* whose repeat branch can end, on some path, without running an
+/// action, a PauseFor of more than 0 s, or a wait on a condition. An error where such a loop
+/// can repeat for ever (RepeatWhile, RepeatUntil) or more often in a row than the DEX allows
+/// (a RepeatFor of kMaxInstantIterations or more); a warning for a RepeatFor below that,
+/// which ends after its count and cannot hang. Tolerates unresolved names and recursion
+/// (other checks report those), so it runs on any mission.
 void check_loops_take_time(const Mission& mission, Diagnostics& diags);
 
 }  // namespace eamos::lang

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "flight.h"
+#include "lang/loop_time.h"
 
 namespace eamos {
 namespace {
@@ -258,6 +259,22 @@ int count_of(const Flight& f, const std::string& event, const std::string& text,
   for (const auto& e : f.events)
     n += e.event == event && e.text == text && (outcome.empty() || e.outcome == outcome);
   return n;
+}
+
+// The checker warns instead of refusing a RepeatFor below the DEX's guard: the two numbers
+// must be one.
+TEST(Semantics, TheCheckersBoundedLoopCountIsTheDexsGuard) {
+  EXPECT_EQ(lang::kMaxInstantIterations, dex::kMaxInstantIterations);
+}
+
+// A RepeatFor of 3 whose body may take no time is a warning, and flies to its end.
+TEST(Semantics, BoundedLoopWhoseBodyMayTakeNoTimeRunsItsCountAndGoesOn) {
+  test::Flight f = test::fly(
+      "var A Quad\nfunc INIT() { A.Arm(); A.Takeoff(5); RepeatFor(true, SEQ_w, SEQ_after, 3) }\n"
+      "func SEQ_w() { DoWhileSync(A.Battery() < 5, SEQ_h, SEQ_d) }\nfunc SEQ_h() { A.Hover(1) }\n"
+      "func SEQ_d() { A.TakePicture() }\nfunc SEQ_after() { A.Land() }\n");
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_GE(f.find("end", "A.Land()", "succeeded"), 0);
 }
 
 TEST(Semantics, LoopThatTakesNoTimeFailsTheMissionAndRunsTheFailsafeInsteadOfSpinning) {
