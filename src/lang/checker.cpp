@@ -205,6 +205,12 @@ void Checker::check_drones() {
                        std::to_string(it->second->loc.line) + "); rename or remove one");
     if (find_function(d.name) >= 0)
       error(d.loc, "'" + d.name + "' is both a drone and a function; rename one");
+    // A drone's name is the common name (CN) of its DDS Security certificate, which X.509
+    // bounds at 64 characters.
+    if (d.name.size() > kMaxDroneNameLength)
+      error(d.loc, "drone name '" + d.name.substr(0, 16) + "…' is " + std::to_string(d.name.size()) +
+                       " characters long; a drone's DDS Security certificate holds at most " +
+                       std::to_string(kMaxDroneNameLength) + ": shorten it");
     out_.drone_types.push_back(fleet_.type_for(d.type));
     fleet_.check_drone(d.name, out_.drone_types.back(), diags_);
   }

@@ -10,6 +10,9 @@
 
 namespace eamos::lang {
 
+/// The longest drone name: the common name of its DDS Security certificate (X.509: 64).
+inline constexpr std::size_t kMaxDroneNameLength = 64;
+
 /// Upper bounds that keep any input from exhausting time or memory: calls are expanded
 /// into the AMT (each call instantiates its block), so a small file can ask for a huge tree.
 struct CheckLimits {
