@@ -251,7 +251,9 @@ void DexProcess::abandon(const std::string& reason, const std::optional<dex::Fai
   err_ << name() << ": " << reason << "\n";
   if (commanded) dex::record_failsafe(mission_.settings, loop_->now(), reason, &tee_);
   failsafe_since_ = loop_->now();
-  wait_for_failsafe();
+  // Looked at from the next turn of the loop, after the callbacks already queued: the ends
+  // of the actions the failsafe cancelled are among them and must reach the trace.
+  loop_->after(0.0, [this] { wait_for_failsafe(); });
 }
 
 void DexProcess::on_stall(double stalled_s) {
