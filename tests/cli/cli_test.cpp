@@ -234,6 +234,48 @@ TEST_F(Cli, PatrolWithTheLeadsBatteryAlreadyLowSkipsTheOrbitAndBringsTheLeadHome
   EXPECT_GT(lead["battery"].get<double>(), 90.0);  // home on its own, not by the failsafe
 }
 
+/// "first+rest+rest+…" with `terms` terms: a left-leaning tree `terms` levels deep.
+std::string sum(const std::string& first, const std::string& rest, int terms) {
+  std::string s = first;
+  for (int i = 1; i < terms; ++i) s += "+" + rest;
+  return s;
+}
+
+/// A one-drone mission whose Takeoff (line 5, its argument from column 13) climbs `altitude`.
+std::string taking_off_to(const std::string& altitude) {
+  return "var D Quad\nfunc INIT() { SEQ_a() }\nfunc SEQ_a() {\n  D.Arm()\n  D.Takeoff(" + altitude +
+         ")\n  D.Land()\n}\n";
+}
+
+// Each operator is a level of the expression as the mission file stores it: a long sum is as
+// deep as its terms, and deeper than the mission reader takes, so every command refuses it
+// where it is written, as it refuses 201 parentheses, instead of overflowing the stack.
+TEST_F(Cli, ASumOfTwentyThousandTermsIsAnErrorAtItsLineNotACrash) {
+  fs::path m = dir_ / "long_sum.eamos";
+  std::ofstream(m) << taking_off_to(sum("1", "1", 20000));
+  for (const std::string& command :
+       std::vector<std::string>{"check ", "compile -q -o " + (dir_ / "out").string() + " ", "run -q "}) {
+    Output r = eamos(command + m.string());
+    EXPECT_EQ(r.status, 1) << command << r.out.substr(0, 300);
+    EXPECT_EQ(r.out.rfind(m.string() + ":5:412: error: expression nested too deeply (more than 200 levels", 0), 0u)
+        << command << r.out.substr(0, 300);
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "D" / "mission.json"));
+}
+
+// The compiler's limit is the one the mission reader holds files to, counted alike: what
+// `eamos check` accepts, `eamos run` (which reads the compiled files back) flies.
+TEST_F(Cli, AnExpressionAtTheDepthLimitFliesAndOneLevelMoreIsAnError) {
+  fs::path at_limit = dir_ / "at_limit.eamos", over = dir_ / "over.eamos";
+  std::ofstream(at_limit) << taking_off_to(sum("5", "0", 200));
+  std::ofstream(over) << taking_off_to(sum("5", "0", 201));
+  Output r = eamos("run -q " + at_limit.string());
+  EXPECT_EQ(r.status, 0) << r.out.substr(0, 600);
+  r = eamos("check " + over.string());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.out.rfind(over.string() + ":5:412: error: expression nested too deeply", 0), 0u) << r.out.substr(0, 300);
+}
+
 }  // namespace
 
 // `eamos dex` reads its mission through the one validating reader: a damaged or edited
