@@ -184,6 +184,20 @@ TEST_F(Cli, RunReportsCompletionWhenTheLastAsyncWorkEndsAndTheTraceEndsWithIt) {
   EXPECT_EQ(before["t"], 2.1);
 }
 
+// A trace that cannot be written (a full disk; /dev/full refuses every write) is said at
+// once, before the first drone moves here since the header is the first write; the flight
+// goes on as it would, and the exit status says the run's record is incomplete.
+TEST_F(Cli, RunWithATraceOnAFullDiskSaysSoAtOnceFliesOnAndExitsNonZero) {
+  Output r = eamos("run " + kListing2 + " --fleet " + std::string(EAMOS_SOURCE_DIR) +
+                   "/examples/listing2-right.yaml --trace /dev/full --summary " + (dir_ / "summary.json").string());
+  EXPECT_EQ(r.status, 1) << r.out;
+  std::size_t error = r.out.find("eamos: error: cannot write the trace '/dev/full' (No space left on device)");
+  ASSERT_NE(error, std::string::npos) << r.out;
+  EXPECT_LT(error, r.out.find("Drone1   start")) << r.out;
+  EXPECT_NE(r.out.find("mission completed in"), std::string::npos) << r.out;
+  EXPECT_EQ(nlohmann::json::parse(read_file(dir_ / "summary.json"))["status"], "completed");
+}
+
 TEST_F(Cli, AsyncWorkInALoopIsNotWarnedAboutAndEveryPictureEndsOnce) {
   Output c = eamos("check " + mission("async_in_loop.eamos"));
   EXPECT_EQ(c.status, 0) << c.out;

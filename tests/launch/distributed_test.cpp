@@ -386,6 +386,18 @@ TEST_F(Distributed, ActionCancelledByAHoveringFailsafeHasItsEndInTheTrace) {
   EXPECT_FALSE(summary["drones"]["Lead"]["landed"]) << summary.dump(2);  // hovering, as told
 }
 
+// The ground writes the merged trace once the mission is over: a write that fails (a full
+// disk) is said and makes the exit status 1 although the mission completed (domain 205).
+TEST_F(Distributed, TraceOnAFullDiskIsReportedAndTheExitStatusIsNonZero) {
+  Output r = eamos("run -q " + std::string(EAMOS_SOURCE_DIR) + "/tests/launch/missions/hops.eamos --distributed "
+                   "--insecure --speed 10 --domain 205 --deploy-dir " + (dir_ / "deploy").string() +
+                   " --trace /dev/full --summary " + (dir_ / "summary.json").string());
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("eamos: error: cannot write the trace '/dev/full' (No space left on device)"),
+            std::string::npos) << r.out;
+  EXPECT_EQ(read_json(dir_ / "summary.json")["status"], "completed");
+}
+
 TEST_F(Distributed, TimeLimitFailsTheMissionOnEveryDrone) {
   Output r = eamos("run -q " + source("listing2.eamos") + " --distributed --speed 5 --time-limit 3 --domain 34 " +
                    "--deploy-dir " + (dir_ / "deploy").string() + " --summary " + (dir_ / "summary.json").string());
