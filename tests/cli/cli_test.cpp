@@ -1,6 +1,7 @@
 // The `eamos` binary end to end: exit status, output files and what a user sees.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -307,9 +308,54 @@ class CliDex : public Cli {
     std::ofstream(file_, std::ios::binary | std::ios::trunc) << text;
     return eamos_test::run_eamos("dex " + (dir_ / "deploy" / "Drone1").string() + " --domain 51 --start-timeout 1");
   }
+  /// `eamos dex` on the folder as it stands, bounded in time and memory: a reader that waits
+  /// for a FIFO's writer or reads /dev/zero for ever fails the test instead of hanging it or
+  /// taking the machine's memory.
+  Output dex_bounded() {
+    std::string cmd = "ulimit -v 2000000; timeout 60 " + std::string(EAMOS_BINARY) + " dex " +
+                      (dir_ / "deploy" / "Drone1").string() + " --domain 51 --start-timeout 1 2>&1";
+    Output r;
+    FILE* p = popen(cmd.c_str(), "r");
+    if (!p) return r;
+    char buf[4096];
+    while (fgets(buf, sizeof buf, p)) r.out += buf;
+    int raw = pclose(p);
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    return r;
+  }
   fs::path file_;
   std::string text_;
 };
+
+TEST_F(CliDex, RefusesAMissionFileThatIsAFifoWithoutWaitingForAWriter) {
+  fs::remove(file_);
+  ASSERT_EQ(mkfifo(file_.c_str(), 0600), 0);
+  Output r = dex_bounded();
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find(file_.string() + ": error: a FIFO, not a regular file; a mission file is the mission.json "
+                                        "`eamos compile` writes"),
+            std::string::npos)
+      << r.out;
+}
+
+TEST_F(CliDex, RefusesAMissionFileThatIsADeviceSuchAsDevZero) {
+  fs::remove(file_);
+  fs::create_symlink("/dev/zero", file_);
+  Output r = dex_bounded();
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find(file_.string() + ": error: a character device, not a regular file;"), std::string::npos) << r.out;
+}
+
+// One byte over the documented 1 GiB: refused by its size, unread (the file is sparse).
+TEST_F(CliDex, RefusesAMissionFileLargerThanTheLimitWithoutReadingIt) {
+  fs::resize_file(file_, (std::uintmax_t{1} << 30) + 1);
+  Output r = dex_bounded();
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find(file_.string() + ": error: 1073741825 bytes, more than the 1073741824 (1 GiB) a mission file may "
+                                        "hold;"),
+            std::string::npos)
+      << r.out;
+}
 
 TEST_F(CliDex, RefusesAMissionFileEditedAfterCompile) {
   Output r = dex_with(eamos_test::replace_once(text_, "\"battery\":100.0", "\"battery\":99.0"));
