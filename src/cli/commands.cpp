@@ -73,6 +73,14 @@ bool write_output(const std::string& path, const std::string& text) {
   return true;
 }
 
+void report_trace_write_errors(dex::JsonlTrace& trace, const std::string& path) {
+  trace.on_write_error([path](const std::string& why) {
+    std::cerr << "eamos: error: cannot write the trace '" << path << "' (" << why
+              << "); it stops here, and the exit status will be 1\n"
+              << std::flush;
+  });
+}
+
 int cmd_check(const CommonOptions& o, bool list_capabilities) {
   graph::Compilation c;
   if (!compile_and_report(o, c)) return 1;

@@ -9,6 +9,7 @@
 
 #include "deploy/drone_package.h"
 #include "dex/runner.h"
+#include "dex/trace_writers.h"
 #include "graph/pipeline.h"
 #include "launch/dex_process.h"
 #include "launch/ground.h"
@@ -131,5 +132,8 @@ bool load_compiled_missions(const graph::Compilation& c, std::vector<dex::Missio
 bool render_svg(const std::string& dot, std::string& svg, std::string& error);
 /// Writes text to a file, or to stdout when path is "" or "-".
 bool write_output(const std::string& path, const std::string& text);
+/// Makes a failed write of the trace at `path` an error on standard error the moment it
+/// happens (a full disk): the trace stops there, what runs goes on.
+void report_trace_write_errors(dex::JsonlTrace& trace, const std::string& path);
 
 }  // namespace eamos::cli

@@ -130,8 +130,10 @@ int report_launch(const RunCommandOptions& r, const launch::LaunchResult& result
       return 1;
     }
     dex::JsonlTrace jsonl(out, result.fleet);
+    report_trace_write_errors(jsonl, r.trace);
     jsonl.write_header(result.header);
     for (const auto& e : result.events) jsonl.record(e);
+    if (!jsonl.write_error().empty()) status = 1;
   }
   if (!report_run(r, result.run, result.events)) return 1;
   return result.run.completed ? status : 1;

@@ -141,6 +141,8 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
       return 1;
     }
     jsonl = std::make_unique<dex::JsonlTrace>(trace_file, missions[0].fleet);
+    // Said when it happens, not at the end: the flight goes on, without its record.
+    report_trace_write_errors(*jsonl, r.trace);
     jsonl->write_header(deploy::trace_header(c, missions[0].hash, r.telemetry_hz));
     tee.add(jsonl.get());
   }
@@ -161,8 +163,12 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   dex::RunResult result = dex::run_in_process(missions, adapters, &tee, options);
   if (progress) progress->finish();
   if (!report_run(r, result, memory.events)) return 1;
+  // A completed mission whose trace was cut is not a run to take as recorded.
+  bool trace_cut = jsonl && !jsonl->write_error().empty();
+  if (trace_cut)
+    std::cerr << "eamos: error: the trace '" << r.trace << "' is incomplete (" << jsonl->write_error() << ")\n";
   if (live_monitor && !hold.was_interrupted()) hold_monitor(*server, hold);
-  return result.completed ? 0 : 1;
+  return result.completed && !trace_cut ? 0 : 1;
 }
 
 void hold_monitor(monitor::MonitorServer& server, MonitorHold& hold) {

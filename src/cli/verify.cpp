@@ -44,6 +44,7 @@ bool write_verify_trace(const std::string& path, const graph::Compilation& c, co
   }
   verify::WorstFlight w = verify::fly_worst_path(c, missions, options, report);
   dex::JsonlTrace jsonl(out, missions[0].fleet);
+  report_trace_write_errors(jsonl, path);
   jsonl.write_header(deploy::trace_header(c, missions[0].hash, 0.0));
   std::size_t next = 0;
   for (const dex::TraceEvent& e : w.events) {
@@ -51,7 +52,7 @@ bool write_verify_trace(const std::string& path, const graph::Compilation& c, co
       out << violation_line(w.violations[next++]);
     jsonl.record(e);
   }
-  return static_cast<bool>(out);
+  return jsonl.write_error().empty() && out.flush();
 }
 
 }  // namespace

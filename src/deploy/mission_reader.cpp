@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "deploy/mission_file.h"
+#include "deploy/regular_file.h"
 #include "deploy/sha256.h"
 #include "lang/parser.h"
 
@@ -779,14 +780,23 @@ bool read_mission(std::string_view text, const std::string& file, dex::Mission& 
 }
 
 bool read_mission_file(const std::string& path, dex::Mission& out, std::vector<std::string>& errors) {
-  std::ifstream in(path, std::ios::binary);
   std::string text;
-  if (in) text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  if (!in && !in.eof()) {
-    errors.push_back(path + ": error: cannot read the mission file; check that the deployment folder holds it");
-    return false;
+  FileRead r = read_regular_file(path, kMaxMissionFileBytes, text);
+  if (r.status == FileRead::ok) return read_mission(text, path, out, errors);
+  std::string what;
+  switch (r.status) {
+    case FileRead::not_regular:
+      what = r.detail + ", not a regular file; a mission file is the mission.json `eamos compile` writes";
+      break;
+    case FileRead::too_large:
+      what = r.detail + " bytes, more than the " + std::to_string(kMaxMissionFileBytes) +
+             " (1 GiB) a mission file may hold; split the mission";
+      break;
+    default:
+      what = "cannot read the mission file (" + r.detail + "); check that the deployment folder holds it";
   }
-  return read_mission(text, path, out, errors);
+  errors.push_back(path + ": error: " + what);
+  return false;
 }
 
 }  // namespace eamos::deploy

@@ -105,6 +105,29 @@ void sample_fleet(mid::EventLoop& loop, TelemetryRecorder& recorder,
   });
 }
 
+/// Runs the loop on after an abandoned mission until every drone's failsafe is over
+/// (failsafe_over). The first look comes after the callbacks already queued, the ends of
+/// the actions the failsafes cancelled among them, so those are traced; later looks every
+/// 0.1 mission s stop the loop at once: a real-time loop would otherwise wait for input
+/// until its limit, and a MAVLink drone's heartbeats never leave it idle.
+void wait_for_failsafes(mid::EventLoop& loop, const std::vector<std::unique_ptr<mid::Drone>>& drones,
+                        const std::vector<Mission>& missions) {
+  const double since = loop.now();
+  mid::TimerId next = mid::kNoTimer;
+  std::function<void()> look = [&] {
+    for (std::size_t d = 0; d < drones.size(); ++d)
+      if (!failsafe_over(drones[d]->state(), missions[d].settings.failsafe, loop.now() - since)) {
+        next = loop.after(0.1, look);
+        return;
+      }
+    next = mid::kNoTimer;
+    loop.stop();
+  };
+  next = loop.after(0.0, look);
+  loop.run_until(since + kFailsafeWaitLimitS);
+  loop.cancel(next);  // it refers to this frame
+}
+
 }  // namespace
 
 TraceEvent message_event(const Mission& receiver, const Message& m, int to, double received) {
@@ -174,6 +197,12 @@ void record_failsafe(const fleet::DroneSettings& settings, double t, const std::
   e.name = fleet::failsafe_name(settings.failsafe);
   e.reason = reason;
   trace->record(e);
+}
+
+bool failsafe_over(const mid::DroneState& s, fleet::Failsafe failsafe, double waited_s) {
+  if (down_and_disarmed(s) || s.link_lost || waited_s >= kFailsafeWaitLimitS) return true;
+  // On the ground every failsafe disarms: that is still to come for an armed drone there.
+  return failsafe == fleet::Failsafe::hover && !s.landed;
 }
 
 void enter_failsafe(mid::Drone& drone, const fleet::DroneSettings& settings, double t, const std::string& reason,
@@ -344,23 +373,7 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
                    " s of mission time; raise --time-limit if it is meant to run longer";
     abandon();
   }
-  if (failed || !result.completed) {
-    // Let failsafes finish: until every drone is down with its motors off, at most 600 s. In
-    // slices, because a real-time loop waits for input until its limit even when nothing is
-    // scheduled, and a MAVLink drone's heartbeats never leave it idle.
-    const double until = loop.now() + 600.0;
-    // A drone whose link is lost cannot be told or watched: waiting for it only delays the
-    // end (its autopilot's own link-loss failsafe flies it, docs/faults.md).
-    auto not_safe_yet = [&] {
-      for (const auto& d : drones) {
-        mid::DroneState st = d->state();
-        if (!down_and_disarmed(st) && !st.link_lost) return true;
-      }
-      return false;
-    };
-    do loop.run_until(std::min(until, loop.now() + 1.0));
-    while (loop.now() < until && not_safe_yet());
-  }
+  if (failed || !result.completed) wait_for_failsafes(loop, drones, missions);
   if (options.interrupt) options.interrupt->detach();
   result.duration = finished_at;
   for (int d = 0; d < n; ++d) {

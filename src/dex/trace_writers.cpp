@@ -1,7 +1,9 @@
 #include "dex/trace_writers.h"
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 #include <nlohmann/json.hpp>
 
@@ -84,9 +86,14 @@ void JsonlTrace::record(const TraceEvent& e) { write(trace_event_json(e, fleet_)
 void JsonlTrace::write_header(const nlohmann::ordered_json& header) { write(header); }
 
 void JsonlTrace::write(const nlohmann::ordered_json& j) {
+  if (!error_.empty()) return;
   // Reasons come from outside (an autopilot's text, another process's ABORT): a byte that
   // is not UTF-8 becomes U+FFFD instead of an exception that loses the rest of the trace.
-  out_ << j.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace) << '\n';
+  errno = 0;
+  out_ << j.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace) << '\n' << std::flush;
+  if (out_) return;
+  error_ = errno != 0 ? std::strerror(errno) : "the write failed";
+  if (on_error_) on_error_(error_);
 }
 
 void LiveLog::record(const TraceEvent& e) {

@@ -1,6 +1,7 @@
 #pragma once
 // Where trace events go: a JSON Lines file (one event per line), the live log a person
 // reads while the mission runs, and a fan-out to both.
+#include <functional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -18,17 +19,25 @@ nlohmann::ordered_json trace_event_json(const TraceEvent& e, const std::vector<s
 
 /// {"t":1.25,"drone":"Drone1","event":"start","name":"Takeoff","line":51,...} per line, in
 /// the schema of docs/trace.md. `fleet` names the drones of message events' from/to.
+/// Each line goes out as it is written, so a write that fails (a full disk) is known at
+/// once: `on_write_error` hears it then, with the system's reason, and nothing more is
+/// written (a trace with a hole would read as whole).
 class JsonlTrace : public TraceSink {
  public:
   explicit JsonlTrace(std::ostream& out, std::vector<std::string> fleet = {}) : out_(out), fleet_(std::move(fleet)) {}
   void record(const TraceEvent& e) override;
   /// The trace's first line (deploy::trace_header makes it).
   void write_header(const nlohmann::ordered_json& header);
+  void on_write_error(std::function<void(const std::string& why)> fn) { on_error_ = std::move(fn); }
+  /// Why a line could not be written ("No space left on device"); "" while none failed.
+  const std::string& write_error() const { return error_; }
 
  private:
   void write(const nlohmann::ordered_json& j);
   std::ostream& out_;
   std::vector<std::string> fleet_;
+  std::function<void(const std::string&)> on_error_;
+  std::string error_;
 };
 
 /// "   12.40 s  Drone1  end    Drone1.Takeoff(3)  succeeded   line 51"; telemetry and

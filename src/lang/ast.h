@@ -30,6 +30,10 @@ struct Expr {
   double number = 0.0;
   bool integer_literal = false;  ///< written without '.' or exponent
   bool boolean = false;
+  /// How deep it nests: 1 for a value, one more for each operator and each pair of
+  /// parentheses on its deepest path (the parser's limit, Parser::kMaxExpressionDepth).
+  /// Here, beside the bools, it fills padding: a large mission holds many expressions.
+  int levels = 1;
   std::string drone;     ///< property: the drone; name: the identifier
   std::string property;  ///< property: the property name
   Op op = Op::none;

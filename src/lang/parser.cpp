@@ -1,5 +1,6 @@
 #include "lang/parser.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <string>
@@ -319,6 +320,7 @@ int binary_precedence(TokenKind k, Op& op) {
   }
 }
 
+/// One level more below the current parse point while it lives.
 struct DepthGuard {
   int& depth;
   explicit DepthGuard(int& d) : depth(d) { ++depth; }
@@ -326,14 +328,19 @@ struct DepthGuard {
 };
 }  // namespace
 
+bool Parser::within_depth(int levels, SourceLocation at) {
+  // A left-leaning chain (1+1+…+1) deepens the tree without recursing, so the limit is
+  // checked on the tree built, below the levels that enclose it (depth_), not only on
+  // the parser's recursion: both count what the mission file will nest.
+  if (depth_ + levels <= kMaxExpressionDepth) return true;
+  diags_.error(&file_, at,
+               "expression nested too deeply (more than " + std::to_string(kMaxExpressionDepth) +
+                   " levels; each operator and each pair of parentheses is one); simplify it or split it");
+  return false;
+}
+
 // expr = unary { binary-op unary }   — precedence climbing over Go's five levels
 std::unique_ptr<Expr> Parser::parse_expression(int min_precedence) {
-  DepthGuard guard(depth_);
-  if (depth_ > kMaxExpressionDepth) {
-    error_here("expression nested too deeply (more than " + std::to_string(kMaxExpressionDepth) +
-               " levels); split it");
-    return nullptr;
-  }
   auto lhs = parse_unary();
   if (!lhs) return nullptr;
   for (;;) {
@@ -342,12 +349,18 @@ std::unique_ptr<Expr> Parser::parse_expression(int min_precedence) {
     if (p == 0 || p < min_precedence) return lhs;
     SourceLocation loc = tok_.loc;
     advance();
-    auto rhs = parse_expression(p + 1);
+    std::unique_ptr<Expr> rhs;
+    {
+      DepthGuard below(depth_);  // the operator is a level above its right operand
+      rhs = parse_expression(p + 1);
+    }
     if (!rhs) return nullptr;
     auto bin = std::make_unique<Expr>();
     bin->kind = ExprKind::binary;
     bin->loc = loc;
     bin->op = op;
+    bin->levels = 1 + std::max(lhs->levels, rhs->levels);
+    if (!within_depth(bin->levels, loc)) return nullptr;
     bin->lhs = std::move(lhs);
     bin->rhs = std::move(rhs);
     lhs = std::move(bin);
@@ -356,20 +369,21 @@ std::unique_ptr<Expr> Parser::parse_expression(int min_precedence) {
 
 // unary = ( "-" | "!" ) unary | primary
 std::unique_ptr<Expr> Parser::parse_unary() {
+  // Every operand starts here: a value at this point is one level below depth_. Checked
+  // before recursing, so no input can exhaust the stack.
+  if (!within_depth(1, tok_.loc)) return nullptr;
   if (tok_.kind == TokenKind::minus || tok_.kind == TokenKind::bang) {
-    DepthGuard guard(depth_);
-    if (depth_ > kMaxExpressionDepth) {
-      error_here("expression nested too deeply (more than " +
-                 std::to_string(kMaxExpressionDepth) + " levels); split it");
-      return nullptr;
-    }
     auto e = std::make_unique<Expr>();
     e->kind = ExprKind::unary;
     e->loc = tok_.loc;
     e->op = tok_.kind == TokenKind::minus ? Op::neg : Op::not_;
     advance();
-    e->lhs = parse_unary();
+    {
+      DepthGuard below(depth_);
+      e->lhs = parse_unary();
+    }
     if (!e->lhs) return nullptr;
+    e->levels = 1 + e->lhs->levels;
     return e;
   }
   return parse_primary();
@@ -404,7 +418,11 @@ std::unique_ptr<Expr> Parser::parse_primary() {
     case TokenKind::lparen: {
       ++paren_depth_;
       advance();
-      auto inner = parse_expression();
+      std::unique_ptr<Expr> inner;
+      {
+        DepthGuard below(depth_);  // parentheses are a level, as the limit is documented
+        inner = parse_expression();
+      }
       --paren_depth_;
       if (!inner) return nullptr;
       if (tok_.kind != TokenKind::rparen) {
@@ -412,6 +430,7 @@ std::unique_ptr<Expr> Parser::parse_primary() {
         return nullptr;
       }
       advance();
+      ++inner->levels;
       return inner;
     }
     case TokenKind::identifier: {

@@ -17,7 +17,9 @@ class Parser {
   Parser(const SourceFile& file, Diagnostics& diags);
   Mission parse();
 
-  /// Deeper expressions are rejected instead of recursing: no input may exhaust the stack.
+  /// Levels an expression may nest (Expr::levels, counted from the whole argument or
+  /// condition): deeper ones are rejected instead of recursing, so no input may exhaust the
+  /// stack, and every expression compiled is one the mission reader accepts.
   static constexpr int kMaxExpressionDepth = 200;
 
  private:
@@ -38,13 +40,16 @@ class Parser {
   std::unique_ptr<Expr> parse_expression(int min_precedence = 1);
   std::unique_ptr<Expr> parse_unary();
   std::unique_ptr<Expr> parse_primary();
+  /// False, with the error at `at`, when `levels` more below the enclosing ones (depth_)
+  /// pass kMaxExpressionDepth.
+  bool within_depth(int levels, SourceLocation at);
 
   const SourceFile& file_;
   Diagnostics& diags_;
   Lexer lexer_;
   Token tok_;
   Token prev_;
-  int depth_ = 0;
+  int depth_ = 0;  ///< expression levels enclosing the parse point (operators, parentheses)
   int paren_depth_ = 0;
 };
 

@@ -278,6 +278,10 @@ bool DexProcess::begin() {
     trace_file_.open(o_.trace_file, std::ios::trunc);
     if (trace_file_) {
       jsonl_ = std::make_unique<dex::JsonlTrace>(trace_file_, mission_.fleet);
+      // This drone's own copy: the ground's merged trace does not depend on it.
+      jsonl_->on_write_error([this](const std::string& why) {
+        err_ << name() << ": cannot write trace '" << o_.trace_file << "' (" << why << "); it stops here\n";
+      });
       tee_.add(jsonl_.get());
     } else {
       err_ << name() << ": cannot write trace '" << o_.trace_file << "'\n";

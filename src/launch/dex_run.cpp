@@ -251,7 +251,9 @@ void DexProcess::abandon(const std::string& reason, const std::optional<dex::Fai
   err_ << name() << ": " << reason << "\n";
   if (commanded) dex::record_failsafe(mission_.settings, loop_->now(), reason, &tee_);
   failsafe_since_ = loop_->now();
-  wait_for_failsafe();
+  // Looked at from the next turn of the loop, after the callbacks already queued: the ends
+  // of the actions the failsafe cancelled are among them and must reach the trace.
+  loop_->after(0.0, [this] { wait_for_failsafe(); });
 }
 
 void DexProcess::on_stall(double stalled_s) {
@@ -269,14 +271,10 @@ void DexProcess::on_internal_error(const std::string& what) {
 }
 
 void DexProcess::wait_for_failsafe() {
-  // Stay up (and alive for the others) until the drone is down with its motors off, hovering
-  // as told, or the failsafe has had ten minutes. Down alone is not safe: a DEX that ended at
-  // the touchdown left its vehicle armed on the ground (seen on PX4 SITL) and reported it so.
-  mid::DroneState s = drone_->state();
-  // A lost link: nothing can reach or watch the drone, its autopilot's own failsafe flies it.
-  bool done = dex::down_and_disarmed(s) || s.link_lost || mission_.settings.failsafe == fleet::Failsafe::hover ||
-              loop_->now() - failsafe_since_ > 600.0;
-  if (done) {
+  // Stay up (and alive for the others) until the failsafe is over as dex::failsafe_over
+  // says, the rule `eamos run` follows too. Down alone is not over: a DEX that ended at the
+  // touchdown left its vehicle armed on the ground (seen on PX4 SITL) and reported it so.
+  if (dex::failsafe_over(drone_->state(), mission_.settings.failsafe, loop_->now() - failsafe_since_)) {
     // Its final state: the ground reports this one, not the one at the abort.
     phase_ = Phase::failed;
     publish_status(true);

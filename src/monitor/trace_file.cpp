@@ -10,6 +10,28 @@ namespace {
 constexpr std::size_t max_line_bytes = 64u << 20;
 // More events than this would not fit in a browser anyway.
 constexpr std::size_t max_events = 5'000'000;
+// An eamos trace line nests four levels (the header's drones and homes); unknown fields
+// are kept, so some room, but a bound: parsing is iterative, serialising again is not.
+constexpr int max_nesting = 64;
+
+/// True when brackets outside strings nest deeper than `limit` in `line`: looked at before
+/// the line is parsed, so that nothing deeper is ever built.
+bool nests_deeper_than(const std::string& line, int limit) {
+  int depth = 0;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    char c = line[i];
+    if (c == '"') {
+      // To the closing quote, over escapes.
+      for (++i; i < line.size() && line[i] != '"'; ++i)
+        if (line[i] == '\\') ++i;
+    } else if (c == '[' || c == '{') {
+      if (++depth > limit) return true;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return false;
+}
 
 bool finite_number(const nlohmann::json& v) { return v.is_number() && std::isfinite(v.get<double>()); }
 
@@ -80,6 +102,11 @@ LoadedTrace read_trace(const std::string& name, std::istream& in, std::size_t ma
     if (line.empty()) continue;
     if (line.size() > max_line_bytes) {
       error(number, "line longer than 64 MiB; this is not an eamos trace");
+      continue;
+    }
+    if (nests_deeper_than(line, max_nesting)) {
+      error(number, "nested more than " + std::to_string(max_nesting) +
+                        " levels deep; an eamos trace line nests a few (docs/trace.md)");
       continue;
     }
     nlohmann::json j = nlohmann::json::parse(line, nullptr, false);

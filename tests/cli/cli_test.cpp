@@ -1,6 +1,7 @@
 // The `eamos` binary end to end: exit status, output files and what a user sees.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -184,6 +185,20 @@ TEST_F(Cli, RunReportsCompletionWhenTheLastAsyncWorkEndsAndTheTraceEndsWithIt) {
   EXPECT_EQ(before["t"], 2.1);
 }
 
+// A trace that cannot be written (a full disk; /dev/full refuses every write) is said at
+// once, before the first drone moves here since the header is the first write; the flight
+// goes on as it would, and the exit status says the run's record is incomplete.
+TEST_F(Cli, RunWithATraceOnAFullDiskSaysSoAtOnceFliesOnAndExitsNonZero) {
+  Output r = eamos("run " + kListing2 + " --fleet " + std::string(EAMOS_SOURCE_DIR) +
+                   "/examples/listing2-right.yaml --trace /dev/full --summary " + (dir_ / "summary.json").string());
+  EXPECT_EQ(r.status, 1) << r.out;
+  std::size_t error = r.out.find("eamos: error: cannot write the trace '/dev/full' (No space left on device)");
+  ASSERT_NE(error, std::string::npos) << r.out;
+  EXPECT_LT(error, r.out.find("Drone1   start")) << r.out;
+  EXPECT_NE(r.out.find("mission completed in"), std::string::npos) << r.out;
+  EXPECT_EQ(nlohmann::json::parse(read_file(dir_ / "summary.json"))["status"], "completed");
+}
+
 TEST_F(Cli, AsyncWorkInALoopIsNotWarnedAboutAndEveryPictureEndsOnce) {
   Output c = eamos("check " + mission("async_in_loop.eamos"));
   EXPECT_EQ(c.status, 0) << c.out;
@@ -234,6 +249,48 @@ TEST_F(Cli, PatrolWithTheLeadsBatteryAlreadyLowSkipsTheOrbitAndBringsTheLeadHome
   EXPECT_GT(lead["battery"].get<double>(), 90.0);  // home on its own, not by the failsafe
 }
 
+/// "first+rest+rest+…" with `terms` terms: a left-leaning tree `terms` levels deep.
+std::string sum(const std::string& first, const std::string& rest, int terms) {
+  std::string s = first;
+  for (int i = 1; i < terms; ++i) s += "+" + rest;
+  return s;
+}
+
+/// A one-drone mission whose Takeoff (line 5, its argument from column 13) climbs `altitude`.
+std::string taking_off_to(const std::string& altitude) {
+  return "var D Quad\nfunc INIT() { SEQ_a() }\nfunc SEQ_a() {\n  D.Arm()\n  D.Takeoff(" + altitude +
+         ")\n  D.Land()\n}\n";
+}
+
+// Each operator is a level of the expression as the mission file stores it: a long sum is as
+// deep as its terms, and deeper than the mission reader takes, so every command refuses it
+// where it is written, as it refuses 201 parentheses, instead of overflowing the stack.
+TEST_F(Cli, ASumOfTwentyThousandTermsIsAnErrorAtItsLineNotACrash) {
+  fs::path m = dir_ / "long_sum.eamos";
+  std::ofstream(m) << taking_off_to(sum("1", "1", 20000));
+  for (const std::string& command :
+       std::vector<std::string>{"check ", "compile -q -o " + (dir_ / "out").string() + " ", "run -q "}) {
+    Output r = eamos(command + m.string());
+    EXPECT_EQ(r.status, 1) << command << r.out.substr(0, 300);
+    EXPECT_EQ(r.out.rfind(m.string() + ":5:412: error: expression nested too deeply (more than 200 levels", 0), 0u)
+        << command << r.out.substr(0, 300);
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "D" / "mission.json"));
+}
+
+// The compiler's limit is the one the mission reader holds files to, counted alike: what
+// `eamos check` accepts, `eamos run` (which reads the compiled files back) flies.
+TEST_F(Cli, AnExpressionAtTheDepthLimitFliesAndOneLevelMoreIsAnError) {
+  fs::path at_limit = dir_ / "at_limit.eamos", over = dir_ / "over.eamos";
+  std::ofstream(at_limit) << taking_off_to(sum("5", "0", 200));
+  std::ofstream(over) << taking_off_to(sum("5", "0", 201));
+  Output r = eamos("run -q " + at_limit.string());
+  EXPECT_EQ(r.status, 0) << r.out.substr(0, 600);
+  r = eamos("check " + over.string());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.out.rfind(over.string() + ":5:412: error: expression nested too deeply", 0), 0u) << r.out.substr(0, 300);
+}
+
 }  // namespace
 
 // `eamos dex` reads its mission through the one validating reader: a damaged or edited
@@ -251,9 +308,54 @@ class CliDex : public Cli {
     std::ofstream(file_, std::ios::binary | std::ios::trunc) << text;
     return eamos_test::run_eamos("dex " + (dir_ / "deploy" / "Drone1").string() + " --domain 51 --start-timeout 1");
   }
+  /// `eamos dex` on the folder as it stands, bounded in time and memory: a reader that waits
+  /// for a FIFO's writer or reads /dev/zero for ever fails the test instead of hanging it or
+  /// taking the machine's memory.
+  Output dex_bounded() {
+    std::string cmd = "ulimit -v 2000000; timeout 60 " + std::string(EAMOS_BINARY) + " dex " +
+                      (dir_ / "deploy" / "Drone1").string() + " --domain 51 --start-timeout 1 2>&1";
+    Output r;
+    FILE* p = popen(cmd.c_str(), "r");
+    if (!p) return r;
+    char buf[4096];
+    while (fgets(buf, sizeof buf, p)) r.out += buf;
+    int raw = pclose(p);
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    return r;
+  }
   fs::path file_;
   std::string text_;
 };
+
+TEST_F(CliDex, RefusesAMissionFileThatIsAFifoWithoutWaitingForAWriter) {
+  fs::remove(file_);
+  ASSERT_EQ(mkfifo(file_.c_str(), 0600), 0);
+  Output r = dex_bounded();
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find(file_.string() + ": error: a FIFO, not a regular file; a mission file is the mission.json "
+                                        "`eamos compile` writes"),
+            std::string::npos)
+      << r.out;
+}
+
+TEST_F(CliDex, RefusesAMissionFileThatIsADeviceSuchAsDevZero) {
+  fs::remove(file_);
+  fs::create_symlink("/dev/zero", file_);
+  Output r = dex_bounded();
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find(file_.string() + ": error: a character device, not a regular file;"), std::string::npos) << r.out;
+}
+
+// One byte over the documented 1 GiB: refused by its size, unread (the file is sparse).
+TEST_F(CliDex, RefusesAMissionFileLargerThanTheLimitWithoutReadingIt) {
+  fs::resize_file(file_, (std::uintmax_t{1} << 30) + 1);
+  Output r = dex_bounded();
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find(file_.string() + ": error: 1073741825 bytes, more than the 1073741824 (1 GiB) a mission file may "
+                                        "hold;"),
+            std::string::npos)
+      << r.out;
+}
 
 TEST_F(CliDex, RefusesAMissionFileEditedAfterCompile) {
   Output r = dex_with(eamos_test::replace_once(text_, "\"battery\":100.0", "\"battery\":99.0"));

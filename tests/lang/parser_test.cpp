@@ -115,6 +115,23 @@ TEST(Parser, DeepNestingIsAnErrorNotAStackOverflow) {
   EXPECT_NE(d.format().find("nested too deeply"), std::string::npos);
 }
 
+// Parentheses and operators count toward one limit: a sum of 101 terms in 100 parentheses
+// is 201 levels deep, one more than allowed; with 100 terms it is at the limit.
+TEST(Parser, ParenthesesAndOperatorsCountTowardOneDepthLimit) {
+  auto nested_sum = [](int terms) {
+    std::string s = std::string(100, '(') + "1";
+    for (int i = 1; i < terms; ++i) s += "+1";
+    return "var A Q\nfunc INIT() { A.FlyByX(" + s + std::string(100, ')') + ") }\n";
+  };
+  SourceFile f, g;
+  Diagnostics at_limit, over;
+  parse(nested_sum(100), at_limit, f);
+  EXPECT_FALSE(at_limit.has_errors()) << at_limit.format();
+  parse(nested_sum(101), over, g);
+  ASSERT_TRUE(over.has_errors());
+  EXPECT_NE(over.format().find("nested too deeply"), std::string::npos) << over.format().substr(0, 300);
+}
+
 TEST(Parser, NewlineInsideArgumentListIsAllowed) {
   SourceFile f;
   Diagnostics d;

@@ -358,6 +358,46 @@ TEST_F(Distributed, FailedActionOnOneDroneFailsTheMissionOnEveryDrone) {
   EXPECT_FALSE(summary["drones"]["Lead"]["armed"]);
 }
 
+// Lead's failsafe is `hover`: the action it runs when Late's ABORT arrives (its Takeoff, or
+// its Hover if the ABORT comes late) is cancelled, and that end is in the trace as with
+// `land`, after the failsafe; the DEX then reports Lead hovering (DDS domain 204).
+TEST_F(Distributed, ActionCancelledByAHoveringFailsafeHasItsEndInTheTrace) {
+  std::string missions = std::string(EAMOS_SOURCE_DIR) + "/tests/launch/missions/";
+  Output r = eamos("run -q " + missions + "refused_takeoff.eamos --fleet " + missions +
+                   "hover_failsafe.yaml --distributed --insecure --speed 5 --domain 204 --deploy-dir " +
+                   (dir_ / "deploy").string() + " --trace " + (dir_ / "trace.jsonl").string() + " --summary " +
+                   (dir_ / "summary.json").string());
+  EXPECT_EQ(r.status, 1) << r.out;
+  std::string running;  // Lead's action started and not ended
+  bool failsafe = false, cancelled_after_failsafe = false;
+  for (const nlohmann::json& e : eamos_test::read_trace(dir_ / "trace.jsonl")) {
+    if (e.value("drone", "") != "Lead") continue;
+    std::string event = e["event"];
+    if (event == "start") running = e["text"];
+    if (event == "failsafe") failsafe = e["name"] == "hover";
+    if (event == "end" && e["text"] == running) {
+      cancelled_after_failsafe = failsafe && e["outcome"] == "cancelled";
+      running.clear();
+    }
+  }
+  EXPECT_TRUE(failsafe) << read_text(dir_ / "trace.jsonl");
+  EXPECT_TRUE(cancelled_after_failsafe) << "Lead's " << running << " never ended\n" << read_text(dir_ / "trace.jsonl");
+  nlohmann::json summary = read_json(dir_ / "summary.json");
+  EXPECT_FALSE(summary["drones"]["Lead"]["landed"]) << summary.dump(2);  // hovering, as told
+}
+
+// The ground writes the merged trace once the mission is over: a write that fails (a full
+// disk) is said and makes the exit status 1 although the mission completed (domain 205).
+TEST_F(Distributed, TraceOnAFullDiskIsReportedAndTheExitStatusIsNonZero) {
+  Output r = eamos("run -q " + std::string(EAMOS_SOURCE_DIR) + "/tests/launch/missions/hops.eamos --distributed "
+                   "--insecure --speed 10 --domain 205 --deploy-dir " + (dir_ / "deploy").string() +
+                   " --trace /dev/full --summary " + (dir_ / "summary.json").string());
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("eamos: error: cannot write the trace '/dev/full' (No space left on device)"),
+            std::string::npos) << r.out;
+  EXPECT_EQ(read_json(dir_ / "summary.json")["status"], "completed");
+}
+
 TEST_F(Distributed, TimeLimitFailsTheMissionOnEveryDrone) {
   Output r = eamos("run -q " + source("listing2.eamos") + " --distributed --speed 5 --time-limit 3 --domain 34 " +
                    "--deploy-dir " + (dir_ / "deploy").string() + " --summary " + (dir_ / "summary.json").string());

@@ -53,6 +53,19 @@ TEST(MonitorTrace, DeepNestingAndBinaryAreErrorsNotCrashes) {
   EXPECT_TRUE(t.events.empty());
 }
 
+// A valid JSON line nested 100,000 deep in a field nobody reads: refused by its depth
+// before it is parsed, as any bad line is, instead of overflowing the stack.
+TEST(MonitorTrace, AValueNestedTooDeeplyIsAnErrorOfItsLineNotACrash) {
+  std::string deep = std::string(100000, '[') + "1" + std::string(100000, ']');
+  std::string path = write_temp("deep.jsonl", "{\"t\":0,\"drone\":\"D\",\"event\":\"start\",\"name\":\"Arm\"}\n"
+                                              "{\"t\":1,\"event\":\"start\",\"future\":" + deep + "}\n");
+  auto r = eamos_test::run_eamos("monitor " + path + " --port 0");
+  EXPECT_EQ(r.status, 1) << r.out.substr(0, 300);
+  EXPECT_NE(r.out.find(path + ":2: error: nested more than 64 levels deep"), std::string::npos) << r.out.substr(0, 300);
+  EXPECT_EQ(r.out.find(":1: error"), std::string::npos) << r.out.substr(0, 300);
+  fs::remove(path);
+}
+
 TEST(MonitorTrace, ACutOffLastLineIsAWarningNotAnError) {
   std::istringstream in("{\"t\":0,\"event\":\"start\",\"drone\":\"D\"}\n{\"t\":1,\"ev");
   eamos::monitor::LoadedTrace t = eamos::monitor::read_trace("x.jsonl", in);
