@@ -17,7 +17,12 @@ $(BUILD)/build.ninja:
 build: deps $(BUILD)/build.ninja
 	cmake --build $(BUILD) -j $(JOBS)
 
-demo: build
+# Only what the demo runs: the `eamos` command (no tests, benchmarks or fuzzers, no npm), and
+# only the Debian packages it needs (scripts/install-deps.sh demo).
+demo:
+	@bash scripts/install-deps.sh demo
+	@$(MAKE) --no-print-directory $(BUILD)/build.ninja
+	cmake --build $(BUILD) -j $(JOBS) --target eamos
 	@bash scripts/demo.sh $(BUILD)
 
 # The real-time tests (SITL firmware, DDS processes, the browser) run at normal priority;

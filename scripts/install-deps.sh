@@ -3,13 +3,19 @@
 # once, then `apt-get install -y`. Safe to run again; does nothing when all are there.
 set -euo pipefail
 
-packages=(
+# `install-deps.sh demo`: only what `make demo` needs to build the `eamos` command and run it
+# (compiler, libraries, Graphviz, Cyclone DDS; GoogleTest and Google Benchmark because the build
+# configures the tests too, without building them). Without an argument: everything `make
+# test` needs as well.
+demo_packages=(
   build-essential cmake ninja-build pkg-config
   libfmt-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev nettle-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   graphviz
   libcivetweb-dev
   cyclonedds-dev cyclonedds-tools libddsc0debian libssl-dev openssl
+)
+test_packages=(
   clang libclang-rt-14-dev
   nodejs
   chromium
@@ -22,6 +28,8 @@ packages=(
   python3-dev python3-pybind11  # the Python module (src/python), built against Debian's /usr/bin/python3
   python3-pytest python3-matplotlib python3-pandas  # test side: tests/python (the module needs neither at run time)
 )
+packages=("${demo_packages[@]}")
+if [ "${1:-}" != demo ]; then packages+=("${test_packages[@]}"); fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -31,7 +39,7 @@ for p in "${packages[@]}"; do
 done
 # npm (test-side tools only: node-mavlink for the MAVLink cross-check) is checked by command,
 # not by package: a NodeSource nodejs bundles npm and conflicts with Debian's npm package.
-if ! command -v npm >/dev/null 2>&1; then
+if [ "${1:-}" != demo ] && ! command -v npm >/dev/null 2>&1; then
   missing+=(npm)
 fi
 

@@ -1,8 +1,13 @@
 #include "cli/commands.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
+
+#include "cli/arguments.h"
+#include "diag/report.h"
+#include "version.h"
 
 #include "deploy/mission_file.h"
 #include "deploy/synthesize.h"
@@ -17,32 +22,54 @@ bool compile_and_report(const CommonOptions& o, graph::Compilation& c, graph::Ke
   Diagnostics diags;
   diags.max_errors = o.max_errors;
   bool ok = graph::compile_file(o.mission, o.fleet, diags, c, keep);
-  // Re-list what the run found: -q drops warnings, --werror turns them into errors.
+  // Re-list what the run found: -q drops warnings (and their notes), --werror turns them
+  // into errors.
   Diagnostics shown;
   shown.max_errors = 0;
+  bool skipping = false;
   for (Diagnostic d : diags.items()) {
-    if (d.severity == Severity::warning && o.quiet) continue;
+    if (d.attached && skipping) continue;
+    skipping = d.severity == Severity::warning && o.quiet;
+    if (skipping) continue;
     if (d.severity == Severity::warning && o.werror) {
       d.severity = Severity::error;
       d.message += " [-Werror]";
     }
     shown.add(std::move(d));
   }
-  std::cerr << shown.format();
-  if (diags.saturated())
-    std::cerr << "error: stopped listing after " << diags.max_errors
-              << " errors; raise the limit with --max-errors N (0 for no limit)\n";
+  print_diagnostics(shown, o.document_on_stdout);
+  const OutputStyle& style = output_style();
+  if (style.diagnostics != "text") {
+    // The document says it all; a tool reads the exit status.
+  } else if (diags.saturated()) {
+    std::cerr << error_prefix() << "stopped listing after " << count_of(diags.max_errors, "error")
+              << "; raise the limit with --max-errors N (0 for no limit)\n";
+  }
   if (diags.has_errors()) {
-    std::cerr << diags.error_count() << " error(s), " << diags.warning_count() << " warning(s)\n";
+    if (style.diagnostics == "text")
+      std::cerr << count_of(diags.error_count(), "error") << ", " << count_of(diags.warning_count(), "warning") << "\n";
     return false;
   }
   if (o.werror && diags.warning_count() > 0) {
-    std::cerr << diags.warning_count() << " warning(s) treated as errors\n";
+    if (style.diagnostics == "text")
+      std::cerr << count_of(diags.warning_count(), "warning") << " treated as errors\n";
     return false;
   }
   return ok;
 }
 
+void print_diagnostics(const Diagnostics& diags, bool on_stdout) {
+  const OutputStyle& style = output_style();
+  std::ostream& out = on_stdout ? std::cout : std::cerr;
+  if (style.diagnostics == "json") {
+    out << diagnostics_json(diags);
+  } else if (style.diagnostics == "sarif") {
+    std::error_code ec;
+    out << diagnostics_sarif(diags, "eamos", EAMOS_VERSION, std::filesystem::current_path(ec).string());
+  } else {
+    std::cerr << diags.format({.color = style.color_stderr});
+  }
+}
 
 bool load_compiled_missions(const graph::Compilation& c, std::vector<dex::Mission>& missions) {
   std::string hash = deploy::mission_hash(c);
@@ -67,7 +94,7 @@ bool write_output(const std::string& path, const std::string& text) {
   out << text;
   out.close();
   if (!out) {
-    std::cerr << "eamos: error: cannot write '" << path << "'; check the path and permissions\n";
+    std::cerr << error_prefix() << "cannot write '" << path << "'; check the path and permissions\n";
     return false;
   }
   return true;
@@ -83,9 +110,13 @@ void report_trace_write_errors(dex::JsonlTrace& trace, const std::string& path) 
 
 int cmd_check(const CommonOptions& o, bool list_capabilities) {
   graph::Compilation c;
-  if (!compile_and_report(o, c)) return 1;
-  std::cout << o.mission << ": ok — " << c.drone_count() << " drones, " << c.amt.nodes.size()
-            << " AMT nodes, " << c.meg.nodes.size() << " MEG nodes\n";
+  CommonOptions with_document = o;
+  with_document.document_on_stdout = true;  // check's only output: `> report.sarif` takes it
+  if (!compile_and_report(with_document, c)) return 1;
+  // With a JSON or SARIF document on standard output, the summary goes to standard error.
+  (output_style().diagnostics == "text" ? std::cout : std::cerr)
+      << o.mission << ": ok — " << count_of(c.drone_count(), "drone") << ", " << count_of(c.amt.nodes.size(), "AMT node")
+      << ", " << count_of(c.meg.nodes.size(), "MEG node") << "\n";
   if (list_capabilities) {
     for (int d = 0; d < c.drone_count(); ++d) {
       const auto& t = c.checked.drone_types[d];
@@ -116,7 +147,7 @@ bool write_security(const graph::Compilation& c, const std::string& dir, const S
   std::vector<std::string> notes;
   std::string error;
   if (!security::write_mission_keys(r, notes, error)) {
-    std::cerr << "eamos: error: cannot make the mission's DDS Security credentials: " << error << "\n";
+    std::cerr << error_prefix() << "cannot make the mission's DDS Security credentials: " << error << "\n";
     return false;
   }
   for (const std::string& n : notes) std::cout << n << "\n";
@@ -129,7 +160,7 @@ int cmd_compile(const CommonOptions& o, const std::string& out_dir, const Securi
   // An option that cannot be packaged is refused before anything is written.
   if (package) {
     if (std::string error = deploy::package_options_error(*package); !error.empty()) {
-      std::cerr << "eamos: error: " << error << "\n";
+      std::cerr << error_prefix() << "" << error << "\n";
       return 1;
     }
   }
@@ -150,8 +181,8 @@ int cmd_compile(const CommonOptions& o, const std::string& out_dir, const Securi
       return 1;
     }
   }
-  std::cout << "compiled " << o.mission << " → " << out_dir << "/ (" << c.drone_count()
-            << " drones, " << c.meg.nodes.size() << " MEG nodes)\n";
+  std::cout << "compiled " << o.mission << " → " << out_dir << "/ (" << count_of(c.drone_count(), "drone") << ", "
+            << count_of(c.meg.nodes.size(), "MEG node") << ")\n";
   if (package)
     std::cout << "packaged each drone's DEX as a systemd service: " << out_dir << "/<drone>/DEPLOY.txt says what to "
               << "copy where" << (package->interface.empty() ? "; set EAMOS_DDS_INTERFACE in each dex.env" : "")
@@ -198,20 +229,20 @@ int cmd_graph(const CommonOptions& o, const std::string& kind, const std::string
   int d = -1;
   if (kind == "mdg") {
     if (drone.empty()) {
-      std::cerr << "eamos: error: --kind mdg needs --drone NAME; drones:";
+      std::cerr << error_prefix() << "--kind mdg needs --drone NAME; drones:";
       for (int i = 0; i < c.drone_count(); ++i) std::cerr << " " << c.drone_name(i);
       std::cerr << "\n";
       return 1;
     }
     d = c.find_drone(drone);
     if (d < 0) {
-      std::cerr << "eamos: error: no drone '" << drone << "' in " << o.mission << "; drones:";
+      std::cerr << error_prefix() << "no drone '" << drone << "' in " << o.mission << "; drones:";
       for (int i = 0; i < c.drone_count(); ++i) std::cerr << " " << c.drone_name(i);
       std::cerr << "\n";
       return 1;
     }
   } else if (!drone.empty()) {
-    std::cerr << "eamos: error: --drone only applies to --kind mdg\n";
+    std::cerr << error_prefix() << "--drone only applies to --kind mdg\n";
     return 1;
   }
   if (format == "json") {
@@ -222,7 +253,7 @@ int cmd_graph(const CommonOptions& o, const std::string& kind, const std::string
   if (format == "dot") return write_output(output, dot) ? 0 : 1;
   std::string svg, error;
   if (!render_svg(dot, svg, error)) {
-    std::cerr << "eamos: error: " << error << "\n";
+    std::cerr << error_prefix() << "" << error << "\n";
     return 1;
   }
   return write_output(output, svg) ? 0 : 1;

@@ -26,6 +26,7 @@ struct CommonOptions {
   std::size_t max_errors = 200;
   bool werror = false;        ///< treat warnings as errors
   bool quiet = false;         ///< no warnings
+  bool document_on_stdout = false;  ///< --diagnostics-format json|sarif: the document to stdout (check)
 };
 
 /// How a compiled mission's DDS Security credentials are made (docs/security.md).
@@ -120,6 +121,9 @@ nlohmann::json launch_view(const std::string& dir);
 /// Parses `at` ("[HOST:]PORT") and starts `server` there; false with the error printed.
 bool start_monitor(monitor::MonitorServer& server, const std::string& at, const nlohmann::json& view);
 
+/// Prints diagnostics as --diagnostics-format and --color say: text on standard error, a
+/// JSON or SARIF document on standard output when `on_stdout`, else on standard error.
+void print_diagnostics(const Diagnostics& diags, bool on_stdout = false);
 /// Compiles and prints every diagnostic; true when the graphs are usable.
 bool compile_and_report(const CommonOptions& o, graph::Compilation& c,
                         graph::Keep keep = graph::Keep::all_graphs);

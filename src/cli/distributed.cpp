@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli/arguments.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
 #include "deploy/mission_file.h"
@@ -126,7 +127,7 @@ int report_launch(const RunCommandOptions& r, const launch::LaunchResult& result
   if (!r.trace.empty()) {
     std::ofstream out(r.trace, std::ios::trunc);
     if (!out) {
-      std::cerr << "eamos: error: cannot write trace '" << r.trace << "'\n";
+      std::cerr << error_prefix() << "cannot write trace '" << r.trace << "'\n";
       return 1;
     }
     dex::JsonlTrace jsonl(out, result.fleet);
@@ -148,7 +149,7 @@ int cmd_run_distributed(const CommonOptions& o, const RunCommandOptions& r, laun
   if (dir.empty()) {
     std::string pattern = (std::filesystem::temp_directory_path() / "eamos-run-XXXXXX").string();
     if (!mkdtemp(pattern.data())) {
-      std::cerr << "eamos: error: cannot make a temporary deployment folder\n";
+      std::cerr << error_prefix() << "cannot make a temporary deployment folder\n";
       return 1;
     }
     dir = pattern;

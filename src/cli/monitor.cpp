@@ -1,11 +1,13 @@
 // `eamos monitor TRACE.jsonl` (replay a finished mission in the browser) and the views
 // `eamos run --monitor` / `eamos launch --monitor` serve live (src/monitor).
 #include <condition_variable>
+#include <filesystem>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <mutex>
 
+#include "cli/arguments.h"
 #include "cli/commands.h"
 #include "cli/signal_watch.h"
 #include "deploy/mission_file.h"
@@ -73,6 +75,30 @@ bool replay_view(const MonitorCommandOptions& m, const monitor::LoadedTrace& tra
   return true;
 }
 
+// A file that is plainly not a trace (a mission, a summary, anything whose first line is not
+// a JSON object) is said so once, instead of one "not valid JSON" per line.
+std::string not_a_trace(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string first;
+  while (first.find_first_not_of(" \t\r") == std::string::npos && std::getline(in, first)) {
+  }
+  if (first.find_first_not_of(" \t\r") == std::string::npos) return "";  // empty: the reader says so
+  std::string text = first + "\n" + std::string(std::istreambuf_iterator<char>(in), {}).substr(0, 1 << 16);
+  bool mission = std::filesystem::path(path).extension() == ".eamos" || text.find("func INIT") != std::string::npos ||
+                 text.rfind("var ", 0) == 0 || text.rfind("package ", 0) == 0 || text.rfind("//", 0) == 0;
+  if (mission)
+    return "'" + path + "' is a mission, not a trace; watch it fly with `eamos run " + path +
+           " --monitor 8080`, or record a trace with `eamos run " + path + " --trace run.jsonl` and replay that";
+  nlohmann::json j = nlohmann::json::parse(first, nullptr, false);
+  if (j.is_object() && j.contains("event")) return "";
+  if (nlohmann::json::parse(text, nullptr, false).is_object())
+    return "'" + path + "' is one JSON document (a summary or a graph?), not a trace: a trace has one event per "
+           "line, as `eamos run --trace` writes it";
+  if (!j.is_object())
+    return "'" + path + "' is not a trace: its first line is not a JSON object; give the file `eamos run --trace` wrote";
+  return "";
+}
+
 }  // namespace
 
 void MonitorHold::wait_for_signal() {
@@ -97,12 +123,12 @@ bool start_monitor(monitor::MonitorServer& server, const std::string& at, const 
   monitor::Endpoint endpoint;
   std::string error;
   if (!monitor::parse_endpoint(at, endpoint, error)) {
-    std::cerr << "eamos: error: --monitor " << error << "\n";
+    std::cerr << error_prefix() << "--monitor " << error << "\n";
     return false;
   }
   server.set_mission(view.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   if (!server.start(endpoint, error)) {
-    std::cerr << "eamos: error: " << error << "\n";
+    std::cerr << error_prefix() << "" << error << "\n";
     return false;
   }
   return true;
@@ -149,7 +175,11 @@ int cmd_monitor(const MonitorCommandOptions& m) {
   });
   std::ifstream in(m.trace, std::ios::binary);
   if (!in) {
-    std::cerr << "eamos: error: cannot read trace '" << m.trace << "'; give the file `eamos run --trace` wrote\n";
+    std::cerr << error_prefix() << "cannot read trace '" << m.trace << "'; give the file `eamos run --trace` wrote\n";
+    return 1;
+  }
+  if (std::string why = not_a_trace(m.trace); !why.empty()) {
+    std::cerr << error_prefix() << why << "\n";
     return 1;
   }
   monitor::LoadedTrace trace = monitor::read_trace(m.trace, in);

@@ -22,6 +22,19 @@ struct DroneProgress {
   std::set<int> done;            ///< action nodes that ended at least once
   std::vector<std::string> running;  ///< texts of the actions running now, oldest first
   bool failsafe = false;
+  int last = -1;                 ///< the drone's node that ended last (index into its mission)
+};
+
+/// Enough of a drone's mission to say on whom it waits: its nodes by MEG id, the nodes each
+/// one's end lets start, and what each node needs from other drones.
+struct WaitGraph {
+  std::vector<int> meg;                      ///< node → MEG id
+  std::vector<int> holder;                   ///< node → the drone that holds it
+  std::vector<std::vector<int>> next;        ///< this drone's node → the nodes its end may start (any drone's)
+  std::vector<std::vector<std::pair<int, int>>> needs;  ///< node → (drone, MEG id) ends it waits for
+  std::vector<std::vector<int>> own_before;  ///< node → this drone's nodes with an exec arc into it
+  std::vector<std::vector<int>> sync;        ///< sync point → other drones that must arrive
+  std::map<int, int> node_of;                ///< MEG id → this drone's node
 };
 
 class ProgressDisplay : public dex::TraceSink {
@@ -35,6 +48,12 @@ class ProgressDisplay : public dex::TraceSink {
 
   /// One drone's status line as drawn (without colour or cursor movement).
   std::string line(const DroneProgress& d) const;
+  /// Every drone's status line as it stands now (fleet order).
+  std::vector<std::string> lines() const;
+  /// "waiting for Drone3", "waiting until Drone1.X() >= 4.5", or "waiting": what an idle drone waits on.
+  std::string waiting_text(const DroneProgress& d) const;
+  /// The drones (or a condition) the nodes `d` can start next still need; false when none.
+  bool pending(int self, const std::vector<int>& nodes, std::set<int>& on, std::string& until) const;
 
  private:
   void apply(const dex::TraceEvent& e);
@@ -43,6 +62,9 @@ class ProgressDisplay : public dex::TraceSink {
 
   std::ostream& out_;
   std::vector<DroneProgress> drones_;
+  std::vector<WaitGraph> graphs_;          ///< per drone, fleet order
+  std::set<std::pair<int, int>> ended_nodes_;
+  std::map<int, std::string> false_conditions_;  ///< MEG id → text of a condition last found false    ///< (drone, MEG id) of every node that ended at least once
   std::map<std::string, int> index_;
   double now_ = 0.0;
   int drawn_ = 0;  ///< status lines on the screen now (0: none drawn yet)

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli/arguments.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
 #include "cli/signal_watch.h"
@@ -137,7 +138,7 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   if (!r.trace.empty()) {
     trace_file.open(r.trace, std::ios::trunc);
     if (!trace_file) {
-      std::cerr << "eamos: error: cannot write trace '" << r.trace << "'\n";
+      std::cerr << error_prefix() << "cannot write trace '" << r.trace << "'\n";
       return 1;
     }
     jsonl = std::make_unique<dex::JsonlTrace>(trace_file, missions[0].fleet);

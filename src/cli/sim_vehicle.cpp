@@ -3,6 +3,7 @@
 #include <csignal>
 #include <iostream>
 
+#include "cli/arguments.h"
 #include "cli/commands.h"
 #include "mavlink/url.h"
 #include "mid/event_loop.h"
@@ -20,7 +21,7 @@ int cmd_sim_vehicle(const SimVehicleCommandOptions& o) {
   if (url.empty()) url = "udpout://127.0.0.1:" + std::to_string(o.udp_port);
   mavlink::EndpointResult endpoint = mavlink::parse_url(url);
   if (!endpoint.endpoint) {
-    std::cerr << "eamos: error: " << endpoint.error << "\n";
+    std::cerr << error_prefix() << "" << endpoint.error << "\n";
     return 1;
   }
   mid::EventLoop loop({mid::ClockMode::real_time, o.speed});
@@ -30,7 +31,7 @@ int cmd_sim_vehicle(const SimVehicleCommandOptions& o) {
   options.dialect = o.autopilot == "ardupilot" ? &sim_vehicle::ardupilot_dialect() : &sim_vehicle::px4_dialect();
   sim_vehicle::SimVehicle vehicle(loop, options);
   if (std::string error = vehicle.open(*endpoint.endpoint); !error.empty()) {
-    std::cerr << "eamos: error: " << error << "\n";
+    std::cerr << error_prefix() << "" << error << "\n";
     return 1;
   }
   // The local port: where a second ground station (a test playing a pilot) reaches the vehicle.

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli/arguments.h"
 #include "cli/commands.h"
 #include "deploy/mission_file.h"
 #include "deploy/synthesize.h"
@@ -39,7 +40,7 @@ bool write_verify_trace(const std::string& path, const graph::Compilation& c, co
                         const verify::VerifyOptions& options, const verify::VerifyReport& report) {
   std::ofstream out(path, std::ios::trunc);
   if (!out) {
-    std::cerr << "eamos: error: cannot write trace '" << path << "'\n";
+    std::cerr << error_prefix() << "cannot write trace '" << path << "'\n";
     return false;
   }
   verify::WorstFlight w = verify::fly_worst_path(c, missions, options, report);
@@ -70,7 +71,13 @@ int cmd_verify(const CommonOptions& o, const VerifyCommandOptions& v) {
   if (!v.plot.empty() && !write_output(v.plot, verify::plot_worst_path(c, missions, options, report))) return 1;
   if (!v.trace.empty() && report.error.empty() && !write_verify_trace(v.trace, c, missions, options, report)) return 1;
   std::cerr.flush();
-  std::cout << (v.json ? verify::json_report(c, report) : verify::format_report(c, report));
+  std::string text = v.json ? verify::json_report(c, report) : verify::format_report(c, report);
+  // The summary line names its mission: a script verifying several says which is which.
+  if (!v.json && report.error.empty()) {
+    std::size_t last = text.rfind('\n', text.size() >= 2 ? text.size() - 2 : 0);
+    text.insert(last == std::string::npos ? 0 : last + 1, o.mission + ": ");
+  }
+  std::cout << text;
   std::cout.flush();
   return report.error.empty() && report.violations.empty() ? 0 : 1;
 }

@@ -5,46 +5,86 @@
 
 namespace eamos {
 
-void Diagnostics::error(const SourceFile* file, SourceLocation loc, std::string message) {
-  add(Severity::error, file, loc, std::move(message));
+void Diagnostics::error(const SourceFile* file, SourceLocation loc, std::string message, int length) {
+  add(Severity::error, file, loc, std::move(message), length);
 }
-void Diagnostics::warning(const SourceFile* file, SourceLocation loc, std::string message) {
-  add(Severity::warning, file, loc, std::move(message));
+void Diagnostics::warning(const SourceFile* file, SourceLocation loc, std::string message, int length) {
+  add(Severity::warning, file, loc, std::move(message), length);
 }
-void Diagnostics::note(const SourceFile* file, SourceLocation loc, std::string message) {
-  add(Severity::note, file, loc, std::move(message));
+void Diagnostics::note(const SourceFile* file, SourceLocation loc, std::string message, int length) {
+  add(Severity::note, file, loc, std::move(message), length);
 }
 
-// Counts the diagnostic and says whether to keep it (errors past max_errors are dropped).
+// Counts the diagnostic and says whether to keep it (errors past max_errors are dropped,
+// and with them the notes that follow them).
 bool Diagnostics::count(Severity severity) {
+  if (severity == Severity::note) return items_.empty() || last_kept_;
+  bool keep = true;
   if (severity == Severity::error) {
     ++error_count_;
     if (max_errors != 0 && error_count_ > max_errors) {
       ++dropped_;
-      return false;
+      keep = false;
     }
-  } else if (severity == Severity::warning) {
+  } else {
     ++warning_count_;
   }
-  return true;
+  last_kept_ = keep;
+  return keep;
 }
 
-void Diagnostics::add(Severity severity, const SourceFile* file, SourceLocation loc,
-                      std::string message) {
+namespace {
+
+bool word_byte(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+// The token at a 1-based column, as mission and fleet files spell them: a name or number, a
+// quoted string, a run of operator characters, else one character; 0 on blanks and past the
+// end, where only a caret makes sense.
+int token_length(std::string_view line, int col) {
+  if (col < 1 || static_cast<std::size_t>(col) > line.size()) return 0;
+  std::size_t i = col - 1, j = i;
+  char c = line[i];
+  if (c == ' ' || c == '\t') return 0;
+  if (word_byte(c)) {
+    bool number = std::isdigit(static_cast<unsigned char>(c));
+    while (j < line.size() && (word_byte(line[j]) || (number && line[j] == '.'))) ++j;
+  } else if (c == '"' || c == '\'') {
+    j = line.find(c, i + 1);
+    j = j == std::string_view::npos ? line.size() : j + 1;
+  } else if (std::string_view("<>=!&|+-*/%").find(c) != std::string_view::npos) {
+    while (j < line.size() && j < i + 2 && std::string_view("<>=!&|").find(line[j]) != std::string_view::npos) ++j;
+    if (j == i) ++j;
+  } else {
+    j = i + 1;
+  }
+  return static_cast<int>(j - i);
+}
+
+}  // namespace
+
+void Diagnostics::add(Severity severity, const SourceFile* file, SourceLocation loc, std::string message,
+                      int length) {
+  bool attached = severity == Severity::note && !items_.empty();
   if (!count(severity)) return;
   Diagnostic d;
   d.severity = severity;
   d.loc = loc;
   d.message = std::move(message);
+  d.attached = attached;
   if (file) {
     d.has_file = true;
     d.path = file->path;
     if (loc.known()) d.source_line = std::string(file->line(loc.line));
   }
+  if (loc.known() && d.has_file) {
+    int room = static_cast<int>(d.source_line.size()) - (loc.col - 1);
+    d.length = length > 0 ? std::max(0, std::min(length, room)) : token_length(d.source_line, loc.col);
+  }
   items_.push_back(std::move(d));
 }
 
 void Diagnostics::add(Diagnostic d) {
+  if (d.attached && !last_kept_) return;
   if (count(d.severity)) items_.push_back(std::move(d));
 }
 
@@ -59,6 +99,24 @@ const char* severity_name(Severity s) {
   return "error";
 }
 
+// clang's colours: bold location and message, red errors, magenta warnings, cyan notes, a
+// green caret and underline.
+struct Paint {
+  bool on = false;
+  std::string operator()(const char* code, const std::string& text) const {
+    return on ? std::string("\x1b[") + code + "m" + text + "\x1b[0m" : text;
+  }
+};
+
+const char* severity_colour(Severity s) {
+  switch (s) {
+    case Severity::error: return "1;31";
+    case Severity::warning: return "1;35";
+    case Severity::note: return "1;36";
+  }
+  return "1;31";
+}
+
 // Control bytes and tabs would break the caret alignment or the terminal; the caret line
 // repeats tabs so it still lines up under the column.
 std::string printable_line(std::string_view line) {
@@ -68,55 +126,73 @@ std::string printable_line(std::string_view line) {
   return out;
 }
 
-std::string caret_line(std::string_view line, int col) {
-  std::string out;
+// A UTF-8 continuation byte takes no column of its own on the screen.
+bool continuation(char c) { return (static_cast<unsigned char>(c) & 0xC0) == 0x80; }
+
+std::string caret_line(std::string_view line, int col, int length, const Paint& paint) {
+  std::string pad;
   for (int i = 0; i + 1 < col && static_cast<std::size_t>(i) < line.size(); ++i)
-    out += line[i] == '\t' ? '\t' : ' ';
-  out += '^';
-  return out;
+    if (!continuation(line[i])) pad += line[i] == '\t' ? '\t' : ' ';
+  std::string mark = "^";
+  for (int i = col; i < col - 1 + length && static_cast<std::size_t>(i) < line.size(); ++i)
+    if (!continuation(line[i])) mark += '~';
+  return pad + paint("1;32", mark);
+}
+
+void format_one(const Diagnostic& d, const Paint& paint, std::string& out) {
+  if (d.has_file) {
+    std::string where = d.path;
+    if (d.loc.known()) where += ":" + std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col);
+    out += paint("1", where + ":") + " ";
+  }
+  out += paint(severity_colour(d.severity), std::string(severity_name(d.severity)) + ":");
+  out += " " + paint("1", d.message) + "\n";
+  if (d.has_file && d.loc.known()) {
+    std::string_view line = d.source_line;
+    out += " " + printable_line(line) + "\n";
+    out += " " + caret_line(line, d.loc.col, d.length, paint) + "\n";
+  }
 }
 
 }  // namespace
 
-std::string Diagnostics::format() const {
-  // Files in the order they were first reported, then by position within each file.
+std::string Diagnostics::format(FormatOptions options) const {
+  // A diagnostic and the notes attached to it form a group; groups are ordered by file (in
+  // the order the files were first reported), then by position within each file.
   // Diagnostics without a file rank as the path "" with has_file false.
+  std::vector<std::vector<const Diagnostic*>> groups;
+  for (const auto& d : items_) {
+    if (d.attached && !groups.empty()) groups.back().push_back(&d);
+    else groups.push_back({&d});
+  }
   std::vector<std::pair<bool, std::string>> file_order;
   auto key = [](const Diagnostic* d) { return std::make_pair(d->has_file, d->path); };
+  for (const auto& g : groups)
+    if (std::find(file_order.begin(), file_order.end(), key(g[0])) == file_order.end())
+      file_order.push_back(key(g[0]));
   auto rank = [&](const Diagnostic* d) {
-    auto it = std::find(file_order.begin(), file_order.end(), key(d));
-    return static_cast<std::size_t>(it - file_order.begin());
+    return static_cast<std::size_t>(std::find(file_order.begin(), file_order.end(), key(d)) - file_order.begin());
   };
-  for (const auto& d : items_)
-    if (std::find(file_order.begin(), file_order.end(), key(&d)) == file_order.end())
-      file_order.push_back(key(&d));
-  std::vector<const Diagnostic*> sorted;
-  for (const auto& d : items_) sorted.push_back(&d);
-  std::stable_sort(sorted.begin(), sorted.end(), [&](const Diagnostic* a, const Diagnostic* b) {
+  std::stable_sort(groups.begin(), groups.end(), [&](const auto& ga, const auto& gb) {
+    const Diagnostic* a = ga[0];
+    const Diagnostic* b = gb[0];
     std::size_t ra = rank(a), rb = rank(b);
     if (ra != rb) return ra < rb;
     if (a->loc.line != b->loc.line) return a->loc.line < b->loc.line;
     return a->loc.col < b->loc.col;
   });
+  Paint paint{options.color};
   std::string out;
-  for (const Diagnostic* d : sorted) {
-    if (d->has_file) {
-      out += d->path;
-      if (d->loc.known()) out += ":" + std::to_string(d->loc.line) + ":" + std::to_string(d->loc.col);
-      out += ": ";
-    }
-    out += severity_name(d->severity);
-    out += ": " + d->message + "\n";
-    if (d->has_file && d->loc.known()) {
-      std::string_view line = d->source_line;
-      out += " " + printable_line(line) + "\n";
-      out += " " + caret_line(line, d->loc.col) + "\n";
-    }
-  }
+  for (const auto& g : groups)
+    for (const Diagnostic* d : g) format_one(*d, paint, out);
   if (dropped_ > 0)
-    out += "error: " + std::to_string(dropped_) + " more errors not shown (limit " +
+    out += paint("1;31", "error:") + " " + count_of(dropped_, "more error") + " not shown (limit " +
            std::to_string(max_errors) + "; raise it with --max-errors N, 0 for no limit)\n";
   return out;
+}
+
+std::string count_of(std::size_t n, const std::string& noun) {
+  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
 }
 
 namespace {

@@ -200,9 +200,11 @@ void Checker::check_drones() {
   std::map<std::string, const DroneDecl*> seen;
   for (const auto& d : m_.drones) {
     auto [it, fresh] = seen.emplace(d.name, &d);
-    if (!fresh)
+    if (!fresh) {
       error(d.loc, "drone '" + d.name + "' is declared twice (first at line " +
                        std::to_string(it->second->loc.line) + "); rename or remove one");
+      diags_.note(file_, it->second->loc, "first declared here");
+    }
     if (find_function(d.name) >= 0)
       error(d.loc, "'" + d.name + "' is both a drone and a function; rename one");
     // A drone's name is the common name (CN) of its DDS Security certificate, which X.509
@@ -227,6 +229,7 @@ void Checker::check_functions() {
     if (first != static_cast<int>(i)) {
       error(f.loc, "function '" + f.name + "' is defined twice (first at line " +
                        std::to_string(m_.functions[first].loc.line) + "); rename or remove one");
+      diags_.note(file_, m_.functions[first].loc, "first defined here");
       continue;
     }
     if (f.name == "INIT") {

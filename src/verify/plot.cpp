@@ -12,7 +12,7 @@ namespace {
 std::string caption(const VerifyReport& report) {
   const FlownPath& p = report.worst;
   std::string out = "Path " + std::to_string(p.number) + " of " + std::to_string(report.paths) + " flown, " +
-                    std::to_string(p.violations) + " violation(s)";
+                    count_of(p.violations, "violation");
   out += p.number == 1 && p.violations == 0 ? " (no path broke a rule)" : " (the path with the most)";
   std::string how;
   for (const Decision& d : p.decisions)

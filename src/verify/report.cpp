@@ -34,15 +34,15 @@ std::string format_report(const graph::Compilation& c, const VerifyReport& r) {
     for (const Located& n : v.notes) out += one(c, Severity::note, n);
     bool on_every_path = v.paths_seen == r.paths;
     if (!v.path.empty() || !v.timing.empty() || !on_every_path) {
-      std::string where = "found on " + std::to_string(v.paths_seen) + " of " + std::to_string(r.paths) +
-                          " path(s) flown" + (v.timing.empty() ? "" : ", first with " + v.timing);
+      std::string where = "found on " + std::to_string(v.paths_seen) + " of " + count_of(r.paths, "path") +
+                          " flown" + (v.timing.empty() ? "" : ", first with " + v.timing);
       out += one(c, Severity::note, {0, 0, where});
       for (const Decision& d : v.path) out += one(c, Severity::note, {d.line, d.col, outcome_text(d)});
     }
   }
-  out += std::to_string(r.violations.size()) + " violation(s) on " + std::to_string(r.paths) + " path(s) flown";
+  out += count_of(r.violations.size(), "violation") + " on " + count_of(r.paths, "path") + " flown";
   out += r.complete ? "; exploration complete" : "; exploration incomplete (raise --paths to fly more)";
-  out += " (" + std::to_string(r.free_conditions) + " condition(s) explored both ways";
+  out += " (" + count_of(r.free_conditions, "condition") + " explored both ways";
   if (r.timing_conditions > 0)
     out += "; " + std::to_string(r.timing_conditions) + " on other drones' timing, " +
            std::to_string(r.timing_both_ways) + " of them seen both ways";

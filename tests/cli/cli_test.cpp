@@ -58,7 +58,7 @@ TEST_F(Cli, CheckFailsWithExitOneAndEveryErrorGccStyle) {
   EXPECT_NE(r.out.find(m.string() + ":3:5: error: drone 'A' of type 'Quad' has no capability 'Tkeoff'; did you mean 'Takeoff'?"),
             std::string::npos) << r.out;
   EXPECT_NE(r.out.find(m.string() + ":4:3: error: unknown drone 'B'"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("2 error(s)"), std::string::npos);
+  EXPECT_NE(r.out.find("2 errors, 0 warnings"), std::string::npos) << r.out;
 }
 
 TEST_F(Cli, WerrorTurnsWarningsIntoFailure) {

@@ -67,12 +67,12 @@ TEST(Errors, UnknownKeyFarFromAnyListsTheAllowedKeys) {
       << first_error(p.diags).message;
 }
 
-TEST(Errors, FormattedErrorShowsFileLineColumnAndCaret) {
+TEST(Errors, FormattedErrorShowsFileLineColumnAndTheValueUnderlined) {
   auto p = parse("drones:\n  Drone1:\n    failsafe: lnd\n");
   EXPECT_EQ(p.diags.format(),
             "fleet.yaml:3:15: error: unknown failsafe 'lnd'; did you mean 'land'?\n"
             "     failsafe: lnd\n"
-            "               ^\n");
+            "               ^~~\n");
 }
 
 TEST(Errors, UnknownCapabilityIsAnErrorWithSuggestion) {

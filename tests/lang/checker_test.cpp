@@ -89,12 +89,12 @@ TEST(Checker, MutualRecursionIsReportedOnce) {
   EXPECT_NE(r.text.find("recursion"), std::string::npos);
 }
 
-TEST(Checker, ErrorCarriesFileLineColumnSourceLineAndCaret) {
+TEST(Checker, ErrorCarriesFileLineColumnSourceLineAndAnUnderlinedToken) {
   Result r = check("var A Quad\nfunc INIT() {\n\tA.Tkeoff(3)\n}\n");
   EXPECT_EQ(r.text,
             "m.eamos:3:4: error: drone 'A' of type 'Quad' has no capability 'Tkeoff'; did you mean 'Takeoff'?\n"
             " \tA.Tkeoff(3)\n"
-            " \t  ^\n");
+            " \t  ^~~~~~\n");
 }
 
 }  // namespace
