@@ -118,7 +118,8 @@ nlohmann::json live_view(const graph::Compilation& c, const std::string& mission
 /// The live page's mission for `eamos launch DIR`.
 nlohmann::json launch_view(const std::string& dir);
 /// Parses `at` ("[HOST:]PORT") and starts `server` there; false with the error printed.
-bool start_monitor(monitor::MonitorServer& server, const std::string& at, const nlohmann::json& view);
+bool start_monitor(monitor::MonitorServer& server, const std::string& at, const nlohmann::json& view,
+                   const std::string& option = "--monitor");
 
 /// Compiles and prints every diagnostic; true when the graphs are usable.
 bool compile_and_report(const CommonOptions& o, graph::Compilation& c,
