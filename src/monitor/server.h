@@ -41,7 +41,7 @@ struct ServerLimits {
   double hello_timeout_s = 3.0;      ///< a WebSocket that has said nothing this long after its handshake is dropped
   double ping_interval_s = 2.0;      ///< the server pings every page this often
   double answer_timeout_s = 6.0;     ///< a page that leaves a ping unanswered this long is dropped
-  double max_lag_s = 10.0;           ///< a page not yet sent an event appended this long ago is dropped
+  double max_lag_s = 30.0;           ///< a page not yet sent an event appended this long ago is dropped
 };
 
 class MonitorServer {

@@ -993,17 +993,21 @@ function graphBox() {
   return { w: box.clientWidth || 600, h: box.clientHeight || 560 };
 }
 
-// Graphviz gives the picture's viewBox; the first view fits its width, from the top (a tall
-// MEG is read from its start), or the whole picture when that is shorter than the panel.
+// Graphviz gives the picture's viewBox (in points). The first view fits its width, from the
+// top (a MEG is read from its start), or the whole picture when that is shorter than the
+// panel; but never smaller than GRAPH_READABLE pixels a point, where its labels can be read:
+// a wide graph opens on its top middle, and "fit" shows it whole.
+const GRAPH_READABLE = 0.75;
 function initGraphView(svg) {
   const vb = svg.viewBox && svg.viewBox.baseVal;
   G.svg = svg;
   G.base = vb && vb.width > 0 ? { x: vb.x, y: vb.y, w: vb.width, h: vb.height } : null;
   svg.setAttribute('preserveAspectRatio', 'xMidYMid meet');
   if (!G.base) return;
-  const { w, h } = graphBox(), viewH = G.base.w * h / w;
-  if (viewH >= G.base.h) fitGraph();
-  else setGraphView({ x: G.base.x, y: G.base.y, w: G.base.w, h: viewH });
+  const { w, h } = graphBox(), b = G.base;
+  const viewW = Math.min(b.w, w / GRAPH_READABLE);
+  if (viewW === b.w && b.w * h / w >= b.h) fitGraph();
+  else setGraphView({ x: b.x + (b.w - viewW) / 2, y: b.y, w: viewW });
 }
 
 function setGraphView(v) {
