@@ -259,8 +259,10 @@ void MonitorServer::watch_loop() {
     Clock::time_point now = Clock::now();
     for (auto it = clients_.begin(); it != clients_.end();) {
       Client& c = *it->second;
-      if (!c.ready && !c.closing && now - c.connected > handshake_limit) {
-        it = clients_.erase(it);  // civetweb gave up on its handshake and will not call us again
+      // civetweb gave up on its handshake (also one cut by drop()) and will not call us again;
+      // it never had a writer.
+      if (!c.ready && now - c.connected > handshake_limit) {
+        it = clients_.erase(it);
         continue;
       }
       if (c.ready && !c.closing && why_drop(c, now)) drop(c);
