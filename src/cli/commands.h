@@ -119,7 +119,8 @@ nlohmann::json live_view(const graph::Compilation& c, const std::string& mission
 /// The live page's mission for `eamos launch DIR`.
 nlohmann::json launch_view(const std::string& dir);
 /// Parses `at` ("[HOST:]PORT") and starts `server` there; false with the error printed.
-bool start_monitor(monitor::MonitorServer& server, const std::string& at, const nlohmann::json& view);
+bool start_monitor(monitor::MonitorServer& server, const std::string& at, const nlohmann::json& view,
+                   const std::string& option = "--monitor");
 
 /// Prints diagnostics as --diagnostics-format and --color say: text on standard error, a
 /// JSON or SARIF document on standard output when `on_stdout`, else on standard error.

@@ -212,7 +212,7 @@ int main(int argc, char** argv) {
       ->required()->check(eamos::cli::existing_file("a trace"));
   monitor->add_option("--port", monitor_opts.port, "Port to serve at (0: any free one)")
       ->default_val(8080)->check(eamos::cli::whole_number(0, 65535));
-  monitor->add_option("--host", monitor_opts.host, "Address to serve at (0.0.0.0: every interface; default loopback only)")
+  monitor->add_option("--host", monitor_opts.host, "Numeric IP address to serve at (0.0.0.0: every interface; default 127.0.0.1, this machine only)")
       ->default_val("127.0.0.1");
   auto* monitor_mission = monitor->add_option("--mission", monitor_opts.mission,
                       "The mission, for a trace that does not carry it (an older trace): adds the graphs and the text")

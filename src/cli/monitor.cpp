@@ -99,6 +99,14 @@ std::string not_a_trace(const std::string& path) {
   return "";
 }
 
+// What the trace is: `eamos verify --trace` says in its header that it holds a verification's
+// worst path (which path, how many violations), and the page says so instead of a run's outcome.
+void add_run_kind(const monitor::LoadedTrace& trace, nlohmann::json& view) {
+  if (!trace.header || !trace.header->contains("run")) return;
+  for (const char* key : {"run", "path", "paths", "violations"})
+    if (trace.header->contains(key)) view[key] = (*trace.header)[key];
+}
+
 }  // namespace
 
 void MonitorHold::wait_for_signal() {
@@ -119,11 +127,12 @@ void MonitorHold::signal() {
   signalled.notify_all();
 }
 
-bool start_monitor(monitor::MonitorServer& server, const std::string& at, const nlohmann::json& view) {
+bool start_monitor(monitor::MonitorServer& server, const std::string& at, const nlohmann::json& view,
+                   const std::string& option) {
   monitor::Endpoint endpoint;
   std::string error;
   if (!monitor::parse_endpoint(at, endpoint, error)) {
-    std::cerr << error_prefix() << "--monitor " << error << "\n";
+    std::cerr << error_prefix() << option << " " << error << "\n";
     return false;
   }
   server.set_mission(view.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
@@ -173,6 +182,13 @@ int cmd_monitor(const MonitorCommandOptions& m) {
     std::fprintf(stderr, "eamos monitor: interrupted (%s): stopping\n", name);
     hold.signal();
   });
+  // The address first: a mistyped one is said before a long trace is read.
+  std::string at = m.host + ":" + std::to_string(m.port), error;
+  monitor::Endpoint endpoint;
+  if (!monitor::parse_endpoint(at, endpoint, error)) {
+    std::cerr << "eamos: error: --host " << error << "\n";
+    return 1;
+  }
   std::ifstream in(m.trace, std::ios::binary);
   if (!in) {
     std::cerr << error_prefix() << "cannot read trace '" << m.trace << "'; give the file `eamos run --trace` wrote\n";
@@ -191,9 +207,9 @@ int cmd_monitor(const MonitorCommandOptions& m) {
   }
   nlohmann::json view;
   if (!replay_view(m, trace, view)) return 1;
+  add_run_kind(trace, view);
   monitor::MonitorServer server;
-  std::string at = m.host + ":" + std::to_string(m.port);
-  if (!start_monitor(server, at, view)) return 1;
+  if (!start_monitor(server, at, view, "--host")) return 1;
   for (auto& e : trace.events) server.append(std::move(e));
   server.finish();
   std::cout << "eamos monitor: replaying " << m.trace << " (" << trace.events.size() << " events) at "

@@ -1,5 +1,7 @@
 // `eamos verify`: compile, read back every drone's mission file as `eamos run` does, and
 // let src/verify fly every explored path in the simulator and check it.
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <iostream>
 
@@ -34,8 +36,59 @@ std::string violation_line(const verify::PlacedViolation& p) {
   return j.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
 }
 
-/// The worst path's trace as `eamos run --trace` writes it, each violation merged in at its
-/// instant (before the first later event; the mission's end stays the last line).
+// Telemetry as a run's trace has it (docs/trace.md: on the 5-per-second grid, a sample only
+// when something in it changed): each drone's state from its track, which holds a sample per
+// change, so its last sample up to a step is its state then. Without it the monitor would draw
+// every drone at its home for the whole flight.
+constexpr double kVerifyTelemetryHz = 5.0;
+
+bool same_sample(const dex::Sample& a, const dex::Sample& b) {
+  return a.x == b.x && a.y == b.y && a.z == b.z && a.armed == b.armed && a.landed == b.landed && a.battery == b.battery;
+}
+
+dex::TraceEvent telemetry_event(const std::string& drone, double t, const dex::Sample& s) {
+  mid::DroneState state;
+  state.t = t;
+  state.x = s.x, state.y = s.y, state.z = s.z;
+  state.armed = s.armed, state.landed = s.landed, state.battery = s.battery;
+  dex::TraceEvent e;
+  e.t = t;
+  e.drone = drone;
+  e.event = "telemetry";
+  e.state = state;
+  return e;
+}
+
+std::vector<dex::TraceEvent> telemetry_events(const verify::WorstFlight& w, double end) {
+  std::vector<dex::TraceEvent> out;
+  const auto steps = static_cast<long>(std::floor(end * kVerifyTelemetryHz + 1e-9));
+  for (const dex::DroneSummary& d : w.drones) {
+    std::size_t at = 0;
+    const dex::Sample* last = nullptr;
+    for (long k = 0; k <= steps && !d.track.empty(); ++k) {
+      double t = k / kVerifyTelemetryHz;
+      while (at + 1 < d.track.size() && d.track[at + 1].t <= t + 1e-9) ++at;
+      if (last && same_sample(*last, d.track[at])) continue;
+      last = &d.track[at];
+      out.push_back(telemetry_event(d.name, t, *last));
+    }
+  }
+  return out;
+}
+
+/// The header says what the trace is: the worst path of a verification, with its violations.
+nlohmann::ordered_json verify_header(const graph::Compilation& c, const std::vector<dex::Mission>& missions,
+                                     const verify::VerifyReport& report, std::size_t violations) {
+  nlohmann::ordered_json h = deploy::trace_header(c, missions[0].hash, kVerifyTelemetryHz);
+  h["run"] = "verify";
+  h["path"] = report.worst.number;
+  h["paths"] = report.paths;
+  h["violations"] = violations;
+  return h;
+}
+
+/// The worst path's trace as `eamos run --trace` writes it, with telemetry and each violation
+/// merged in at its instant (before the first later event; the mission's end stays the last line).
 bool write_verify_trace(const std::string& path, const graph::Compilation& c, const std::vector<dex::Mission>& missions,
                         const verify::VerifyOptions& options, const verify::VerifyReport& report) {
   std::ofstream out(path, std::ios::trunc);
@@ -44,15 +97,24 @@ bool write_verify_trace(const std::string& path, const graph::Compilation& c, co
     return false;
   }
   verify::WorstFlight w = verify::fly_worst_path(c, missions, options, report);
+  std::vector<dex::TraceEvent> events, ends;
+  for (dex::TraceEvent& e : w.events) (e.event == "mission" ? ends : events).push_back(std::move(e));
+  double end = events.empty() ? 0.0 : events.back().t;
+  for (const dex::TraceEvent& e : ends) end = std::max(end, e.t);
+  std::vector<dex::TraceEvent> samples = telemetry_events(w, end);
+  events.insert(events.end(), samples.begin(), samples.end());
+  std::stable_sort(events.begin(), events.end(), [](const dex::TraceEvent& a, const dex::TraceEvent& b) { return a.t < b.t; });
+  events.insert(events.end(), ends.begin(), ends.end());
   dex::JsonlTrace jsonl(out, missions[0].fleet);
   report_trace_write_errors(jsonl, path);
-  jsonl.write_header(deploy::trace_header(c, missions[0].hash, 0.0));
+  jsonl.write_header(verify_header(c, missions, report, w.violations.size()));
   std::size_t next = 0;
-  for (const dex::TraceEvent& e : w.events) {
+  for (const dex::TraceEvent& e : events) {
     while (next < w.violations.size() && (e.event == "mission" || w.violations[next].violation.t < e.t))
       out << violation_line(w.violations[next++]);
     jsonl.record(e);
   }
+  while (next < w.violations.size()) out << violation_line(w.violations[next++]);
   return jsonl.write_error().empty() && out.flush();
 }
 

@@ -1,12 +1,11 @@
 #include "monitor/server.h"
 
+#include <arpa/inet.h>
 #include <civetweb.h>
+#include <sys/socket.h>
 
 #include <cctype>
-#include <chrono>
-#include <cstdio>
 #include <cstring>
-#include <vector>
 
 #include "monitor/web_assets.h"
 
@@ -16,13 +15,6 @@ namespace {
 
 // Beyond this a mission keeps flying and the page misses events (it is told how many).
 constexpr std::size_t max_history = 5'000'000;
-// The most events in one WebSocket message: a browser parses each message in one go.
-constexpr std::size_t max_batch = 20'000;
-constexpr std::size_t max_clients = 32;
-
-bool valid_host_char(char c) {
-  return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == ':' || c == '[' || c == ']';
-}
 
 bool is_loopback(const std::string& host) {
   return host == "127.0.0.1" || host == "localhost" || host == "::1" || host == "[::1]";
@@ -48,12 +40,22 @@ void send_status(mg_connection* conn, int code, const char* text) {
             code, text, std::strlen(text), text);
 }
 
-// Unix ms to the microsecond: enough for a latency in ms, short on the wire.
-std::string stamp_text(double ms) {
-  if (ms <= 0) return "0";
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3f", ms);
-  return text;
+// A numeric address, as the operating system reads one: civetweb itself takes each of the
+// four numbers modulo 256 (999.1.1.1 listened on 231.1.1.1).
+bool parse_host(std::string host, std::string& out, std::string& error) {
+  if (host.size() > 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+  if (host == "localhost") host = "127.0.0.1";
+  unsigned char address[16];
+  if (host.size() < 64 && (inet_pton(AF_INET, host.c_str(), address) == 1 || inet_pton(AF_INET6, host.c_str(), address) == 1)) {
+    out = host;
+    return true;
+  }
+  std::string shown = host.size() > 64 ? host.substr(0, 64) + "…" : host;
+  for (char& c : shown)
+    if (static_cast<unsigned char>(c) < 0x20) c = '?';
+  error = "'" + shown + "' is not an IP address; give a numeric address of this machine: 127.0.0.1 (this machine "
+          "only, the default), 0.0.0.0 (every interface), ::1 or an address of one interface";
+  return false;
 }
 
 }  // namespace
@@ -65,24 +67,18 @@ bool parse_endpoint(const std::string& text, Endpoint& out, std::string& error) 
     host = text.substr(0, colon);
     port = text.substr(colon + 1);
   }
-  bool host_ok = !host.empty() && host.size() <= 255;
-  for (char c : host) host_ok = host_ok && valid_host_char(c);
-  if (!host_ok) {
-    error = "'" + text + "' is not [HOST:]PORT; give e.g. 8080 or 127.0.0.1:8080 (0.0.0.0:8080 to serve other machines)";
-    return false;
-  }
   bool port_ok = !port.empty() && port.size() <= 5;
   for (char c : port) port_ok = port_ok && std::isdigit(static_cast<unsigned char>(c));
   if (!port_ok || std::stoi(port) > 65535) {
-    error = "'" + port + "' is not a port number; give 0 to 65535 (0: any free port)";
+    error = "'" + port + "' is not a port number; give 0 to 65535 (0: any free port), as [HOST:]PORT";
     return false;
   }
-  out.host = host;
+  if (!parse_host(host, out.host, error)) return false;
   out.port = std::stoi(port);
   return true;
 }
 
-MonitorServer::MonitorServer() { mg_init_library(0); }
+MonitorServer::MonitorServer(ServerLimits limits) : limits_(limits) { mg_init_library(0); }
 
 MonitorServer::~MonitorServer() {
   stop();
@@ -92,12 +88,20 @@ MonitorServer::~MonitorServer() {
 void MonitorServer::set_mission(std::string mission_json) { mission_json_ = std::move(mission_json); }
 
 bool MonitorServer::start(const Endpoint& at, std::string& error) {
-  std::string ports = at.host.find(':') != std::string::npos && at.host.front() != '['
-                          ? "[" + at.host + "]:" + std::to_string(at.port)
-                          : at.host + ":" + std::to_string(at.port);
-  const char* options[] = {"listening_ports", ports.c_str(), "num_threads", "40",
-                           "enable_directory_listing", "no", "request_timeout_ms", "10000",
-                           "enable_websocket_ping_pong", "yes",
+  std::string ports = at.host.find(':') != std::string::npos ? "[" + at.host + "]:" + std::to_string(at.port)
+                                                             : at.host + ":" + std::to_string(at.port);
+  // Every connection holds one of civetweb's threads for its life (a WebSocket for as long
+  // as its page is open): the page's own requests keep threads of their own.
+  std::string threads = std::to_string(limits_.max_websockets + limits_.http_workers);
+  std::string timeout = std::to_string(limits_.header_timeout_ms);
+  const char* options[] = {"listening_ports", ports.c_str(), "num_threads", threads.c_str(),
+                           "enable_directory_listing", "no", "enable_keep_alive", "no",
+                           // Bounds how long a request's headers may take in all, and how long
+                           // a write to a browser may go without progress.
+                           "request_timeout_ms", timeout.c_str(),
+                           // The server pings and times out the pages itself (websocket_clients.cpp):
+                           // civetweb's own pings would hide the answers it needs to see.
+                           "enable_websocket_ping_pong", "no", "websocket_timeout_ms", "1000",
                            // Each live event is a small write: with Nagle's algorithm one waits for
                            // the browser's delayed ACK of the one before (tens of ms on loopback).
                            "tcp_nodelay", "1", nullptr};
@@ -115,61 +119,69 @@ bool MonitorServer::start(const Endpoint& at, std::string& error) {
   port_ = n > 0 ? bound[0].port : at.port;
   loopback_ = is_loopback(at.host);
   std::string shown = at.host == "0.0.0.0" || at.host == "::" ? "127.0.0.1" : at.host;
-  if (shown.find(':') != std::string::npos && shown.front() != '[') shown = "[" + shown + "]";
+  if (shown.find(':') != std::string::npos) shown = "[" + shown + "]";
   url_ = "http://" + shown + ":" + std::to_string(port_) + "/";
   mg_set_request_handler(context_, "/", &MonitorServer::on_http, this);
   mg_set_websocket_handler(context_, "/ws", &MonitorServer::on_ws_connect, &MonitorServer::on_ws_ready,
                            &MonitorServer::on_ws_data, &MonitorServer::on_ws_close, this);
-  sender_ = std::thread([this] { send_loop(); });
+  watchdog_ = std::thread([this] { watch_loop(); });
   return true;
 }
 
 void MonitorServer::stop() {
   {
-    std::lock_guard<std::mutex> lock(events_mutex_);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (stopping_ && !context_) return;
     stopping_ = true;
+    // Writers blocked on a browser that does not read return at once.
+    for (auto& [conn, client] : clients_)
+      if (client->fd >= 0) shutdown(client->fd, SHUT_RDWR);
   }
-  events_changed_.notify_all();
-  if (sender_.joinable()) sender_.join();
-  if (context_) mg_stop(context_);
+  changed_.notify_all();
+  watch_wake_.notify_all();
+  if (watchdog_.joinable()) watchdog_.join();
+  if (context_) mg_stop(context_);  // closes every connection: each close joins its writer
   context_ = nullptr;
 }
 
 void MonitorServer::append(std::string event_json, double emitted_ms) {
   {
-    std::lock_guard<std::mutex> lock(events_mutex_);
+    std::lock_guard<std::mutex> lock(mutex_);
     if (events_.size() >= max_history) {
       ++dropped_;
       return;
     }
-    events_.push_back(Event{std::move(event_json), emitted_ms});
-    news_ = true;
+    events_.push_back(Event{std::move(event_json), emitted_ms, Clock::now()});
   }
-  events_changed_.notify_one();
+  changed_.notify_all();
 }
 
 void MonitorServer::finish() {
   {
-    std::lock_guard<std::mutex> lock(events_mutex_);
+    std::lock_guard<std::mutex> lock(mutex_);
     finished_ = true;
-    news_ = true;
   }
-  events_changed_.notify_one();
+  changed_.notify_all();
 }
 
 std::size_t MonitorServer::event_count() const {
-  std::lock_guard<std::mutex> lock(events_mutex_);
+  std::lock_guard<std::mutex> lock(mutex_);
   return events_.size();
 }
 
 std::size_t MonitorServer::dropped_count() const {
-  std::lock_guard<std::mutex> lock(events_mutex_);
+  std::lock_guard<std::mutex> lock(mutex_);
   return dropped_;
 }
 
 std::size_t MonitorServer::client_count() const {
-  std::lock_guard<std::mutex> lock(clients_mutex_);
+  std::lock_guard<std::mutex> lock(mutex_);
   return clients_.size();
+}
+
+std::size_t MonitorServer::dropped_clients() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return dropped_clients_;
 }
 
 // A page on another site must not read the mission through a name that points here
@@ -204,103 +216,10 @@ int MonitorServer::on_http(mg_connection* conn, void* self_ptr) {
             "HTTP/1.1 200 OK\r\nContent-Type: %s\r\nContent-Length: %zu\r\nCache-Control: no-store\r\n"
             "X-Content-Type-Options: nosniff\r\nX-Frame-Options: DENY\r\nReferrer-Policy: no-referrer\r\n"
             "Content-Security-Policy: default-src 'self'; img-src 'self' data:; style-src 'self' 'unsafe-inline'; "
-            "connect-src 'self'; frame-ancestors 'none'\r\n\r\n",
+            "connect-src 'self'; frame-ancestors 'none'\r\nConnection: close\r\n\r\n",
             asset->content_type, asset->size);
   if (!head) mg_write(conn, asset->data, asset->size);
   return 200;
-}
-
-int MonitorServer::on_ws_connect(const mg_connection* conn, void* self_ptr) {
-  auto* self = static_cast<MonitorServer*>(self_ptr);
-  if (!self->host_allowed(conn)) return 1;  // non-zero refuses the connection
-  const char* origin = mg_get_header(conn, "Origin");
-  const char* host = mg_get_header(conn, "Host");
-  if (origin && host && std::string(origin) != std::string("http://") + host) return 1;
-  std::lock_guard<std::mutex> lock(self->clients_mutex_);
-  if (self->clients_.size() >= max_clients) return 1;
-  self->clients_[conn] = Client{};
-  return 0;
-}
-
-void MonitorServer::on_ws_ready(mg_connection* conn, void* self_ptr) {
-  auto* self = static_cast<MonitorServer*>(self_ptr);
-  {
-    std::lock_guard<std::mutex> lock(self->clients_mutex_);
-    auto it = self->clients_.find(conn);
-    if (it != self->clients_.end()) it->second.ready = true;
-  }
-  {
-    std::lock_guard<std::mutex> lock(self->events_mutex_);
-    self->news_ = true;
-  }
-  self->events_changed_.notify_one();
-}
-
-// The page may say hello; nothing it sends is read, so nothing it sends can change anything.
-int MonitorServer::on_ws_data(mg_connection*, int bits, char*, std::size_t, void*) {
-  const int opcode = bits & 0x0f;
-  return opcode == MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE ? 0 : 1;
-}
-
-void MonitorServer::on_ws_close(const mg_connection* conn, void* self_ptr) {
-  auto* self = static_cast<MonitorServer*>(self_ptr);
-  std::lock_guard<std::mutex> lock(self->clients_mutex_);
-  self->clients_.erase(conn);
-}
-
-void MonitorServer::send_loop() {
-  for (;;) {
-    {
-      std::unique_lock<std::mutex> lock(events_mutex_);
-      // Woken by news, also news that came while the last batch was being written (a notify
-      // then finds nobody waiting: waiting for it anyway cost up to the timeout per event).
-      events_changed_.wait_for(lock, std::chrono::milliseconds(50), [this] { return news_ || stopping_; });
-      news_ = false;
-      if (stopping_) return;
-    }
-    std::lock_guard<std::mutex> lock(clients_mutex_);
-    for (auto& [conn, client] : clients_)
-      if (client.ready) send_pending(const_cast<mg_connection*>(conn), client);
-  }
-}
-
-void MonitorServer::send_pending(mg_connection* conn, Client& client) {
-  if (!client.sent_mission) {
-    std::string hello = "{\"type\":\"mission\",\"mission\":" + (mission_json_.empty() ? "{}" : mission_json_) + "}";
-    if (mg_websocket_write(conn, MG_WEBSOCKET_OPCODE_TEXT, hello.data(), hello.size()) <= 0) return;
-    client.sent_mission = true;
-  }
-  for (;;) {
-    std::string batch, emitted;
-    std::size_t from = client.cursor, count = 0, dropped = 0;
-    bool finished = false;
-    {
-      std::lock_guard<std::mutex> lock(events_mutex_);
-      std::size_t to = std::min(events_.size(), from + max_batch);
-      count = to - from;
-      for (std::size_t i = from; i < to; ++i) {
-        batch += i == from ? "" : ",";
-        batch += events_[i].json;
-        emitted += i == from ? "" : ",";
-        emitted += stamp_text(events_[i].emitted_ms);
-      }
-      finished = finished_ && to == events_.size();
-      dropped = dropped_;
-    }
-    if (count > 0) {
-      double sent_ms = std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch()).count();
-      std::string message = "{\"type\":\"events\",\"sent\":" + stamp_text(sent_ms) + ",\"from\":" + std::to_string(from) + ",\"dropped\":" +
-                            std::to_string(dropped) + ",\"events\":[" + batch + "],\"emitted\":[" + emitted + "]}";
-      if (mg_websocket_write(conn, MG_WEBSOCKET_OPCODE_TEXT, message.data(), message.size()) <= 0) return;
-      client.cursor = from + count;
-    }
-    if (finished && !client.sent_finish) {
-      std::string message = "{\"type\":\"finished\"}";
-      if (mg_websocket_write(conn, MG_WEBSOCKET_OPCODE_TEXT, message.data(), message.size()) <= 0) return;
-      client.sent_finish = true;
-    }
-    if (count < max_batch) return;
-  }
 }
 
 }  // namespace eamos::monitor

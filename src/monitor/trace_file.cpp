@@ -46,13 +46,16 @@ bool is_string(const nlohmann::json& v) { return v.is_string(); }
 bool is_bool(const nlohmann::json& v) { return v.is_boolean(); }
 bool is_count(const nlohmann::json& v) { return v.is_number_integer() && v.get<long long>() >= 0; }
 bool is_number_or_bool(const nlohmann::json& v) { return v.is_boolean() || finite_number(v); }
+bool number_or_null(const nlohmann::json& v) { return v.is_null() || finite_number(v); }
 
 std::string check_header(const nlohmann::json& j) {
   if (!j.contains("version") || !j["version"].is_number_integer()) return "the header's \"version\" must be an integer";
   if (j["version"].get<long long>() != 1)
     return "trace schema version " + j["version"].dump() + " is not supported (this eamos reads version 1)";
-  for (const char* key : {"mission", "source", "fleet"})
+  for (const char* key : {"mission", "source", "fleet", "run"})
     if (std::string e = check_field(j, key, is_string, "a string"); !e.empty()) return e;
+  for (const char* key : {"path", "paths", "violations"})
+    if (std::string e = check_field(j, key, is_count, "a whole number >= 0"); !e.empty()) return e;
   if (j.contains("drones")) {
     if (!j["drones"].is_array()) return "\"drones\" must be a list";
     for (const auto& d : j["drones"]) {
@@ -77,8 +80,10 @@ std::string check_event(const nlohmann::json& j) {
     if (std::string e = check_field(j, key, is_string, "a string"); !e.empty()) return e;
   for (const char* key : {"line", "node", "instance"})
     if (std::string e = check_field(j, key, is_count, "a whole number >= 0"); !e.empty()) return e;
-  for (const char* key : {"x", "y", "z", "heading", "battery", "sent", "received"})
+  for (const char* key : {"x", "y", "z", "battery", "sent", "received"})
     if (std::string e = check_field(j, key, finite_number, "a number"); !e.empty()) return e;
+  // null: the vehicle reports no heading (docs/trace.md, "Telemetry").
+  if (std::string e = check_field(j, "heading", number_or_null, "a number or null"); !e.empty()) return e;
   for (const char* key : {"armed", "landed"})
     if (std::string e = check_field(j, key, is_bool, "true or false"); !e.empty()) return e;
   if (std::string e = check_field(j, "value", is_number_or_bool, "a number or true/false"); !e.empty()) return e;

@@ -70,6 +70,7 @@ WorstFlight fly_worst_path(const graph::Compilation& c, const std::vector<dex::M
   std::stable_sort(out.violations.begin(), out.violations.end(),
                    [](const PlacedViolation& a, const PlacedViolation& b) { return a.violation.t < b.violation.t; });
   out.events = std::move(f.events);
+  out.drones = std::move(f.result.drones);
   return out;
 }
 

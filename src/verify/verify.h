@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "dex/mission.h"
+#include "dex/runner.h"
 #include "dex/trace.h"
 #include "graph/pipeline.h"
 
@@ -102,6 +103,7 @@ struct PlacedViolation {
 struct WorstFlight {
   std::vector<dex::TraceEvent> events;
   std::vector<PlacedViolation> violations;  ///< in time order
+  std::vector<dex::DroneSummary> drones;    ///< each drone's track: a sample per change of position or phase
 };
 WorstFlight fly_worst_path(const graph::Compilation& c, const std::vector<dex::Mission>& missions,
                            const VerifyOptions& options, const VerifyReport& report);

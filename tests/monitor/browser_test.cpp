@@ -256,3 +256,50 @@ TEST(MonitorBrowser, LaunchOfADeploymentIsServedLiveToItsEnd) {
 }
 
 }  // namespace
+
+namespace {
+
+// Issue 37: a failed live run went on saying "● live", with no banner and the reason nowhere on
+// the page. tests/monitor/missions/timeout.eamos fails at 3.65 s; its drones land until 8.2 s.
+TEST(MonitorBrowser, AFailedLiveRunShowsItsFailureAndNoLongerSaysLive) {
+  if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
+  auto run = eamos_test::start_eamos({"run", "tests/monitor/missions/timeout.eamos", "--fleet",
+                                      "tests/monitor/missions/timeout.fleet.yaml", "-q", "--realtime", "--monitor",
+                                      "127.0.0.1:0"});
+  ASSERT_GT(run.pid, 0);
+  std::string url = read_url(run, "monitor at");
+  ASSERT_FALSE(url.empty()) << run.seen;
+  bool held = false;
+  std::thread reader([&] { held = eamos_test::read_until(run, "until Ctrl-C"); });
+  std::string output;
+  bool passed = run_browser("failed", url, output);
+  std::cout << output;
+  reader.join();
+  int status = -1;
+  stop(run, status);
+  EXPECT_TRUE(passed) << output;
+  EXPECT_TRUE(held) << run.seen;
+  EXPECT_EQ(status, 1) << run.seen;  // the mission's status: failed
+}
+
+// The end of a four-drone PAR: every drone waits for the slowest; one labelled span per pause.
+TEST(MonitorBrowser, WaitSpansOfAFourDroneParNeitherOverlapNorOverflow) {
+  if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
+  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-par4-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  std::string trace = (dir / "par4.jsonl").string();
+  auto run = eamos_test::run_eamos("run tests/monitor/missions/par4.eamos -q --trace " + trace);
+  ASSERT_EQ(run.status, 0) << run.out;
+  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0"});
+  std::string url = read_url(monitor, "replaying");
+  ASSERT_FALSE(url.empty()) << monitor.seen;
+  std::string output;
+  bool passed = run_browser("waits", url, output);
+  int status = -1;
+  stop(monitor, status);
+  EXPECT_TRUE(passed) << output;
+  EXPECT_EQ(status, 0) << monitor.seen;
+  fs::remove_all(dir);
+}
+
+}  // namespace

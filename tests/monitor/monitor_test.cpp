@@ -82,6 +82,18 @@ TEST(MonitorTrace, AHeaderOfAnotherSchemaVersionIsRefused) {
   EXPECT_NE(t.errors[0].find("version 7 is not supported"), std::string::npos) << t.errors[0];
 }
 
+// docs/trace.md: "heading" is null when the vehicle reports none (a MAVLink vehicle may not);
+// such a trace was refused line by line.
+TEST(MonitorTrace, TelemetryWithoutAHeadingIsReplayed) {
+  std::istringstream in("{\"t\":0.2,\"event\":\"telemetry\",\"drone\":\"D\",\"x\":1,\"y\":2,\"z\":3,"
+                        "\"heading\":null,\"armed\":true,\"landed\":false,\"battery\":99,\"mode\":\"\"}\n"
+                        "{\"t\":0.4,\"event\":\"telemetry\",\"drone\":\"D\",\"heading\":\"north\"}\n");
+  eamos::monitor::LoadedTrace t = eamos::monitor::read_trace("x.jsonl", in);
+  EXPECT_EQ(t.events.size(), 1u);
+  ASSERT_EQ(t.errors.size(), 1u);
+  EXPECT_NE(t.errors[0].find("x.jsonl:2: error: \"heading\" must be a number or null"), std::string::npos) << t.errors[0];
+}
+
 TEST(MonitorTrace, UnknownEventsAndFieldsAreKept) {
   std::istringstream in("{\"t\":0.5,\"event\":\"something-new\",\"future\":{\"a\":1}}\n");
   eamos::monitor::LoadedTrace t = eamos::monitor::read_trace("x.jsonl", in);
@@ -102,6 +114,38 @@ TEST(MonitorEndpoint, HostAndPortAreChecked) {
   EXPECT_NE(error.find("is not a port number"), std::string::npos);
   EXPECT_FALSE(eamos::monitor::parse_endpoint("host;rm:80", e, error));
   EXPECT_FALSE(eamos::monitor::parse_endpoint("", e, error));
+}
+
+// civetweb read each of the four numbers modulo 256: 999.1.1.1 listened on 231.1.1.1.
+TEST(MonitorEndpoint, OnlyRealIpAddressesAreAccepted) {
+  eamos::monitor::Endpoint e;
+  std::string error;
+  for (const char* bad : {"999.1.1.1:8080", "256.0.0.1:80", "1.2.3:80", "1.2.3.4.5:80", "example.com:80", "::g:80",
+                          "[127.0.0.1]x:80"}) {
+    error.clear();
+    EXPECT_FALSE(eamos::monitor::parse_endpoint(bad, e, error)) << bad;
+    EXPECT_NE(error.find("is not an IP address"), std::string::npos) << bad << ": " << error;
+  }
+  EXPECT_TRUE(eamos::monitor::parse_endpoint("localhost:80", e, error));
+  EXPECT_EQ(e.host, "127.0.0.1");
+  EXPECT_TRUE(eamos::monitor::parse_endpoint("[::1]:8080", e, error));
+  EXPECT_EQ(e.host, "::1");
+  EXPECT_EQ(e.port, 8080);
+  EXPECT_TRUE(eamos::monitor::parse_endpoint("10.1.2.3:0", e, error));
+  EXPECT_EQ(e.host, "10.1.2.3");
+}
+
+TEST(MonitorEndpoint, AnInvalidHostIsRefusedBeforeAnythingIsServed) {
+  std::string trace = write_temp("host.jsonl", "{\"t\":0,\"event\":\"start\",\"drone\":\"Drone1\"}\n");
+  auto r = eamos_test::run_eamos("monitor " + trace + " --host 999.1.1.1 --port 0");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("error: --host '999.1.1.1' is not an IP address"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("replaying"), std::string::npos) << r.out;
+  auto run = eamos_test::run_eamos("run examples/listing2.eamos -q --monitor 999.1.1.1:0");
+  EXPECT_EQ(run.status, 1);
+  EXPECT_NE(run.out.find("error: --monitor '999.1.1.1' is not an IP address"), std::string::npos) << run.out;
+  EXPECT_EQ(run.out.find("monitor at"), std::string::npos) << run.out;
+  fs::remove(trace);
 }
 
 // One raw HTTP/1.1 request to 127.0.0.1:port; the whole answer ("" when none).
@@ -182,7 +226,7 @@ TEST(MonitorRun, AFleetWithoutItsMissionIsAnError) {
   std::string trace = write_temp("fleet.jsonl", "{\"t\":0,\"event\":\"start\",\"drone\":\"Drone1\"}\n");
   auto r = eamos_test::run_eamos("monitor " + trace + " --fleet examples/listing2-right.yaml --port 0");
   EXPECT_EQ(r.status, 1);
-  EXPECT_NE(r.out.find("--fleet requires --mission"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--fleet needs --mission"), std::string::npos) << r.out;
   fs::remove(trace);
 }
 

@@ -141,6 +141,45 @@ TEST(VerifyTrace, WritesThePathWithAViolationEventAtTheResponsibleLine) {
   EXPECT_NE(violations[0]["text"].get<std::string>().find("come within 1.88 m"), std::string::npos);
 }
 
+// The monitor drew every drone of a verify trace at its home under "mission completed": the
+// trace now says what it is (header) and where the drones flew (telemetry, as a run's trace).
+TEST(VerifyTrace, SaysItIsAVerificationAndCarriesTheDronesPositions) {
+  fs::path trace = fs::temp_directory_path() / ("verify_trace_pos_" + std::to_string(::getpid()) + ".jsonl");
+  eamos_test::Output run = eamos_test::run_eamos(
+      "verify separation.eamos --fleet separation.fleet.yaml --trace " + trace.string(), {}, kMissions.string());
+  EXPECT_EQ(run.status, 1) << run.out;
+  std::string text = read_file(trace);
+  fs::remove(trace);
+  std::istringstream lines(text);
+  std::string first;
+  std::getline(lines, first);
+  nlohmann::json header = nlohmann::json::parse(first, nullptr, false);
+  ASSERT_TRUE(header.is_object()) << first;
+  EXPECT_EQ(header["run"], "verify");
+  EXPECT_EQ(header["path"], 1);
+  EXPECT_EQ(header["paths"], 1);
+  EXPECT_EQ(header["violations"], 1);
+  EXPECT_EQ(header["telemetry_hz"], 5.0);
+  std::map<std::string, std::vector<nlohmann::json>> samples;
+  nlohmann::json violation;
+  for (std::string line; std::getline(lines, line);) {
+    nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
+    if (j.value("event", "") == "telemetry") samples[j["drone"].get<std::string>()].push_back(j);
+    if (j.value("event", "") == "violation") violation = j;
+  }
+  ASSERT_EQ(samples.size(), 2u);
+  // Drone1 flies from (0, 0) to (0, 10) at 5 m: where it was at the violation is a sample's place.
+  const nlohmann::json* at = nullptr;
+  for (const auto& s : samples["Drone1"])
+    if (s["t"].get<double>() <= violation["t"].get<double>() + 1e-9) at = &s;
+  ASSERT_NE(at, nullptr);
+  EXPECT_GT((*at)["y"].get<double>(), 2.0);
+  EXPECT_LT((*at)["y"].get<double>(), 8.0);
+  EXPECT_NEAR((*at)["z"].get<double>(), 5.0, 0.1);
+  EXPECT_NEAR((*at)["y"].get<double>(), violation["y"].get<double>(), 1.0);
+  EXPECT_NEAR(samples["Drone2"].back()["y"].get<double>(), 0.0, 0.6) << "Drone2 ends at Drone1's home";
+}
+
 // branch.eamos breaks a rule only when its If is forced the other way (the second path): the
 // picture shows that path, not the clean first one, and says which combination it is.
 TEST(VerifyPlot, DrawsThePathWithTheMostViolationsAndNamesItsCombination) {

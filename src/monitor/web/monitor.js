@@ -37,7 +37,8 @@ function resetDerived() {
   D = {
     drones: [], droneIndex: new Map(), bars: [], openBars: new Map(), conds: [], telemetry: new Map(),
     messages: [], nodeHistory: new Map(), end: 0, outcome: '', failures: [], eventTimes: [], violations: [],
-    nodeKey: new Map(), nodes: new Map(), lastIngested: 0,
+    nodeKey: new Map(), nodes: new Map(), lastIngested: 0, missionReason: '', missionT: null, failMarks: [],
+    waitSpans: new Map(),
   };
   const m = S.mission || {};
   for (const d of Array.isArray(m.drones) ? m.drones : []) addDrone(str(d.name), d);
@@ -96,7 +97,12 @@ function ingest(e) {
     const open = D.openBars.get(key);
     const bar = open && open.length ? open.pop() : null;
     if (bar) { bar.end = t; bar.outcome = str(e.outcome); bar.reason = str(e.reason); bar.changed = true; }
-    if (e.outcome === 'failed') D.failures.push(t);
+    if (e.outcome === 'failed') {
+      const f = { t, kind: 'action', drone: str(e.drone), name: str(e.name), text: str(e.text) || str(e.name),
+                  line: e.line | 0, reason: str(e.reason), nodes: nodesOf(e) };
+      D.failures.push(f);
+      D.failMarks.push(f);
+    }
     S.itemsDirty = true;
   } else if (e.event === 'condition') {
     D.conds.push({ drone: str(e.drone), name: str(e.name), line: e.line | 0, text: str(e.text), t, value: !!e.value,
@@ -112,16 +118,21 @@ function ingest(e) {
     S.itemsDirty = true;
   } else if (e.event === 'mission') {
     D.outcome = str(e.outcome);
-    if (D.outcome === 'failed') D.failures.push(t);
+    D.missionReason = str(e.reason);
+    D.missionT = t;
+    if (D.outcome === 'failed') D.failures.push({ t, kind: 'mission', drone: '', text: 'the mission failed', line: 0,
+                                                  reason: D.missionReason, nodes: [] });
   } else if (e.event === 'violation') {
     // `eamos verify --trace`: a rule the path broke, at the action responsible.
     const others = Array.isArray(e.drones) ? e.drones.map(str).filter(n => n) : [];
     D.violations.push({ drone: str(e.drone), kind: str(e.kind), line: e.line | 0, text: str(e.text), t, others,
                         x: num(e.x, NaN), y: num(e.y, NaN) });
-    D.failures.push(t);
+    D.failures.push({ t, kind: 'violation', drone: str(e.drone), text: str(e.kind) + ' violation', line: e.line | 0,
+                      reason: str(e.text), nodes: [] });
     S.itemsDirty = true;
   } else if (e.event === 'failsafe' || e.event === 'error') {
-    D.failures.push(t);
+    D.failures.push({ t, kind: e.event, drone: str(e.drone), text: e.event + ' ' + str(e.name), line: e.line | 0,
+                      reason: str(e.reason) || str(e.text), nodes: [] });
     S.itemsDirty = true;
   }
   if (e.event !== 'telemetry' && e.event !== 'message') {
@@ -254,14 +265,111 @@ function renderControls() {
   if (document.activeElement !== scrub) scrub.value = String(S.clock);
   $('clock').textContent = S.clock.toFixed(2) + ' s / ' + end.toFixed(2) + ' s';
   $('clock').dataset.t = S.clock.toFixed(3);
-  const mode = S.live && !S.finished ? 'live' : 'replay';
+  const mode = pageMode();
+  putText($('mode'), { live: '● live', ended: 'live run ended', replay: 'replay', verify: 'verify run (replay)' }[mode]);
   $('mode').dataset.mode = mode;
-  $('mode').textContent = mode === 'live' ? '● live' : 'replay';
-  $('outcome').dataset.outcome = D.outcome;
-  $('outcome').textContent = D.outcome ? 'mission ' + D.outcome : '';
+  const [outcome, text] = outcomeShown();
+  $('outcome').dataset.outcome = outcome;
+  putText($('outcome'), text);
   $('follow').parentElement.hidden = mode !== 'live';
   $('play').disabled = S.playing;
   $('pause').disabled = !S.playing;
+  $('next-failure').disabled = $('prev-failure').disabled = D.failures.length === 0;
+  renderBanner();
+}
+
+function putText(node, text) { if (node.textContent !== text) node.textContent = text; }
+
+// A live run is live until its outcome is in (the `mission` event), not until the server
+// stops sending: a failed run's failsafes go on for a while after it ended.
+function pageMode() {
+  if (S.live) return S.finished || D.outcome ? 'ended' : 'live';
+  return isVerify() ? 'verify' : 'replay';
+}
+function isVerify() { return !!S.mission && S.mission.run === 'verify'; }
+
+// The header's outcome: the mission's, or for a verification what it found.
+function outcomeShown() {
+  if (isVerify()) {
+    const n = D.violations.length;
+    return n ? ['violations', n + (n === 1 ? ' violation' : ' violations')] : ['verified', 'no violations'];
+  }
+  return [D.outcome, D.outcome ? 'mission ' + D.outcome : ''];
+}
+
+// What went wrong, as one line under the header: the first failed action (drone, action,
+// line, reason) and the mission's own reason; for a verification, its violations.
+function bannerText() {
+  const seconds = t => t.toFixed(2) + ' s';
+  if (isVerify()) {
+    const m = S.mission, n = D.violations.length, v = D.violations[0];
+    const path = Number.isInteger(m.path) && Number.isInteger(m.paths) ? ` (path ${m.path} of ${m.paths} flown)` : '';
+    if (!n) return { kind: 'verified', text: `Verification run${path}: no violations on this path` };
+    return { kind: 'verify', failure: D.failures.find(f => f.kind === 'violation'),
+             text: `Verification run${path}: ${n} ${n === 1 ? 'violation' : 'violations'} — first: ${v.kind} at ` +
+                   `${seconds(v.t)}, ${v.drone}, line ${v.line}: ${v.text}` };
+  }
+  const f = D.failures.find(x => x.kind === 'action');
+  if (f) {
+    let text = `Mission failed at ${seconds(f.t)}: ${f.drone} · ${f.text} · line ${f.line} · ${f.reason || 'no reason given'}`;
+    if (D.missionReason && !D.missionReason.includes(f.reason)) text += ' — ' + D.missionReason;
+    return { kind: 'failed', failure: f, text };
+  }
+  if (D.outcome === 'failed')
+    return { kind: 'failed', failure: D.failures.find(x => x.kind === 'mission'),
+             text: `Mission failed at ${seconds(D.missionT || 0)}: ${D.missionReason || 'no reason given'}` };
+  return null;
+}
+
+function renderBanner() {
+  const b = bannerText(), banner = $('banner');
+  banner.hidden = !b;
+  if (!b) return;
+  banner.dataset.kind = b.kind;
+  putText($('banner-text'), b.text);
+  const f = b.failure;
+  banner.dataset.drone = f ? f.drone : '';
+  banner.dataset.action = f && f.kind === 'action' ? f.name : '';
+  banner.dataset.line = f ? String(f.line) : '';
+  banner.dataset.reason = f ? f.reason : D.missionReason;
+  banner.dataset.t = f ? String(f.t) : '';
+  $('banner-show').hidden = !f;
+  S.bannerFailure = f || null;
+}
+
+// ---- failures: next / previous, and what the selection says about one ----
+
+// One stop per instant, the most telling failure there (a failed action before the
+// failsafes and the mission's end it caused).
+function failureStops() {
+  const rank = { action: 0, violation: 1, error: 2, mission: 3, failsafe: 4 };
+  const at = new Map();
+  for (const f of D.failures) {
+    const key = f.t.toFixed(6), best = at.get(key);
+    if (!best || rank[f.kind] < rank[best.kind]) at.set(key, f);
+  }
+  return [...at.values()].sort((a, b) => a.t - b.t);
+}
+
+// Past the last failure "next" starts again from the first, before the first "previous"
+// from the last: the buttons always go somewhere while there is a failure at all.
+function jumpToFailure(direction) {
+  const stops = failureStops();
+  if (!stops.length) return;
+  let i = -1;
+  if (direction > 0) i = stops.findIndex(f => f.t > S.clock + 1e-6);
+  else for (let k = stops.length - 1; k >= 0 && i < 0; k--) if (stops[k].t < S.clock - 1e-6) i = k;
+  const wrapped = i < 0;
+  if (wrapped) i = direction > 0 ? 0 : stops.length - 1;
+  showFailure(stops[i], `failure ${i + 1} of ${stops.length}` +
+                        (wrapped ? (direction > 0 ? ' (back to the first)' : ' (back to the last)') : ''));
+}
+
+function showFailure(f, prefix) {
+  S.follow = false; $('follow').checked = false; S.playing = false;
+  setClock(f.t);
+  select({ nodes: f.nodes, line: f.line, drone: f.drone, text: (f.drone ? f.drone + ' · ' : '') + f.text, t: f.t,
+           outcome: f.kind === 'action' ? 'failed' : f.kind, reason: f.reason, prefix });
 }
 
 function trackWidth() {
@@ -305,8 +413,10 @@ function buildLanes() {
   lanes.hidden = !useDom;
   $('lanes-canvas').hidden = useDom;
   lanes.dataset.drones = String(D.drones.length);
-  for (const item of [...D.bars, ...D.conds, ...D.violations]) item.el = null;
-  for (const tr of D.triggerList || []) tr.el = tr.waitEl = null;
+  for (const item of [...D.bars, ...D.conds, ...D.violations, ...D.failMarks]) item.el = null;
+  for (const w of D.waitSpans ? D.waitSpans.values() : []) w.el = null;
+  D.waitSpans = new Map();
+  for (const tr of D.triggerList || []) tr.el = null;
   D.triggerList = [];
   $('triggers').textContent = '';
   D.condRows = new Map();
@@ -320,6 +430,7 @@ function buildLanes() {
     lane.appendChild(track);
     lanes.appendChild(lane);
     d.track = track;
+    d.lane = lane;
   }
   addLaneItems();
 }
@@ -346,6 +457,7 @@ function addLaneItems() {
   });
   for (const c of D.conds) if (!c.el) makeCond(c);
   buildViolationMarks();
+  buildFailMarks();
   updateTriggers();
 }
 
@@ -357,7 +469,10 @@ function makeBar(b, i) {
   bar.dataset.line = String(b.line);
   bar.dataset.start = String(b.start);
   bar.dataset.node = b.nodes.join(' ');
-  bar.addEventListener('click', () => select({ nodes: b.nodes, line: b.line, drone: b.drone, text: b.text, t: b.start }));
+  bar.addEventListener('click', () => select({ nodes: b.nodes, line: b.line, drone: b.drone, text: b.text || b.name,
+                                                t: b.start, end: b.end === null ? undefined : b.end,
+                                                outcome: b.end === null ? 'running' : b.outcome || 'succeeded',
+                                                reason: b.reason }));
   b.el = bar;
   D.drones[D.droneIndex.get(b.drone)].track.appendChild(bar);
 }
@@ -374,7 +489,8 @@ function makeCond(c) {
   const row = D.condRows.get(c.drone) || 0;
   D.condRows.set(c.drone, row + 1);
   mark.style.top = (row % 2 === 0 ? 42 : 54) + 'px';
-  mark.addEventListener('click', () => select({ nodes: c.nodes, line: c.line, drone: c.drone, text: c.text, t: c.t }));
+  mark.addEventListener('click', () => select({ nodes: c.nodes, line: c.line, drone: c.drone, text: c.text, t: c.t,
+                                                 outcome: c.value ? 'true' : 'false' }));
   c.el = mark;
   D.drones[D.droneIndex.get(c.drone)].track.appendChild(mark);
 }
@@ -391,8 +507,27 @@ function buildViolationMarks() {
     mark.dataset.t = String(v.t);
     mark.title = v.kind + ' at ' + v.t.toFixed(2) + ' s (line ' + v.line + '): ' + v.text +
                  (v.others.length ? ' [with ' + v.others.join(', ') + ']' : '');
-    mark.addEventListener('click', () => select({ nodes: [], line: v.line, drone: v.drone, text: v.text, t: v.t }));
+    mark.addEventListener('click', () => select({ nodes: [], line: v.line, drone: v.drone, text: v.drone + ' · ' + v.kind,
+                                                   t: v.t, outcome: 'violation', reason: v.text }));
     v.el = mark;
+    d.track.appendChild(mark);
+  }
+}
+
+// A red ✗ where a drone's action failed, at the end of its red bar; the reason is its title.
+function buildFailMarks() {
+  for (const f of D.failMarks) {
+    const d = D.drones[D.droneIndex.get(f.drone)];
+    if (f.el || !d || !d.track) continue;
+    const mark = el('div', 'fail-mark', '✗');
+    mark.dataset.drone = f.drone;
+    mark.dataset.name = f.name;
+    mark.dataset.line = String(f.line);
+    mark.dataset.t = String(f.t);
+    mark.dataset.reason = f.reason;
+    mark.title = `${f.text} failed at ${f.t.toFixed(2)} s (line ${f.line}): ${f.reason}`;
+    mark.addEventListener('click', () => showFailure(f, 'failure'));
+    f.el = mark;
     d.track.appendChild(mark);
   }
 }
@@ -425,7 +560,7 @@ function updateTriggers() {
   let kept = 0;
   while (kept < old.length && kept < now.length && old[kept].el && same(old[kept], now[kept])) kept++;
   if (kept < old.length) {
-    for (const tr of old) { if (tr.el) tr.el.remove(); if (tr.waitEl) tr.waitEl.remove(); }
+    for (const tr of old) if (tr.el) tr.el.remove();
     kept = 0;
   }
   if (!svg.querySelector('defs')) {
@@ -436,6 +571,64 @@ function updateTriggers() {
   }
   D.triggerList = old.slice(0, kept).concat(now.slice(kept));
   for (const tr of D.triggerList.slice(kept)) drawTrigger(svg, tr);
+  updateWaits();
+}
+
+// Whether `drone` was between actions just before `t` (a trigger that arrives while it
+// still flies its previous action is no wait). Final once the clock of the trace passed t.
+function idleBefore(drone, t) {
+  for (const b of D.bars)
+    if (b.drone === drone && b.start < t - 1e-9 && (b.end === null || b.end > t + 1e-9)) return false;
+  return true;
+}
+
+// One hatched span per pause of a drone between two actions: from its last end to the last
+// trigger it waited for. Several drones that each trigger it (the end of a PAR) make one
+// span, labelled with the one it waited for last and how many others.
+function updateWaits() {
+  const groups = new Map();
+  for (const tr of D.triggerList) {
+    if (tr.received - tr.waitFrom <= 0.01) continue;
+    if (tr.idle === undefined) tr.idle = idleBefore(tr.to, tr.received);
+    if (!tr.idle) continue;
+    const key = tr.to + '|' + tr.waitFrom;
+    const g = groups.get(key);
+    if (!g) groups.set(key, { to: tr.to, waitFrom: tr.waitFrom, last: tr, others: [] });
+    else if (tr.received > g.last.received) { g.others.push(g.last.from); g.last = tr; }
+    else g.others.push(tr.from);
+  }
+  for (const [key, w] of D.waitSpans) if (!groups.has(key)) { if (w.el) w.el.remove(); D.waitSpans.delete(key); }
+  for (const [key, g] of groups) {
+    let w = D.waitSpans.get(key);
+    if (!w) { w = { el: null }; D.waitSpans.set(key, w); }
+    Object.assign(w, { to: g.to, on: g.last.from, waitFrom: g.waitFrom, until: g.last.received,
+                       others: [...new Set(g.others.filter(o => o !== g.last.from))] });
+    const d = D.drones[D.droneIndex.get(w.to)];
+    if (!w.el && d && d.track) { w.el = el('div', 'wait'); d.track.appendChild(w.el); }
+    if (!w.el) continue;
+    w.el.dataset.drone = w.to;
+    w.el.dataset.on = w.on;
+    w.el.dataset.wait = (w.until - w.waitFrom).toFixed(2);
+    w.el.dataset.others = w.others.join(' ');
+    w.el.title = `${w.to} waited ${(w.until - w.waitFrom).toFixed(2)} s, from ${w.waitFrom.toFixed(2)} s until ` +
+                 `${w.on}'s trigger at ${w.until.toFixed(2)} s` +
+                 (w.others.length ? ` (also triggered by ${w.others.join(', ')}, earlier)` : '');
+  }
+}
+
+// The spans' places, and their labels as long as fits: "waits 2.55 s on D1 (+2)", "2.55 s · D1", or none.
+function renderWaits(px, now) {
+  for (const w of D.waitSpans.values()) {
+    if (!w.el) continue;
+    const width = Math.max(2, px(w.until - w.waitFrom));
+    put(w.el, 'left', px(w.waitFrom) + 'px');
+    put(w.el, 'width', width + 'px');
+    flag(w.el, 'future', w.waitFrom > now + 1e-9);
+    const secs = (w.until - w.waitFrom).toFixed(2) + ' s';
+    const full = `waits ${secs} on ${w.on}` + (w.others.length ? ` (+${w.others.length})` : '');
+    const short = `${secs} · ${w.on}`;
+    putText(w.el, width >= full.length * 5.6 + 4 ? full : width >= short.length * 5.6 + 4 ? short : '');
+  }
 }
 
 function drawTrigger(svg, tr) {
@@ -454,14 +647,6 @@ function drawTrigger(svg, tr) {
   line.appendChild(title);
   svg.appendChild(line);
   tr.el = line;
-  const d = D.drones[D.droneIndex.get(tr.to)];
-  if (d && d.track && tr.received - tr.waitFrom > 0.01) {
-    const wait = el('div', 'wait', 'waits ' + (tr.received - tr.waitFrom).toFixed(2) + ' s on ' + tr.from);
-    wait.dataset.drone = tr.to;
-    wait.dataset.on = tr.from;
-    tr.waitEl = wait;
-    d.track.appendChild(wait);
-  }
 }
 
 function barState(b) {
@@ -493,6 +678,15 @@ function renderLanes() {
     put(v.el, 'left', px(v.t) + 'px');
     flag(v.el, 'future', v.t > now + 1e-9);
   }
+  const failedNow = new Set();
+  for (const f of D.failMarks) {
+    if (f.t <= now + 1e-9) failedNow.add(f.drone);
+    if (!f.el) continue;
+    put(f.el, 'left', px(f.t) + 'px');
+    flag(f.el, 'future', f.t > now + 1e-9);
+  }
+  for (const d of D.drones) if (d.lane) flag(d.lane, 'failed', failedNow.has(d.name));
+  renderWaits(px, now);
   // The lanes' size from what is known, not read back from the page (see render).
   const laneH = 68, height = D.drones.length * laneH;
   const svg = $('triggers');
@@ -504,11 +698,6 @@ function renderLanes() {
     const x1 = xOf(tr.sent), x2 = xOf(tr.received);
     putAttr(tr.el, 'd', `M${x1},${y1} C${x1 + 30},${y1} ${x2 - 30},${y2} ${x2},${y2}`);
     flag(tr.el, 'future', tr.received > now + 1e-9);
-    if (tr.waitEl) {
-      put(tr.waitEl, 'left', px(tr.waitFrom) + 'px');
-      put(tr.waitEl, 'width', Math.max(2, px(tr.received - tr.waitFrom)) + 'px');
-      flag(tr.waitEl, 'future', tr.waitFrom > now + 1e-9);
-    }
   }
   const head = $('playhead');
   put(head, 'left', xOf(now) + 'px');
@@ -611,13 +800,39 @@ function renderMap() {
     if (!p) continue;
     g.fillStyle = d.colour;
     g.beginPath(); g.arc(X(p.x), Y(p.y), many ? 2 : 5, 0, 2 * Math.PI); g.fill();
-    if (!many) { g.fillStyle = '#222'; g.font = '11px sans-serif'; g.fillText(d.name, X(p.x) + 7, Y(p.y) - 6); }
+    const failed = failedBy(d.name, S.clock);
+    if (failed) { g.strokeStyle = '#d50000'; g.lineWidth = 2; g.beginPath(); g.arc(X(p.x), Y(p.y), 9, 0, 2 * Math.PI);
+                  g.stroke(); g.lineWidth = 1; }
+    if (!many) {
+      g.fillStyle = failed ? '#d50000' : '#222'; g.font = (failed ? 'bold ' : '') + '11px sans-serif';
+      g.fillText(d.name + (failed ? ' ✗ failed' : ''), X(p.x) + 11, Y(p.y) - 8);
+    }
   }
   drawViolations(g, X, Y, many);
+  drawFailures(g, X, Y);
   renderSide(B);
   const hasTelemetry = D.telemetry.size > 0;
   $('map-note').textContent = hasTelemetry ? '' : (D.drones.some(d => d.home) ?
     'this trace has no telemetry: homes only' : 'this trace has no telemetry and names no homes');
+}
+
+// The failed action of `drone`, once the clock has passed it; null otherwise.
+function failedBy(drone, t) {
+  for (const f of D.failMarks) if (f.drone === drone && f.t <= t + 1e-9) return f;
+  return null;
+}
+
+// A red cross where each failed action's drone was when it failed.
+function drawFailures(g, X, Y) {
+  g.strokeStyle = '#d50000'; g.lineWidth = 2.5;
+  for (const f of D.failMarks) {
+    const d = D.drones[D.droneIndex.get(f.drone)];
+    const p = d && f.t <= S.clock + 1e-9 ? positionAt(d, f.t) : null;
+    if (!p) continue;
+    const x = X(p.x), y = Y(p.y);
+    g.beginPath(); g.moveTo(x - 6, y - 6); g.lineTo(x + 6, y + 6); g.moveTo(x + 6, y - 6); g.lineTo(x - 6, y + 6); g.stroke();
+  }
+  g.lineWidth = 1;
 }
 
 // Violations that have happened by now: a red ring where the drone was.
@@ -690,7 +905,11 @@ function renderDroneList() {
     const li = list.children[i];
     const p = positionAt(d, S.clock), act = currentAction(d.name);
     li.dataset.action = act ? act.name : '';
-    let text = d.name + '  ' + (act ? act.text || act.name : '—');
+    const failed = failedBy(d.name, S.clock);
+    flag(li, 'failed', !!failed);
+    li.dataset.failed = failed ? failed.name : '';
+    let text = d.name + '  ' + (failed ? '✗ ' + failed.text + ' failed: ' + failed.reason + '  ' : '') +
+               (act ? act.text || act.name : failed ? '' : '—');
     if (p) {
       li.dataset.x = p.x.toFixed(2); li.dataset.y = p.y.toFixed(2); li.dataset.z = p.z.toFixed(2);
       text += `  (${p.x.toFixed(1)}, ${p.y.toFixed(1)}, ${p.z.toFixed(1)})`;
@@ -755,12 +974,104 @@ function showGraph(index) {
     node.dataset.node = String(id);
     if (holder) node.dataset.holder = holder;
     node.addEventListener('click', () => {
+      if (G.dragged) return;  // the end of a pan, not a click on the node
       const n = D.nodes.get(id);
       select({ nodes: [id], line: n ? n.line : 0, drone: n ? n.drone : '', text: n ? n.label : '' });
     });
   }
   box.appendChild(svg);
+  initGraphView(svg);
   S.dirty = true;
+}
+
+// ---- the graph's zoom and pan: the SVG's viewBox, kept at the panel's aspect ----
+
+const G = { svg: null, base: null, view: null, drag: null, dragged: false };
+
+function graphBox() {
+  const box = $('graph');
+  return { w: box.clientWidth || 600, h: box.clientHeight || 560 };
+}
+
+// Graphviz gives the picture's viewBox (in points). The first view fits its width, from the
+// top (a MEG is read from its start), or the whole picture when that is shorter than the
+// panel; but never smaller than GRAPH_READABLE pixels a point, where its labels can be read:
+// a wide graph opens on its top middle, and "fit" shows it whole.
+const GRAPH_READABLE = 0.75;
+function initGraphView(svg) {
+  const vb = svg.viewBox && svg.viewBox.baseVal;
+  G.svg = svg;
+  G.base = vb && vb.width > 0 ? { x: vb.x, y: vb.y, w: vb.width, h: vb.height } : null;
+  svg.setAttribute('preserveAspectRatio', 'xMidYMid meet');
+  if (!G.base) return;
+  const { w, h } = graphBox(), b = G.base;
+  const viewW = Math.min(b.w, w / GRAPH_READABLE);
+  if (viewW === b.w && b.w * h / w >= b.h) fitGraph();
+  else setGraphView({ x: b.x + (b.w - viewW) / 2, y: b.y, w: viewW });
+}
+
+function setGraphView(v) {
+  const { w, h } = graphBox();
+  v.h = v.w * h / w;  // the panel's aspect: a pixel is as wide as it is high, and pans map 1:1
+  G.view = v;
+  G.svg.setAttribute('viewBox', `${v.x} ${v.y} ${v.w} ${v.h}`);
+  $('graph').dataset.zoom = (G.base.w / v.w).toFixed(3);
+}
+
+function fitGraph() {
+  if (!G.base) return;
+  const { w, h } = graphBox(), b = G.base;
+  const vw = Math.max(b.w, b.h * w / h), vh = vw * h / w;
+  setGraphView({ x: b.x - (vw - b.w) / 2, y: b.y - (vh - b.h) / 2, w: vw });
+}
+
+// Zooms by `factor` (>1: closer) keeping the point at (fx, fy), fractions of the panel, still.
+function zoomGraph(factor, fx = 0.5, fy = 0.5) {
+  if (!G.view) return;
+  const v = G.view, span = Math.max(G.base.w, G.base.h);
+  const w = Math.min(span * 4, Math.max(span / 40, v.w / factor));
+  setGraphView({ x: v.x + fx * v.w - fx * w, y: v.y + fy * v.h - fy * (w * v.h / v.w), w });
+}
+
+// Pans the selected node to the middle of the panel when it is not in view.
+function bringIntoView(node) {
+  if (!G.view) return;
+  const box = $('graph').getBoundingClientRect(), r = node.getBoundingClientRect();
+  if (r.left >= box.left && r.right <= box.right && r.top >= box.top && r.bottom <= box.bottom) return;
+  const scale = G.view.w / box.width;
+  const dx = (r.left + r.width / 2 - (box.left + box.width / 2)) * scale;
+  const dy = (r.top + r.height / 2 - (box.top + box.height / 2)) * scale;
+  setGraphView({ x: G.view.x + dx, y: G.view.y + dy, w: G.view.w });
+}
+
+function wireGraphView() {
+  const box = $('graph');
+  $('zoom-in').onclick = () => zoomGraph(1.5);
+  $('zoom-out').onclick = () => zoomGraph(1 / 1.5);
+  $('zoom-fit').onclick = () => fitGraph();
+  box.addEventListener('wheel', e => {
+    if (!G.view) return;
+    e.preventDefault();
+    const r = box.getBoundingClientRect();
+    zoomGraph(Math.pow(1.0015, -e.deltaY), (e.clientX - r.left) / r.width, (e.clientY - r.top) / r.height);
+  }, { passive: false });
+  box.addEventListener('pointerdown', e => {
+    if (!G.view || e.button !== 0) return;
+    G.drag = { x: e.clientX, y: e.clientY, view: { ...G.view }, id: e.pointerId };
+    G.dragged = false;
+  });
+  box.addEventListener('pointermove', e => {
+    const d = G.drag;
+    if (!d || e.pointerId !== d.id) return;
+    const dx = e.clientX - d.x, dy = e.clientY - d.y;
+    if (!G.dragged && Math.hypot(dx, dy) < 4) return;
+    if (!G.dragged) { G.dragged = true; box.setPointerCapture(e.pointerId); box.classList.add('panning'); }
+    const scale = d.view.w / box.getBoundingClientRect().width;
+    setGraphView({ x: d.view.x - dx * scale, y: d.view.y - dy * scale, w: d.view.w });
+  });
+  const end = () => { G.drag = null; box.classList.remove('panning'); setTimeout(() => { G.dragged = false; }, 0); };
+  box.addEventListener('pointerup', end);
+  box.addEventListener('pointercancel', end);
 }
 
 function stateAt(id) {
@@ -820,13 +1131,29 @@ function select(what) {
     row.classList.toggle('selected', on);
     if (on) lineRow = row;
   }
-  if (lineRow) lineRow.scrollIntoView({ block: 'center' });
+  if (lineRow) lineRow.scrollIntoView({ block: 'nearest' });
   const g = $('graph').querySelector('g.node.selected');
-  if (g) g.scrollIntoView({ block: 'center', inline: 'center' });
-  $('selection').textContent = (what.text || '') + (what.line ? '  — line ' + what.line : '') +
-                               (nodes.size ? '  — MEG node ' + [...nodes].join(', ') : '');
-  $('selection').dataset.line = String(what.line || '');
-  $('selection').dataset.node = [...nodes].join(' ');
+  if (g) bringIntoView(g);
+  const sel = $('selection');
+  sel.textContent = selectionText(what, nodes);
+  sel.dataset.line = String(what.line || '');
+  sel.dataset.node = [...nodes].join(' ');
+  sel.dataset.outcome = what.outcome || '';
+  sel.dataset.reason = what.reason || '';
+}
+
+// "Drone2.FlyByX(40) — failed: timed out after 2.0 s — 1.65 s to 3.65 s — line 8 — MEG node 9"
+function selectionText(what, nodes) {
+  const parts = [];
+  if (what.prefix) parts.push(what.prefix + ':');
+  parts.push(what.text || '');
+  if (what.outcome) parts.push('— ' + what.outcome + (what.reason ? ': ' + what.reason : ''));
+  if (typeof what.t === 'number')
+    parts.push('— ' + (typeof what.end === 'number' ? `${what.t.toFixed(2)} s to ${what.end.toFixed(2)} s`
+                                                     : `at ${what.t.toFixed(2)} s`));
+  if (what.line) parts.push('— line ' + what.line);
+  if (nodes.size) parts.push('— MEG node ' + [...nodes].join(', '));
+  return parts.join(' ');
 }
 
 // ---- the connection ----
@@ -898,13 +1225,13 @@ function wireControls() {
   $('speed').onchange = e => { S.speed = Number(e.target.value) || 1; };
   $('scrub').oninput = e => { S.follow = false; $('follow').checked = false; setClock(Number(e.target.value)); };
   $('next-event').onclick = () => { const t = nextEventTime(S.clock); if (t !== null) { S.follow = false; $('follow').checked = false; setClock(t); } };
-  $('next-failure').onclick = () => {
-    const t = D.failures.filter(f => f > S.clock + 1e-6).sort((a, b) => a - b)[0];
-    if (t !== undefined) { S.follow = false; $('follow').checked = false; S.playing = false; setClock(t); }
-  };
+  $('next-failure').onclick = () => jumpToFailure(1);
+  $('prev-failure').onclick = () => jumpToFailure(-1);
+  $('banner-show').onclick = () => { if (S.bannerFailure) showFailure(S.bannerFailure, 'the failure'); };
+  wireGraphView();
   $('follow').onchange = e => { S.follow = e.target.checked; S.dirty = true; };
   // A control's effect shows at once, not at the next animation frame.
-  for (const id of ['play', 'pause', 'scrub', 'next-event', 'next-failure', 'follow'])
+  for (const id of ['play', 'pause', 'scrub', 'next-event', 'next-failure', 'prev-failure', 'banner-show', 'follow'])
     $(id).addEventListener(id === 'scrub' ? 'input' : 'click', () => render());
   $('graph-select').onchange = e => showGraph(Number(e.target.value));
   window.addEventListener('resize', () => { S.dirty = true; });
@@ -923,6 +1250,8 @@ window.eamosMonitor = {
   liveLatency: () => latencyStats(S.latencies),
   arrivalLatency: () => latencyStats(S.arrivals),
   serverLatency: () => latencyStats(S.serverDelays),
+  // The drones marked failed on the map and in their lanes at the clock.
+  failedDrones: () => D.drones.filter(d => failedBy(d.name, S.clock)).map(d => d.name),
   triggers: () => (D.triggerList || []).map(t => ({ from: t.from, to: t.to, sent: t.sent, received: t.received, wait: t.received - t.waitFrom })),
 };
 

@@ -1,6 +1,6 @@
 // Drives Debian's chromium headless against a running `eamos monitor` / `eamos run --monitor`
 // and checks what the page shows, through its DOM. Called by tests/monitor/browser_test.cpp:
-//   node monitor_check.js replay|live|live20|launch|v1|scale|violation URL SCREENSHOT_DIR CHROMIUM
+//   node monitor_check.js replay|live|live20|launch|v1|scale|violation|failed|waits URL SCREENSHOT_DIR CHROMIUM
 // Prints "ok: ..." lines and exits 0, or prints "FAIL: what" and exits 1.
 'use strict';
 const fs = require('fs');
@@ -99,6 +99,8 @@ async function replay(browser) {
   check(s.drones.length === 3, 'the map lists three drones');
   await page.screenshot({ path: path.join(shots, 'replay-listing2-t5.png'), fullPage: true });
 
+  await graphZoomAndPan(page);
+
   // Selecting Drone1's Land in its lane selects its node and its source line.
   await page.click('.bar[data-drone="Drone1"][data-name="Land"]');
   const sel = await page.evaluate(() => ({
@@ -116,6 +118,42 @@ async function replay(browser) {
   await page.waitForFunction(() => Number(document.getElementById('clock').dataset.t) > 6, { timeout: 10000, polling: 100 });
   check(true, 'play advances the clock');
   await page.close();
+}
+
+// The graph panel: the buttons and the wheel zoom around a point, a drag pans, "fit" shows it whole.
+async function graphZoomAndPan(page) {
+  const view = () => page.evaluate(() => {
+    const [x, y, w, h] = document.getElementById('graph-svg').getAttribute('viewBox').split(/\s+/).map(Number);
+    return { x, y, w, h };
+  });
+  const v0 = await view();
+  await page.click('#zoom-in');
+  const v1 = await view();
+  check(Math.abs(v1.w - v0.w / 1.5) < 0.01 * v0.w, `"+" zooms in 1.5× (${v0.w.toFixed(0)} → ${v1.w.toFixed(0)} wide)`);
+  const box = await page.evaluate(() => { const r = document.getElementById('graph').getBoundingClientRect();
+                                          return { x: r.left, y: r.top, w: r.width, h: r.height }; });
+  await page.mouse.move(box.x + box.w / 2, box.y + box.h / 2);
+  await page.mouse.wheel({ deltaY: -400 });
+  await page.waitForFunction(w => Number(document.getElementById('graph-svg').getAttribute('viewBox').split(/\s+/)[2]) < w,
+                             { timeout: 5000, polling: 50 }, v1.w);
+  const v2 = await view();
+  check(v2.w < v1.w, `the wheel zooms in further (${v1.w.toFixed(0)} → ${v2.w.toFixed(0)} wide)`);
+  await page.mouse.down();
+  for (let i = 1; i <= 5; i++) await page.mouse.move(box.x + box.w / 2 - 20 * i, box.y + box.h / 2 - 10 * i);
+  await page.mouse.up();
+  const v3 = await view();
+  const scale = v2.w / box.w;
+  check(Math.abs(v3.x - v2.x - 100 * scale) < 2 * scale && Math.abs(v3.y - v2.y - 50 * scale) < 2 * scale,
+        `a drag of 100 × 50 px pans the view with the pointer (x ${v2.x.toFixed(1)} → ${v3.x.toFixed(1)})`);
+  await page.click('#zoom-fit');
+  const fitted = await page.evaluate(() => {
+    const box = document.getElementById('graph').getBoundingClientRect();
+    const nodes = [...document.querySelectorAll('#graph g.node')].map(g => g.getBoundingClientRect());
+    return { count: nodes.length, inside: nodes.every(r => r.left >= box.left - 1 && r.right <= box.right + 1 &&
+                                                            r.top >= box.top - 1 && r.bottom <= box.bottom + 1) };
+  });
+  check(fitted.count > 20 && fitted.inside, `"fit" shows all ${fitted.count} nodes in the panel`);
+  await page.screenshot({ path: path.join(shots, 'replay-listing2-graph-fit.png') });
 }
 
 // A schema v1 trace: the mission comes from its header, positions from its telemetry, the
@@ -158,6 +196,22 @@ async function violation(browser) {
   await page.click('#next-failure');
   const clock = await page.evaluate(() => Number(document.getElementById('clock').dataset.t));
   check(Math.abs(clock - 3.75) < 1e-6, '"next failure" stops at the violation: ' + clock);
+  // It says what it is: a verification with one violation, not a green "mission completed".
+  const head = await page.evaluate(() => ({
+    mode: document.getElementById('mode').dataset.mode, modeText: document.getElementById('mode').textContent,
+    outcome: document.getElementById('outcome').dataset.outcome, outcomeText: document.getElementById('outcome').textContent,
+    banner: document.getElementById('banner').hidden ? '' : document.getElementById('banner-text').textContent,
+    note: document.getElementById('map-note').textContent,
+    d1: (() => { const li = document.querySelector('#drone-list li[data-drone="Drone1"]');
+                 return li ? { x: Number(li.dataset.x), y: Number(li.dataset.y), z: Number(li.dataset.z) } : null; })() }));
+  check(head.mode === 'verify' && head.modeText.includes('verify'), 'the header says it is a verify run: ' + head.modeText);
+  check(head.outcome === 'violations' && head.outcomeText === '1 violation', 'and that it found 1 violation: ' + head.outcomeText);
+  check(!head.outcomeText.includes('completed'), 'no "mission completed"');
+  check(head.banner.includes('Verification run (path 1 of 1 flown): 1 violation') && head.banner.includes('separation at 3.75 s'),
+        'the banner names the path and the first violation: ' + head.banner);
+  check(head.note === '', 'the map has positions: "' + head.note + '"');
+  check(head.d1 && head.d1.y > 2 && head.d1.y < 8 && Math.abs(head.d1.z - 5) < 0.2,
+        'at 3.75 s Drone1 is on its way at 5 m, not at its home: ' + JSON.stringify(head.d1));
   await page.screenshot({ path: path.join(shots, 'replay-verify-separation.png'), fullPage: true });
 }
 
@@ -250,6 +304,94 @@ async function launchLive(browser) {
   await page.screenshot({ path: path.join(shots, 'launch-listing2-end.png'), fullPage: true });
 }
 
+// A live run whose action fails (tests/monitor/missions/timeout.eamos): the banner with drone,
+// action, line and reason; "● live" gone once the outcome is in; the failed drone marked; each
+// bar's outcome and reason on a click; next / previous failure past either end.
+async function failedLive(browser) {
+  const page = await open(browser, '');
+  await page.waitForFunction(() => document.querySelectorAll('.lane').length === 2, { timeout: 30000, polling: 50 });
+  const first = await page.evaluate(snapshot);
+  if (first.outcome === '') check(first.mode === 'live', 'before its outcome the run is live: ' + first.mode);
+  await page.waitForFunction(() => document.getElementById('outcome').dataset.outcome === 'failed',
+                             { timeout: 30000, polling: 50 });
+  const atEnd = await page.evaluate(() => ({ mode: document.getElementById('mode').dataset.mode,
+    text: document.getElementById('mode').textContent, finished: document.body.dataset.finished === 'true' }));
+  check(atEnd.mode === 'ended' && !atEnd.text.includes('live ●') && atEnd.text !== '● live',
+        `once the run failed the page no longer says live: "${atEnd.text}"` +
+        (atEnd.finished ? '' : ' (while the drones still land)'));
+  const banner = await page.evaluate(() => { const b = document.getElementById('banner');
+    return { hidden: b.hidden, text: document.getElementById('banner-text').textContent, ...b.dataset }; });
+  check(!banner.hidden && banner.drone === 'Drone2' && banner.action === 'FlyByX' && banner.line === '11' &&
+        banner.reason === 'timed out after 2.0 s', 'the banner: ' + banner.text);
+  check(banner.text.startsWith('Mission failed at 3.65 s: Drone2 · Drone2.FlyByX(40) · line 11 · timed out after 2.0 s'),
+        'it reads: ' + banner.text);
+  await page.waitForFunction(() => document.body.dataset.finished === 'true', { timeout: 60000, polling: 100 });
+  await page.evaluate(() => window.eamosMonitor.setClock(1e9));
+  const marks = await page.evaluate(() => ({
+    lanes: [...document.querySelectorAll('.lane.failed')].map(l => l.dataset.drone),
+    fail: [...document.querySelectorAll('.fail-mark')].map(m => m.dataset.drone + ':' + m.dataset.reason),
+    list: [...document.querySelectorAll('#drone-list li.failed')].map(li => li.dataset.drone),
+    map: window.eamosMonitor.failedDrones(), mode: document.getElementById('mode').dataset.mode }));
+  check(JSON.stringify(marks.lanes) === '["Drone2"]' && JSON.stringify(marks.fail) === '["Drone2:timed out after 2.0 s"]',
+        'Drone2\'s lane is marked failed, with a ✗ at the failure: ' + JSON.stringify(marks));
+  check(JSON.stringify(marks.list) === '["Drone2"]' && JSON.stringify(marks.map) === '["Drone2"]',
+        'and so are its line under the map and its place on the map');
+  check(marks.mode === 'ended', 'after the end the page says the live run ended: ' + marks.mode);
+  const clickBar = async (drone, name) => {
+    await page.click(`.bar[data-drone="${drone}"][data-name="${name}"]`);
+    return page.evaluate(() => ({ ...document.getElementById('selection').dataset,
+                                  text: document.getElementById('selection').textContent }));
+  };
+  let sel = await clickBar('Drone2', 'FlyByX');
+  check(sel.outcome === 'failed' && sel.reason === 'timed out after 2.0 s' && sel.text.includes('1.65 s to 3.65 s'),
+        'a click on the red bar: ' + sel.text);
+  sel = await clickBar('Drone1', 'FlyByX');
+  check(sel.outcome === 'cancelled' && sel.reason === 'cancelled', 'on Drone1\'s FlyByX: ' + sel.text);
+  sel = await clickBar('Drone1', 'Takeoff');
+  check(sel.outcome === 'succeeded' && sel.reason === '', 'on a green bar: ' + sel.text);
+  const jump = async (button, from) => {
+    await page.evaluate(t => window.eamosMonitor.setClock(t), from);
+    await page.click(button);
+    return page.evaluate(() => ({ t: Number(document.getElementById('clock').dataset.t),
+      text: document.getElementById('selection').textContent, ...document.getElementById('selection').dataset }));
+  };
+  let j = await jump('#next-failure', 0);
+  check(Math.abs(j.t - 3.65) < 1e-6 && j.text.startsWith('failure 1 of 1:') && j.outcome === 'failed' &&
+        j.reason === 'timed out after 2.0 s', 'next failure from 0 s: ' + j.text);
+  j = await jump('#next-failure', 5);
+  check(Math.abs(j.t - 3.65) < 1e-6 && j.text.includes('back to the first'), 'next failure after the last: ' + j.text);
+  j = await jump('#prev-failure', 0);
+  check(Math.abs(j.t - 3.65) < 1e-6 && j.text.includes('back to the last'), 'previous failure before the first: ' + j.text);
+  j = await jump('#prev-failure', 8);
+  check(Math.abs(j.t - 3.65) < 1e-6 && j.text.startsWith('failure 1 of 1:'), 'previous failure from the end: ' + j.text);
+  await page.evaluate(() => window.eamosMonitor.setClock(5));
+  await page.screenshot({ path: path.join(shots, 'live-failed-run.png'), fullPage: true });
+}
+
+// Four drones at the end of each PAR wait for the slowest: one span per pause, and the labels
+// neither overlap nor overflow their spans (tests/monitor/missions/par4.eamos).
+async function waits(browser) {
+  const page = await open(browser, '?t=9.2');
+  await page.waitForSelector('body[data-finished="true"]', { timeout: 15000, polling: 100 });
+  const r = await page.evaluate(() => [...document.querySelectorAll('.lane')].map(lane => ({
+    drone: lane.dataset.drone,
+    spans: [...lane.querySelectorAll('.wait')].map(w => { const b = w.getBoundingClientRect();
+      return { left: b.left, right: b.right, text: w.textContent, on: w.dataset.on, fits: w.scrollWidth <= w.clientWidth + 1 }; }) })));
+  let labels = 0;
+  for (const lane of r) {
+    const spans = lane.spans.sort((a, b) => a.left - b.left);
+    labels += spans.filter(s => s.text).length;
+    const overlap = spans.some((s, i) => i > 0 && s.left < spans[i - 1].right - 0.5);
+    check(!overlap, `${lane.drone}: ${spans.length} wait spans, none over another`);
+    check(spans.every(s => s.fits), `${lane.drone}: every label fits its span (${spans.map(s => s.text || '·').join(' | ')})`);
+  }
+  check(labels >= 4, `${labels} spans are labelled`);
+  const d1 = r.find(l => l.drone === 'D1');
+  check(d1 && d1.spans.length >= 2 && d1.spans.every(s => s.on === 'D4'), 'D1 waits on D4, the slowest, each time: ' +
+        JSON.stringify(d1 && d1.spans.map(s => s.on)));
+  await page.screenshot({ path: path.join(shots, 'replay-par4-waits.png'), fullPage: true });
+}
+
 (async () => {
   fs.mkdirSync(shots, { recursive: true });
   const { browser, profile } = await launch();
@@ -261,6 +403,8 @@ async function launchLive(browser) {
     else if (mode === 'v1') await v1(browser);
     else if (mode === 'scale') await scale(browser);
     else if (mode === 'violation') await violation(browser);
+    else if (mode === 'failed') await failedLive(browser);
+    else if (mode === 'waits') await waits(browser);
     else failures.push('unknown mode ' + mode);
   } finally {
     await browser.close();
