@@ -22,8 +22,8 @@ demo: build
 
 # The real-time tests (SITL firmware, DDS processes, the browser) run at normal priority;
 # beside them, at low priority, the fuzzers (built, then 5 s per target: a smoke run; `make
-# fuzz` runs 120 s each) and every other test (scripts/test.sh). A failed test runs once
-# more; one that fails twice fails the run, and the first failure stays in the log.
+# fuzz` runs 120 s each) and every other test (scripts/test.sh). A failed real-time test
+# runs once more (one that fails twice fails the run); any other test fails the run at once.
 test: build
 	@bash scripts/test.sh $(BUILD) $(BUILD)-fuzz 5
 
