@@ -4,7 +4,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build demo test bench fuzz clean
+.PHONY: all deps build demo test sanitize bench fuzz clean
 
 all: build
 
@@ -27,6 +27,12 @@ demo: build
 test: build
 	@bash scripts/test.sh $(BUILD) $(BUILD)-fuzz 5
 
+# The suites under AddressSanitizer + UBSan and under ThreadSanitizer, each sanitizer in a
+# build tree of its own ($(BUILD)-asan, $(BUILD)-tsan; scripts/sanitize.sh). .ci/run runs it
+# after `make test`.
+sanitize: deps
+	@bash scripts/sanitize.sh all $(BUILD)
+
 bench: build
 	@bash scripts/bench.sh $(BUILD)
 
@@ -34,4 +40,4 @@ fuzz: deps
 	@bash scripts/fuzz.sh $(BUILD)-fuzz 120
 
 clean:
-	rm -rf $(BUILD) $(BUILD)-fuzz out
+	rm -rf $(BUILD) $(BUILD)-fuzz $(BUILD)-asan $(BUILD)-tsan out
