@@ -4,7 +4,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build demo test bench fuzz clean
+.PHONY: all deps build demo test sanitize bench fuzz clean
 
 all: build
 
@@ -27,10 +27,16 @@ demo:
 
 # The real-time tests (SITL firmware, DDS processes, the browser) run at normal priority;
 # beside them, at low priority, the fuzzers (built, then 5 s per target: a smoke run; `make
-# fuzz` runs 120 s each) and every other test (scripts/test.sh). A failed test runs once
-# more; one that fails twice fails the run, and the first failure stays in the log.
+# fuzz` runs 120 s each) and every other test (scripts/test.sh). A failed real-time test
+# runs once more (one that fails twice fails the run); any other test fails the run at once.
 test: build
 	@bash scripts/test.sh $(BUILD) $(BUILD)-fuzz 5
+
+# The suites under AddressSanitizer + UBSan and under ThreadSanitizer, each sanitizer in a
+# build tree of its own ($(BUILD)-asan, $(BUILD)-tsan; scripts/sanitize.sh). .ci/run runs it
+# after `make test`.
+sanitize: deps
+	@bash scripts/sanitize.sh all $(BUILD)
 
 bench: build
 	@bash scripts/bench.sh $(BUILD)
@@ -39,4 +45,4 @@ fuzz: deps
 	@bash scripts/fuzz.sh $(BUILD)-fuzz 120
 
 clean:
-	rm -rf $(BUILD) $(BUILD)-fuzz out
+	rm -rf $(BUILD) $(BUILD)-fuzz $(BUILD)-asan $(BUILD)-tsan out

@@ -266,11 +266,14 @@ void FleetParser::signing(const YAML::Node& node, const std::string& where, Dron
   }
   std::set<std::string> seen;
   std::string key, file;
-  const YAML::Node* at = &node;
+  // The key's value node, for the error's place. A copy, not a pointer: the map's iterator
+  // yields each pair as a temporary that is gone after its round. Not assigned with `=`, which
+  // would write into the document: a YAML::Node is a handle.
+  std::optional<YAML::Node> value;
   for (const auto& kv : node) {
     std::string field = r_.field(kv.first, kSigningKeys, seen, what);
-    if (field == "key" && r_.text(kv.second, "key of " + what, key)) at = &kv.second;
-    if (field == "key_file" && r_.text(kv.second, "key_file of " + what, file)) at = &kv.second;
+    if (field == "key" && r_.text(kv.second, "key of " + what, key)) value.emplace(kv.second);
+    if (field == "key_file" && r_.text(kv.second, "key_file of " + what, file)) value.emplace(kv.second);
     if (field == "setup" && !kv.second.IsScalar())
       r_.error(kv.second, "setup of " + what + " must be true or false; got " + describe(kv.second));
     else if (field == "setup" && !YAML::convert<bool>::decode(kv.second, settings.signing_setup))
@@ -284,9 +287,9 @@ void FleetParser::signing(const YAML::Node& node, const std::string& where, Dron
     // Relative to the fleet file, like every path a fleet file names.
     std::filesystem::path p(file);
     if (p.is_relative() && r_.file && !r_.file->path.empty()) p = std::filesystem::path(r_.file->path).parent_path() / p;
-    if (std::string why = read_signing_key_file(p.string(), key); !why.empty()) return r_.error(*at, why);
+    if (std::string why = read_signing_key_file(p.string(), key); !why.empty()) return r_.error(value.value_or(node), why);
   } else if (std::string why = signing_key_problem(key); !why.empty()) {
-    return r_.error(*at, "key of " + what + ": " + why);
+    return r_.error(value.value_or(node), "key of " + what + ": " + why);
   }
   settings.signing_key = key;
 }

@@ -56,6 +56,7 @@ TEST(Signing, AKeyFileOthersMayReadIsRefusedWithTheFix) {
   EXPECT_FALSE(p.ok);
   Diagnostic e = first_error(p.diags);
   EXPECT_EQ(e.loc.line, 3);
+  EXPECT_EQ(e.loc.col, 25) << "at the key_file's value";
   EXPECT_TRUE(contains(e.message, "may be read or written by others (mode 0644)")) << e.message;
   EXPECT_TRUE(contains(e.message, "chmod 600")) << e.message;
 }

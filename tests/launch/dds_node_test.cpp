@@ -15,6 +15,9 @@
 namespace eamos::transport {
 namespace {
 
+// Filled by the handlers on Cyclone's listener threads. Its mutex is never held while a node
+// goes away: deleting a node waits for its listeners, which may be waiting for this mutex
+// while Cyclone holds the reader's own lock (a deadlock ThreadSanitizer reported).
 struct Received {
   std::mutex mutex;
   std::condition_variable cv;
@@ -74,8 +77,10 @@ TEST(DdsNode, LateReaderGetsEveryTriggerWrittenBeforeItJoined) {
   auto reader = DdsNode::open(options, record_into(got), error);
   ASSERT_TRUE(reader) << error;
   ASSERT_TRUE(got.wait([&] { return got.triggers.size() >= 500; })) << got.triggers.size();
-  std::lock_guard<std::mutex> lock(got.mutex);
-  for (int i = 0; i < 500; ++i) EXPECT_EQ(got.triggers[i].seq, static_cast<std::uint64_t>(i + 1));
+  {
+    std::lock_guard<std::mutex> lock(got.mutex);
+    for (int i = 0; i < 500; ++i) EXPECT_EQ(got.triggers[i].seq, static_cast<std::uint64_t>(i + 1));
+  }
   reader.reset();
   writer.reset();
 }
@@ -99,9 +104,11 @@ TEST(DdsNode, LateReaderGetsOnlyTheNewestTelemetryPerDrone) {
   auto reader = DdsNode::open(options, record_into(got), error);
   ASSERT_TRUE(reader) << error;
   ASSERT_TRUE(got.wait([&] { return got.telemetry.size() >= 2; }));
-  std::lock_guard<std::mutex> lock(got.mutex);
-  ASSERT_EQ(got.telemetry.size(), 2u);
-  for (const TelemetrySample& s : got.telemetry) EXPECT_EQ(s.telemetry.state.x, 10);
+  {
+    std::lock_guard<std::mutex> lock(got.mutex);
+    ASSERT_EQ(got.telemetry.size(), 2u);
+    for (const TelemetrySample& s : got.telemetry) EXPECT_EQ(s.telemetry.state.x, 10);
+  }
   reader.reset();
   writer.reset();
 }
@@ -124,8 +131,10 @@ TEST(DdsNode, ReportsWhoseStatusWriterWentAway) {
   ASSERT_TRUE(watcher.wait([&] { return !watcher.status.empty(); }));
   drone.reset();  // the process goes away
   ASSERT_TRUE(watcher.wait([&] { return !watcher.lost.empty(); }));
-  std::lock_guard<std::mutex> lock(watcher.mutex);
-  EXPECT_EQ(watcher.lost.front(), std::make_tuple(std::string("h"), 2, std::uint64_t{99}));
+  {
+    std::lock_guard<std::mutex> lock(watcher.mutex);
+    EXPECT_EQ(watcher.lost.front(), std::make_tuple(std::string("h"), 2, std::uint64_t{99}));
+  }
   observer.reset();
 }
 
@@ -157,9 +166,11 @@ TEST(DdsNode, HandlerThatThrowsLosesOnlyItsSample) {
   auto reader = DdsNode::open(options, std::move(h), error);
   ASSERT_TRUE(reader) << error;
   ASSERT_TRUE(got.wait([&] { return got.triggers.size() >= 2; })) << got.triggers.size();
-  std::lock_guard<std::mutex> lock(got.mutex);
-  EXPECT_EQ(got.triggers[0].seq, 1u);
-  EXPECT_EQ(got.triggers[1].seq, 3u);
+  {
+    std::lock_guard<std::mutex> lock(got.mutex);
+    EXPECT_EQ(got.triggers[0].seq, 1u);
+    EXPECT_EQ(got.triggers[1].seq, 3u);
+  }
   reader.reset();
   writer.reset();
 }
@@ -210,11 +221,13 @@ TEST(DdsNode, DropsAndLogsASampleFromADroneOutsideTheFleetAndDeliversTheNext) {
   good.message.from = 0;
   ASSERT_TRUE(writer->write(good));
   ASSERT_TRUE(got.wait([&] { return !got.triggers.empty(); }));
-  std::lock_guard<std::mutex> lock(got.mutex);
-  ASSERT_EQ(got.triggers.size(), 1u);
-  EXPECT_EQ(got.triggers[0].seq, 2u);
-  ASSERT_EQ(dropped.size(), 1u);
-  EXPECT_EQ(dropped[0], "dropped a trigger sample: from 99 is not a drone of the mission (2 drones) (1 dropped so far)");
+  {
+    std::lock_guard<std::mutex> lock(got.mutex);
+    ASSERT_EQ(got.triggers.size(), 1u);
+    EXPECT_EQ(got.triggers[0].seq, 2u);
+    ASSERT_EQ(dropped.size(), 1u);
+    EXPECT_EQ(dropped[0], "dropped a trigger sample: from 99 is not a drone of the mission (2 drones) (1 dropped so far)");
+  }
   EXPECT_EQ(reader->dropped_count(), 1u);
   reader.reset();
   writer.reset();
@@ -253,7 +266,6 @@ TEST(DdsNode, DropsASampleWhoseSenderIsNotTheDroneWhosePartitionItsWriterIsIn) {
   ASSERT_TRUE(drone1->write(own));
   ASSERT_TRUE(got.wait([&] { return !got.status.empty(); }));
   {
-    // Not held while the nodes go: their listeners (liveliness lost) take it too.
     std::lock_guard<std::mutex> lock(got.mutex);
     ASSERT_EQ(got.status.size(), 1u);
     EXPECT_EQ(got.status[0].drone, 0);

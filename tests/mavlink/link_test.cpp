@@ -159,7 +159,7 @@ TEST(UdpLink, ListenerBeforeTheVehicleIsKnownFollowsTheLastValidFrameOfAnySystem
 TEST(UdpLink, HandlerThatThrowsLosesOnlyThatDatagram) {
   Mailbox got;
   int calls = 0;
-  FrameHandler throwing_once = [&got, &calls, inner = got.handler()](Frame f) {
+  FrameHandler throwing_once = [&calls, inner = got.handler()](Frame f) {
     if (++calls == 1) throw std::runtime_error("bad frame");
     inner(std::move(f));
   };

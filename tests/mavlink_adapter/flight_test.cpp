@@ -79,8 +79,8 @@ TEST(MavlinkFlight, ArmTakeoffFlyAndLand) {
 TEST(MavlinkFlight, Px4TakesOffToTheAltitudeAboveTheGroundWhenItsHomeIsNotWhereItStands) {
   sim_vehicle::VehicleOptions o;
   o.home_above_origin_m = -0.5;
-  test::VehicleThread vehicle(25321, kSpeed, o);
-  Flight f(25321);
+  test::VehicleThread vehicle(25379, kSpeed, o);
+  Flight f(25379);
   ASSERT_TRUE(f.drone) << f.created.message;
   ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
   mid::ActionEnd e = f.fly("Takeoff", {3});

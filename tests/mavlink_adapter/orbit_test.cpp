@@ -217,8 +217,9 @@ TEST(MavlinkOrbit, Px4sHeartbeatIsAskedForWhileItOrbitsAndNotWhileItHovers) {
 TEST(MavlinkOrbit, ARefusedRadiusCorrectionIsNotedAndTheOrbitGoesOn) {
   sim_vehicle::VehicleOptions options = VehicleThread::options(sim_vehicle::px4_dialect(), 1, 100.0, true);
   options.orbit_shortfall = -0.2;  // flown 20 % wide
-  VehicleThread vehicle(25368, kSpeed, options);
-  Flight f(25368);
+  VehicleThread vehicle(25377, kSpeed, options);
+  Flight f(25377);
+  ASSERT_TRUE(f.drone) << f.created.message;
   std::vector<std::string> messages;
   f.drone->set_message_sink([&](const std::string& m) { messages.push_back(m); });
   Orbiting o;
@@ -290,8 +291,8 @@ TEST(MavlinkOrbit, ArduPilotOrbitIsStillFlownFromSetpointsInGuided) {
 // the east point they start on the circle asked for (a lead fixed from the start held the
 // vehicle 0.2 m out while it sped up, on SITL), and they widen as the vehicle speeds up.
 TEST(MavlinkOrbit, ArduPilotsSetpointsGoRoundFromTheRadiusAskedForAndWidenWithTheVehiclesSpeed) {
-  VehicleThread vehicle(25370, 1, kSpeed, sim_vehicle::ardupilot_dialect());
-  Flight f(25370);
+  VehicleThread vehicle(25378, 1, kSpeed, sim_vehicle::ardupilot_dialect());
+  Flight f(25378);
   Orbiting o;
   take_off_and_orbit(f, o, 0.0);
   std::optional<double> first_round, widest;
