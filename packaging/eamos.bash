@@ -47,15 +47,16 @@ _eamos_options() {
     done < <(_eamos_section "$1" Options)
 }
 
-# What option $2 of subcommand $1 takes: "flag", or its CLI11 type (TEXT:FILE, TEXT:DIR,
-# TEXT:{amt,meg,mdg}, UINT, TEXT, ...): the upper-case word after the names. CLI11 writes names
-# and type in a column 30 wide, the description after it (or on the next line).
+# What option $2 of subcommand $1 takes: "flag", or its type as the help writes it (TEXT:FILE,
+# TEXT:FOLDER, TEXT:amt|meg|mdg, UINT=200, INT:WHOLE, TEXT, ...): the upper-case word after the
+# names. A flag's names may be followed by "Excludes: ..." or "Needs: ...", which is no type.
+# CLI11 writes names and type in a column 30 wide, the description after it (or on the next line).
 _eamos_option_type() {
     local line left
     while IFS= read -r line; do
         left=$line
         [[ ${#line} -gt 30 && ${line:29:1} == " " && ${line:30:1} != " " ]] && left=${line:0:30}
-        [[ $left =~ ^\ \ ((-[A-Za-z],)?--[A-Za-z0-9-]+)(\ ([A-Z][^ ]*))? ]] || continue
+        [[ $left =~ ^\ \ ((-[A-Za-z],)?--[A-Za-z0-9-]+)(\ ([A-Z]+([:=][^ ]*)?)(\ |$))? ]] || continue
         [[ ",${BASH_REMATCH[1]}," == *",$2,"* ]] || continue
         printf '%s\n' "${BASH_REMATCH[4]:-flag}"
         return
@@ -71,9 +72,10 @@ _eamos_positional() {
     done < <(_eamos_section "$1" Positionals)
 }
 
-# Adds the completions of a value to COMPREPLY: $1 the option or positional name, $2 its type.
+# Adds the completions of a value to COMPREPLY: $1 the option or positional name, $2 its type
+# (a default after '=' dropped).
 _eamos_values() {
-    local name=$1 type=$2 cur=$3 ext=""
+    local name=$1 type=${2%%=*} cur=$3 ext=""
     case $name in
         mission) ext='*.eamos' ;;
         trace) ext='*.jsonl' ;;
@@ -81,9 +83,9 @@ _eamos_values() {
         --dds-config) ext='*.xml' ;;
     esac
     case $type in
-        *:{*}) local words=${type#*:\{}; words=${words%\}}
-               COMPREPLY+=($(compgen -W "${words//,/ }" -- "$cur")) ;;
-        *:DIR) compopt -o filenames 2>/dev/null
+        *:*\|*) local words=${type#*:}
+               COMPREPLY+=($(compgen -W "${words//|/ }" -- "$cur")) ;;
+        *:FOLDER) compopt -o filenames 2>/dev/null
                COMPREPLY+=($(compgen -d -- "$cur")) ;;
         TEXT|TEXT:FILE)
             compopt -o filenames 2>/dev/null
@@ -108,10 +110,7 @@ _eamos() {
         word=${COMP_WORDS[i]}
         if [[ $word != -* && $'\n'$subs$'\n' == *$'\n'$word$'\n'* ]]; then sub=$word; break; fi
     done
-    if [[ -z $sub ]]; then
-        COMPREPLY=($(compgen -W "$subs $(_eamos_options "")" -- "$cur"))
-        return 0
-    fi
+    # The value of an option, of eamos's own (--color) before the subcommand or of the subcommand's.
     if [[ $prev == -* ]]; then
         local type
         type=$(_eamos_option_type "$sub" "$prev")
@@ -119,6 +118,10 @@ _eamos() {
             _eamos_values "$prev" "$type" "$cur"
             return 0
         fi
+    fi
+    if [[ -z $sub ]]; then
+        COMPREPLY=($(compgen -W "$subs $(_eamos_options "")" -- "$cur"))
+        return 0
     fi
     if [[ $cur == -* ]]; then
         COMPREPLY=($(compgen -W "$(_eamos_options "$sub")" -- "$cur"))

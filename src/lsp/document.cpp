@@ -38,33 +38,72 @@ CheckResult update(Document& doc, std::string text, const std::string& fleet_pat
   doc.mission = std::move(c.mission);
 
   CheckResult r;
+  Published* last = nullptr;  // the diagnostic an attached note belongs to
   for (const Diagnostic& d : diags.items()) {
+    if (d.attached && last) {
+      last->notes.push_back(d);
+      continue;
+    }
     bool fleet_file = d.has_file && !fleet_path.empty() && d.path == fleet_path && d.path != doc.path;
-    (fleet_file ? r.fleet : r.mission).push_back(d);
+    std::vector<Published>& list = fleet_file ? r.fleet : r.mission;
+    list.push_back({d, {}});
+    last = &list.back();
   }
   if (diags.saturated()) {
     Diagnostic d;
     d.message = "stopped listing after " + std::to_string(diags.max_errors) +
                 " errors; fix these first, and the next ones show";
-    r.mission.push_back(d);
+    r.mission.push_back({d, {}});
   }
-  auto by_place = [](const Diagnostic& a, const Diagnostic& b) {
-    return std::make_pair(a.loc.line, a.loc.col) < std::make_pair(b.loc.line, b.loc.col);
+  auto by_place = [](const Published& a, const Published& b) {
+    return std::make_pair(a.diagnostic.loc.line, a.diagnostic.loc.col) <
+           std::make_pair(b.diagnostic.loc.line, b.diagnostic.loc.col);
   };
   std::stable_sort(r.mission.begin(), r.mission.end(), by_place);
   std::stable_sort(r.fleet.begin(), r.fleet.end(), by_place);
   return r;
 }
 
-nlohmann::json diagnostics_json(const std::vector<Diagnostic>& items, Encoding enc) {
+namespace {
+
+nlohmann::json one_diagnostic(const Diagnostic& d, Encoding enc) {
+  // 1 error, 2 warning, 3 information: a note is information beside its error.
+  int severity = d.severity == Severity::error ? 1 : d.severity == Severity::warning ? 2 : 3;
+  return {{"range", to_json(word_range(d.source_line, d.loc, enc))},
+          {"severity", severity},
+          {"source", "eamos"},
+          {"message", d.message}};
+}
+
+std::string where(const Diagnostic& note) {
+  std::string at = note.path;
+  if (note.loc.known()) at += ":" + std::to_string(note.loc.line) + ":" + std::to_string(note.loc.col);
+  return at;
+}
+
+}  // namespace
+
+nlohmann::json diagnostics_json(const std::vector<Published>& items, const PublishOptions& options) {
   nlohmann::json out = nlohmann::json::array();
-  for (const Diagnostic& d : items) {
-    // 1 error, 2 warning, 3 information: a note is information beside its error.
-    int severity = d.severity == Severity::error ? 1 : d.severity == Severity::warning ? 2 : 3;
-    out.push_back({{"range", to_json(word_range(d.source_line, d.loc, enc))},
-                   {"severity", severity},
-                   {"source", "eamos"},
-                   {"message", d.message}});
+  for (const Published& p : items) {
+    nlohmann::json d = one_diagnostic(p.diagnostic, options.encoding);
+    std::string parent_uri = options.uri_of(p.diagnostic);
+    std::vector<nlohmann::json> beside;
+    for (const Diagnostic& n : p.notes) {
+      // relatedInformation needs a place in a file; a note without one ends the message.
+      if (options.related_information && n.has_file) {
+        d["relatedInformation"].push_back(
+            {{"location",
+              {{"uri", options.uri_of(n)}, {"range", to_json(word_range(n.source_line, n.loc, options.encoding))}}},
+             {"message", n.message}});
+      } else if (n.has_file && p.diagnostic.has_file && options.uri_of(n) == parent_uri) {
+        beside.push_back(one_diagnostic(n, options.encoding));
+      } else {
+        d["message"] = d["message"].get<std::string>() + "\nnote: " + (n.has_file ? where(n) + ": " : "") + n.message;
+      }
+    }
+    out.push_back(std::move(d));
+    for (nlohmann::json& b : beside) out.push_back(std::move(b));
   }
   return out;
 }

@@ -2,6 +2,7 @@
 // One open mission as the editor last sent it, checked by the same stages as `eamos check`
 // (parse, check, graphs and their static checks), kept with what the editor features
 // need: the AST, partial when the text does not parse, and the tokens with their places.
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -31,10 +32,17 @@ struct Document {
   std::vector<Token> tokens;  ///< in order; no semicolon the lexer inserted at a newline
 };
 
-/// What one check found, split by the file each diagnostic is about.
+/// An error or warning with the notes that belong to it ("first defined here"), each with its
+/// own place, which may be in the other file. A note that belongs to nothing stands alone.
+struct Published {
+  Diagnostic diagnostic;
+  std::vector<Diagnostic> notes;
+};
+
+/// What one check found, split by the file each error or warning is about.
 struct CheckResult {
-  std::vector<Diagnostic> mission;  ///< the document's, and those tied to no file
-  std::vector<Diagnostic> fleet;    ///< the fleet file's
+  std::vector<Published> mission;  ///< the document's, and those tied to no file
+  std::vector<Published> fleet;    ///< the fleet file's
 };
 
 /// Gives the document `text` and checks it as `eamos check [--fleet fleet_path]` does,
@@ -42,8 +50,17 @@ struct CheckResult {
 /// fleet the document was checked against, for hover and completion.
 CheckResult update(Document& doc, std::string text, const std::string& fleet_path, fleet::Fleet& fleet);
 
+/// How the diagnostics of one file are published. A note goes into its diagnostic's
+/// relatedInformation (at `uri_of` its file) when the client shows those; otherwise a note in
+/// the same file is published beside it as information, and one elsewhere ends its message.
+struct PublishOptions {
+  Encoding encoding = Encoding::utf16;
+  bool related_information = false;
+  std::function<std::string(const Diagnostic&)> uri_of;
+};
+
 /// The protocol's Diagnostic[] for diagnostics all about one file.
-nlohmann::json diagnostics_json(const std::vector<Diagnostic>& items, Encoding enc);
+nlohmann::json diagnostics_json(const std::vector<Published>& items, const PublishOptions& options);
 
 /// The source line (1-based) of the document; empty past the end.
 std::string_view line_of(const Document& doc, int line);

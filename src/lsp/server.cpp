@@ -232,6 +232,9 @@ json Server::initialize(const json& params) {
   const json* hierarchical =
       at_path(params, {"capabilities", "textDocument", "documentSymbol", "hierarchicalDocumentSymbolSupport"});
   hierarchical_symbols_ = hierarchical && *hierarchical == true;
+  const json* related =
+      at_path(params, {"capabilities", "textDocument", "publishDiagnostics", "relatedInformation"});
+  related_information_ = related && *related == true;
 
   fleet_path_ = absolute_fleet(options_.fleet, "");
   if (const json* options = at_path(params, {"initializationOptions"}); options && at_path(*options, {"fleet"}))
@@ -312,21 +315,37 @@ void Server::close(const json& params) {
                      {"params", {{"uri", uri}, {"diagnostics", json::array()}}}});
 }
 
+// A note's file as a URI: the document's own, the fleet file's, or any other file it names.
+PublishOptions Server::publishing(const Document& doc) const {
+  PublishOptions options;
+  options.encoding = encoding_;
+  options.related_information = related_information_;
+  options.uri_of = [uri = doc.uri, path = doc.path, fleet = fleet_path_](const Diagnostic& d) {
+    if (!d.has_file || d.path == path) return uri;
+    if (d.path == fleet) return path_to_uri(fleet);
+    std::error_code ec;
+    std::filesystem::path absolute = std::filesystem::absolute(d.path, ec);
+    return path_to_uri(ec ? d.path : absolute.string());
+  };
+  return options;
+}
+
 void Server::check(Document& doc, std::string text) {
   CheckResult r = update(doc, std::move(text), fleet_path_, fleet_);
-  outbox_.push_back(
-      {{"jsonrpc", "2.0"},
-       {"method", "textDocument/publishDiagnostics"},
-       {"params",
-        {{"uri", doc.uri}, {"version", doc.version}, {"diagnostics", diagnostics_json(r.mission, encoding_)}}}});
-  publish_fleet(r.fleet);
+  outbox_.push_back({{"jsonrpc", "2.0"},
+                     {"method", "textDocument/publishDiagnostics"},
+                     {"params",
+                      {{"uri", doc.uri},
+                       {"version", doc.version},
+                       {"diagnostics", diagnostics_json(r.mission, publishing(doc))}}}});
+  publish_fleet(r.fleet, publishing(doc));
 }
 
 // The fleet file's problems go to its own URI, once per change: every keystroke in a
 // mission re-reads the fleet file, but repeats nothing the editor already shows.
-void Server::publish_fleet(const std::vector<Diagnostic>& items) {
+void Server::publish_fleet(const std::vector<Published>& items, const PublishOptions& options) {
   if (fleet_path_.empty()) return;
-  json diagnostics = diagnostics_json(items, encoding_);
+  json diagnostics = diagnostics_json(items, options);
   if (diagnostics == fleet_published_) return;
   fleet_published_ = diagnostics;
   outbox_.push_back({{"jsonrpc", "2.0"},

@@ -48,7 +48,8 @@ class Server {
   void change(const nlohmann::json& params);
   void close(const nlohmann::json& params);
   void check(Document& doc, std::string text);
-  void publish_fleet(const std::vector<Diagnostic>& items);
+  void publish_fleet(const std::vector<Published>& items, const PublishOptions& options);
+  PublishOptions publishing(const Document& doc) const;
   void reply(const nlohmann::json& id, nlohmann::json result);
   void reply_error(const nlohmann::json& id, int code, const std::string& message);
 
@@ -57,6 +58,7 @@ class Server {
   bool shutting_down_ = false;
   Encoding encoding_ = Encoding::utf16;
   bool hierarchical_symbols_ = false;
+  bool related_information_ = false;  ///< the client shows a diagnostic's notes with it
   std::string fleet_path_;                     ///< absolute, or as given when relative to no known folder
   fleet::Fleet fleet_;                         ///< as loaded by the last check
   std::map<std::string, Document> documents_;  ///< by URI

@@ -70,7 +70,8 @@ TEST_F(CompilePackage, BadInterfaceIsRefusedBeforeAnythingIsWritten) {
   EXPECT_FALSE(fs::exists(dir_ / "deploy"));
   eamos_test::Shell alone = compile("--interface wlan0");
   EXPECT_EQ(alone.status, 1);
-  EXPECT_NE(alone.out.find("--interface requires --package"), std::string::npos) << alone.out;
+  EXPECT_NE(alone.out.find("eamos: error: --interface needs --package too"), std::string::npos) << alone.out;
+  EXPECT_FALSE(fs::exists(dir_ / "deploy"));
 }
 
 }  // namespace
