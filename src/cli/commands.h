@@ -89,6 +89,7 @@ struct SimVehicleCommandOptions {
   double battery = 100.0;   ///< % at start; 0 makes it refuse to arm
   double speed = 1.0;       ///< mission time runs this many times as fast as the wall clock
   double duration = 0.0;    ///< stop after this many mission seconds; 0 = until SIGINT/SIGTERM
+  std::string ground_station;  ///< a second link URL for a GCS (QGroundControl); "" = none
 };
 int cmd_sim_vehicle(const SimVehicleCommandOptions& o);
 int cmd_gen_stress(const std::string& shape, long long nodes, int drones, int work_per_step, unsigned seed,

@@ -241,6 +241,8 @@ int main(int argc, char** argv) {
   eamos::cli::SimVehicleCommandOptions simv_opts;
   auto* udp = simv->add_option("--udp", simv_opts.udp_port, "Send to 127.0.0.1:PORT, like PX4 SITL (whose instance i sends to 14540 + i)")
       ->check(eamos::cli::whole_number(1, 65535));
+  simv->add_option("--gcs", simv_opts.ground_station,
+                   "Also stream to a ground station so QGroundControl shows the vehicle, e.g. udpout://127.0.0.1:14550");
   simv->add_option("--connection", simv_opts.connection, "Any link URL instead: udp://:PORT, udpout://HOST:PORT or tcp://HOST:PORT")
       ->excludes(udp);
   simv->add_option("--sysid", simv_opts.sysid, "MAVLink system id")->check(eamos::cli::whole_number(1, 255));

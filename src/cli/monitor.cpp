@@ -83,14 +83,15 @@ std::string not_a_trace(const std::string& path) {
   while (first.find_first_not_of(" \t\r") == std::string::npos && std::getline(in, first)) {
   }
   if (first.find_first_not_of(" \t\r") == std::string::npos) return "";  // empty: the reader says so
+  nlohmann::json j = nlohmann::json::parse(first, nullptr, false);
+  // A trace's header carries the mission's source: a first line that is an event is a trace.
+  if (j.is_object() && j.contains("event")) return "";
   std::string text = first + "\n" + std::string(std::istreambuf_iterator<char>(in), {}).substr(0, 1 << 16);
   bool mission = std::filesystem::path(path).extension() == ".eamos" || text.find("func INIT") != std::string::npos ||
                  text.rfind("var ", 0) == 0 || text.rfind("package ", 0) == 0 || text.rfind("//", 0) == 0;
   if (mission)
     return "'" + path + "' is a mission, not a trace; watch it fly with `eamos run " + path +
            " --monitor 8080`, or record a trace with `eamos run " + path + " --trace run.jsonl` and replay that";
-  nlohmann::json j = nlohmann::json::parse(first, nullptr, false);
-  if (j.is_object() && j.contains("event")) return "";
   if (nlohmann::json::parse(text, nullptr, false).is_object())
     return "'" + path + "' is one JSON document (a summary or a graph?), not a trace: a trace has one event per "
            "line, as `eamos run --trace` writes it";

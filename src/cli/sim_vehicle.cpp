@@ -34,6 +34,14 @@ int cmd_sim_vehicle(const SimVehicleCommandOptions& o) {
     std::cerr << error_prefix() << "" << error << "\n";
     return 1;
   }
+  if (!o.ground_station.empty()) {
+    mavlink::EndpointResult gcs = mavlink::parse_url(o.ground_station);
+    std::string error = gcs.endpoint ? vehicle.open_ground_station(*gcs.endpoint) : gcs.error;
+    if (!error.empty()) {
+      std::cerr << error_prefix() << "--gcs " << error << "\n";
+      return 1;
+    }
+  }
   // The local port: where a second ground station (a test playing a pilot) reaches the vehicle.
   std::cout << "sim-vehicle: system " << o.sysid << " (" << options.dialect->name << "-like) on " << url
             << ", receiving on port " << vehicle.local_port() << std::endl;

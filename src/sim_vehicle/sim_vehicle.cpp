@@ -109,6 +109,19 @@ std::string SimVehicle::open(const ml::Endpoint& endpoint) {
   return "";
 }
 
+std::string SimVehicle::open_ground_station(const ml::Endpoint& endpoint) {
+  std::weak_ptr<bool> alive = alive_;
+  mid::EventLoop* loop = &loop_;
+  ml::OpenResult opened = ml::Link::open(endpoint, [this, alive, loop](ml::Frame f) {
+    loop->post([this, alive, f = std::move(f)] {
+      if (alive.lock()) on_frame(f);
+    });
+  });
+  if (!opened.link) return opened.error;
+  ground_station_ = std::move(opened.link);
+  return "";
+}
+
 // --- input ---------------------------------------------------------------------------------
 
 void SimVehicle::on_frame(const ml::Frame& frame) {
@@ -500,7 +513,10 @@ ml::Message SimVehicle::telemetry(uint32_t id) const {
 }
 
 void SimVehicle::send(const ml::Message& m) {
-  if (link_) link_->send(encoder_.encode(m));
+  if (!link_ && !ground_station_) return;
+  std::vector<uint8_t> frame = encoder_.encode(m);
+  if (link_) link_->send(frame);
+  if (ground_station_) ground_station_->send(frame);
 }
 
 }  // namespace eamos::sim_vehicle

@@ -121,6 +121,10 @@ class SimVehicle {
 
   /// Opens the link and starts heartbeats and telemetry; "" on success, else why not.
   std::string open(const mavlink::Endpoint& endpoint);
+  /// A second link, to a ground station (QGroundControl on udpout://127.0.0.1:14550): it gets
+  /// every frame the vehicle sends, and what it sends is handled as from the first link, as
+  /// an autopilot with a telemetry radio beside its companion computer does.
+  std::string open_ground_station(const mavlink::Endpoint& endpoint);
 
   Mode mode() const { return mode_; }
   /// The local port it receives on (anyone may send there, as a second GCS could).
@@ -191,6 +195,7 @@ class SimVehicle {
   sim::SimDrone drone_;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);  ///< see MavlinkDrone::alive_
   std::unique_ptr<mavlink::Link> link_;
+  std::unique_ptr<mavlink::Link> ground_station_;  ///< open_ground_station's link, or null
   mavlink::Encoder encoder_;
 
   const Dialect& dialect_;

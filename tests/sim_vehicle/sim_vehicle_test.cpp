@@ -7,6 +7,10 @@
 #include <condition_variable>
 #include <mutex>
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include "../mavlink_adapter/vehicle_thread.h"
 #include "mavlink/enums.h"
 #include "mavlink/link.h"
@@ -226,6 +230,37 @@ TEST(SimVehicle, ArduPilotAnswersDoOrbitAsUnsupported) {
   test::VehicleThread vehicle(25347, 1, kSpeed, ardupilot_dialect());
   await_first_frame(companion);
   EXPECT_EQ(companion.command(ml::cmd::DO_ORBIT, orbit(-3)), ml::result::UNSUPPORTED);
+}
+
+// `eamos sim-vehicle --gcs`: a ground station (here the project's own MAVLink reader, where
+// QGroundControl listens on 14550) sees the vehicle the companion flies: its heartbeat and
+// its climb after the companion's takeoff.
+TEST(SimVehicle, AGroundStationSeesTheVehicleTheCompanionFlies) {
+  Companion companion(25344);
+  Companion ground_station(25345);
+  pid_t pid = fork();
+  if (pid == 0) {
+    execl(EAMOS_BINARY, EAMOS_BINARY, "sim-vehicle", "--udp", "25344", "--gcs", "udpout://127.0.0.1:25345",
+          "--speed", "4", "--duration", "40", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  ASSERT_GT(pid, 0);
+  await_first_frame(companion);
+  EXPECT_GE(ground_station.wait_for(0, [](const ml::Message& m) {
+    auto h = ml::unpack_heartbeat(m);
+    return h && h->autopilot == ml::autopilot::PX4;
+  }), 0) << "no heartbeat at the ground station";
+  ASSERT_EQ(companion.command(ml::cmd::COMPONENT_ARM_DISARM, {1}), ml::result::ACCEPTED);
+  ASSERT_EQ(companion.command(ml::cmd::NAV_TAKEOFF, {0, 0, 0, 0, NAN, NAN, 491}), ml::result::ACCEPTED);
+  int climbed = ground_station.wait_for(0, [](const ml::Message& m) {
+    auto p = ml::unpack_global_position_int(m);
+    return p && p->relative_alt > 1000;
+  });
+  EXPECT_GE(climbed, 0) << "the ground station never saw the vehicle above 1 m";
+  kill(pid, SIGTERM);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
 }
 
 }  // namespace
