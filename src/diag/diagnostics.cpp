@@ -88,8 +88,6 @@ void Diagnostics::add(Diagnostic d) {
   if (count(d.severity)) items_.push_back(std::move(d));
 }
 
-namespace {
-
 const char* severity_name(Severity s) {
   switch (s) {
     case Severity::error: return "error";
@@ -98,6 +96,8 @@ const char* severity_name(Severity s) {
   }
   return "error";
 }
+
+namespace {
 
 // clang's colours: bold location and message, red errors, magenta warnings, cyan notes, a
 // green caret and underline.

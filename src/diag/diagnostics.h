@@ -10,6 +10,8 @@
 namespace eamos {
 
 enum class Severity { error, warning, note };
+/// "error", "warning" or "note": the word every format prints (text, JSON, SARIF, Python).
+const char* severity_name(Severity s);
 
 /// A diagnostic owns the text it prints (the file's path and the one source line it points
 /// at) instead of pointing into the SourceFile: a fleet or mission source is often gone by

@@ -11,10 +11,6 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
-const char* severity_name(Severity s) {
-  return s == Severity::error ? "error" : s == Severity::warning ? "warning" : "note";
-}
-
 Json one_json(const Diagnostic& d) {
   Json j;
   j["file"] = d.has_file ? Json(d.path) : Json(nullptr);

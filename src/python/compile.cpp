@@ -14,15 +14,6 @@ namespace eamos::python {
 
 namespace {
 
-const char* severity_name(Severity s) {
-  switch (s) {
-    case Severity::error: return "error";
-    case Severity::warning: return "warning";
-    case Severity::note: return "note";
-  }
-  return "error";
-}
-
 py::dict diagnostic_dict(const Diagnostic& d) {
   // The text of this diagnostic alone, as `eamos check` prints it (location, source line, caret).
   Diagnostics one;
