@@ -198,14 +198,11 @@ void write_arc(JsonWriter& w, int from, int to, graph::ArcKind kind, graph::Bran
 /// A sorted drone set as [first, last] ranges: a fleet-wide set is one pair.
 void write_drone_ranges(JsonWriter& w, const std::vector<int>& set) {
   w.begin_array();
-  for (std::size_t i = 0; i < set.size();) {
-    std::size_t j = i;
-    while (j + 1 < set.size() && set[j + 1] == set[j] + 1) ++j;
+  for (auto [first, last] : graph::drone_ranges(set)) {
     w.begin_array();
-    w.value(set[i]);
-    w.value(set[j]);
+    w.value(first);
+    w.value(last);
     w.end_array();
-    i = j + 1;
   }
   w.end_array();
 }

@@ -343,8 +343,9 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
   }
   // Each drone's broker feeds its own engine directly and every other drone through the
   // transport (the OutBridge side of telemetry); a first publication seeds every board.
-  // Before anything runs, every engine holds every drone's initial state, as a DEX would
-  // after the start barrier: a condition at t = 0 never reads a value that is not there yet.
+  // Before anything runs, every engine holds the initial state of every drone it reads, as
+  // a DEX does after the start barrier: a condition at t = 0 never reads a value that is
+  // not there yet. One shared copy per drone: a fleet of k is k copies, not k².
   for (int d = 0; d < n; ++d) {
     auto initial = std::make_shared<const Telemetry>(Telemetry{missions[d].hash, d, drones[d]->state()});
     for (int to : transport.readers_of(d))

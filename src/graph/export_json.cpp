@@ -101,16 +101,11 @@ json meg_json(const Compilation& c) {
 
 namespace {
 /// Each sorted drone set as [first, last] index ranges, as mission files write them.
-json drone_ranges(const std::vector<std::vector<int>>& sets) {
+json drone_sets_json(const std::vector<std::vector<int>>& sets) {
   json all = json::array();
   for (const std::vector<int>& set : sets) {
     json ranges = json::array();
-    for (std::size_t i = 0; i < set.size();) {
-      std::size_t j = i;
-      while (j + 1 < set.size() && set[j + 1] == set[j] + 1) ++j;
-      ranges.push_back({set[i], set[j]});
-      i = j + 1;
-    }
+    for (auto [first, last] : graph::drone_ranges(set)) ranges.push_back({first, last});
     all.push_back(std::move(ranges));
   }
   return all;
@@ -150,7 +145,7 @@ json mdg_json(const Compilation& c, int drone) {
     arcs.push_back(std::move(j));
   }
   return {{"graph", "mdg"}, {"drone", c.drone_name(drone)}, {"reads", drone_list(c, g.reads)},
-          {"drone_sets", drone_ranges(g.drone_sets)}, {"nodes", nodes}, {"arcs", arcs}};
+          {"drone_sets", drone_sets_json(g.drone_sets)}, {"nodes", nodes}, {"arcs", arcs}};
 }
 
 json stats_json(const Compilation& c) {

@@ -54,6 +54,15 @@ std::vector<std::vector<int>> sync_clones(const Meg& meg) {
   return clones;
 }
 
+std::vector<std::pair<int, int>> drone_ranges(const std::vector<int>& set) {
+  std::vector<std::pair<int, int>> ranges;
+  for (int d : set) {
+    if (!ranges.empty() && ranges.back().second + 1 == d) ranges.back().second = d;
+    else ranges.push_back({d, d});
+  }
+  return ranges;
+}
+
 std::vector<std::vector<int>> sync_arrivers(const Meg& meg) {
   std::vector<std::vector<int>> arrivers(meg.nodes.size());
   for (const MegArc& a : meg.arcs) {

@@ -11,6 +11,7 @@
 // holder (`notify`); each clone counts the arrivals it needs (`waits`). Both name a set of
 // drones in the MDG's table `drone_sets`, shared by every sync point with the same set.
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "graph/meg.h"
@@ -64,6 +65,10 @@ std::vector<std::vector<int>> sync_clones(const Meg& meg);
 /// The drones whose work leads into each sync point (empty for other nodes): the holders
 /// of its non-sync predecessors, sorted.
 std::vector<std::vector<int>> sync_arrivers(const Meg& meg);
+
+/// A sorted drone set as [first, last] runs of consecutive indices, the way mission files
+/// and the graph export write `drone_sets`: a fleet-wide set is one run.
+std::vector<std::pair<int, int>> drone_ranges(const std::vector<int>& set);
 
 /// One MDG per drone, in declaration order.
 std::vector<Mdg> build_mdgs(const Meg& meg);

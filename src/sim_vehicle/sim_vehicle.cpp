@@ -93,14 +93,19 @@ SimVehicle::~SimVehicle() {
   loop_.cancel(orbit_timer_);
 }
 
-std::string SimVehicle::open(const ml::Endpoint& endpoint) {
+// Frames cross from the link's receive thread to the loop, and only while the vehicle lives.
+ml::OpenResult SimVehicle::open_link(const ml::Endpoint& endpoint) {
   std::weak_ptr<bool> alive = alive_;
   mid::EventLoop* loop = &loop_;
-  ml::OpenResult opened = ml::Link::open(endpoint, [this, alive, loop](ml::Frame f) {
+  return ml::Link::open(endpoint, [this, alive, loop](ml::Frame f) {
     loop->post([this, alive, f = std::move(f)] {
       if (alive.lock()) on_frame(f);
     });
   });
+}
+
+std::string SimVehicle::open(const ml::Endpoint& endpoint) {
+  ml::OpenResult opened = open_link(endpoint);
   if (!opened.link) return opened.error;
   link_ = std::move(opened.link);
   rates_hz_[ml::msg::HEARTBEAT] = 1.0;
@@ -110,13 +115,7 @@ std::string SimVehicle::open(const ml::Endpoint& endpoint) {
 }
 
 std::string SimVehicle::open_ground_station(const ml::Endpoint& endpoint) {
-  std::weak_ptr<bool> alive = alive_;
-  mid::EventLoop* loop = &loop_;
-  ml::OpenResult opened = ml::Link::open(endpoint, [this, alive, loop](ml::Frame f) {
-    loop->post([this, alive, f = std::move(f)] {
-      if (alive.lock()) on_frame(f);
-    });
-  });
+  ml::OpenResult opened = open_link(endpoint);
   if (!opened.link) return opened.error;
   ground_station_ = std::move(opened.link);
   return "";

@@ -189,6 +189,7 @@ class SimVehicle {
   void check_preflight_disarm();
   mavlink::Message telemetry(uint32_t message_id) const;
   void send(const mavlink::Message& m);
+  mavlink::OpenResult open_link(const mavlink::Endpoint& endpoint);
 
   mid::EventLoop& loop_;
   VehicleOptions options_;
