@@ -171,6 +171,9 @@ class MavlinkDrone final : public mid::AdapterDrone {
   /// vehicle_clock_rate() as mission_s() allows for it: within 0.2 … 1.
   double deadline_clock_rate() const override;
   void hold_here();
+  // giving way (mavlink_drone_give_way.cpp)
+  bool hold_vehicle(mid::ActionId id, double climb_m) override;
+  void resume_vehicle(mid::ActionId id) override;
   /// Ends every running action `failed` for `why`, dropping the motion's goal and orbit.
   void fail_all(mid::FailureReason why, const std::string& reason);
   /// Ends the motion the adapter flies (if any) `failed`, dropping its goal and orbit.

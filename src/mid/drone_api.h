@@ -126,6 +126,18 @@ class Drone {
   /// home and land, or hover. After it the drone refuses new actions.
   virtual void failsafe(fleet::Failsafe what) = 0;
 
+  /// Give way to another drone (dex/separation.h): stop the running goal-directed motion
+  /// (FlyTo, FlyBy*, Takeoff, ReturnHome, Land) where the vehicle can stop, `climb_m` higher
+  /// (negative: lower; 0: at its altitude), and keep the action running: it neither ends nor
+  /// times out while held. False when no such motion runs, it is already held, or the
+  /// vehicle cannot hold it (the autopilot flies it in a mode of its own).
+  virtual bool hold_motion(double /*climb_m*/) { return false; }
+  /// The held motion flies on to its own goal; its deadline moves on by the time it was
+  /// held. False when nothing is held.
+  virtual bool resume_motion() { return false; }
+  /// Whether a motion is held now.
+  virtual bool motion_held() const { return false; }
+
   /// Where the vehicle's own messages go (an autopilot's STATUSTEXT, what the adapter did
   /// about the vehicle on its own, such as re-arming after an auto-disarm): the DEX puts each
   /// in the trace. Called on the loop's thread; an empty function stops them. Default: none.
