@@ -89,6 +89,27 @@ void write_settings(JsonWriter& w, const fleet::DroneSettings& s, int index) {
   w.end_object();
 }
 
+/// `separation` (min_separation, when not the default) and `priorities` (when any drone
+/// sets `priority:`): written only then, so a mission without them keeps its file and hash.
+void write_separation(JsonWriter& w, const Compilation& c) {
+  const fleet::Separation& s = c.fleet.safety.min_separation;
+  if (s.horizontal_m != fleet::Separation{}.horizontal_m || s.vertical_m != fleet::Separation{}.vertical_m) {
+    w.key("separation");
+    w.begin_object();
+    w.member("horizontal", s.horizontal_m);
+    w.member("vertical", s.vertical_m);
+    w.end_object();
+  }
+  bool any = false;
+  for (const fleet::DroneSettings& d : c.settings) any |= d.priority > 0;
+  if (!any) return;
+  w.key("priorities");
+  w.begin_array();
+  for (std::size_t d = 0; d < c.settings.size(); ++d)
+    w.value(c.settings[d].priority > 0 ? c.settings[d].priority : static_cast<int>(d) + 1);
+  w.end_array();
+}
+
 void write_type(JsonWriter& w, const fleet::DroneType& t) {
   w.begin_object();
   w.member("name", t.name);
@@ -316,6 +337,7 @@ bool write_drone_mission(std::ostream& out, const Compilation& c, int drone, con
   const graph::Mdg& g = c.mdgs[drone];
   w.key("reads");
   write_drone_names(w, c, g.reads);
+  write_separation(w, c);
   write_mdg(w, c, g);
   if (!w.flush()) return false;
   tee.stop_digest();
@@ -352,6 +374,7 @@ std::string mission_hash(const Compilation& c) {
       w.end_array();
     }
     w.end_array();
+    write_separation(w, c);
     w.member("init", c.meg.init);
     w.member("end", c.meg.end);
     w.key("nodes");

@@ -40,6 +40,10 @@ struct DroneSettings {
   std::string connection;                    ///< adapter URL, e.g. udp://:14540; "" for sim
   int sysid = 0;                             ///< MAVLink system id; 0 = not set
   double battery_percent = 100.0;            ///< charge at mission start
+  /// Who gives way when two drones would come too close (docs/fleet.md `priority:`): the
+  /// lower number goes first, ties to the drone declared first; 0 = not set, which ranks as
+  /// the drone's place in the declaration order (1, 2, …).
+  int priority = 0;
   std::map<std::string, double> timeouts_s;  ///< per action name; overrides derived ones
   /// MAVLink 2 signing (docs/fleet.md `signing:`): the link's secret key as 64 hex digits;
   /// "" = frames unsigned. A secret: only the drone's own deployment folder holds it.

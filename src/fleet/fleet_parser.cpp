@@ -22,7 +22,8 @@ const std::vector<std::string> kToleranceKeys = {"horizontal", "vertical", "spee
 const std::vector<std::string> kDroneKeys = {"home",     "battery",  "sensors",
                                              "limits",   "failsafe", "adapter",
                                              "connection", "sysid",  "timeouts",
-                                             "geofence", "signing",  "announce_as_gcs"};
+                                             "geofence", "signing",  "announce_as_gcs",
+                                             "priority"};
 const std::vector<std::string> kSigningKeys = {"key", "key_file", "setup"};
 const std::vector<std::string> kLimitKeys = {"max_speed", "max_climb", "max_descent",
                                              "max_accel", "max_altitude"};
@@ -245,6 +246,11 @@ void FleetParser::drone(const std::string& name, const YAML::Node& node) {
       if (key == "sysid" && r_.whole_number(v, what, sysid)) {
         if (sysid >= 1 && sysid <= 255) s.sysid = static_cast<int>(sysid);
         else r_.error(v, what + " must be a MAVLink system id from 1 to 255; got " + describe(v));
+      }
+      long long priority = 0;
+      if (key == "priority" && r_.whole_number(v, what, priority)) {
+        if (priority >= 1 && priority <= 1000000) s.priority = static_cast<int>(priority);
+        else r_.error(v, what + " must be a whole number from 1 (goes first) to 1000000; got " + describe(v));
       }
       if (key == "timeouts") timeouts(v, where, s);
       if (key == "geofence") geofence(v, where, o.geofence);
