@@ -1,5 +1,7 @@
 #include "dex/runner.h"
 
+#include "dex/separation.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -300,9 +302,11 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
   // fleet file says) every drone still in the air. Every drone is commanded before any
   // failsafe is recorded: a trace write may block.
   bool abandoned = false;
+  std::unique_ptr<SeparationGuard> separation;
   auto abandon = [&] {
     if (abandoned) return;
     abandoned = true;
+    if (separation) separation->halt();
     for (auto& e : engines) e->halt();
     std::vector<bool> commanded(n);
     for (int d = 0; d < n; ++d) commanded[d] = command_failsafe(*drones[d], missions[d].settings);
@@ -351,9 +355,17 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     for (int to : transport.readers_of(d))
       if (to != d) engines[to]->receive(initial);
   }
+  if (options.keep_separation) {
+    separation = std::make_unique<SeparationGuard>(missions[0], loop, SeparationHooks{trace, stop_mission});
+    for (int d = 0; d < n; ++d) {
+      separation->fly(d, *drones[d], missions[d].settings.limits);
+      separation->update(d, drones[d]->state());
+    }
+  }
   for (int d = 0; d < n; ++d) {
     drones[d]->subscribe([&, d](const mid::DroneState& s) {
       if (options.keep_tracks) record_sample(tracks[d], s);
+      if (separation) separation->update(d, s);
       engines[d]->properties_changed(d);
       if (!transport.readers_of(d).empty())
         transport.publish(std::make_shared<const Telemetry>(Telemetry{missions[d].hash, d, s}));

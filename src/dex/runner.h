@@ -53,6 +53,9 @@ struct RunOptions {
   /// flight) in the result, for verify's checks and the plot. Off, a track holds the
   /// drone's first and last state only: a 1,000-drone show flies 18 million samples.
   bool keep_tracks = true;
+  /// Keep the fleet's min_separation in flight: drones give way (dex/separation.h). Off for
+  /// `eamos verify`, which flies the mission as written to find where it plans drones too close.
+  bool keep_separation = true;
 };
 
 /// One drone's position and phase at a moment its broker published a change of them.

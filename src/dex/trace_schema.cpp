@@ -144,6 +144,13 @@ void check_event(const json& j, const std::string& event, LineCheck& c, const st
     c.drone("drone", fleet);
     c.one_of("name", {"land", "return_home", "hover"});
     c.string("reason");
+  } else if (event == "conflict" || event == "give_way" || event == "resume") {
+    c.drone("drone", fleet);
+    c.string("name");
+    c.integer("line", 0);
+    c.drone("other", fleet);
+    if (c.number("distance") && j["distance"].get<double>() < 0) c.fail("\"distance\" is negative");
+    c.string("reason");
   } else if (event == "vehicle") {
     c.drone("drone", fleet);
     c.string("text");
