@@ -140,11 +140,11 @@ void SeparationGuard::for_neighbours(int d, double reach_m, Fn fn) {
     for (long long y = iy - rings; y <= iy + rings; ++y) {
       auto it = grid_.find((x << 32) ^ (y & 0xffffffffLL));
       if (it == grid_.end()) continue;
-      // A copy: a callback may give way, which never moves a drone between cells, but the
-      // list must not change under the loop whatever a callback does.
-      const std::vector<int> members = it->second;
-      for (int n : members)
-        if (n != d) fn(n);
+      // By index, not by copy: giving way and resuming never move a drone between cells
+      // (only update() does), so the list stays as it is while `fn` runs.
+      const std::vector<int>& members = it->second;
+      for (std::size_t i = 0; i < members.size(); ++i)
+        if (members[i] != d) fn(members[i]);
     }
 }
 
@@ -168,12 +168,16 @@ void SeparationGuard::update(int d, const mid::DroneState& s) {
 
 void SeparationGuard::check(int d) {
   const Track& k = tracks_[d];
+  const bool own = k.drone != nullptr;
   const double reach = min_.horizontal_m + kSeparationHorizonS * (std::hypot(k.v.x, k.v.y) + fastest_seen_);
-  if (tracks_[d].drone && holding(d)) try_resume(d);
+  if (own && holding(d)) try_resume(d);
   for_neighbours(d, reach, [&](int n) {
-    if (tracks_[d].drone) consider(d, n);
+    // A drone this process flies looks at its own pairs when its own state comes in; a pair
+    // with a drone flown elsewhere is looked at from that drone's telemetry too.
+    if (own) consider(d, n);
     if (!tracks_[n].drone) return;
-    consider(n, d);
+    if (!own) consider(n, d);
+    // A held drone stands still and publishes seldom: whoever moves near it looks again.
     if (holding(n)) try_resume(n);
   });
 }
@@ -223,16 +227,19 @@ void SeparationGuard::try_resume(int h) {
   Track& H = tracks_[h];
   const Vec here = now_at(H);
   int blocker = -1;
-  const double reach = min_.horizontal_m + kSeparationHorizonS * (std::hypot(H.resume_v.x, H.resume_v.y) + fastest_seen_);
+  const double reach = min_.horizontal_m + kResumeHorizonS * (std::hypot(H.resume_v.x, H.resume_v.y) + fastest_seen_);
   for_neighbours(h, reach, [&](int n) {
     if (blocker >= 0 || !tracks_[n].airborne) return;
     ++pairs_;
     const Track& N = tracks_[n];
     // It speeds up from a stop: its course at the speed it had when it gave way, and at a
     // quarter, half, three quarters and all of its full speed.
-    if (predict(here, H.hold_v, now_at(N), N.v, min_, kSeparationHorizonS).conflict) blocker = n;
+    // Over twice the horizon: a conflict that just slipped past the horizon as it braked
+    // would otherwise let it fly on at once and stop again.
+    const double horizon = kResumeHorizonS;
+    if (predict(here, H.hold_v, now_at(N), N.v, min_, horizon).conflict) blocker = n;
     for (double share : {0.25, 0.5, 0.75, 1.0})
-      if (predict(here, H.resume_v * share, now_at(N), N.v, min_, kSeparationHorizonS).conflict) blocker = n;
+      if (predict(here, H.resume_v * share, now_at(N), N.v, min_, horizon).conflict) blocker = n;
   });
   H.blocked_by = blocker;
   if (blocker >= 0) {
@@ -272,6 +279,7 @@ void SeparationGuard::trace(int d, int other, const char* event, const std::stri
   e.event = event;
   e.name = "separation";
   e.other = other >= 0 ? m_.fleet[other] : "";
+  e.to = other;
   if (other >= 0) e.distance = std::round(distance(d, other) * 1000.0) / 1000.0;
   e.reason = reason;
   hooks_.trace->record(e);

@@ -32,6 +32,7 @@
 namespace eamos::dex {
 
 inline constexpr double kSeparationHorizonS = 3.0;  ///< how far ahead courses are predicted
+inline constexpr double kResumeHorizonS = 6.0;     ///< a held drone's course must be clear this far ahead
 inline constexpr double kSeparationCheckS = 0.2;    ///< a drone's pairs are looked at at most this often
 inline constexpr double kMaxGiveWayS = 30.0;        ///< a longer hold fails the mission
 inline constexpr double kLastMomentS = 1.5;         ///< this close to a loss, priority no longer counts
