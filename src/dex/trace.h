@@ -38,6 +38,12 @@ struct TraceEvent {
   std::optional<mid::DroneState> state;
 };
 
+/// conflict, give_way and resume (dex/separation.h): `other` names the other drone, `to`
+/// holds its index (how it crosses DDS) and `distance` how far apart the two are.
+inline bool is_separation_event(const std::string& event) {
+  return event == "conflict" || event == "give_way" || event == "resume";
+}
+
 class TraceSink {
  public:
   virtual ~TraceSink() = default;

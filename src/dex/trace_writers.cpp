@@ -78,6 +78,7 @@ nlohmann::ordered_json trace_event_json(const TraceEvent& e, const std::vector<s
     if (e.node >= 0) j["node"] = e.node;
     if (e.instance >= 0) j["instance"] = e.instance;
     if (!e.other.empty()) j["other"] = e.other;
+    else if (is_separation_event(e.event) && e.to >= 0) j["other"] = drone_name(e.to);
     if (e.distance) j["distance"] = *e.distance;
   }
   return j;

@@ -301,9 +301,11 @@ bool DexProcess::begin() {
   // went idle (StatusSample::since), which is the mission's duration.
   hooks.on_idle = [this] { publish_status(); };
   engine_ = std::make_unique<dex::Engine>(mission_, *drone_, *loop_, hooks);
+  start_separation();
   phase_ = Phase::running;
   inbox_.attach(*loop_, [this](const TelemetrySample& s) { seed_telemetry(s); });
   drone_->subscribe([this](const mid::DroneState& s) {
+    separation_->update(mission_.self, s);
     engine_->properties_changed(mission_.self);
     transport_->publish(std::make_shared<const dex::Telemetry>(dex::Telemetry{mission_.hash, mission_.self, s}));
   });
@@ -321,6 +323,15 @@ bool DexProcess::begin() {
   engine_->start();
   tick();
   return true;
+}
+
+void DexProcess::start_separation() {
+  dex::SeparationHooks hooks;
+  hooks.trace = &tee_;
+  hooks.on_stuck = [this](const std::string& why) { abandon(why, std::nullopt, true); };
+  separation_ = std::make_unique<dex::SeparationGuard>(mission_, *loop_, hooks);
+  separation_->fly(mission_.self, *drone_, mission_.settings.limits);
+  separation_->update(mission_.self, drone_->state());
 }
 
 int run_dex_process(const DexProcessOptions& options, const mid::AdapterRegistry& adapters,

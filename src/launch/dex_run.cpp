@@ -87,6 +87,7 @@ void DexProcess::seed_telemetry(const TelemetrySample& s) {
   // state every DEX publishes while it waits) or this run (a drone that started first).
   if (s.telemetry.mission_hash != mission_.hash || s.telemetry.from == mission_.self) return;
   if (s.run_id != 0 && s.run_id != start_.run_id) return;
+  separation_->update(s.telemetry.from, s.telemetry.state);
   engine_->receive(std::make_shared<const dex::Telemetry>(s.telemetry));
 }
 
@@ -96,6 +97,7 @@ void DexProcess::on_telemetry(const TelemetrySample& s) {
   // Once running, only this run's telemetry: run 0 now comes from a DEX that was started
   // again and stands at home, not from the drone that flies.
   if (s.run_id != start_.run_id) return;
+  separation_->update(s.telemetry.from, s.telemetry.state);
   engine_->receive(std::make_shared<const dex::Telemetry>(s.telemetry));
 }
 
@@ -240,6 +242,7 @@ void DexProcess::abandon(const std::string& reason, const std::optional<dex::Fai
   // Safety first, words second: this drone's failsafe, then the ABORT that starts everyone
   // else's (a DDS write may block), and only then the log and the trace.
   engine_->halt();
+  if (separation_) separation_->halt();
   bool commanded = dex::command_failsafe(*drone_, mission_.settings);
   if (broadcast) {
     LifecycleSample abort{mission_.hash, mission_.self, LifecycleKind::abort, start_.run_id};

@@ -16,6 +16,7 @@
 
 #include "dex/engine.h"
 #include "dex/mission.h"
+#include "dex/separation.h"
 #include "dex/trace_writers.h"
 #include "launch/dex_process.h"
 #include "launch/termination.h"
@@ -92,6 +93,7 @@ class DexProcess {
   /// --max-trigger-latency: the mission is then abandoned and the message not obeyed.
   bool too_late(const dex::TraceEvent& event);
   void on_telemetry(const TelemetrySample& s);
+  void start_separation();
   void seed_telemetry(const TelemetrySample& s);
   void on_lifecycle(const LifecycleSample& s);
   /// A START of another run: refused when it names this process (it runs one already).
@@ -161,6 +163,7 @@ class DexProcess {
   std::unique_ptr<dex::LiveLog> live_;
   dex::TeeTrace tee_;
   std::unique_ptr<dex::Engine> engine_;
+  std::unique_ptr<dex::SeparationGuard> separation_;  ///< give-ways of this drone (dex/separation.h)
   Phase phase_ = Phase::waiting;
   bool end_reached_ = false;
   std::uint64_t received_ = 0;

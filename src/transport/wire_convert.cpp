@@ -345,8 +345,11 @@ eamos_wire_TraceRecord to_wire(const TraceSample& s) {
   w.text = borrow(e.text);
   w.outcome = borrow(e.outcome);
   w.value = e.value ? (*e.value ? 1 : 0) : -1;
-  w.has_reading = e.reading.has_value();
-  w.reading = e.reading.value_or(0.0);
+  // A give-way's distance travels in `reading` and its other drone in `to`: the wire type
+  // stays as it is (dex::is_separation_event).
+  const std::optional<double>& number = dex::is_separation_event(e.event) ? e.distance : e.reading;
+  w.has_reading = number.has_value();
+  w.reading = number.value_or(0.0);
   w.reason = borrow(e.reason);
   w.failure = borrow(e.failure);
   w.detail = borrow(e.detail);
@@ -396,6 +399,11 @@ bool from_wire(const eamos_wire_TraceRecord& w, const WireLimits& limits, TraceS
     check.drone("from", w.from);
     check.drone("to", w.to);
     check.finite("sent", w.sent);
+  }
+  if (dex::is_separation_event(e.event)) {
+    check.drone("to", w.to);
+    e.distance = e.reading;
+    e.reading.reset();
   }
   e.from = w.from;
   e.to = w.to;
