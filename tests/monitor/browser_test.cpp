@@ -146,6 +146,27 @@ TEST(MonitorBrowser, ReplayOfAVerifyTraceMarksTheViolationInRedInItsLane) {
   fs::remove_all(dir);
 }
 
+TEST(MonitorBrowser, ReplayShowsWhoGaveWayToWhomInItsLane) {
+  if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
+  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-give-way-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  std::string trace = (dir / "crossing.jsonl").string();
+  auto run = eamos_test::run_eamos("run -q tests/launch/missions/separation_crossing.eamos --fleet "
+                                   "tests/launch/missions/separation_crossing.yaml --trace " + trace);
+  ASSERT_EQ(run.status, 0) << run.out;
+  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0"});
+  ASSERT_GT(monitor.pid, 0);
+  std::string url = read_url(monitor, "replaying");
+  ASSERT_FALSE(url.empty()) << monitor.seen;
+  std::string output;
+  bool passed = run_browser("giveway", url, output);
+  int status = -1;
+  stop(monitor, status);
+  EXPECT_TRUE(passed) << output;
+  EXPECT_EQ(status, 0) << monitor.seen;
+  fs::remove_all(dir);
+}
+
 TEST(MonitorBrowser, AThousandDroneReplayDrawsItsLanesOnACanvas) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
   fs::path dir = fs::temp_directory_path() / ("eamos-monitor-scale-" + std::to_string(getpid()));
