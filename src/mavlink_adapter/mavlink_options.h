@@ -28,7 +28,7 @@ struct MavlinkOptions {
   double position_hz = 10.0;       ///< LOCAL_POSITION_NED rate asked for
   /// HEARTBEAT rate asked for: the armed flag travels only there, and a disarm (the
   /// autopilot's auto-disarm on the ground) must be seen within 100 ms, latency included.
-  /// PX4 refuses it (poll_heartbeat).
+  /// PX4 refuses it (LinkWatch::poll_heartbeat).
   double heartbeat_hz = 20.0;
   /// Wall seconds at connect to read the autopilot's speed parameters (PARAM_REQUEST_READ,
   /// resent every half second); what has not come by then keeps the fleet's limit.

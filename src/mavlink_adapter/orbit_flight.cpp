@@ -38,7 +38,7 @@ constexpr double kRadiusGain = 0.25;  ///< 1/s: what the lead leaves (0.5: 4.80 
 // still (the EKF's velocity and position disagree by that much as the vehicle speeds up). The
 // integral only takes out what is left over a turn: a faster one (0.25 /s) lags PX4's
 // once-a-turn swing by a quarter turn and feeds it. Five corrections a vehicle second (the
-// HEARTBEAT is polled for it, poll_heartbeat): fewer, the loop trails the swing it corrects.
+// HEARTBEAT is polled for it, LinkWatch::poll_heartbeat): fewer, the loop trails the swing it corrects.
 // The integral runs from the start: held back while the vehicle speeds up, it would leave the
 // mean up to 0.2 m off for most of a short orbit.
 constexpr double kDoOrbitGain = 0.2;        ///< 1/s of vehicle time, on the radius error
