@@ -8,20 +8,18 @@
 namespace eamos::mavlink_adapter {
 
 bool MavlinkDrone::hold_vehicle(mid::ActionId id, double climb_m) {
-  if (id != motion_owner_ || until_ != Until::reached || !goal_ || !streaming_ || orbit_.active ||
-      !vehicle_.have_position)
+  // A goal the setpoints fly to (never an orbit, which has none).
+  if (id != motion_owner_ || until_ != Until::reached || !goal_ || !stream_.streaming() || !vehicle_.have_position)
     return false;
   fleet::Vec3 here = position();
   here.z += climb_m;
-  setpoint_ = here;
-  stream_setpoints();
+  stream_.hold(here);
   return true;
 }
 
 void MavlinkDrone::resume_vehicle(mid::ActionId id) {
   if (id != motion_owner_ || !goal_) return;
-  setpoint_ = goal_->target();
-  stream_setpoints();
+  stream_.hold(goal_->target());
 }
 
 }  // namespace eamos::mavlink_adapter
