@@ -7,9 +7,9 @@
 #include <map>
 #include <sstream>
 
-#include "dex/plot.h"
+#include "trace/plot.h"
 #include "dex/separation.h"
-#include "dex/trace_schema.h"
+#include "trace/trace_schema.h"
 #include "dex/flight.h"
 
 namespace eamos::test {
@@ -102,7 +102,7 @@ void expect_valid_trace(const Flight& f) {
               R"(,"type":"Quad","home":[0,0,0]})";
   header += "]}\n";
   std::istringstream whole(header + f.jsonl);
-  std::vector<std::string> errors = dex::check_trace(whole, {.strict = true});
+  std::vector<std::string> errors = trace::check_trace(whole, {.strict = true});
   EXPECT_TRUE(errors.empty()) << errors.front();
 }
 
@@ -134,7 +134,7 @@ TEST(Separation, CrossingPathsTheLaterDeclaredDroneGivesWayAndBothComplete) {
   EXPECT_NE(f.jsonl.find(R"("other":"A")"), std::string::npos);
   expect_valid_trace(f);
   // The plot rings where B gave way and dots where it flew on.
-  std::string svg = dex::plot_svg(f.result, f.events);
+  std::string svg = trace::plot_svg(f.result, f.events);
   EXPECT_NE(svg.find(R"(<circle class="give-way" data-drone="B" data-other="A")"), std::string::npos);
   EXPECT_NE(svg.find(R"(<circle class="resume" data-drone="B" data-other="A")"), std::string::npos);
 }

@@ -14,7 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dex/trace_schema.h"
+#include "trace/trace_schema.h"
 #include "support/read_files.h"
 #include "support/run_eamos.h"
 
@@ -76,7 +76,7 @@ class SeparationDistributed : public ::testing::Test {
   fs::path trace() const { return dir_ / "trace.jsonl"; }
   std::string schema_errors() const {
     std::ifstream in(trace());
-    std::vector<std::string> errors = eamos::dex::check_trace(in, {.strict = true});
+    std::vector<std::string> errors = eamos::trace::check_trace(in, {.strict = true});
     return errors.empty() ? "" : errors.front();
   }
   fs::path dir_;
