@@ -3,6 +3,8 @@
 // mavlink_drone_link.cpp.
 #include "mavlink_adapter/mavlink_drone.h"
 
+#include "mid/site_limits.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -36,7 +38,11 @@ MavlinkDrone::MavlinkDrone(fleet::DroneSettings settings, fleet::DroneType type,
     : AdapterDrone(loop, std::move(type)),
       settings_(std::move(settings)),
       options_(options),
-      commands_(loop, [this](const ml::Message& m) { send(m); }, options.commands) {}
+      commands_(loop, [this](const ml::Message& m) { send(m); }, options.commands),
+      pacer_(mid::flight_limits(settings_),
+             settings_.site.max_speed_mps || settings_.site.max_climb_mps || settings_.site.max_descent_mps) {
+  keep_site(settings_);
+}
 
 MavlinkDrone::~MavlinkDrone() {
   if (link_ && link_->foreign_datagrams() > 0)
@@ -544,7 +550,9 @@ mid::SubscriptionId MavlinkDrone::subscribe(mid::StateCallback fn) {
 }
 
 void MavlinkDrone::publish() {
-  if (!broker_.empty()) broker_.publish(state());
+  mid::DroneState s = state();
+  watch_site(s);
+  if (!broker_.empty()) broker_.publish(s);
 }
 
 }  // namespace eamos::mavlink_adapter

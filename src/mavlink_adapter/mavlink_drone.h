@@ -31,6 +31,7 @@
 #include "mavlink_adapter/autopilot.h"
 #include "mavlink_adapter/autopilot_params.h"
 #include "mavlink_adapter/command_sender.h"
+#include "mavlink_adapter/setpoint_pacer.h"
 #include "mavlink_adapter/telemetry.h"
 #include "mid/adapter_drone.h"
 #include "mid/drone_api.h"
@@ -315,6 +316,7 @@ class MavlinkDrone final : public mid::AdapterDrone {
   bool mode_confirmed_ = false;
   double mode_granted_at_ = 0.0;  ///< loop time the setpoint mode was last granted
   fleet::Vec3 setpoint_;          ///< mission frame
+  SetpointPacer pacer_;           ///< the site's speed limits on setpoint_ (setpoint_pacer.h)
   Orbit orbit_;  ///< active: our setpoints fly it; commanded: the autopilot does
   int setpoints_sent_ = 0;
   /// Commands in flight that change the flight mode (DO_SET_MODE, NAV_TAKEOFF, NAV_LAND,

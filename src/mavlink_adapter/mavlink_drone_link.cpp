@@ -11,6 +11,8 @@
 
 #include "mavlink/enums.h"
 #include "mavlink_adapter/mavlink_drone.h"
+
+#include "mid/site_limits.h"
 #include "mid/vec.h"
 
 namespace eamos::mavlink_adapter {
@@ -180,7 +182,7 @@ std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
                                                       send(ml::pack(ml::ParamRequestRead{sysid_, ml::comp::AUTOPILOT1, name, -1}));
                                                     });
   lock.unlock();
-  limits_ = combine_limits(*autopilot_, settings_.limits, values);
+  limits_ = combine_limits(*autopilot_, mid::flight_limits(settings_), values);
   for (const std::string& w : limits_.warnings) std::cerr << "eamos: warning: " << settings_.name << ": " << w << "\n";
   send_heartbeat();
   link_watchdog();
@@ -560,7 +562,8 @@ void MavlinkDrone::stream_tick() {
   sp.target_component = ml::comp::AUTOPILOT1;
   sp.coordinate_frame = ml::kFrameLocalNed;
   sp.type_mask = ml::kPositionOnlyMask;
-  Vec3 ned = mission_to_ned(setpoint_, settings_.home);
+  Vec3 target = orbit_.active ? setpoint_ : pacer_.next(setpoint_, position(), dt);
+  Vec3 ned = mission_to_ned(target, settings_.home);
   sp.x = static_cast<float>(ned.x);
   sp.y = static_cast<float>(ned.y);
   sp.z = static_cast<float>(ned.z);
