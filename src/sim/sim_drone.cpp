@@ -227,7 +227,10 @@ void SimDrone::step() {
   ++steps_;
   const double dt = 1.0 / options_.step_hz;
   StepEvent event = step_motion(motion_, kin_, settings_.limits, dt);
-  if (gust_blows()) kin_.position = kin_.position + settings_.gust->velocity * dt;
+  // A step covers (now - dt, now]: the gust moves the drone on every step that ends in its window.
+  const auto& g = settings_.gust;
+  if (g && !landed_ && loop_.now() > g->at_s + 1e-9 && loop_.now() <= g->at_s + g->for_s + 1e-9)
+    kin_.position = kin_.position + g->velocity * dt;
   if (kin_.position.z < ground_z()) {  // the ground stops a braking descent
     kin_.position.z = ground_z();
     kin_.velocity.z = std::max(0.0, kin_.velocity.z);
@@ -274,12 +277,13 @@ void SimDrone::phase_changed() {
 
 bool SimDrone::gust_blows() const {
   const auto& g = settings_.gust;
-  return g && !landed_ && loop_.now() >= g->at_s && loop_.now() < g->at_s + g->for_s;
+  // Through the window's last instant: its last step ends there.
+  return g && !landed_ && loop_.now() >= g->at_s && loop_.now() <= g->at_s + g->for_s + 1e-9;
 }
 
 void SimDrone::gust_changed() {
   gust_timer_ = mid::kNoTimer;
-  if (loop_.now() < settings_.gust->at_s + settings_.gust->for_s)
+  if (loop_.now() <= settings_.gust->at_s)
     gust_timer_ = loop_.at(settings_.gust->at_s + settings_.gust->for_s, [this] { gust_changed(); });
   update_timers();
 }
