@@ -5,12 +5,8 @@
 
 namespace eamos::mavlink_adapter {
 
-fleet::Vec3 SetpointPacer::next(fleet::Vec3 goal, fleet::Vec3 vehicle, double dt) {
+fleet::Vec3 SetpointPacer::next(fleet::Vec3 goal, double dt) {
   if (!active_) return goal;
-  if (!goal_ || goal_->x != goal.x || goal_->y != goal.y || goal_->z != goal.z) {
-    goal_ = goal;
-    carrot_ = vehicle;
-  }
   double dx = goal.x - carrot_.x, dy = goal.y - carrot_.y, dz = goal.z - carrot_.z;
   double horizontal = std::hypot(dx, dy);
   double step = caps_.max_speed_mps * dt;

@@ -5,8 +5,6 @@
 // than change the vehicle's parameters, the adapter moves the setpoint it streams toward the
 // goal no faster than the site allows, so the vehicle, chasing it, cannot fly faster. The
 // same on every autopilot, and nothing on the vehicle is left changed after the mission.
-#include <optional>
-
 #include "fleet/catalog.h"
 #include "fleet/fleet.h"
 
@@ -16,14 +14,17 @@ class SetpointPacer {
  public:
   /// `caps`: the limits to keep; `active` false sends every goal as it is.
   SetpointPacer(fleet::Limits caps, bool active) : caps_(caps), active_(active) {}
-  /// The setpoint to stream now for `goal`, `dt` seconds after the previous one. A goal
-  /// other than the last one starts the pacing again from `vehicle`, where the drone is.
-  fleet::Vec3 next(fleet::Vec3 goal, fleet::Vec3 vehicle, double dt);
+  /// A stream starts (again) with the vehicle at `vehicle`: the paced setpoint starts there.
+  void restart(fleet::Vec3 vehicle) { carrot_ = vehicle; }
+  /// The setpoint to stream now for `goal`, `dt` seconds after the previous one: the last
+  /// one moved toward `goal` by at most what the caps allow in `dt`. A new goal (the next
+  /// FlyTo, an orbit's moving point) is followed from where the last setpoint was, so the
+  /// setpoints never jump.
+  fleet::Vec3 next(fleet::Vec3 goal, double dt);
 
  private:
   fleet::Limits caps_;
   bool active_;
-  std::optional<fleet::Vec3> goal_;
   fleet::Vec3 carrot_;
 };
 
