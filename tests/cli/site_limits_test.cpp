@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -151,6 +152,24 @@ TEST_F(SiteLimits, DistributedAFlyToOutsideTheFenceIsRefusedBeforeTheDroneMoves)
   EXPECT_LT(farthest_x(failsafe), 0.01);
   EXPECT_TRUE(failsafe);
   expect_down_and_disarmed();
+}
+
+// One DEX per drone: Drone1 is pushed out while it pauses (no action to carry the fault);
+// its DEX fails over and its ABORT puts Drone2, on another process, in its failsafe too.
+TEST_F(SiteLimits, DistributedADronePushedOutPutsEveryDroneInItsFailsafe) {
+  eamos_test::Output r = run("two.eamos", "gust_two.yaml",
+                             "--distributed --speed 5 --domain 213 --deploy-dir " + (dir_ / "deploy").string());
+  EXPECT_EQ(r.status, 1) << r.out;
+  nlohmann::json s = summary();
+  EXPECT_EQ(s["error"].get<std::string>().rfind("Drone1 left its geofence at (10.", 0), 0u) << s.dump(2);
+  std::set<std::string> failsafes;
+  for (const nlohmann::json& e : eamos_test::read_trace(dir_ / "trace.jsonl"))
+    if (e.value("event", "") == "failsafe") failsafes.insert(e.value("drone", ""));
+  EXPECT_EQ(failsafes, (std::set<std::string>{"Drone1", "Drone2"})) << r.out;
+  for (const char* d : {"Drone1", "Drone2"}) {
+    EXPECT_TRUE(s["drones"][d]["landed"]) << d;
+    EXPECT_FALSE(s["drones"][d]["armed"]) << d;
+  }
 }
 
 }  // namespace
