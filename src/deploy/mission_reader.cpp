@@ -458,7 +458,6 @@ class Reader {
     optional_number(*j, "max_speed", w, out.max_speed_mps, 1e-9);
     optional_number(*j, "max_climb", w, out.max_climb_mps, 1e-9);
     optional_number(*j, "max_descent", w, out.max_descent_mps, 1e-9);
-    f_.boolean(*j, "upload_fence", w, out.upload_fence, false);
     const json* g = f_.member(*j, "geofence", w, false);
     if (!g || !f_.object(*g, "/drone/site/geofence")) return;
     fleet::Geofence fence;

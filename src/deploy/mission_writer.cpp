@@ -77,7 +77,6 @@ void write_site(JsonWriter& w, const fleet::SiteLimits& site) {
   write_optional(w, "max_speed", site.max_speed_mps);
   write_optional(w, "max_climb", site.max_climb_mps);
   write_optional(w, "max_descent", site.max_descent_mps);
-  if (site.upload_fence) w.member("upload_fence", true);
   w.end_object();
 }
 

@@ -42,17 +42,15 @@ struct Geofence {
 };
 
 /// The site's rules one drone keeps in flight (`safety:` in the fleet file, and the drone's
-/// own `geofence:`/`upload_fence:`): they travel in its mission file, so the DEX that flies
+/// own `geofence:`): they travel in its mission file, so the DEX that flies
 /// it needs nothing else. Empty members: no such rule.
 struct SiteLimits {
   std::optional<Geofence> geofence;
   std::optional<double> max_speed_mps;    ///< horizontal
   std::optional<double> max_climb_mps;
   std::optional<double> max_descent_mps;
-  /// MAVLink: also upload the geofence to the autopilot's own fence at connect.
-  bool upload_fence = false;
   bool empty() const {
-    return !geofence && !max_speed_mps && !max_climb_mps && !max_descent_mps && !upload_fence;
+    return !geofence && !max_speed_mps && !max_climb_mps && !max_descent_mps;
   }
 };
 
@@ -116,7 +114,6 @@ struct Safety {
   std::optional<double> max_climb_mps;
   std::optional<double> max_descent_mps;
   std::optional<Geofence> geofence;        ///< every drone's, unless a drone gives its own
-  bool upload_fence = false;               ///< every MAVLink drone's, unless it says otherwise
 };
 
 /// The values a sensor may read in flight (`range: [low, high]`): what `eamos verify`
@@ -147,7 +144,6 @@ struct DroneOverrides {
   std::map<std::string, SourceLocation> sensor_locations;  ///< where each SensorK is set
   std::map<std::string, SensorRange> sensor_ranges;        ///< SensorK → declared range
   std::optional<Geofence> geofence;                        ///< replaces the fleet's
-  std::optional<bool> upload_fence;                        ///< replaces the fleet's
 };
 
 struct Fleet {

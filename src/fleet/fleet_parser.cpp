@@ -14,8 +14,7 @@ namespace {
 
 const std::vector<std::string> kRootKeys = {"types", "drones", "safety"};
 const std::vector<std::string> kSafetyKeys = {"min_separation", "battery_reserve", "max_speed",
-                                              "max_climb",      "max_descent",     "geofence",
-                                              "upload_fence"};
+                                              "max_climb",      "max_descent",     "geofence"};
 const std::vector<std::string> kSeparationKeys = {"horizontal", "vertical"};
 const std::vector<std::string> kGeofenceKeys = {"polygon", "min_altitude", "max_altitude"};
 const std::vector<std::string> kTypeKeys = {"adapter", "capabilities", "sensors", "limits", "tolerance"};
@@ -24,7 +23,7 @@ const std::vector<std::string> kDroneKeys = {"home",     "battery",  "sensors",
                                              "limits",   "failsafe", "adapter",
                                              "connection", "sysid",  "timeouts",
                                              "geofence", "signing",  "announce_as_gcs",
-                                             "upload_fence", "gust"};
+                                             "gust"};
 const std::vector<std::string> kGustKeys = {"at", "for", "velocity"};
 const std::vector<std::string> kSigningKeys = {"key", "key_file", "setup"};
 const std::vector<std::string> kLimitKeys = {"max_speed", "max_climb", "max_descent",
@@ -255,8 +254,6 @@ void FleetParser::drone(const std::string& name, const YAML::Node& node) {
       if (key == "geofence") geofence(v, where, o.geofence);
       if (key == "signing") signing(v, where, s);
       if (key == "announce_as_gcs") flag(v, what, s.announce_as_gcs);
-      bool upload = false;
-      if (key == "upload_fence" && flag(v, what, upload)) o.upload_fence = upload;
       if (key == "gust") gust(v, what, s.gust);
     }
   }
@@ -394,7 +391,6 @@ void FleetParser::safety(const YAML::Node& node) {
     if (key == "max_climb" && positive(v, "max_climb of safety", value)) s.max_climb_mps = value;
     if (key == "max_descent" && positive(v, "max_descent of safety", value)) s.max_descent_mps = value;
     if (key == "geofence") geofence(v, "safety", s.geofence);
-    if (key == "upload_fence") flag(v, "upload_fence of safety", s.upload_fence);
   }
 }
 

@@ -196,12 +196,11 @@ TEST_F(MissionReader, RefusesAFileThatCannotBeRead) {
 }  // namespace
 // The site's rules travel in the drone's mission file: the DEX that flies it needs no fleet
 // file to keep them.
-TEST(MissionSite, TheGeofenceSpeedsUploadChoiceAndGustSurviveWriteAndRead) {
+TEST(MissionSite, TheGeofenceSpeedsAndGustSurviveWriteAndRead) {
   std::string fleet = std::string(test::kListing2Fleet) +
                       "    gust: {at: 4, for: 1.5, velocity: [2, 0, -0.5]}\n"
                       "safety:\n"
                       "  max_speed: 3.5\n"
-                      "  upload_fence: true\n"
                       "  geofence: {polygon: [[-40, -40], [40, -40], [40, 40], [-40, 40]], min_altitude: 1, "
                       "max_altitude: 25}\n";
   auto c = test::compile_mission(test::listing2_text(), fleet);
@@ -219,7 +218,6 @@ TEST(MissionSite, TheGeofenceSpeedsUploadChoiceAndGustSurviveWriteAndRead) {
   EXPECT_EQ(*site.geofence->max_altitude_m, 25.0);
   EXPECT_EQ(*site.max_speed_mps, 3.5);
   EXPECT_FALSE(site.max_climb_mps);
-  EXPECT_TRUE(site.upload_fence);
   ASSERT_TRUE(m.settings.gust);
   EXPECT_EQ(m.settings.gust->for_s, 1.5);
   EXPECT_EQ(m.settings.gust->velocity.z, -0.5);
