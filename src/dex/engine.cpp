@@ -56,11 +56,6 @@ Engine::~Engine() {
   drone_.set_fault_sink(nullptr);
 }
 
-std::string failure_text(const Failure& f) {
-  if (f.action.empty()) return f.reason;  // the drone's own fault: its reason names the drone
-  return f.drone + "." + f.action + " (line " + std::to_string(f.line) + ") failed: " + f.reason;
-}
-
 void Engine::start() {
   for (std::size_t i = 0; i < m_.nodes.size(); ++i) {
     const Node& n = m_.nodes[i];
