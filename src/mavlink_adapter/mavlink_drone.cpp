@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <iostream>
 #include <limits>
 
+#include "diag/log.h"
 #include "mavlink/enums.h"
 #include "mid/requests.h"
 #include "mid/timeouts.h"
@@ -40,8 +40,8 @@ MavlinkDrone::MavlinkDrone(fleet::DroneSettings settings, fleet::DroneType type,
 
 MavlinkDrone::~MavlinkDrone() {
   if (link_ && link_->foreign_datagrams() > 0)
-    std::cerr << "mavlink: " << settings_.name << ": " << link_->foreign_datagrams()
-              << " datagram(s) from other addresses than the vehicle's were ignored in all\n";
+    diag::Logger{"mavlink", settings_.name}.warning(std::to_string(link_->foreign_datagrams()) +
+                                                    " datagram(s) from other addresses than the vehicle's were ignored in all");
   link_.reset();  // joins the receive thread: nothing new gets posted
   for (mid::TimerId t : {stream_timer_, heartbeat_timer_, watchdog_timer_, heartbeat_poll_timer_}) loop_.cancel(t);
 }

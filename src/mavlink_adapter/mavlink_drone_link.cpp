@@ -5,10 +5,10 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
-#include <iostream>
 #include <map>
 #include <mutex>
 
+#include "diag/log.h"
 #include "mavlink/enums.h"
 #include "mavlink_adapter/mavlink_drone.h"
 #include "mid/vec.h"
@@ -95,8 +95,8 @@ std::string MavlinkDrone::give_key(FirstHeartbeat& first, std::unique_lock<std::
            std::to_string(static_cast<int>(options_.connect_timeout_s)) +
            " s; does its autopilot support MAVLink 2 signing (ArduPilot does; PX4 needs MAV_SIGN_CFG)?";
   link_->require_signed(true);
-  std::cerr << "eamos: " << settings_.name << ": system " << int(sysid_)
-            << " took the signing key; unsigned frames are dropped from now on\n";
+  diag::Logger{"mavlink", settings_.name}.info("system " + std::to_string(sysid_) +
+                                               " took the signing key; unsigned frames are dropped from now on");
   return "";
 }
 
@@ -181,7 +181,7 @@ std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
                                                     });
   lock.unlock();
   limits_ = combine_limits(*autopilot_, settings_.limits, values);
-  for (const std::string& w : limits_.warnings) std::cerr << "eamos: warning: " << settings_.name << ": " << w << "\n";
+  for (const std::string& w : limits_.warnings) diag::Logger{"mavlink", settings_.name}.warning(w);
   send_heartbeat();
   link_watchdog();
   return "";
@@ -384,8 +384,8 @@ void MavlinkDrone::note_rejected(const char* what) {
   ++rejected_frames_;
   // The first few, then every thousandth: a flood of bad frames must not flood the log.
   if (rejected_frames_ <= 10 || rejected_frames_ % 1000 == 0)
-    std::cerr << "mavlink: " << settings_.name << ": dropped a frame of system " << int(sysid_) << ": " << what
-              << " (" << rejected_frames_ << " dropped so far)\n";
+    diag::Logger{"mavlink", settings_.name}.warning("dropped a frame of system " + std::to_string(sysid_) + ": " + what +
+                                                    " (" + std::to_string(rejected_frames_) + " dropped so far)");
 }
 
 void MavlinkDrone::note_foreign() {
@@ -397,7 +397,7 @@ void MavlinkDrone::note_foreign() {
   if (!first && !thousandth) return;
   std::string text = "ignored " + std::to_string(n) + " datagram(s) from other addresses than system " +
                      std::to_string(sysid_) + "'s (not the vehicle: someone else is sending to this port)";
-  std::cerr << "mavlink: " << settings_.name << ": " << text << "\n";
+  diag::Logger{"mavlink", settings_.name}.warning(text);
   if (first) note(text);
 }
 
