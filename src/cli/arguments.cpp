@@ -8,8 +8,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <iostream>
 
 #include "diag/diagnostics.h"
+#include "diag/log.h"
 
 namespace eamos::cli {
 
@@ -26,6 +28,18 @@ bool use_color(const std::string& when, int fd) {
   const char* no_color = std::getenv("NO_COLOR");
   const char* term = std::getenv("TERM");
   return isatty(fd) && !(no_color && *no_color) && !(term && std::strcmp(term, "dumb") == 0);
+}
+
+void apply_log_level(const std::string& argument) {
+  if (!argument.empty()) {
+    diag::set_log_level(diag::parse_log_level(argument).value_or(diag::LogLevel::info));
+    setenv(diag::kLogLevelVariable, argument.c_str(), 1);
+    return;
+  }
+  const char* env = std::getenv(diag::kLogLevelVariable);
+  if (env && !diag::parse_log_level(env))
+    std::cerr << "eamos: warning: " << diag::kLogLevelVariable << "='" << env
+              << "' is not a log level; info is used (set it to error, warning, info or debug)\n";
 }
 
 std::string color_argument(const std::vector<std::string>& args) {
@@ -202,7 +216,7 @@ std::string argument_error(const std::vector<std::string>& args, ArgSpot at, con
 
 namespace {
 
-const std::vector<std::string> kValuedAppOptions = {"--color", "--diagnostics-format"};
+const std::vector<std::string> kValuedAppOptions = {"--color", "--diagnostics-format", "--log-level"};
 
 bool looks_like_option(const std::string& t) {
   return t.size() >= 2 && t[0] == '-' && (t[1] == '-' ? t.size() > 2 : std::isalpha(static_cast<unsigned char>(t[1])));

@@ -81,6 +81,11 @@ int main(int argc, char** argv) {
   app.add_option("--color", color,
                  "Colour in diagnostics: auto (on a terminal, unless NO_COLOR is set), always, never")
       ->check(eamos::cli::one_of({"auto", "always", "never"}));
+  std::string log_level;
+  app.add_option("--log-level", log_level,
+                 "Which messages of eamos's parts (links, transport, executor) reach standard error: error, warning, "
+                 "info (default, or $EAMOS_LOG_LEVEL) or debug; the DEX processes a launch starts inherit it")
+      ->check(eamos::cli::one_of({"error", "warning", "info", "debug"}));
   std::string diagnostics_format = "text";
   app.add_option("--diagnostics-format", diagnostics_format,
                  "How errors and warnings of a mission are printed: text (GCC style), json, or sarif (SARIF 2.1.0); "
@@ -280,6 +285,7 @@ int main(int argc, char** argv) {
   }
   style.color_stderr = eamos::cli::use_color(color, STDERR_FILENO);
   style.diagnostics = diagnostics_format;
+  eamos::cli::apply_log_level(log_level);
 
   // Every file a command writes is checked before it compiles or flies anything: a run must
   // not end in "cannot write" after the flight.

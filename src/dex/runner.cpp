@@ -5,8 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <iostream>
 #include <unordered_map>
+
+#include "diag/log.h"
 
 namespace eamos::dex {
 
@@ -332,7 +333,7 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     loop.stop();  // a real-time loop would otherwise wait out the time limit; failsafes run below
   };
   loop.on_callback_error([&](const std::string& what) {
-    std::cerr << "eamos: internal error in the executor: " << what << "\n";
+    diag::Logger{"dex", ""}.error("internal error in the executor: " + what);
     stop_mission("internal error in the executor: " + what);
   });
   for (int d = 0; d < n; ++d) {

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "diag/xml.h"
 #include "graph/palette.h"
 
 namespace eamos::trace {
@@ -46,18 +47,7 @@ const char* outcome_colour(const std::string& outcome) {
   return "#56B4E9";  // still running when the run ended
 }
 
-std::string xml(const std::string& s) {
-  std::string out;
-  for (char c : s) switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
-    }
-  return out;
-}
+std::string xml(const std::string& s) { return diag::xml_escape(s); }
 
 /// Fixed-point number without trailing zeros ("12.5", "3", "-0.25").
 std::string num(double v, int decimals = 2) {

@@ -4,8 +4,6 @@
 // monitor cannot command a drone. Text from the trace is only ever set as textContent.
 'use strict';
 
-const PALETTE = ['#0072B2', '#D55E00', '#009E73', '#CC79A7', '#E69F00', '#56B4E9', '#F0E442', '#000000',
-                 '#7f3c8d', '#11a579', '#3969ac', '#f2b701', '#e73f74', '#80ba5a', '#e68310', '#008695'];
 const STATE_FILL = {
   waiting: '#fff59d', running: '#90caf9', succeeded: '#a5d6a7', failed: '#ef9a9a', preempted: '#ffcc80',
   cancelled: '#bdbdbd', released: '#b2ebf2', true: '#a5d6a7', false: '#cfd8dc', 'not-run': '#f5f5f5',
@@ -54,10 +52,18 @@ function addDrone(name, info) {
   if (!name || D.droneIndex.has(name)) return D.droneIndex.get(name);
   const i = D.drones.length;
   const home = info && Array.isArray(info.home) ? info.home.map(v => num(v, 0)) : null;
-  D.drones.push({ name, index: i, home, geofence: info ? info.geofence : null, colour: PALETTE[i % PALETTE.length] });
+  D.drones.push({ name, index: i, home, geofence: info ? info.geofence : null, colour: droneColour(i) });
   D.droneIndex.set(name, i);
   S.structureDirty = true;
   return i;
+}
+
+// Drone i's colour in every picture of eamos: the server sends the palette (graph/palette.h)
+// with the mission, so the page and the SVGs cannot disagree.
+function droneColour(i) {
+  const p = S.mission && Array.isArray(S.mission.palette) ? S.mission.palette : [];
+  const c = p.length ? p[i % p.length] : null;
+  return typeof c === 'string' && /^#[0-9A-Fa-f]{6}$/.test(c) ? c : '#555555';
 }
 
 // The MEG nodes an event is about: its "node" field, else (older traces) drone + line + name.
