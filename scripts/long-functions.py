@@ -85,11 +85,31 @@ def is_function(header):
     return True
 
 
+def in_initializer_list(header):
+    """Whether a `{` after `header` opens a member's brace initialiser in a constructor's
+    initialiser list (`Foo() : a_{1}`) rather than the constructor's body."""
+    h = header.rstrip()
+    if not h or not (h[-1].isalnum() or h[-1] in '_>'):
+        return False
+    depth = 0
+    closed = False  # the parameter list has closed
+    for i, ch in enumerate(h):
+        if ch == '(':
+            depth += 1
+        elif ch == ')':
+            depth -= 1
+            closed = closed or depth == 0
+        elif ch == ':' and depth == 0 and closed:
+            if h[i - 1:i] != ':' and h[i + 1:i + 2] != ':':
+                return True
+    return False
+
+
 def functions(text):
     """(first line, last line, name) of every function defined at namespace or class scope."""
     s = strip(text)
     found = []
-    scopes = []  # per open brace: 'scope' (namespace, class), 'func', 'other'
+    scopes = []  # per open brace: 'scope' (namespace, class), 'func', 'init' (a member's braces), 'other'
     start = 0  # where the current declaration's text begins
     line = 1
     line_at = []
@@ -100,7 +120,7 @@ def functions(text):
     func_start = None
     for i, ch in enumerate(s):
         if ch == '{':
-            in_scope = all(k == 'scope' for k in scopes)
+            in_scope = all(k in ('scope', 'init') for k in scopes)
             kind = 'other'
             if in_scope:
                 header = s[start:i].strip()
@@ -108,19 +128,22 @@ def functions(text):
                     kind = 'scope'
                 elif ENUM.match(header):
                     kind = 'other'
+                elif in_initializer_list(header):
+                    kind = 'init'
                 elif is_function(header):
                     kind = 'func'
                     first = start + (len(s[start:i]) - len(s[start:i].lstrip()))
                     name = re.findall(r'([~\w:]+(?:operator\s*\S+?)?)\s*\(', header)
                     func_start = (line_at[first], name[0] if name else '?')
             scopes.append(kind)
-            start = i + 1
+            if kind != 'init':
+                start = i + 1
         elif ch == '}':
             kind = scopes.pop() if scopes else 'scope'
             if kind == 'func' and all(k == 'scope' for k in scopes) and func_start:
                 found.append((func_start[0], line_at[i], func_start[1]))
                 func_start = None
-            if all(k == 'scope' for k in scopes):
+            if kind != 'init' and all(k == 'scope' for k in scopes):
                 start = i + 1
         elif ch == ';' and all(k == 'scope' for k in scopes):
             start = i + 1
@@ -175,6 +198,7 @@ def main():
             tag = ' (long: reason given)' if reason else ''
             print(f'{path}:{first}: {name}: {length} lines{tag}')
     if a.check and listed:
+        sys.stdout.flush()
         print(f'{listed} function(s) over {a.max} lines without a `// long:` reason above them; '
               'split them, or say why one is genuinely one thing', file=sys.stderr)
         return 1
