@@ -42,7 +42,7 @@ struct Fleet {
   std::vector<std::unique_ptr<dex::Engine>> engines;
 };
 
-TEST(Failsafe, AnAbandonedFleetIsCommandedWholeBeforeAnyFailsafeIsRecorded) {
+TEST(AbandonedMission, AnAbandonedFleetIsCommandedWholeBeforeAnyFailsafeIsRecorded) {
   Fleet f;
   ASSERT_EQ(f.drones.size(), 3u);
   ASSERT_NEAR(f.drones[1]->state().z, 5.0, 0.1);
@@ -64,7 +64,7 @@ TEST(Failsafe, AnAbandonedFleetIsCommandedWholeBeforeAnyFailsafeIsRecorded) {
   EXPECT_EQ(trace.events[0].reason, "a test");
 }
 
-TEST(Failsafe, TheWaitEndsOnceTheLastDroneIsDownAndDisarmed) {
+TEST(AbandonedMission, TheWaitEndsOnceTheLastDroneIsDownAndDisarmed) {
   Fleet f;
   dex::abandon_drones(f.all(), f.loop.now(), "a test", nullptr);
   double abandoned_at = f.loop.now();
@@ -81,7 +81,7 @@ TEST(Failsafe, TheWaitEndsOnceTheLastDroneIsDownAndDisarmed) {
   EXPECT_LT(f.loop.now(), abandoned_at + 60.0);
 }
 
-TEST(Failsafe, HoveringDronesNeedNoWait) {
+TEST(AbandonedMission, HoveringDronesNeedNoWait) {
   Fleet f(fleet::Failsafe::hover);
   dex::abandon_drones(f.all(), f.loop.now(), "a test", nullptr);
   double abandoned_at = f.loop.now();
@@ -97,7 +97,7 @@ TEST(Failsafe, HoveringDronesNeedNoWait) {
   EXPECT_FALSE(f.drones[0]->state().landed);
 }
 
-TEST(Failsafe, AWaitDestroyedBeforeTheEndLooksNoMore) {
+TEST(AbandonedMission, AWaitDestroyedBeforeTheEndLooksNoMore) {
   Fleet f;
   dex::abandon_drones(f.all(), f.loop.now(), "a test", nullptr);
   int over = 0;
