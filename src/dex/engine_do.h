@@ -4,7 +4,7 @@
 // state (one watched run of the do-branch per condition, its flip and the cancel of that
 // run on every drone) lives in engine_do.cpp, behind Engine::activate_do,
 // Engine::recheck_do and Engine::cancel_do_run.
-#include "dex/mission.h"  // lang::ControlKind
+#include "vocab/kinds.h"
 
 namespace eamos::dex {
 
