@@ -374,7 +374,7 @@ void InProcessRun::fail(const Failure& f) {
   failed_ = true;
   finished_at_ = loop_.now();
   result_.failure = f;
-  result_.error = f.drone + "." + f.action + " (line " + std::to_string(f.line) + ") failed: " + f.reason;
+  result_.error = failure_text(f);
   abandon();
   loop_.stop();  // a real-time loop would otherwise wait out the time limit; failsafes run in fly()
 }

@@ -3,6 +3,7 @@
 #include "mavlink_adapter/mavlink_drone.h"
 
 #include "mavlink/enums.h"
+#include "mid/site_limits.h"
 #include "mid/vec.h"
 
 namespace eamos::mavlink_adapter {
@@ -28,7 +29,9 @@ MavlinkDrone::MavlinkDrone(fleet::DroneSettings settings, fleet::DroneType type,
       watch_(loop, options_, link_, commands_, clock_, watch_hooks()),
       stream_(loop, options_, settings_, link_, modes_, vehicle_, watch_, stream_hooks()),
       orbit_(settings_, link_, vehicle_, clock_, stream_, modes_, commands_, orbit_hooks()),
-      camera_(link_, commands_, options_.picture_confirm_s, camera_hooks()) {}
+      camera_(link_, commands_, options_.picture_confirm_s, camera_hooks()) {
+  keep_site(settings_);
+}
 
 MavlinkDrone::~MavlinkDrone() { link_.close(); }
 
@@ -171,7 +174,9 @@ mid::DroneState MavlinkDrone::state() const {
 mid::SubscriptionId MavlinkDrone::subscribe(mid::StateCallback fn) { return broker_.subscribe(std::move(fn)); }
 
 void MavlinkDrone::publish() {
-  if (!broker_.empty()) broker_.publish(state());
+  mid::DroneState s = state();
+  watch_site(s);
+  if (!broker_.empty()) broker_.publish(s);
 }
 
 }  // namespace eamos::mavlink_adapter

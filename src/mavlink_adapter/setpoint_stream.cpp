@@ -1,6 +1,7 @@
 #include "mavlink_adapter/setpoint_stream.h"
 
 #include "mavlink/enums.h"
+#include "mid/site_limits.h"
 
 namespace eamos::mavlink_adapter {
 
@@ -17,7 +18,9 @@ SetpointStream::SetpointStream(mid::EventLoop& loop, const MavlinkOptions& optio
       modes_(modes),
       vehicle_(vehicle),
       watch_(watch),
-      hooks_(std::move(hooks)) {}
+      hooks_(std::move(hooks)),
+      pacer_(mid::flight_limits(settings),
+             settings.site.max_speed_mps || settings.site.max_climb_mps || settings.site.max_descent_mps) {}
 
 SetpointStream::~SetpointStream() { loop_.cancel(timer_); }
 
@@ -25,6 +28,7 @@ void SetpointStream::start() {
   streaming_ = true;
   if (timer_ != mid::kNoTimer) return;
   sent_ = 0;
+  pacer_.restart(mission_position(vehicle_, settings_.home));
   tick();
 }
 
@@ -39,7 +43,7 @@ void SetpointStream::tick() {
   sp.target_component = ml::comp::AUTOPILOT1;
   sp.coordinate_frame = ml::kFrameLocalNed;
   sp.type_mask = ml::kPositionOnlyMask;
-  Vec3 ned = mission_to_ned(setpoint_, settings_.home);
+  Vec3 ned = mission_to_ned(pacer_.next(setpoint_, dt), settings_.home);
   sp.x = static_cast<float>(ned.x);
   sp.y = static_cast<float>(ned.y);
   sp.z = static_cast<float>(ned.z);

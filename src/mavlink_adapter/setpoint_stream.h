@@ -11,6 +11,7 @@
 #include "fleet/fleet.h"
 #include "mavlink_adapter/link_watch.h"
 #include "mavlink_adapter/mode_commands.h"
+#include "mavlink_adapter/setpoint_pacer.h"
 #include "mavlink_adapter/telemetry.h"
 #include "mavlink_adapter/vehicle_link.h"
 #include "mid/event_loop.h"
@@ -77,6 +78,7 @@ class SetpointStream {
   bool mode_confirmed_ = false;
   double mode_granted_at_ = 0.0;  ///< loop time the setpoint mode was last granted
   fleet::Vec3 setpoint_;          ///< mission frame
+  SetpointPacer pacer_;  ///< the site's speed limits on what is sent (setpoint_pacer.h)
   int sent_ = 0;                  ///< setpoints since the stream (re)started
   mid::TimerId timer_ = mid::kNoTimer;
 };

@@ -1,5 +1,7 @@
 #include "mavlink_adapter/vehicle_link.h"
 
+#include "mid/site_limits.h"
+
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
@@ -171,7 +173,7 @@ void VehicleLink::read_limits(FirstHeartbeat& first, std::unique_lock<std::mutex
         send(ml::pack(ml::ParamRequestRead{sysid_, ml::comp::AUTOPILOT1, name, -1}));
       });
   lock.unlock();
-  limits_ = combine_limits(*autopilot_, settings_.limits, values);
+  limits_ = combine_limits(*autopilot_, mid::flight_limits(settings_), values);
   for (const std::string& w : limits_.warnings) std::cerr << "eamos: warning: " << settings_.name << ": " << w << "\n";
 }
 
