@@ -113,6 +113,7 @@ void check_violation(const json& j, LineCheck& c, const std::set<std::string>& f
 
 const std::set<std::string> kOutcomes = {"succeeded", "preempted", "cancelled", "failed"};
 
+// long: the schema of docs/trace.md as a table, one branch per event, read side by side with the doc.
 void check_event(const json& j, const std::string& event, LineCheck& c, const std::set<std::string>& fleet,
                  bool strict) {
   if (event == "start" || event == "end" || event == "condition" || event == "sensor") {
