@@ -65,6 +65,7 @@ struct Geofence {
   std::vector<std::pair<double, double>> polygon;  ///< (x east, y north), m; empty = no polygon
   std::optional<double> min_altitude_m;
   std::optional<double> max_altitude_m;
+  std::optional<SourceLocation> max_altitude_at;  ///< where the fleet file sets max_altitude
   /// True when (x, y, z) lies inside (a point on the boundary is inside).
   bool contains(double x, double y, double z) const;
   bool contains_xy(double x, double y) const;
@@ -104,6 +105,7 @@ struct LimitOverrides {
   std::optional<double> max_descent_mps;
   std::optional<double> max_accel_mps2;
   std::optional<double> max_altitude_m;
+  std::optional<SourceLocation> max_altitude_at;  ///< where the fleet file sets max_altitude
 
   void apply(Limits& limits) const;
 };
@@ -128,6 +130,8 @@ struct Fleet {
   std::map<std::string, SourceLocation> drone_locations;  ///< where each drone is described
   std::shared_ptr<SourceFile> source;        ///< keeps the file text for diagnostics
   Safety safety;                             ///< operating rules for `eamos verify`
+  /// Where a type's `limits:` set max_altitude, per type name (a note for diagnostics).
+  std::map<std::string, SourceLocation> type_max_altitude_at;
 
   /// The geofence `drone` must stay in: its own, else the fleet's; null when neither is set.
   const Geofence* geofence_for(const std::string& drone) const;

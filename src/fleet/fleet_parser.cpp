@@ -135,6 +135,7 @@ void FleetParser::type(const std::string& name, const YAML::Node& node) {
         LimitOverrides given;
         limits(v, where, given);
         given.apply(t.limits);
+        if (given.max_altitude_at) out_.type_max_altitude_at[name] = *given.max_altitude_at;
       }
       if (key == "tolerance") tolerance(v, where, t.tolerance);
       if (key == "sensors" && r_.whole_number(v, "sensors of " + where, sensor_count) &&
@@ -200,7 +201,10 @@ void FleetParser::limits(const YAML::Node& node, const std::string& where, Limit
     if (key == "max_climb") out.max_climb_mps = value;
     if (key == "max_descent") out.max_descent_mps = value;
     if (key == "max_accel") out.max_accel_mps2 = value;
-    if (key == "max_altitude") out.max_altitude_m = value;
+    if (key == "max_altitude") {
+      out.max_altitude_m = value;
+      out.max_altitude_at = location_of(kv.second.Mark());
+    }
   }
 }
 
@@ -443,6 +447,7 @@ void FleetParser::geofence(const YAML::Node& node, const std::string& where, std
     if (key == "min_altitude" && r_.number(kv.second, "min_altitude of " + what, value)) g.min_altitude_m = value;
     if (key == "max_altitude" && r_.number(kv.second, "max_altitude of " + what, value)) {
       g.max_altitude_m = value;
+      g.max_altitude_at = location_of(kv.second.Mark());
       max_node = kv.second;
     }
   }
