@@ -6,6 +6,8 @@
 #include <iostream>
 #include <unordered_map>
 
+#include "mid/home_check.h"
+
 namespace eamos::dex {
 
 namespace {
@@ -276,6 +278,14 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
       return result;
     }
     drones.push_back(std::move(c.drone));
+  }
+  std::vector<mid::Drone*> connected;
+  std::vector<fleet::DroneSettings> declared;
+  for (int d = 0; d < n; ++d) connected.push_back(drones[d].get()), declared.push_back(missions[d].settings);
+  if (std::string wrong = mid::check_homes_at_connect(loop, connected, declared, mid::kHomeFixTimeoutS);
+      !wrong.empty()) {
+    result.error = "the vehicles do not stand where the fleet file puts them; nothing was armed:\n" + wrong;
+    return result;
   }
   std::vector<std::vector<Sample>> tracks(n);
   for (int d = 0; d < n; ++d) record_sample(tracks[d], drones[d]->state());

@@ -81,6 +81,7 @@ DroneSettings Fleet::settings_for(const std::string& drone, const std::string& t
   if (!o || !o->adapter) s.adapter = type.adapter;
   s.limits = type.limits;
   s.tolerance = type.tolerance;
+  s.home_tolerance_m = safety.home_tolerance_m;
   if (o) o->limits.apply(s.limits);
   // A sensor the type lacks can never be read (the checker rejects it); check_drone
   // reports it, and dropping it keeps the mission file to what the drone can do.

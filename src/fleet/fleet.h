@@ -28,6 +28,10 @@ struct SensorModel {
 enum class Failsafe { land, return_home, hover };
 const char* failsafe_name(Failsafe f);
 
+/// How far (m, horizontally) the vehicles may stand from where their declared homes put them,
+/// relative to each other, before the mission refuses to arm (`safety: home_tolerance:`).
+inline constexpr double kDefaultHomeToleranceM = 3.0;
+
 struct DroneSettings {
   std::string name;
   std::string type;
@@ -49,6 +53,8 @@ struct DroneSettings {
   /// gives STATUSTEXT only to a link with a GCS tells us why it refused (docs/fleet.md:
   /// it also hides the loss of the real ground station from PX4's link-loss failsafe).
   bool announce_as_gcs = false;
+  /// The fleet's `safety: home_tolerance` (mid/home_check.h).
+  double home_tolerance_m = kDefaultHomeToleranceM;
 };
 
 /// "" when `hex` is a usable signing key (64 hex digits, not all zero), else what is wrong.
@@ -88,6 +94,8 @@ struct Safety {
   std::optional<double> max_climb_mps;
   std::optional<double> max_descent_mps;
   std::optional<Geofence> geofence;        ///< every drone's, unless a drone gives its own
+  /// Vehicles that report a global position must stand as their homes say within this (m).
+  double home_tolerance_m = kDefaultHomeToleranceM;
 };
 
 /// The values a sensor may read in flight (`range: [low, high]`): what `eamos verify`

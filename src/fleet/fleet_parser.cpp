@@ -14,7 +14,8 @@ namespace {
 
 const std::vector<std::string> kRootKeys = {"types", "drones", "safety"};
 const std::vector<std::string> kSafetyKeys = {"min_separation", "battery_reserve", "max_speed",
-                                              "max_climb",      "max_descent",     "geofence"};
+                                              "max_climb",      "max_descent",     "geofence",
+                                              "home_tolerance"};
 const std::vector<std::string> kSeparationKeys = {"horizontal", "vertical"};
 const std::vector<std::string> kGeofenceKeys = {"polygon", "min_altitude", "max_altitude"};
 const std::vector<std::string> kTypeKeys = {"adapter", "capabilities", "sensors", "limits", "tolerance"};
@@ -388,6 +389,7 @@ void FleetParser::safety(const YAML::Node& node) {
         s.battery_reserve_percent = value;
     }
     if (key == "max_speed" && positive(v, "max_speed of safety", value)) s.max_speed_mps = value;
+    if (key == "home_tolerance" && positive(v, "home_tolerance of safety", value)) s.home_tolerance_m = value;
     if (key == "max_climb" && positive(v, "max_climb of safety", value)) s.max_climb_mps = value;
     if (key == "max_descent" && positive(v, "max_descent of safety", value)) s.max_descent_mps = value;
     if (key == "geofence") geofence(v, "safety", s.geofence);
