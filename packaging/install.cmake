@@ -19,20 +19,27 @@ set(EAMOS_INCLUDE_DIR ${CMAKE_INSTALL_INCLUDEDIR}/eamos)
 set(EAMOS_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/eamos)
 
 # eamos_export(TARGET NAME DIR HEADERS...): TARGET becomes eamos::NAME for a program that
-# links it, here (an alias) and installed; HEADERS (in src/DIR) are the ones its users may
-# include: everything an installed header includes must be installed too (InstallTree.*
-# checks). The source folder is an include directory only while building.
+# links it, here (an alias) and installed; HEADERS (in src/DIR, each one of its public headers,
+# cmake/layers.cmake) are the ones its users may include: everything an installed header
+# includes must be installed too (InstallTree.* checks). The build's include roots stay in
+# the build (BUILD_INTERFACE); an installed target's users find include/eamos.
 function(eamos_export target name dir)
   set(headers ${ARGN})
+  get_target_property(public ${target} EAMOS_PUBLIC_HEADERS)
+  foreach(h IN LISTS headers)
+    if(NOT h IN_LIST public)
+      message(FATAL_ERROR "eamos_export(${target}): src/${dir}/${h} is not one of its public headers")
+    endif()
+  endforeach()
   list(TRANSFORM headers PREPEND ${PROJECT_SOURCE_DIR}/src/${dir}/)
-  set_target_properties(${target} PROPERTIES EXPORT_NAME ${name}
-                        INTERFACE_INCLUDE_DIRECTORIES "$<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src>")
-  target_compile_features(${target} PUBLIC cxx_std_20)
-  target_sources(${target} PUBLIC FILE_SET HEADERS BASE_DIRS ${PROJECT_SOURCE_DIR}/src FILES ${headers})
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${name})
+  target_compile_features(${target} INTERFACE cxx_std_20)
+  install(FILES ${headers} DESTINATION ${EAMOS_INCLUDE_DIR}/${dir} COMPONENT dev)
   add_library(eamos::${name} ALIAS ${target})
   set_property(GLOBAL APPEND PROPERTY EAMOS_EXPORTED_TARGETS ${target})
 endfunction()
 
+eamos_export(eamos_vocab vocab vocab kinds.h)
 eamos_export(eamos_diag diag diag source.h diagnostics.h)
 eamos_export(eamos_fleet fleet fleet catalog.h fleet.h)
 eamos_export(eamos_lang lang lang ast.h token.h lexer.h parser.h checker.h)
@@ -40,25 +47,25 @@ eamos_export(eamos_graph graph graph amt.h meg.h mdg.h pipeline.h export.h)
 eamos_export(eamos_deploy deploy deploy mission_file.h synthesize.h drone_package.h)
 eamos_export(eamos_mid mid mid drone_api.h event_loop.h adapter_registry.h adapter_drone.h action_tracker.h
              requests.h mover.h state_broker.h location_validator.h timeouts.h vec.h)
-eamos_export(eamos_dex dex dex bridge.h engine.h expr.h latency.h mission.h observer.h plot.h runner.h trace.h
-             trace_schema.h trace_writers.h)
+eamos_export(eamos_dex dex dex bridge.h engine.h expr.h failure.h latency.h mission.h observer.h runner.h trace.h
+             trace_writers.h)
+eamos_export(eamos_trace trace trace plot.h trace_schema.h)
 eamos_export(eamos_sim sim sim battery.h motion.h sim_adapter.h sim_drone.h)
 eamos_export(eamos_mavlink mavlink mavlink crc.h enums.h field_def.h fields.h frame.h link.h messages.h payloads.h
              signing.h url.h)
 eamos_export(eamos_mavlink_adapter mavlink_adapter mavlink_adapter adapter.h autopilot.h autopilot_params.h
-             command_sender.h mavlink_drone.h telemetry.h)
+             autopilot_texts.h camera.h command_sender.h link_watch.h mavlink_drone.h mavlink_options.h
+             mode_commands.h orbit_flight.h setpoint_stream.h telemetry.h vehicle_clock.h vehicle_link.h)
 # version.h (EAMOS_VERSION) is generated into the build tree.
 set_target_properties(eamos_version PROPERTIES EXPORT_NAME version
                       INTERFACE_INCLUDE_DIRECTORIES "$<BUILD_INTERFACE:${PROJECT_BINARY_DIR}/generated>")
-target_sources(eamos_version INTERFACE FILE_SET HEADERS BASE_DIRS ${PROJECT_BINARY_DIR}/generated
-               FILES ${PROJECT_BINARY_DIR}/generated/version.h)
+install(FILES ${PROJECT_BINARY_DIR}/generated/version.h DESTINATION ${EAMOS_INCLUDE_DIR} COMPONENT dev)
 add_library(eamos::version ALIAS eamos_version)
 get_property(exported GLOBAL PROPERTY EAMOS_EXPORTED_TARGETS)
 
 install(TARGETS eamos RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
 install(TARGETS ${exported} eamos_version EXPORT eamosTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev
-        FILE_SET HEADERS DESTINATION ${EAMOS_INCLUDE_DIR} COMPONENT dev
         INCLUDES DESTINATION ${EAMOS_INCLUDE_DIR})
 install(EXPORT eamosTargets NAMESPACE eamos:: DESTINATION ${EAMOS_CMAKE_DIR} COMPONENT dev)
 configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/eamosConfig.cmake.in

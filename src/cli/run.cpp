@@ -13,7 +13,7 @@
 #include "cli/signal_watch.h"
 #include "deploy/mission_file.h"
 #include "deploy/synthesize.h"
-#include "dex/plot.h"
+#include "trace/plot.h"
 #include "dex/runner.h"
 #include "dex/trace_writers.h"
 #include "graph/pipeline.h"
@@ -181,7 +181,7 @@ void hold_monitor(monitor::MonitorServer& server, MonitorHold& hold) {
 
 bool report_run(const RunCommandOptions& r, const dex::RunResult& result, const std::vector<dex::TraceEvent>& events) {
   if (!r.summary.empty() && !write_output(r.summary, summary_json(result).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n")) return false;
-  if (!r.plot.empty() && !write_output(r.plot, dex::plot_svg(result, events))) return false;
+  if (!r.plot.empty() && !write_output(r.plot, trace::plot_svg(result, events))) return false;
   if (result.latency) print_latency(*result.latency);
   if (result.completed)
     std::cout << "mission completed in " << result.duration << " s (mission time)\n";

@@ -189,6 +189,9 @@ class Fields {
 };
 
 constexpr double kAny = std::numeric_limits<double>::max();
+/// Corners a geofence polygon may have in a mission file: far beyond any site's, small
+/// enough that the in-flight checks of every target stay cheap.
+constexpr std::size_t kMaxFenceCorners = 10000;
 
 template <typename Enum>
 std::vector<std::string> names_of(std::initializer_list<Enum> values, const char* (*name)(Enum)) {
@@ -414,6 +417,8 @@ class Reader {
     if (f_.one_of(*d, "failsafe", "/drone", kFailsafes, failsafe)) s.failsafe = static_cast<fleet::Failsafe>(failsafe);
     limits(*d);
     tolerance(*d);
+    site(*d);
+    gust(*d);
     sensors(*d);
     if (const json* t = f_.member(*d, "timeouts", "/drone"); t && f_.object(*t, "/drone/timeouts"))
       for (const auto& [action, seconds] : t->items()) {
@@ -443,6 +448,64 @@ class Reader {
     f_.number(*t, "horizontal", w, out.horizontal_m, 1e-9, kAny);
     f_.number(*t, "vertical", w, out.vertical_m, 1e-9, kAny);
     f_.number(*t, "speed", w, out.settled_mps, 1e-9, kAny);
+  }
+
+  // Optional: written only when the fleet file has rules for the site.
+  void site(const json& d) {
+    const json* j = f_.member(d, "site", "/drone", false);
+    if (!j || !f_.object(*j, "/drone/site")) return;
+    fleet::SiteLimits& out = m_.settings.site;
+    const std::string w = "/drone/site";
+    optional_number(*j, "max_speed", w, out.max_speed_mps, 1e-9);
+    optional_number(*j, "max_climb", w, out.max_climb_mps, 1e-9);
+    optional_number(*j, "max_descent", w, out.max_descent_mps, 1e-9);
+    const json* g = f_.member(*j, "geofence", w, false);
+    if (!g || !f_.object(*g, "/drone/site/geofence")) return;
+    fleet::Geofence fence;
+    const std::string gw = "/drone/site/geofence";
+    optional_number(*g, "min_altitude", gw, fence.min_altitude_m, -kAny);
+    optional_number(*g, "max_altitude", gw, fence.max_altitude_m, -kAny);
+    if (polygon(*g, gw, fence)) out.geofence = std::move(fence);
+  }
+
+  void optional_number(const json& obj, const char* key, const std::string& where, std::optional<double>& out,
+                       double lo) {
+    double v = 0;
+    if (obj.contains(key) && f_.number(obj, key, where, v, lo, kAny)) out = v;
+  }
+
+  bool polygon(const json& g, const std::string& where, fleet::Geofence& out) {
+    const json* p = f_.member(g, "polygon", where);
+    std::string here = at(where, "polygon");
+    if (!p || !f_.array(*p, here)) return false;
+    if (p->size() < 3 || p->size() > kMaxFenceCorners) {
+      d_.add(here, std::to_string(p->size()) + " corners; a polygon has 3 to " + std::to_string(kMaxFenceCorners));
+      return false;
+    }
+    bool ok = true;
+    for (std::size_t i = 0; i < p->size(); ++i) {
+      const json& c = (*p)[i];
+      std::string ci = at(here, static_cast<int>(i));
+      if (!f_.array(c, ci) || c.size() != 2) {
+        if (c.is_array()) d_.add(ci, "expected 2 numbers [x, y], found " + std::to_string(c.size()));
+        ok = false;
+        continue;
+      }
+      double x = 0, y = 0;
+      ok &= f_.number_value(c[0], at(ci, 0), x, -kAny, kAny) & f_.number_value(c[1], at(ci, 1), y, -kAny, kAny);
+      out.polygon.push_back({x, y});
+    }
+    return ok;
+  }
+
+  void gust(const json& d) {
+    const json* j = f_.member(d, "gust", "/drone", false);
+    if (!j || !f_.object(*j, "/drone/gust")) return;
+    fleet::Gust g;
+    bool ok = f_.number(*j, "at", "/drone/gust", g.at_s, 0, kAny);
+    ok &= f_.number(*j, "for", "/drone/gust", g.for_s, 1e-9, kAny);
+    ok &= vec3(*j, "velocity", "/drone/gust", g.velocity);
+    if (ok) m_.settings.gust = g;
   }
 
   void sensors(const json& d) {

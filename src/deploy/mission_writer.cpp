@@ -50,6 +50,45 @@ void write_tolerance(JsonWriter& w, const fleet::GoalTolerance& t) {
   w.end_object();
 }
 
+void write_optional(JsonWriter& w, const char* key, const std::optional<double>& v) {
+  if (v) w.member(key, *v);
+}
+
+// Written only when the fleet sets a rule, so a mission without `safety:` keeps its bytes.
+void write_site(JsonWriter& w, const fleet::SiteLimits& site) {
+  w.begin_object();
+  if (site.geofence) {
+    const fleet::Geofence& g = *site.geofence;
+    w.key("geofence");
+    w.begin_object();
+    w.key("polygon");
+    w.begin_array();
+    for (const auto& [x, y] : g.polygon) {
+      w.begin_array();
+      w.value(x);
+      w.value(y);
+      w.end_array();
+    }
+    w.end_array();
+    write_optional(w, "min_altitude", g.min_altitude_m);
+    write_optional(w, "max_altitude", g.max_altitude_m);
+    w.end_object();
+  }
+  write_optional(w, "max_speed", site.max_speed_mps);
+  write_optional(w, "max_climb", site.max_climb_mps);
+  write_optional(w, "max_descent", site.max_descent_mps);
+  w.end_object();
+}
+
+void write_gust(JsonWriter& w, const fleet::Gust& g) {
+  w.begin_object();
+  w.member("at", g.at_s);
+  w.member("for", g.for_s);
+  w.key("velocity");
+  write_vec3(w, g.velocity);
+  w.end_object();
+}
+
 void write_settings(JsonWriter& w, const fleet::DroneSettings& s, int index) {
   w.begin_object();
   w.member("name", s.name);
@@ -73,6 +112,14 @@ void write_settings(JsonWriter& w, const fleet::DroneSettings& s, int index) {
   write_limits(w, s.limits);
   w.key("tolerance");
   write_tolerance(w, s.tolerance);
+  if (!s.site.empty()) {
+    w.key("site");
+    write_site(w, s.site);
+  }
+  if (s.gust) {
+    w.key("gust");
+    write_gust(w, *s.gust);
+  }
   w.key("sensors");
   w.begin_object();
   for (const auto& [name, model] : s.sensors) {

@@ -8,7 +8,7 @@
 #include <memory>
 #include <string>
 
-#include "graph/meg.h"
+#include "vocab/kinds.h"
 #include "mid/drone_api.h"
 
 namespace eamos::dex {

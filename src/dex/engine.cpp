@@ -44,9 +44,17 @@ Engine::Engine(const Mission& mission, mid::Drone& drone, mid::EventLoop& loop, 
       hooks_.trace->record(e);
     });
   }
+  // A fault of the drone no action carried (it left its geofence between actions): the
+  // drone has already commanded its failsafe; the mission fails as on a failed action.
+  drone_.set_fault_sink([this](const mid::ActionEnd& e) {
+    if (!halted_ && hooks_.on_failure) hooks_.on_failure({m_.fleet[m_.self], "", 0, e.reason, e.failure, e.detail});
+  });
 }
 
-Engine::~Engine() { drone_.set_message_sink(nullptr); }
+Engine::~Engine() {
+  drone_.set_message_sink(nullptr);
+  drone_.set_fault_sink(nullptr);
+}
 
 void Engine::start() {
   for (std::size_t i = 0; i < m_.nodes.size(); ++i) {

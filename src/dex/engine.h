@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "dex/bridge.h"
+#include "dex/failure.h"
 #include "dex/mission.h"
 #include "dex/observer.h"
 #include "dex/trace.h"
@@ -23,16 +24,6 @@ namespace eamos::dex {
 /// A uniform property (X, Y, Z, Battery, Armed, Landed, SensorK) of a drone state;
 /// booleans as 0/1, an unknown sensor as 0.
 double property_of(const mid::DroneState& s, const std::string& name);
-
-/// Why a mission failed: the drone, the action and the source line.
-struct Failure {
-  std::string drone;
-  std::string action;
-  int line = 0;
-  std::string reason;
-  mid::FailureReason kind = mid::FailureReason::none;  ///< none: not an action's failure
-  std::string detail;  ///< the vehicle's own words (MAV_RESULT, STATUSTEXT), or ""
-};
 
 struct EngineHooks {
   Transport* transport = nullptr;  ///< OutBridge's way out

@@ -11,8 +11,7 @@
 
 #include "dex/expr.h"
 #include "fleet/fleet.h"
-#include "graph/meg.h"
-#include "lang/ast.h"
+#include "vocab/kinds.h"
 
 namespace eamos::dex {
 

@@ -333,7 +333,7 @@ RunResult run_in_process(const std::vector<Mission>& missions, const mid::Adapte
     failed = true;
     finished_at = loop.now();
     result.failure = f;
-    result.error = f.drone + "." + f.action + " (line " + std::to_string(f.line) + ") failed: " + f.reason;
+    result.error = failure_text(f);
     abandon();
     loop.stop();  // a real-time loop would otherwise wait out the time limit; failsafes run below
   };

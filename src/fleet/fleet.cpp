@@ -83,6 +83,10 @@ DroneSettings Fleet::settings_for(const std::string& drone, const std::string& t
   s.tolerance = type.tolerance;
   s.home_tolerance_m = safety.home_tolerance_m;
   if (o) o->limits.apply(s.limits);
+  if (const Geofence* g = geofence_for(drone)) s.site.geofence = *g;
+  s.site.max_speed_mps = safety.max_speed_mps;
+  s.site.max_climb_mps = safety.max_climb_mps;
+  s.site.max_descent_mps = safety.max_descent_mps;
   // A sensor the type lacks can never be read (the checker rejects it); check_drone
   // reports it, and dropping it keeps the mission file to what the drone can do.
   std::erase_if(s.sensors, [&](const auto& kv) { return sensor_index(kv.first, type.sensors) == 0; });

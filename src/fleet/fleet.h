@@ -32,6 +32,43 @@ const char* failsafe_name(Failsafe f);
 /// relative to each other, before the mission refuses to arm (`safety: home_tolerance:`).
 inline constexpr double kDefaultHomeToleranceM = 3.0;
 
+/// Where drones may fly (docs/fleet.md, `geofence:`): inside a polygon of the mission frame's
+/// x/y plane (none: anywhere) and between two altitudes (each optional). `eamos verify`
+/// checks the flown tracks and every motion target against it; in flight every adapter's
+/// drone refuses a target outside it and fails over when the drone leaves it (mid/site_limits.h).
+struct Geofence {
+  std::vector<std::pair<double, double>> polygon;  ///< (x east, y north), m; empty = no polygon
+  std::optional<double> min_altitude_m;
+  std::optional<double> max_altitude_m;
+  std::optional<SourceLocation> max_altitude_at;  ///< where the fleet file sets max_altitude
+  /// True when (x, y, z) lies inside (a point on the boundary is inside).
+  bool contains(double x, double y, double z) const;
+  bool contains_xy(double x, double y) const;
+};
+
+/// The site's rules one drone keeps in flight (`safety:` in the fleet file, and the drone's
+/// own `geofence:`): they travel in its mission file, so the DEX that flies
+/// it needs nothing else. Empty members: no such rule.
+struct SiteLimits {
+  std::optional<Geofence> geofence;
+  std::optional<double> max_speed_mps;    ///< horizontal
+  std::optional<double> max_climb_mps;
+  std::optional<double> max_descent_mps;
+  bool empty() const {
+    return !geofence && !max_speed_mps && !max_climb_mps && !max_descent_mps;
+  }
+};
+
+/// The simulator's deterministic push (`gust:` of a drone): from mission time `at_s` for
+/// `for_s` seconds the air moves the drone by `velocity` on top of whatever it flies, as a
+/// gust stronger than its motors would. For testing what happens when a drone is pushed
+/// out of its fence; other adapters ignore it.
+struct Gust {
+  double at_s = 0.0;
+  double for_s = 0.0;
+  Vec3 velocity;  ///< m/s, mission frame
+};
+
 struct DroneSettings {
   std::string name;
   std::string type;
@@ -53,6 +90,8 @@ struct DroneSettings {
   /// gives STATUSTEXT only to a link with a GCS tells us why it refused (docs/fleet.md:
   /// it also hides the loss of the real ground station from PX4's link-loss failsafe).
   bool announce_as_gcs = false;
+  SiteLimits site;             ///< the site's rules this drone keeps in flight
+  std::optional<Gust> gust;    ///< simulator only
   /// The fleet's `safety: home_tolerance` (mid/home_check.h).
   double home_tolerance_m = kDefaultHomeToleranceM;
 };
@@ -64,19 +103,6 @@ std::string signing_key_problem(const std::string& hex);
 /// or write is refused: the key lets whoever holds it fly the vehicle.
 std::string read_signing_key_file(const std::string& path, std::string& hex);
 
-/// Where drones may fly (docs/fleet.md, `geofence:`): inside a polygon of the mission frame's
-/// x/y plane (none: anywhere) and between two altitudes (each optional). `eamos verify`
-/// checks the flown tracks and every motion target against it; nothing in flight uses it.
-struct Geofence {
-  std::vector<std::pair<double, double>> polygon;  ///< (x east, y north), m; empty = no polygon
-  std::optional<double> min_altitude_m;
-  std::optional<double> max_altitude_m;
-  std::optional<SourceLocation> max_altitude_at;  ///< where the fleet file sets max_altitude
-  /// True when (x, y, z) lies inside (a point on the boundary is inside).
-  bool contains(double x, double y, double z) const;
-  bool contains_xy(double x, double y) const;
-};
-
 /// Two airborne drones are too close when they are nearer than `horizontal_m` horizontally
 /// and nearer than `vertical_m` vertically at the same time.
 struct Separation {
@@ -84,7 +110,8 @@ struct Separation {
   double vertical_m = 1.0;
 };
 
-/// The fleet's operating rules (`safety:`), checked by `eamos verify` before a flight.
+/// The fleet's operating rules (`safety:`): checked by `eamos verify` before a flight, and
+/// (geofence and speeds, through each drone's SiteLimits) kept by every drone in flight.
 /// The speed limits here are the operator's, not the vehicle's: a drone able to fly 10 m/s
 /// may be allowed 5 m/s over a site.
 struct Safety {

@@ -23,7 +23,9 @@ const std::vector<std::string> kToleranceKeys = {"horizontal", "vertical", "spee
 const std::vector<std::string> kDroneKeys = {"home",     "battery",  "sensors",
                                              "limits",   "failsafe", "adapter",
                                              "connection", "sysid",  "timeouts",
-                                             "geofence", "signing",  "announce_as_gcs"};
+                                             "geofence", "signing",  "announce_as_gcs",
+                                             "gust"};
+const std::vector<std::string> kGustKeys = {"at", "for", "velocity"};
 const std::vector<std::string> kSigningKeys = {"key", "key_file", "setup"};
 const std::vector<std::string> kLimitKeys = {"max_speed", "max_climb", "max_descent",
                                              "max_accel", "max_altitude"};
@@ -85,6 +87,8 @@ class FleetParser {
   void polygon(const YAML::Node& node, const std::string& what, Geofence& out);
   void timeouts(const YAML::Node& node, const std::string& where, DroneSettings& settings);
   void signing(const YAML::Node& node, const std::string& where, DroneSettings& settings);
+  bool flag(const YAML::Node& node, const std::string& what, bool& out);
+  void gust(const YAML::Node& node, const std::string& what, std::optional<Gust>& out);
   bool saturated() const { return r_.diags.saturated(); }
 
   YamlReader r_;
@@ -254,8 +258,8 @@ void FleetParser::drone(const std::string& name, const YAML::Node& node) {
       if (key == "timeouts") timeouts(v, where, s);
       if (key == "geofence") geofence(v, where, o.geofence);
       if (key == "signing") signing(v, where, s);
-      if (key == "announce_as_gcs" && (!v.IsScalar() || !YAML::convert<bool>::decode(v, s.announce_as_gcs)))
-        r_.error(v, what + " must be true or false; got " + describe(v));
+      if (key == "announce_as_gcs") flag(v, what, s.announce_as_gcs);
+      if (key == "gust") gust(v, what, s.gust);
     }
   }
   out_.drones[name] = std::move(s);
@@ -394,6 +398,39 @@ void FleetParser::safety(const YAML::Node& node) {
     if (key == "max_descent" && positive(v, "max_descent of safety", value)) s.max_descent_mps = value;
     if (key == "geofence") geofence(v, "safety", s.geofence);
   }
+}
+
+bool FleetParser::flag(const YAML::Node& node, const std::string& what, bool& out) {
+  if (node.IsScalar() && YAML::convert<bool>::decode(node, out)) return true;
+  r_.error(node, what + " must be true or false; got " + describe(node));
+  return false;
+}
+
+void FleetParser::gust(const YAML::Node& node, const std::string& what, std::optional<Gust>& out) {
+  if (!node.IsMap()) {
+    r_.error(node, what + " must be a map {at: S, for: S, velocity: [vx, vy, vz]}; got " + describe(node));
+    return;
+  }
+  Gust g;
+  bool ok = true;
+  std::set<std::string> seen;
+  for (const auto& kv : node) {
+    std::string key = r_.field(kv.first, kGustKeys, seen, what);
+    if (key == "at") {
+      ok &= r_.number(kv.second, "at of " + what, g.at_s);
+      if (g.at_s < 0) {
+        r_.error(kv.second, "at of " + what + " must be a mission time (s) not below 0; got " + describe(kv.second));
+        ok = false;
+      }
+    }
+    if (key == "for") ok &= positive(kv.second, "for of " + what, g.for_s);
+    if (key == "velocity") ok &= r_.vec3(kv.second, "velocity of " + what, g.velocity);
+  }
+  if (!seen.count("for") || !seen.count("velocity")) {
+    r_.error(node, what + " needs `for` (s) and `velocity` ([vx, vy, vz] m/s); e.g. {at: 5, for: 2, velocity: [10, 0, 0]}");
+    ok = false;
+  }
+  if (ok) out = g;
 }
 
 bool FleetParser::positive(const YAML::Node& node, const std::string& what, double& out) {

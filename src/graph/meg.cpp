@@ -5,45 +5,6 @@
 
 namespace eamos::graph {
 
-const char* meg_kind_name(MegKind k) {
-  switch (k) {
-    case MegKind::init: return "init";
-    case MegKind::action: return "action";
-    case MegKind::fork: return "fork";
-    case MegKind::condition: return "condition";
-    case MegKind::terminal: return "terminal";
-    case MegKind::pause: return "pause";
-    case MegKind::end: return "end";
-  }
-  return "";
-}
-
-const char* branch_name(Branch b) {
-  switch (b) {
-    case Branch::any: return "";
-    case Branch::true_: return "true";
-    case Branch::false_: return "false";
-    case Branch::go: return "go";
-    case Branch::repeat: return "repeat";
-    case Branch::exit: return "exit";
-    case Branch::do_: return "do";
-    case Branch::skip: return "skip";
-    case Branch::done: return "done";
-    case Branch::continue_: return "continue";
-  }
-  return "";
-}
-
-const char* arc_kind_name(ArcKind k) {
-  switch (k) {
-    case ArcKind::exec: return "exec";
-    case ArcKind::back: return "back";
-    case ArcKind::partner: return "partner";
-    case ArcKind::stop: return "stop";
-  }
-  return "";
-}
-
 int Meg::add_node(MegKind kind, SourceLocation loc, int amt) {
   MegNode n;
   n.id = static_cast<int>(nodes.size());

@@ -9,47 +9,9 @@
 #include "diag/source.h"
 #include "graph/amt.h"
 #include "lang/ast.h"
+#include "vocab/kinds.h"  // MegKind, Branch, ArcKind
 
 namespace eamos::graph {
-
-enum class MegKind {
-  init,       ///< mission start; a sync point cloned onto every drone that needs it
-  action,     ///< a drone action
-  fork,       ///< start of a PAR block; a sync point (no drone until the MDG clones it)
-  condition,  ///< a control structure's decision; evaluated by exactly one drone
-  terminal,   ///< end of a control-structure branch (or of an async branch)
-  pause,      ///< PauseFor: a timer on one drone
-  end,        ///< mission end: held by the mission lead (the first declared drone)
-};
-const char* meg_kind_name(MegKind k);
-/// Sync points have no drone of their own; the MDG clones them per drone.
-inline bool is_sync_point(MegKind k) { return k == MegKind::init || k == MegKind::fork; }
-
-/// Which outcome of a condition an arc follows; `any` for every other source node.
-enum class Branch {
-  any,
-  true_,     ///< If: condition held
-  false_,    ///< If: condition did not hold
-  go,        ///< Wait*/Pause*: the awaited state was reached
-  repeat,    ///< Repeat*: run one more iteration
-  exit,      ///< Repeat*: stop repeating, run the after-branch
-  do_,       ///< Do*: condition says "do", start the do-branch
-  skip,      ///< Do*: condition says "don't", nothing to do
-  done,      ///< Do*: condition flipped while the do-branch ran; it was cancelled
-  continue_, ///< Do*Async: the sequence goes on at once
-};
-const char* branch_name(Branch b);
-
-enum class ArcKind {
-  exec,     ///< execution link: the target may start once all its exec arcs fired
-  back,     ///< execution link closing a Repeat loop: re-runs the condition
-  partner,  ///< control link that releases a terminal: it ends without its branch having
-            ///< run. Between the two terminals of a structure (the one that ends releases
-            ///< the other, so the untaken branch counts as ended), and from a Do condition
-            ///< to its do-terminal on the `skip` outcome
-  stop,     ///< control link from a Do's do-terminal to its condition: stop watching
-};
-const char* arc_kind_name(ArcKind k);
 
 struct MegArc {
   int from = 0;

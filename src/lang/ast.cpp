@@ -27,40 +27,6 @@ const char* op_text(Op op) {
   return "";
 }
 
-namespace {
-struct ControlEntry {
-  ControlKind kind;
-  const char* name;
-};
-constexpr ControlEntry kControls[] = {
-    {ControlKind::If, "If"},
-    {ControlKind::WaitUntil, "WaitUntil"},
-    {ControlKind::WaitWhile, "WaitWhile"},
-    {ControlKind::RepeatUntil, "RepeatUntil"},
-    {ControlKind::RepeatWhile, "RepeatWhile"},
-    {ControlKind::RepeatFor, "RepeatFor"},
-    {ControlKind::PauseUntil, "PauseUntil"},
-    {ControlKind::PauseWhile, "PauseWhile"},
-    {ControlKind::PauseFor, "PauseFor"},
-    {ControlKind::DoUntilAsync, "DoUntilAsync"},
-    {ControlKind::DoWhileAsync, "DoWhileAsync"},
-    {ControlKind::DoUntilSync, "DoUntilSync"},
-    {ControlKind::DoWhileSync, "DoWhileSync"},
-};
-}  // namespace
-
-const char* control_name(ControlKind kind) {
-  for (const auto& e : kControls)
-    if (e.kind == kind) return e.name;
-  return "";
-}
-
-ControlKind control_from_name(const std::string& name) {
-  for (const auto& e : kControls)
-    if (name == e.name) return e.kind;
-  return ControlKind::none;
-}
-
 int Mission::find_drone(const std::string& name) const {
   for (std::size_t i = 0; i < drones.size(); ++i)
     if (drones[i].name == name) return static_cast<int>(i);

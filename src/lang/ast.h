@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "diag/source.h"
+#include "vocab/kinds.h"  // ControlKind
 
 namespace eamos::lang {
 
@@ -43,15 +44,6 @@ struct Expr {
   int drone_index = -1;  ///< property: index into Mission::drones
   ValueType type = ValueType::unknown;
 };
-
-/// The 13 mission control structures of the paper, rules (9)–(19).
-enum class ControlKind {
-  none,
-  If, WaitUntil, WaitWhile, RepeatUntil, RepeatWhile, RepeatFor,
-  PauseUntil, PauseWhile, PauseFor, DoUntilAsync, DoWhileAsync, DoUntilSync, DoWhileSync,
-};
-const char* control_name(ControlKind kind);
-ControlKind control_from_name(const std::string& name);
 
 enum class StatementKind {
   action,     ///< Drone.Capability(args)

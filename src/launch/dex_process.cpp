@@ -298,7 +298,7 @@ bool DexProcess::begin() {
   hooks.transport = transport_.get();
   hooks.trace = &tee_;
   hooks.on_failure = [this](const dex::Failure& f) {
-    abandon(f.drone + "." + f.action + " (line " + std::to_string(f.line) + ") failed: " + f.reason, f, true);
+    abandon(dex::failure_text(f), f, true);
   };
   hooks.on_end = [this] {
     end_reached_ = true;

@@ -147,4 +147,8 @@ fleet::Vec3 mission_to_ned(fleet::Vec3 p, fleet::Vec3 home) {
   return {p.y - home.y, p.x - home.x, home.z - p.z};
 }
 
+fleet::Vec3 mission_position(const VehicleState& v, fleet::Vec3 home) {
+  return v.have_position ? ned_to_mission(v.ned, home) : home;
+}
+
 }  // namespace eamos::mavlink_adapter

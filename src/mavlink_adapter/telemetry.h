@@ -83,5 +83,7 @@ std::pair<int32_t, int32_t> offset_lat_lon(int32_t lat, int32_t lon, double nort
 
 fleet::Vec3 ned_to_mission(fleet::Vec3 ned, fleet::Vec3 home);
 fleet::Vec3 mission_to_ned(fleet::Vec3 mission, fleet::Vec3 home);
+/// Where the vehicle is in the mission frame; `home` until its first position report.
+fleet::Vec3 mission_position(const VehicleState& v, fleet::Vec3 home);
 
 }  // namespace eamos::mavlink_adapter

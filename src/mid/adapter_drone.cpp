@@ -1,5 +1,7 @@
 #include "mid/adapter_drone.h"
 
+#include "mid/site_limits.h"
+
 namespace eamos::mid {
 
 AdapterDrone::AdapterDrone(EventLoop& loop, fleet::DroneType type)
@@ -64,6 +66,41 @@ void AdapterDrone::clear_action_timer(ActionId id) {
   if (it == action_timers_.end()) return;
   loop_.cancel(it->second);
   action_timers_.erase(it);
+}
+
+void AdapterDrone::keep_site(const fleet::DroneSettings& s) {
+  name_ = s.name;
+  fence_ = s.site.geofence;
+  fence_failsafe_ = s.failsafe;
+}
+
+void AdapterDrone::watch_site(const DroneState& s) {
+  if (!fence_ || breach_pending_ || !failsafe_reason_.empty() || !s.armed || s.landed) return;
+  // min_altitude does not hold while the drone climbs to it or comes down from it.
+  const ActionRequest* motion = tracker_.request(tracker_.motion());
+  bool climbing_or_landing = motion && (motion->name == "Takeoff" || motion->name == "Land" || motion->name == "ReturnHome");
+  std::string where = fence_breach(*fence_, s, climbing_or_landing);
+  if (where.empty()) return;
+  // Acted on from the loop at this same instant: the adapter is in the middle of a step
+  // or a telemetry frame, which a failsafe must not cut short.
+  breach_pending_ = true;
+  loop_.after(0.0, [this, where] { left_fence(where); });
+}
+
+void AdapterDrone::left_fence(const std::string& where) {
+  breach_pending_ = false;
+  if (!failsafe_reason_.empty()) return;  // the mission's own failsafe came first
+  ActionEnd e{.outcome = Outcome::failed,
+              .reason = name_ + " left its geofence " + where + "; its failsafe (" +
+                        fleet::failsafe_name(fence_failsafe_) + ") was commanded",
+              .failure = FailureReason::vehicle_fault,
+              .detail = "geofence breach"};
+  bool carried = !tracker_.running_ids().empty();
+  end_all(e);                 // reported later, through the loop
+  failsafe(fence_failsafe_);  // commanded now: the vehicle first, the words after
+  if (!carried && fault_sink_) loop_.after(0.0, [this, e] {
+      if (fault_sink_) fault_sink_(e);
+    });
 }
 
 void AdapterDrone::end_all(const ActionEnd& e) {

@@ -29,6 +29,7 @@ class AdapterDrone : public Drone {
   ActionId start(const ActionRequest& request, EndCallback on_end) final;
   /// Stops the vehicle's part (stop_action) and ends the action `cancelled`.
   bool cancel(ActionId id) final;
+  void set_fault_sink(std::function<void(const ActionEnd&)> sink) final { fault_sink_ = std::move(sink); }
 
  protected:
   /// Why the vehicle can take no action at all now (its link is lost, say), as the end to
@@ -61,6 +62,16 @@ class AdapterDrone : public Drone {
   /// deadline stretched for a slow vehicle clock still reads in the fleet file's seconds.
   virtual double deadline_clock_rate() const { return 1.0; }
 
+  /// The site's rules this drone keeps in flight (fleet::SiteLimits) and the failsafe it flies
+  /// when it finds itself outside its geofence; the adapter's constructor gives them.
+  void keep_site(const fleet::DroneSettings& s);
+  /// Every state the adapter publishes passes here first. Outside the geofence (armed, in the
+  /// air, no failsafe yet) the drone fails over at the same instant: every running action
+  /// ends `failed` (vehicle_fault) and failsafe() is commanded, and only then, through the
+  /// loop, are the ends and the fault reported (the fault sink, when no action ran).
+  void watch_site(const DroneState& s);
+  bool watches_site() const { return fence_.has_value(); }
+
   /// Runs `fn` after `delay_s` for a running action; cleared when the action stops.
   void after_for(ActionId id, double delay_s, std::function<void()> fn);
   void clear_action_timer(ActionId id);
@@ -76,6 +87,13 @@ class AdapterDrone : public Drone {
 
  private:
   std::map<ActionId, TimerId> action_timers_;  ///< ends of payload, system, Hover(s), …
+  void left_fence(const std::string& where);
+
+  std::string name_;                      ///< for the fault's words
+  std::optional<fleet::Geofence> fence_;  ///< none: nothing to watch
+  fleet::Failsafe fence_failsafe_ = fleet::Failsafe::land;
+  bool breach_pending_ = false;           ///< a breach is being acted on this instant
+  std::function<void(const ActionEnd&)> fault_sink_;
 };
 
 }  // namespace eamos::mid

@@ -136,6 +136,11 @@ class Drone {
   /// about the vehicle on its own, such as re-arming after an auto-disarm): the DEX puts each
   /// in the trace. Called on the loop's thread; an empty function stops them. Default: none.
   virtual void set_message_sink(std::function<void(const std::string&)>) {}
+  /// Where a fault of the drone itself goes that no running action carried (it left its
+  /// geofence while it hovered between actions): `failed` with the reason, reported through
+  /// the loop after the drone already commanded its failsafe. The DEX fails the mission on
+  /// it as on a failed action. An empty function stops them. Default: none.
+  virtual void set_fault_sink(std::function<void(const ActionEnd&)>) {}
 
   /// Whether the vehicle tells where it stands on the Earth (an autopilot with GPS); the
   /// built-in simulator has no such frame. Default: no.

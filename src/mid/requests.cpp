@@ -1,5 +1,7 @@
 #include "mid/requests.h"
 
+#include "mid/site_limits.h"
+
 #include <cstdio>
 
 #include <algorithm>
@@ -53,7 +55,7 @@ std::string uniform_refusal(const ActionRequest& r, const fleet::ActionSpec& spe
     if (a[0] <= 0.0) return "takeoff altitude must be positive, got " + metres(a[0]);
     if (a[0] > settings.limits.max_altitude_m)
       return "takeoff altitude " + metres(a[0]) + " is above max_altitude " + metres(settings.limits.max_altitude_m);
-    return "";
+    return fence_refusal(r, v, settings);
   }
   if (r.name == "Land") return "";
   if (v.landed) return "on the ground: take off before " + r.name;
@@ -68,7 +70,7 @@ std::string uniform_refusal(const ActionRequest& r, const fleet::ActionSpec& spe
       return "target z = " + metres(goal->z) + " is above max_altitude " + metres(settings.limits.max_altitude_m) +
              " over the ground";
   }
-  return "";
+  return fence_refusal(r, v, settings);
 }
 
 }  // namespace eamos::mid

@@ -39,7 +39,8 @@ struct VehicleFacts {
 /// "" when `request` (already passed check_request, whose spec is `spec`) may start on a
 /// vehicle in the state `v`, otherwise why not, in words: Disarm in the air or while a
 /// motion runs, motion while disarmed, anything but Takeoff or Land on the ground, targets
-/// below the ground or above max_altitude, non-positive radii and altitudes. What only a
+/// below the ground or above max_altitude, non-positive radii and altitudes, targets outside
+/// the drone's geofence (mid/site_limits.h). What only a
 /// platform knows (battery, the autopilot's own checks) each adapter adds.
 std::string uniform_refusal(const ActionRequest& request, const fleet::ActionSpec& spec, const VehicleFacts& v,
                             const fleet::DroneSettings& settings);

@@ -1,12 +1,12 @@
 // Reading a trace file (JSON Lines, docs/trace.md) into Python: checked line by line with
-// the schema's own check (dex::check_trace) before any of it is handed over.
+// the schema's own check (trace::check_trace) before any of it is handed over.
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 
 #include "bindings.h"
-#include "dex/trace_schema.h"
+#include "trace/trace_schema.h"
 
 namespace eamos::python {
 
@@ -56,7 +56,7 @@ py::list errors_of(const std::string& path, const std::string& text) {
     return out;
   }
   std::istringstream in(text);
-  std::vector<std::string> errors = dex::check_trace(in);
+  std::vector<std::string> errors = trace::check_trace(in);
   for (std::size_t i = 0; i < errors.size() && i < kMaxTraceErrors; ++i) out.append(utf8(located(path, errors[i])));
   if (errors.size() > kMaxTraceErrors)
     out.append(utf8(path + ": error: " + std::to_string(errors.size() - kMaxTraceErrors) + " more problems not listed"));

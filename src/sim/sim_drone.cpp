@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "mid/requests.h"
+#include "mid/site_limits.h"
 #include "mid/timeouts.h"
 #include "mid/vec.h"
 
@@ -23,6 +24,10 @@ SimDrone::SimDrone(fleet::DroneSettings settings, fleet::DroneType type, mid::Ev
       options_(options),
       battery_(settings_.battery_percent, loop.now()) {
   kin_.position = settings_.home;
+  // The site's speed limits are the ones it flies by (and derives its deadlines from).
+  settings_.limits = mid::flight_limits(settings_);
+  keep_site(settings_);
+  if (settings_.gust) gust_timer_ = loop_.at(settings_.gust->at_s, [this] { gust_changed(); });
   for (int k = 1; k <= type_.sensors; ++k) {
     std::string name = "Sensor" + std::to_string(k);
     auto it = settings_.sensors.find(name);
@@ -31,7 +36,7 @@ SimDrone::SimDrone(fleet::DroneSettings settings, fleet::DroneType type, mid::Ev
 }
 
 SimDrone::~SimDrone() {
-  for (mid::TimerId t : {step_timer_, telemetry_timer_, empty_timer_, publish_timer_})
+  for (mid::TimerId t : {step_timer_, telemetry_timer_, empty_timer_, publish_timer_, gust_timer_})
     loop_.cancel(t);
 }
 
@@ -222,6 +227,10 @@ void SimDrone::step() {
   ++steps_;
   const double dt = 1.0 / options_.step_hz;
   StepEvent event = step_motion(motion_, kin_, settings_.limits, dt);
+  // A step covers (now - dt, now]: the gust moves the drone on every step that ends in its window.
+  const auto& g = settings_.gust;
+  if (g && !landed_ && loop_.now() > g->at_s + 1e-9 && loop_.now() <= g->at_s + g->for_s + 1e-9)
+    kin_.position = kin_.position + g->velocity * dt;
   if (kin_.position.z < ground_z()) {  // the ground stops a braking descent
     kin_.position.z = ground_z();
     kin_.velocity.z = std::max(0.0, kin_.velocity.z);
@@ -266,8 +275,21 @@ void SimDrone::phase_changed() {
   if (armed_ && !landed_) empty_timer_ = loop_.at(battery_.empty_at(), [this] { battery_empty(); });
 }
 
+bool SimDrone::gust_blows() const {
+  const auto& g = settings_.gust;
+  // Through the window's last instant: its last step ends there.
+  return g && !landed_ && loop_.now() >= g->at_s && loop_.now() <= g->at_s + g->for_s + 1e-9;
+}
+
+void SimDrone::gust_changed() {
+  gust_timer_ = mid::kNoTimer;
+  if (loop_.now() <= settings_.gust->at_s)
+    gust_timer_ = loop_.at(settings_.gust->at_s + settings_.gust->for_s, [this] { gust_changed(); });
+  update_timers();
+}
+
 void SimDrone::update_timers() {
-  bool moving = motion_.kind != MotionKind::idle;
+  bool moving = motion_.kind != MotionKind::idle || gust_blows();
   if (moving && step_timer_ == mid::kNoTimer) {
     // A run of steps starts one step from now; its later steps are counted from that origin,
     // so their times do not drift by rounding.
@@ -341,7 +363,10 @@ void SimDrone::unsubscribe(mid::SubscriptionId id) {
 }
 
 void SimDrone::publish() {
-  if (!broker_.empty()) broker_.publish(state());
+  if (broker_.empty() && !watches_site()) return;
+  mid::DroneState s = state();
+  watch_site(s);
+  if (!broker_.empty()) broker_.publish(s);
 }
 
 void SimDrone::post_publish() {

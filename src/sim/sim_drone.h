@@ -72,6 +72,9 @@ class SimDrone final : public mid::AdapterDrone {
   double sensor_value(int k) const;
   std::string mode_name() const;
   double ground_z() const { return settings_.home.z; }
+  /// The fleet file's `gust:` pushes the drone now (in the air, within its time window).
+  bool gust_blows() const;
+  void gust_changed();  ///< at the gust's start and end: steps follow it
 
   fleet::DroneSettings settings_;
   /// "Sensor1" … "SensorN" of the type and the fleet file's model of each (null: reads 0),
@@ -97,6 +100,7 @@ class SimDrone final : public mid::AdapterDrone {
   mid::TimerId telemetry_timer_ = mid::kNoTimer;
   mid::TimerId empty_timer_ = mid::kNoTimer;
   mid::TimerId publish_timer_ = mid::kNoTimer;
+  mid::TimerId gust_timer_ = mid::kNoTimer;
 };
 
 }  // namespace eamos::sim

@@ -198,7 +198,7 @@ class SimVehicle {
   mid::EventLoop& loop_;
   VehicleOptions options_;
   sim::SimDrone drone_;
-  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);  ///< see MavlinkDrone::alive_
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);  ///< see VehicleLink::alive_
   std::unique_ptr<mavlink::Link> link_;
   std::unique_ptr<mavlink::Link> ground_station_;  ///< open_ground_station's link, or null
   mavlink::Encoder encoder_;

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "dex/bridge.h"
-#include "dex/engine.h"
+#include "dex/failure.h"
 #include "dex/trace.h"
 #include "mid/drone_api.h"
 

@@ -1,7 +1,7 @@
 // `eamos verify --plot`: the worst path's picture with its violations marked.
 #include <algorithm>
 
-#include "dex/plot.h"
+#include "trace/plot.h"
 #include "verify/flight.h"
 
 namespace eamos::verify {
@@ -55,10 +55,10 @@ std::string plot_worst_path(const graph::Compilation& c, const std::vector<dex::
                             const VerifyOptions& options, const VerifyReport& report) {
   Setup setup{c, missions, options};
   Flight f = fly_worst(setup, report);
-  std::vector<dex::PlotMark> marks;
+  std::vector<trace::PlotMark> marks;
   for (const PlacedViolation& p : place_violations(setup, f))
-    marks.push_back(dex::PlotMark{p.violation.t, p.x, p.y, p.violation.kind});
-  return dex::plot_svg(f.result, f.events, marks, caption(report));
+    marks.push_back(trace::PlotMark{p.violation.t, p.x, p.y, p.violation.kind});
+  return trace::plot_svg(f.result, f.events, marks, caption(report));
 }
 
 WorstFlight fly_worst_path(const graph::Compilation& c, const std::vector<dex::Mission>& missions,

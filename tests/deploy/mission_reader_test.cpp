@@ -194,4 +194,38 @@ TEST_F(MissionReader, RefusesAFileThatCannotBeRead) {
 }
 
 }  // namespace
+// The site's rules travel in the drone's mission file: the DEX that flies it needs no fleet
+// file to keep them.
+TEST(MissionSite, TheGeofenceSpeedsAndGustSurviveWriteAndRead) {
+  std::string fleet = std::string(test::kListing2Fleet) +
+                      "    gust: {at: 4, for: 1.5, velocity: [2, 0, -0.5]}\n"
+                      "safety:\n"
+                      "  max_speed: 3.5\n"
+                      "  geofence: {polygon: [[-40, -40], [40, -40], [40, 40], [-40, 40]], min_altitude: 1, "
+                      "max_altitude: 25}\n";
+  auto c = test::compile_mission(test::listing2_text(), fleet);
+  ASSERT_TRUE(c);
+  int d2 = 1;
+  std::string text = deploy::mission_text(*c, d2, deploy::mission_hash(*c));
+  dex::Mission m;
+  std::vector<std::string> errors;
+  ASSERT_TRUE(deploy::read_mission(text, "Drone2/mission.json", m, errors)) << errors.front();
+  const fleet::SiteLimits& site = m.settings.site;
+  ASSERT_TRUE(site.geofence);
+  EXPECT_EQ(site.geofence->polygon.size(), 4u);
+  EXPECT_EQ(site.geofence->polygon[1], std::make_pair(40.0, -40.0));
+  EXPECT_EQ(*site.geofence->min_altitude_m, 1.0);
+  EXPECT_EQ(*site.geofence->max_altitude_m, 25.0);
+  EXPECT_EQ(*site.max_speed_mps, 3.5);
+  EXPECT_FALSE(site.max_climb_mps);
+  ASSERT_TRUE(m.settings.gust);
+  EXPECT_EQ(m.settings.gust->for_s, 1.5);
+  EXPECT_EQ(m.settings.gust->velocity.z, -0.5);
+}
+
+TEST_F(MissionReader, AFileWithoutSafetyRulesHasNoSiteMember) {
+  EXPECT_FALSE(doc_["drone"].contains("site"));
+  EXPECT_FALSE(doc_["drone"].contains("gust"));
+}
+
 }  // namespace eamos

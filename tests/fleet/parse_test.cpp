@@ -218,3 +218,49 @@ TEST(Safety, ReadsEveryKeyAndADroneFenceReplacesTheFleets) {
 
 }  // namespace
 }  // namespace eamos::fleet
+
+namespace eamos::fleet {
+namespace {
+
+TEST(SiteRules, EachDroneGetsItsFenceAndTheSitesSpeeds) {
+  test::Parsed p = test::parse(
+      "safety:\n"
+      "  max_speed: 4\n"
+      "  max_descent: 1\n"
+      "  geofence: {polygon: [[0, 0], [10, 0], [10, 10]]}\n"
+      "drones:\n"
+      "  Drone2:\n"
+      "    geofence: {polygon: [[0, 0], [5, 0], [5, 5]], max_altitude: 9}\n"
+      "    gust: {at: 3, for: 2, velocity: [1, 0, 0]}\n");
+  ASSERT_TRUE(p.ok) << p.diags.format();
+  DroneSettings d1 = p.fleet.settings_for("Drone1", "Quad", 0);
+  DroneSettings d2 = p.fleet.settings_for("Drone2", "Quad", 1);
+  EXPECT_EQ(*d1.site.max_speed_mps, 4.0);
+  EXPECT_EQ(*d2.site.max_descent_mps, 1.0);
+  EXPECT_FALSE(d1.site.max_climb_mps);
+  ASSERT_TRUE(d1.site.geofence && d2.site.geofence);
+  EXPECT_EQ(d1.site.geofence->polygon.size(), 3u);
+  EXPECT_EQ(*d2.site.geofence->max_altitude_m, 9.0);
+  EXPECT_FALSE(d1.gust);
+  ASSERT_TRUE(d2.gust);
+  EXPECT_EQ(d2.gust->at_s, 3.0);
+  EXPECT_EQ(d2.gust->velocity.x, 1.0);
+}
+
+TEST(SiteRules, ABadGustIsAnErrorAtItsLineWithEveryOtherError) {
+  test::Parsed p = test::parse(
+      "safety:\n"
+      "  max_climb: sometimes\n"
+      "drones:\n"
+      "  Drone1:\n"
+      "    gust: {at: -1, velocity: [1, 0]}\n");
+  EXPECT_FALSE(p.ok);
+  std::string all = p.diags.format();
+  EXPECT_NE(all.find("fleet.yaml:2:14: error: max_climb of safety"), std::string::npos) << all;
+  EXPECT_NE(all.find("velocity of gust of drone 'Drone1'"), std::string::npos) << all;
+  EXPECT_NE(all.find("at of gust of drone 'Drone1' must be a mission time"), std::string::npos) << all;
+  EXPECT_NE(all.find("needs `for` (s) and `velocity`"), std::string::npos) << all;
+}
+
+}  // namespace
+}  // namespace eamos::fleet

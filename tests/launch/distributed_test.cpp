@@ -23,7 +23,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dex/trace_schema.h"
+#include "trace/trace_schema.h"
 #include "support/mission_edit.h"
 #include "support/read_files.h"
 #include "support/run_eamos.h"
@@ -96,7 +96,7 @@ std::string order_difference(const Events& local, const Events& dist) {
 std::string schema_errors(const fs::path& trace) {
   std::ifstream in(trace);
   std::string all;
-  for (const std::string& e : eamos::dex::check_trace(in, {.strict = true})) all += e + "\n";
+  for (const std::string& e : eamos::trace::check_trace(in, {.strict = true})) all += e + "\n";
   return all;
 }
 

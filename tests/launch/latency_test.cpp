@@ -22,7 +22,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dex/trace_schema.h"
+#include "trace/trace_schema.h"
 #include "support/eamos_process.h"
 #include "support/run_eamos.h"
 
@@ -42,7 +42,7 @@ std::vector<nlohmann::json> read_trace(const fs::path& p) {
 std::string check_errors(const fs::path& p) {
   std::ifstream in(p);
   std::string all;
-  for (const std::string& e : eamos::dex::check_trace(in, {.strict = true})) all += e + "\n";
+  for (const std::string& e : eamos::trace::check_trace(in, {.strict = true})) all += e + "\n";
   return all;
 }
 

@@ -21,7 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dex/trace_schema.h"
+#include "trace/trace_schema.h"
 
 #include "support/run_eamos.h"
 
@@ -63,7 +63,7 @@ std::string read_text(const fs::path& p) {
 std::string schema_errors(const fs::path& trace) {
   std::ifstream in(trace);
   std::string all;
-  for (const std::string& e : eamos::dex::check_trace(in, {.strict = true})) all += e + "\n";
+  for (const std::string& e : eamos::trace::check_trace(in, {.strict = true})) all += e + "\n";
   return all;
 }
 

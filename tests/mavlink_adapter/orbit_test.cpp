@@ -51,7 +51,7 @@ TEST(MavlinkOrbit, Px4FliesOrbitItselfAfterDoOrbitCirclingTheStartCounterClockwi
   VehicleThread vehicle(25360, 1, kSpeed);
   Flight f(25360);
   Orbiting o;
-  take_off_and_orbit(f, o, 8.0);
+  ASSERT_NO_FATAL_FAILURE(take_off_and_orbit(f, o, 8.0));
   EXPECT_FALSE(o.end);  // an orbit has no end of its own
   // The first DO_ORBIT started it; any later one only corrected its radius (next test).
   auto sent = vehicle.inspect([](const sim_vehicle::SimVehicle& s) { return s.orbit_commands(); });
@@ -94,7 +94,7 @@ TEST(MavlinkOrbit, APx4OrbitFlownShortIsCorrectedByDoOrbitsSentAgainWithTheCentr
   Orbiting o;
   // The lead makes up half the shortfall at once, the integral (0.2 /s, set for PX4 SITL) the
   // rest; with an integral of 0.1 /s this vehicle still flies 2.83-2.90 m at 24 s.
-  take_off_and_orbit(f, o, 40.0);
+  ASSERT_NO_FATAL_FAILURE(take_off_and_orbit(f, o, 40.0));
   EXPECT_FALSE(o.end);
   EXPECT_EQ(vehicle_mode(vehicle), Mode::orbit);
   auto sent = vehicle.inspect([](const sim_vehicle::SimVehicle& s) { return s.orbit_commands(); });
@@ -126,7 +126,7 @@ TEST(MavlinkOrbit, OnItsWayOutToAPx4OrbitTheVehicleTurnsToFaceTheCentreBeforeDoO
   VehicleThread vehicle(25376, 1, kSpeed);
   Flight f(25376);
   Orbiting o;
-  take_off_and_orbit(f, o, 0.0);
+  ASSERT_NO_FATAL_FAILURE(take_off_and_orbit(f, o, 0.0));
   std::optional<double> named;
   // The heading the adapter knew while the vehicle had no DO_ORBIT yet: once in its Orbit mode,
   // this vehicle reports its own heading again (90), and under load that report can come in
@@ -154,7 +154,7 @@ TEST(MavlinkOrbit, APx4HoldStandingOffTheEastPointStillStartsTheOrbitAfterTheWai
   VehicleThread vehicle(25411, kSpeed, options);
   Flight f(25411);
   Orbiting o;
-  take_off_and_orbit(f, o, 0.0);
+  ASSERT_NO_FATAL_FAILURE(take_off_and_orbit(f, o, 0.0));
   double stood_off = 0.0;
   for (int i = 0; i < 200 && do_orbits(vehicle) == 0 && !o.end; ++i) {  // 10 mission s at most
     stood_off = std::max(stood_off, f.drone->state().x - kRadius);
@@ -180,7 +180,7 @@ TEST(MavlinkOrbit, APx4OrbitStartsOnceTheVehicleNoLongerMovesOutWhateverItsVeloc
   VehicleThread vehicle(25412, kSpeed, options);
   Flight f(25412);
   Orbiting o;
-  take_off_and_orbit(f, o, 0.0);
+  ASSERT_NO_FATAL_FAILURE(take_off_and_orbit(f, o, 0.0));
   for (int i = 0; i < 400 && do_orbits(vehicle) == 0 && !o.end; ++i) f.loop.run_until(f.loop.now() + 0.05);
   ASSERT_GT(do_orbits(vehicle), 0) << "DO_ORBIT never went";
   EXPECT_FALSE(o.end);
@@ -223,7 +223,7 @@ TEST(MavlinkOrbit, ARefusedRadiusCorrectionIsNotedAndTheOrbitGoesOn) {
   std::vector<std::string> messages;
   f.drone->set_message_sink([&](const std::string& m) { messages.push_back(m); });
   Orbiting o;
-  take_off_and_orbit(f, o, 20.0, 1.0);
+  ASSERT_NO_FATAL_FAILURE(take_off_and_orbit(f, o, 20.0, 1.0));
   EXPECT_FALSE(o.end);
   EXPECT_EQ(vehicle_mode(vehicle), Mode::orbit);
   // The start and the steps of its speed, all at 1 m; one correction below 1 m refused, no
@@ -244,7 +244,7 @@ TEST(MavlinkOrbit, CancellingAPx4OrbitLeavesOrbitModeAndHoldsWithSetpoints) {
   VehicleThread vehicle(25361, 1, kSpeed);
   Flight f(25361);
   Orbiting o;
-  take_off_and_orbit(f, o, 8.0);
+  ASSERT_NO_FATAL_FAILURE(take_off_and_orbit(f, o, 8.0));
   ASSERT_EQ(vehicle_mode(vehicle), Mode::orbit);
   EXPECT_TRUE(f.drone->cancel(o.id));
   f.loop.run_until(f.loop.now() + 3.0);
@@ -262,7 +262,7 @@ TEST(MavlinkOrbit, AFlyToPreemptingAPx4OrbitLeavesOrbitAndArrives) {
   VehicleThread vehicle(25362, 1, kSpeed);
   Flight f(25362);
   Orbiting o;
-  take_off_and_orbit(f, o, 6.0);
+  ASSERT_NO_FATAL_FAILURE(take_off_and_orbit(f, o, 6.0));
   mid::ActionEnd e = f.fly("FlyTo", {8, 4, 4});
   ASSERT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
   ASSERT_TRUE(o.end);
@@ -276,7 +276,7 @@ TEST(MavlinkOrbit, ArduPilotOrbitIsStillFlownFromSetpointsInGuided) {
   VehicleThread vehicle(25363, 1, kSpeed, sim_vehicle::ardupilot_dialect());
   Flight f(25363);
   Orbiting o;
-  take_off_and_orbit(f, o, 8.0);
+  ASSERT_NO_FATAL_FAILURE(take_off_and_orbit(f, o, 8.0));
   EXPECT_FALSE(o.end);
   EXPECT_EQ(do_orbits(vehicle), 0);
   EXPECT_EQ(vehicle_mode(vehicle), Mode::setpoint);
@@ -294,7 +294,7 @@ TEST(MavlinkOrbit, ArduPilotsSetpointsGoRoundFromTheRadiusAskedForAndWidenWithTh
   VehicleThread vehicle(25378, 1, kSpeed, sim_vehicle::ardupilot_dialect());
   Flight f(25378);
   Orbiting o;
-  take_off_and_orbit(f, o, 0.0);
+  ASSERT_NO_FATAL_FAILURE(take_off_and_orbit(f, o, 0.0));
   std::optional<double> first_round, widest;
   for (int i = 0; i < 200 && !o.end; ++i) {
     f.loop.run_until(f.loop.now() + 0.05);
@@ -320,7 +320,7 @@ TEST(MavlinkOrbit, DoOrbitRefusedByPx4FailsWithTheResultInWordsAndKeepsHolding) 
   VehicleThread vehicle(25364, kSpeed, options);
   Flight f(25364);
   Orbiting o;
-  take_off_and_orbit(f, o, 6.0);
+  ASSERT_NO_FATAL_FAILURE(take_off_and_orbit(f, o, 6.0));
   ASSERT_TRUE(o.end);
   EXPECT_EQ(o.end->outcome, mid::Outcome::failed);
   EXPECT_EQ(o.end->reason,
@@ -337,7 +337,7 @@ TEST(MavlinkOrbit, AnOrbitBeyondPx4sLargestRadiusIsRefusedBeforeTheVehicleMoves)
   VehicleThread vehicle(25369, 1, kSpeed);
   Flight f(25369);
   Orbiting o;
-  take_off_and_orbit(f, o, 2.0, 2000.0);
+  ASSERT_NO_FATAL_FAILURE(take_off_and_orbit(f, o, 2.0, 2000.0));
   ASSERT_TRUE(o.end);
   EXPECT_EQ(o.end->outcome, mid::Outcome::failed);
   EXPECT_EQ(o.end->failure, mid::FailureReason::refused);
@@ -350,7 +350,7 @@ TEST(MavlinkOrbit, APilotsModeSwitchFailsAPx4Orbit) {
   VehicleThread vehicle(25365, 1, kSpeed);
   Flight f(25365);
   Orbiting o;
-  take_off_and_orbit(f, o, 4.0);
+  ASSERT_NO_FATAL_FAILURE(take_off_and_orbit(f, o, 4.0));
   ASSERT_FALSE(o.end);
   // A ground station on the same vehicle switches to POSCTL, as a pilot's switch would.
   auto gcs = ml::Link::open(*ml::parse_url("udpout://127.0.0.1:" + std::to_string(vehicle.port())).endpoint,

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -402,6 +403,52 @@ TEST_P(Sitl, VehiclesOnOneSpotWhileTheFleetPutsThemFiveMetresApartAreRefusedBefo
 TEST_P(Sitl, ARefusedActionFailsTheMissionWithTheAutopilotsAnswerInTheSummary) { fly_refused(""); }
 
 TEST_P(Sitl, ARefusedActionOfOneDexPerDroneReachesTheSummaryWithTheAutopilotsAnswer) { fly_refused("--distributed"); }
+
+// The site's rules on the real autopilots, one instance: FlyByX(8) paced to the site's 2 m/s
+// (the autopilots cruise at 5 m/s, PX4 MPC_XY_CRUISE, and 10 m/s, ArduPilot WPNAV_SPEED), then
+// a FlyTo outside the geofence refused before the vehicle moves, and the drone's failsafe.
+TEST_P(Sitl, TheSitesMaxSpeedPacesAFlightAndATargetOutsideTheFenceIsRefused) {
+  const std::vector<eamos_test::SitlHome> one = {kHomes[0]};
+  auto sitl = start_fleet(one);
+  if (HasFailure()) return;
+  std::ofstream(dir_ / "site.eamos") << "var Drone1 Quad\nfunc INIT() { Drone1.Arm(); Drone1.Takeoff(3); "
+                                        "Drone1.FlyByX(8); Drone1.FlyTo(40, 0, 3); Drone1.Land(); Drone1.Disarm() }\n";
+  std::string fleet = "safety:\n  max_speed: 2\n  geofence: {polygon: [[-15, -15], [15, -15], [15, 15], [-15, 15]], "
+                      "max_altitude: 20}\n" + fleet_file(*sitl, one);
+  Flight f = fly((dir_ / "site.eamos").string(), fleet, dir_, {.extra = "--telemetry-hz 10"});
+  EXPECT_NE(f.run.status, 0) << f.run.out;
+  const std::vector<std::string>& a = f.actions["Drone1"];
+  EXPECT_NE(std::find(a.begin(), a.end(), "Drone1.FlyByX(8) succeeded"), a.end()) << f.run.out;
+  EXPECT_NE(std::find(a.begin(), a.end(), "Drone1.FlyTo(40, 0, 3) failed"), a.end()) << f.run.out;
+  EXPECT_NE(f.run.out.find("target (40.0, 0.0, 3.0) is outside its polygon"), std::string::npos) << f.run.out;
+  EXPECT_EQ(f.failsafes, std::vector<std::string>{"Drone1"}) << f.run.out;
+  // From the trace: how long FlyByX took, and the fastest second of it.
+  double began = -1, ended = -1, fastest = 0, refused_at = -1, x_at_refusal = 0, x_after = 0;
+  std::vector<std::array<double, 3>> track;  // t, x, y
+  std::ifstream in(dir_ / "trace.jsonl");
+  for (std::string line; std::getline(in, line);) {
+    auto e = nlohmann::json::parse(line, nullptr, false);
+    if (e.is_discarded() || e.value("drone", "") != "Drone1") continue;
+    std::string event = e.value("event", ""), text = e.value("text", "");
+    if (event == "start" && text == "Drone1.FlyByX(8)") began = e["t"];
+    if (event == "end" && text == "Drone1.FlyByX(8)") ended = e["t"];
+    if (event == "end" && text == "Drone1.FlyTo(40, 0, 3)") refused_at = e["t"];
+    if (event != "telemetry") continue;
+    track.push_back({e["t"].get<double>(), e["x"].get<double>(), e["y"].get<double>()});
+    if (refused_at < 0) x_at_refusal = track.back()[1];
+    else if (track.back()[0] < refused_at + 2) x_after = std::max(x_after, track.back()[1]);
+  }
+  for (std::size_t i = 0, j = 0; i < track.size(); ++i) {
+    while (track[i][0] - track[j][0] > 1.0) ++j;
+    if (track[i][0] >= began && track[i][0] <= ended && track[i][0] - track[j][0] > 0.8)
+      fastest = std::max(fastest, std::hypot(track[i][1] - track[j][1], track[i][2] - track[j][2]) /
+                                      (track[i][0] - track[j][0]));
+  }
+  std::cout << "[sitl] FlyByX(8) took " << ended - began << " mission s, fastest second " << fastest << " m/s\n";
+  EXPECT_GT(ended - began, 3.5) << f.run.out;  // 8 m at 2 m/s, not at the autopilot's cruise
+  EXPECT_LT(fastest, 2.8) << f.run.out;
+  EXPECT_LT(x_after - x_at_refusal, 0.5) << f.run.out;  // no step toward x = 40
+}
 
 // The test stops Drone2's autopilot in flight: its link is lost, the mission fails saying
 // so, and the two others run their failsafe. `extra`: --distributed, where the lost vehicle's

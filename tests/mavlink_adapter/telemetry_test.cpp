@@ -126,7 +126,7 @@ TEST(Telemetry, RefusesUnknownLandedStatesAndBatteriesBeyondAHundredPercent) {
   EXPECT_FALSE(v.have_altitude);
 }
 
-// The orbit's radius is measured from the centre the autopilot reports (mavlink_drone_orbit.cpp):
+// The orbit's radius is measured from the centre the autopilot reports (orbit_flight.cpp):
 // a centre off the earth, a NaN radius or a position off the earth is refused whole.
 TEST(Telemetry, TakesTheOrbitCentreInAGlobalFrameAndRefusesOneOffTheEarth) {
   VehicleState v;

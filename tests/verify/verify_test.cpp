@@ -15,7 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dex/trace_schema.h"
+#include "trace/trace_schema.h"
 #include "support/run_eamos.h"
 
 namespace eamos {
@@ -121,7 +121,7 @@ TEST(VerifyTrace, WritesThePathWithAViolationEventAtTheResponsibleLine) {
   std::string text = read_file(trace);
   fs::remove(trace);
   std::istringstream in(text);
-  EXPECT_EQ(eamos::dex::check_trace(in, {.strict = true}), std::vector<std::string>{});
+  EXPECT_EQ(eamos::trace::check_trace(in, {.strict = true}), std::vector<std::string>{});
   std::vector<nlohmann::json> violations;
   bool has_actions = false;
   std::istringstream lines(text);

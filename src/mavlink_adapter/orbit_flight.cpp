@@ -1,7 +1,7 @@
-// Orbit, two ways. PX4 flies MAV_CMD_DO_ORBIT itself in its Orbit mode; ArduPilot Copter has
-// no DO_ORBIT, so there the adapter moves a position setpoint around the circle. Both circle
-// like the simulator: centre where the orbit started, counter-clockwise seen from above, at
-// the simulator's speed, until the action is preempted or cancelled.
+// How the orbit is flown, and why each bound is what it is. The figures in the comments
+// were measured on ArduCopter SITL and PX4 SITL (SIH) flying Listing 2's orbit of 5 m.
+#include "mavlink_adapter/orbit_flight.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -9,7 +9,6 @@
 #include <utility>
 
 #include "mavlink/enums.h"
-#include "mavlink_adapter/mavlink_drone.h"
 #include "mid/vec.h"
 
 namespace eamos::mavlink_adapter {
@@ -17,7 +16,6 @@ namespace eamos::mavlink_adapter {
 namespace ml = eamos::mavlink;
 using fleet::Vec3;
 using mid::ActionId;
-using mid::Outcome;
 
 namespace {
 constexpr float kYawFrontToCentre = 0;  ///< ORBIT_YAW_BEHAVIOUR_HOLD_FRONT_TO_CIRCLE_CENTER
@@ -40,7 +38,7 @@ constexpr double kRadiusGain = 0.25;  ///< 1/s: what the lead leaves (0.5: 4.80 
 // still (the EKF's velocity and position disagree by that much as the vehicle speeds up). The
 // integral only takes out what is left over a turn: a faster one (0.25 /s) lags PX4's
 // once-a-turn swing by a quarter turn and feeds it. Five corrections a vehicle second (the
-// HEARTBEAT is polled for it, poll_heartbeat): fewer, the loop trails the swing it corrects.
+// HEARTBEAT is polled for it, LinkWatch::poll_heartbeat): fewer, the loop trails the swing it corrects.
 // The integral runs from the start: held back while the vehicle speeds up, it would leave the
 // mean up to 0.2 m off for most of a short orbit.
 constexpr double kDoOrbitGain = 0.2;        ///< 1/s of vehicle time, on the radius error
@@ -73,70 +71,120 @@ constexpr double kStartOutwardMps = 0.08;   ///< ... and on PX4 no longer moves 
 constexpr double kStartWaitMostS = 5.0;     ///< ... or has waited this long
 }  // namespace
 
+OrbitFlight::OrbitFlight(const fleet::DroneSettings& settings, VehicleLink& link, VehicleState& vehicle,
+                         const VehicleClock& clock, SetpointStream& stream, ModeCommands& modes,
+                         CommandSender& commands, Hooks hooks)
+    : settings_(settings),
+      link_(link),
+      vehicle_(vehicle),
+      clock_(clock),
+      stream_(stream),
+      modes_(modes),
+      commands_(commands),
+      hooks_(std::move(hooks)) {}
+
+// PX4 orbits from 1 m to MC_ORBIT_RAD_MAX. The vehicle first flies out to the circle
+// (start), so a radius PX4 would refuse is refused before it moves, not at the circle.
+std::string OrbitFlight::radius_refusal(double radius) const {
+  char text[160];
+  if (radius < 1.0) {
+    std::snprintf(text, sizeof text, "orbit radius %.1f m is below the smallest %s flies (1 m)", radius,
+                  autopilot().name);
+    return text;
+  }
+  const double largest = link_.limits().orbit_radius_max_m;
+  if (largest <= 0.0 || radius <= largest) return "";
+  std::snprintf(text, sizeof text, "orbit radius %.1f m is above %s's MC_ORBIT_RAD_MAX %.0f m", radius,
+                autopilot().name, largest);
+  return text;
+}
+
+
+
 // How near the east point the wait for the orbit's start begins. PX4 circles from where it
 // is, and its OFFBOARD hold can stand 0.6-0.7 m off the east point for seconds (its estimate of
 // velocity and position disagreeing): judged by the goal tolerance (0.5 m), the wait might not
 // begin for 10 s, and a short orbit (Listing 2's, ended by the others' landing) would be mostly
 // spent waiting. Within PX4's own acceptance radius (kOnCircleM) it begins; our setpoint orbit
 // (ArduCopter) starts at the goal tolerance.
-double MavlinkDrone::near_orbit_start_m() const {
-  return autopilot_->do_orbit ? std::max(kOnCircleM, settings_.tolerance.horizontal_m)
+double OrbitFlight::near_start_m() const {
+  return autopilot().do_orbit ? std::max(kOnCircleM, settings_.tolerance.horizontal_m)
                               : settings_.tolerance.horizontal_m;
 }
 
-double MavlinkDrone::orbit_speed(double radius) const {
+double OrbitFlight::orbit_speed(double radius) const {
   // The simulator's: as fast as allowed while the centripetal acceleration keeps a margin,
   // within the slower of the fleet's and the autopilot's acceleration (ArduPilot
   // WPNAV_ACCEL, PX4 MPC_ACC_HOR). Above the autopilot's the vehicle cannot turn that tight:
   // on ArduCopter at 4 m/s (3.2 m/s² for 5 m, WPNAV_ACCEL 2.5) the orbit came out 4.72 m,
   // at 3.16 m/s 4.83 m before the radius correction below.
-  const fleet::Limits& l = limits_.motion;
+  const fleet::Limits& l = link_.limits().motion;
   return std::min(l.max_speed_mps, std::sqrt(0.8 * l.max_accel_mps2 * radius));
 }
 
-void MavlinkDrone::start_orbit(Vec3 centre, double radius) {
+void OrbitFlight::start(ActionId id, Vec3 centre, double radius) {
   // Out to the circle's east point on our setpoints first, like the simulator; from there
   // ArduCopter goes round on our setpoints, PX4 by itself (send_do_orbit).
+  id_ = id;
+  ++epoch_;
   orbit_ = {true, centre, radius, 0.0, false, false, false, radius};
   orbit_.sent_radius = radius;
   char text[128];
   std::snprintf(text, sizeof text, "orbit of %.2f m around x %.2f, y %.2f", radius, centre.x, centre.y);
-  note(text);  // where the vehicle circles, for a reader of the trace (and the SITL tests)
+  hooks_.note(text);  // where the vehicle circles, for a reader of the trace (and the SITL tests)
   // Named to PX4 in degrees, converted when DO_ORBIT goes (send_do_orbit).
-  orbit_.centre_known = autopilot_->do_orbit && vehicle_.have_altitude;
+  orbit_.centre_known = autopilot().do_orbit && vehicle_.have_altitude;
   // Without a global position the centre cannot be named to PX4: it orbits where the vehicle
   // is, from there (its own approach out to the circle overshoots it by up to 0.7 m).
-  if (autopilot_->do_orbit && !orbit_.centre_known) return send_do_orbit();
-  stream_setpoints();
+  if (autopilot().do_orbit && !orbit_.centre_known) return send_do_orbit();
+  stream_.start();
+}
+
+void OrbitFlight::reset() {
+  ++epoch_;
+  orbit_ = {};
+}
+
+void OrbitFlight::stop() {
+  bool autopilot_orbits = orbit_.commanded;
+  reset();
+  if (autopilot_orbits) leave();
+}
+
+std::optional<double> OrbitFlight::steer(double dt) {
+  if (orbit_.active) advance(dt);
+  return setpoint_yaw();
+}
+
+void OrbitFlight::on_global_position() {
+  if (orbit_.commanded) correct_radius();
+}
+
+bool OrbitFlight::on_heartbeat() {
+  if (left_mode()) return true;
+  send_due_correction();
+  return false;
 }
 
 // PX4 circles from where it is when DO_ORBIT comes: started at the centre, its approach is
 // its circle's radial term from 5 m off, which overshot to 5.7 m and swung 4.4 .. 5.7 m on a
 // loaded SITL. Started on the circle, with the centre named (COMMAND_INT, degE7), it only
 // speeds up along it.
-void MavlinkDrone::send_do_orbit() {
-  const ActionId id = motion_owner_;  // the Orbit: any other motion would have reset orbit_
+void OrbitFlight::send_do_orbit() {
   orbit_.do_orbit_sent = true;
-  auto done = [this, id](const CommandResult& result) {
+  auto done = [this, id = id_, epoch = epoch_](const CommandResult& result) {
     if (!result.accepted) {
-      if (motion_owner_ == id) orbit_ = {};
-      if (tracker_.running(id)) end_refused(id, result);
+      if (epoch == epoch_) reset();
+      hooks_.refused(id, result);
       return;
     }
-    if (motion_owner_ != id) return orbit_stopped_in_flight();
-    streaming_ = false;
-    in_control_ = false;
-    orbit_.active = false;  // PX4 moves around the circle now, not our setpoints
-    orbit_.on_circle = false;  // for the radius correction: PX4's own word on its circle
-    orbit_.commanded = true;
-    vehicle_.have_orbit_centre = false;  // a report from before is of an orbit before this one
-    if (!orbit_.centre_known && vehicle_.have_position) orbit_.centre = position();
-    vehicle_.custom_mode = autopilot_->orbit_mode;  // until the next HEARTBEAT says otherwise
+    if (epoch != epoch_) return stopped_in_flight();
+    do_orbit_taken();
   };
   // From the centre PX4 flies out first (no standstill on the circle): the orbit's speed at once.
   orbit_.sent_speed = orbit_.centre_known ? std::min(kSpeedLeadMps, orbit_speed(orbit_.radius)) : orbit_speed(orbit_.radius);
   if (!orbit_.centre_known)
-    return send_mode_command(command(ml::cmd::DO_ORBIT, do_orbit_params(orbit_.radius, orbit_.sent_speed)), done);
+    return modes_.send(link_.command(ml::cmd::DO_ORBIT, do_orbit_params(orbit_.radius, orbit_.sent_speed)), done);
   // The centre in degrees from where the vehicle is now, standing still on its circle:
   // GLOBAL_POSITION_INT and LOCAL_POSITION_NED are separate reports, and converted from a
   // vehicle still moving (as when the Orbit starts after a FlyTo) their skew put PX4's circle
@@ -151,17 +199,27 @@ void MavlinkDrone::send_do_orbit() {
   orbit_.sent_radius = orbit_.radius;
   auto p = do_orbit_params(orbit_.sent_radius, orbit_.sent_speed);
   ml::CommandInt c;
-  c.target_system = sysid_;
+  c.target_system = link_.sysid();
   c.target_component = ml::comp::AUTOPILOT1;
   c.frame = ml::kFrameGlobal;  // z NaN: the altitude it has
   c.command = ml::cmd::DO_ORBIT;
   c.param = {p[0], p[1], p[2], p[3]};
   c.x = orbit_.centre_lat_e7, c.y = orbit_.centre_lon_e7;
   c.z = NAN;
-  send_mode_command(c, done);
+  modes_.send(c, done);
 }
 
-std::array<float, 7> MavlinkDrone::do_orbit_params(double radius, double speed) const {
+void OrbitFlight::do_orbit_taken() {
+  stream_.hand_over();
+  orbit_.active = false;  // PX4 moves around the circle now, not our setpoints
+  orbit_.on_circle = false;  // for the radius correction: PX4's own word on its circle
+  orbit_.commanded = true;
+  vehicle_.have_orbit_centre = false;  // a report from before is of an orbit before this one
+  if (!orbit_.centre_known && vehicle_.have_position) orbit_.centre = position();
+  vehicle_.custom_mode = autopilot().orbit_mode;  // until the next HEARTBEAT says otherwise
+}
+
+std::array<float, 7> OrbitFlight::do_orbit_params(double radius, double speed) const {
   // Radius negative = counter-clockwise; centre and altitude NaN = where the vehicle is when
   // PX4 enters its Orbit mode, and, sent again in that mode, the centre it has: only radius
   // and speed change. param4 NaN = the autopilot's default number of turns (for ever). The
@@ -169,45 +227,42 @@ std::array<float, 7> MavlinkDrone::do_orbit_params(double radius, double speed) 
   return {-static_cast<float>(radius), static_cast<float>(speed), kYawFrontToCentre, NAN, NAN, NAN, NAN};
 }
 
-void MavlinkDrone::orbit_stopped_in_flight() {
+void OrbitFlight::stopped_in_flight() {
   // Cancelled or preempted while DO_ORBIT was on its way, and the autopilot took it after all.
   // If our setpoints fly the vehicle now, ask for the setpoint mode again; if a command
   // (Land, ReturnHome) came after it, the autopilot already left the orbit for that.
-  if (!streaming_) return;
-  in_control_ = false;
-  vehicle_.custom_mode = autopilot_->orbit_mode;
+  if (!stream_.streaming()) return;
+  stream_.lose_control();
+  vehicle_.custom_mode = autopilot().orbit_mode;
 }
 
-void MavlinkDrone::leave_orbit() {
+void OrbitFlight::leave() {
   // The hold mode at once, so the vehicle stops circling now, not after the setpoint stream
   // has earned the setpoint mode again (PX4: half a second of setpoints first).
-  auto p = set_mode_params(*autopilot_, autopilot_->hold_mode);
-  send_mode_command(command(ml::cmd::DO_SET_MODE, {p[0], p[1], p[2]}), nullptr);
-  in_control_ = false;
+  auto p = set_mode_params(autopilot(), autopilot().hold_mode);
+  modes_.send(link_.command(ml::cmd::DO_SET_MODE, {p[0], p[1], p[2]}), nullptr);
+  stream_.lose_control();
 }
 
-bool MavlinkDrone::left_orbit_mode() {
+bool OrbitFlight::left_mode() {
   // Like the setpoint mode: someone else (a pilot, a failsafe) ended the autopilot's orbit.
   // Judged only once a HEARTBEAT has shown the orbit mode: one sent between the ACK and the
   // autopilot's next status may still show the mode from before.
-  if (!orbit_.commanded || mode_commands_pending_ > 0) return false;
-  if (vehicle_.custom_mode == autopilot_->orbit_mode) orbit_.mode_seen = true;
-  if (!orbit_.mode_seen || vehicle_.custom_mode == autopilot_->orbit_mode) return false;
-  ActionId id = motion_owner_;
-  motion_owner_ = mid::kNoAction;
-  orbit_ = {};
-  std::string mode = mode_name(*autopilot_, vehicle_.custom_mode);
-  tracker_.fail(id, mid::FailureReason::pilot_took_over,
-                "the vehicle left " + mode_name(*autopilot_, autopilot_->orbit_mode) + " for " + mode, "mode " + mode);
+  if (!orbit_.commanded || modes_.pending()) return false;
+  if (vehicle_.custom_mode == autopilot().orbit_mode) orbit_.mode_seen = true;
+  if (!orbit_.mode_seen || vehicle_.custom_mode == autopilot().orbit_mode) return false;
+  reset();
+  std::string mode = mode_name(autopilot(), vehicle_.custom_mode);
+  hooks_.left("the vehicle left " + mode_name(autopilot(), autopilot().orbit_mode) + " for " + mode, "mode " + mode);
   return true;
 }
 
-void MavlinkDrone::advance_orbit(double dt) {
+void OrbitFlight::advance(double dt) {
   const double r = orbit_.radius;
   if (!orbit_.on_circle) {
     // Out to the circle's east point first, like the simulator, then around it.
-    setpoint_ = {orbit_.centre.x + r, orbit_.centre.y, orbit_.centre.z};
-    if (horizontal_norm(position() - setpoint_) > near_orbit_start_m()) return;
+    stream_.aim({orbit_.centre.x + r, orbit_.centre.y, orbit_.centre.z});
+    if (horizontal_norm(position() - stream_.target()) > near_start_m()) return;
     // Round from a standstill there. PX4 (send_do_orbit starts it on the circle): its radial
     // term is slow, and a vehicle still drifting out at 0.15-0.3 m/s when DO_ORBIT came went on
     // 0.3-0.6 m past its circle. ArduCopter, started as it came within the tolerance (still
@@ -215,19 +270,19 @@ void MavlinkDrone::advance_orbit(double dt) {
     // gusty hold) starts after kStartWaitS all the same.
     if (orbit_.do_orbit_sent) return;
     orbit_.waited_at_start_s += dt;
-    if (autopilot_->do_orbit && !done_moving_out()) return;
+    if (autopilot().do_orbit && !done_moving_out()) return;
     const bool still = norm(vehicle_.ned_velocity) <= kStartStillMps &&
                        std::fabs(horizontal_norm(position() - orbit_.centre) - r) <= kStartOnCircleM &&
-                       faces_orbit_centre();
+                       faces_centre();
     if (!still && (orbit_.waited_at_start_s < kStartWaitS || norm(vehicle_.ned_velocity) > settings_.tolerance.settled_mps))
       return;
-    if (autopilot_->do_orbit) return send_do_orbit();
+    if (autopilot().do_orbit) return send_do_orbit();
     orbit_.on_circle = true;
     return;
   }
   // Moved by the vehicle's clock, which a SITL on a loaded machine runs slower than --speed:
   // moved by mission time, the setpoint would go round faster than the vehicle can turn.
-  const double vehicle_dt = dt * std::clamp(vehicle_clock_rate(), 0.2, 2.0);
+  const double vehicle_dt = dt * std::clamp(clock_.rate(), 0.2, 2.0);
   orbit_.angle = std::fmod(orbit_.angle + orbit_speed(r) * vehicle_dt / r, 2.0 * M_PI);
   // A position setpoint moving around the circle is followed with a lag, along a chord:
   // ArduCopter circled at 4.5 m for 5 m. No feed-forward: on ArduCopter SITL, at the
@@ -244,8 +299,8 @@ void MavlinkDrone::advance_orbit(double dt) {
   }
   const double w = std::min(horizontal_norm(vehicle_.ned_velocity), orbit_speed(r)) / r;
   const double rc = orbit_.commanded_radius * std::sqrt(1.0 + w * w * kFollowerLagS * kFollowerLagS);
-  setpoint_ = {orbit_.centre.x + rc * std::cos(orbit_.angle),
-               orbit_.centre.y + rc * std::sin(orbit_.angle), orbit_.centre.z};
+  stream_.aim({orbit_.centre.x + rc * std::cos(orbit_.angle), orbit_.centre.y + rc * std::sin(orbit_.angle),
+                orbit_.centre.z});
 }
 
 // PX4 SITL arrives at the east point overshooting it by 0.2-0.45 m (its velocity integrator,
@@ -255,7 +310,7 @@ void MavlinkDrone::advance_orbit(double dt) {
 // 0.3 m out of its circle 2 s later. So the start waits, by the vehicle's positions over the
 // last half second, until the distance from the centre no longer grows, at most
 // kStartWaitMostS.
-bool MavlinkDrone::done_moving_out() const {
+bool OrbitFlight::done_moving_out() const {
   if (orbit_.waited_at_start_s >= kStartWaitMostS) return true;
   const double span_s = vehicle_.track_span_s();
   if (span_s <= 0.0) return true;
@@ -270,15 +325,15 @@ bool MavlinkDrone::done_moving_out() const {
 // heading as the orbit begins, a quarter turn at PX4's yaw rate limit while the vehicle speeds
 // up, the circle sinks 0.2-0.3 m in its first seconds (to 4.68-4.81 m for 5); turned on the
 // way out, it does not. ArduCopter's setpoint orbit keeps its heading: no yaw is sent there.
-std::optional<double> MavlinkDrone::orbit_setpoint_yaw() const {
-  if (!orbit_.active || !autopilot_->do_orbit) return std::nullopt;
-  const Vec3 to_centre = orbit_.centre - setpoint_;  // mission frame: x east, y north
+std::optional<double> OrbitFlight::setpoint_yaw() const {
+  if (!orbit_.active || !autopilot().do_orbit) return std::nullopt;
+  const Vec3 to_centre = orbit_.centre - stream_.target();  // mission frame: x east, y north
   if (horizontal_norm(to_centre) < 0.1) return std::nullopt;  // no direction to face
   return std::atan2(to_centre.x, to_centre.y);
 }
 
-bool MavlinkDrone::faces_orbit_centre() const {
-  const std::optional<double> yaw = orbit_setpoint_yaw();
+bool OrbitFlight::faces_centre() const {
+  const std::optional<double> yaw = setpoint_yaw();
   if (!yaw || vehicle_.heading_deg < 0) return true;
   return std::fabs(std::remainder(vehicle_.heading_deg - *yaw * 180.0 / M_PI, 360.0)) <= kFacingDeg;
 }
@@ -290,10 +345,10 @@ bool MavlinkDrone::faces_orbit_centre() const {
 // with the centre left NaN. The radius flown is the distance from the centre PX4 reports
 // (ORBIT_EXECUTION_STATUS), measured in GLOBAL_POSITION_INT's frame, not a circle fitted to
 // the last half turn: such a fit swings 4.3 .. 6.1 m while the vehicle flies 4.6 .. 5.4 m.
-// Without the autopilot's centre, the one it was given (start_orbit); without either, no
+// Without the autopilot's centre, the one it was given (start); without either, no
 // correction: PX4's own circle is better than one corrected by a wrong measure.
-void MavlinkDrone::correct_orbit_radius() {
-  Orbit& o = orbit_;
+void OrbitFlight::correct_radius() {
+  State& o = orbit_;
   const double vehicle_s = vehicle_.global_time_boot_ms / 1000.0;
   const double dt = o.last_report_s < 0 ? 0.0 : vehicle_s - o.last_report_s;
   o.last_report_s = vehicle_s;
@@ -301,7 +356,7 @@ void MavlinkDrone::correct_orbit_radius() {
   // The centre PX4 says it circles, else the one it was given.
   const bool said = vehicle_.have_orbit_centre;
   if (!said && !o.centre_known) return;
-  if (said && o.centre_known && !o.centre_compared) trace_orbit_centre();
+  if (said && o.centre_known && !o.centre_compared) trace_centre();
   const Vec3 out = north_east_between(said ? vehicle_.orbit_centre_lat_e7 : o.centre_lat_e7,
                                       said ? vehicle_.orbit_centre_lon_e7 : o.centre_lon_e7, vehicle_.lat_e7,
                                       vehicle_.lon_e7);
@@ -334,32 +389,32 @@ void MavlinkDrone::correct_orbit_radius() {
 
 // The radius to send: the integral, led by how far off the circle the vehicle is and damped
 // by how fast it moves out.
-double MavlinkDrone::led_radius() const {
-  const Orbit& o = orbit_;
+double OrbitFlight::led_radius() const {
+  const State& o = orbit_;
   return o.commanded_radius + kDoOrbitLead * (o.radius - o.recent_flown_m) - kDoOrbitDampingS * o.outward_mps;
 }
 
 // Where PX4 circles may differ from the centre it was given (its own projection, a position
 // that moved between the two reports the centre was computed from): said once, for a reader
 // of the trace judging the circle flown.
-void MavlinkDrone::trace_orbit_centre() {
+void OrbitFlight::trace_centre() {
   orbit_.centre_compared = true;
   const Vec3 off = north_east_between(orbit_.centre_lat_e7, orbit_.centre_lon_e7, vehicle_.orbit_centre_lat_e7,
                                       vehicle_.orbit_centre_lon_e7);
   char text[128];
   std::snprintf(text, sizeof text, "the autopilot circles %.2f m north, %.2f m east of the centre it was given",
                 off.x, off.y);
-  note(text);
+  hooks_.note(text);
 }
 
 // Sent only right after a HEARTBEAT that shows the Orbit mode: DO_ORBIT in any other mode
 // makes PX4 enter Orbit, and one that crossed a pilot's mode switch would take the vehicle
 // back from the pilot. Right after the HEARTBEAT that window is the link's latency, not the
 // heartbeat period.
-void MavlinkDrone::send_due_orbit_correction() {
-  Orbit& o = orbit_;
+void OrbitFlight::send_due_correction() {
+  State& o = orbit_;
   if (!o.commanded || !o.on_circle || o.corrections_stopped || o.correcting || !o.mode_seen) return;
-  if (vehicle_.custom_mode != autopilot_->orbit_mode || mode_commands_pending_ > 0) return;
+  if (vehicle_.custom_mode != autopilot().orbit_mode || modes_.pending()) return;
   if (o.last_flown_m <= 0.0 || o.last_report_s - o.sent_at_s < kCorrectionEveryS) return;
   const double speed = std::min(orbit_speed(o.radius), std::max(o.sent_speed, o.flown_speed + kSpeedLeadMps));
   // Within PX4's acceptance radius of where the vehicle is, else it re-approaches its circle.
@@ -373,8 +428,8 @@ void MavlinkDrone::send_due_orbit_correction() {
   std::snprintf(text, sizeof text,
                 "orbit of %.2f m: flown at %.2f m from the autopilot's centre at %.2f m/s, DO_ORBIT radius %.2f m at %.2f m/s",
                 o.radius, o.last_flown_m, o.flown_speed, radius, speed);
-  note(text);
-  const ActionId id = motion_owner_;
+  hooks_.note(text);
+  const uint64_t epoch = epoch_;
   const double before_radius = o.sent_radius, before_speed = o.sent_speed;
   o.correcting = true;
   o.sent_at_s = o.last_report_s;
@@ -382,13 +437,13 @@ void MavlinkDrone::send_due_orbit_correction() {
   o.sent_speed = speed;
   // Once the orbit ended (cancelled: AUTO.LOITER sent), a resend would put the vehicle back
   // in its Orbit mode.
-  auto still_orbiting = [this, id] {
-    return motion_owner_ == id && orbit_.commanded && vehicle_.custom_mode == autopilot_->orbit_mode;
+  auto still_orbiting = [this, epoch] {
+    return epoch == epoch_ && orbit_.commanded && vehicle_.custom_mode == autopilot().orbit_mode;
   };
   commands_.send(
-      command(ml::cmd::DO_ORBIT, do_orbit_params(radius, speed)),
-      [this, id, radius, before_radius, before_speed](const CommandResult& result) {
-        if (motion_owner_ != id || !orbit_.commanded) return;  // the orbit ended meanwhile
+      link_.command(ml::cmd::DO_ORBIT, do_orbit_params(radius, speed)),
+      [this, epoch, radius, before_radius, before_speed](const CommandResult& result) {
+        if (epoch != epoch_ || !orbit_.commanded) return;  // the orbit ended meanwhile
         orbit_.correcting = false;
         if (result.accepted) return;
         // The orbit goes on as PX4 flies it: a refusal of a correction is no failure of the
@@ -397,7 +452,7 @@ void MavlinkDrone::send_due_orbit_correction() {
         orbit_.corrections_stopped = true;
         char text[96];
         std::snprintf(text, sizeof text, "orbit radius correction to %.2f m not taken: ", radius);
-        note(text + result.error + "; the orbit goes on without corrections");
+        hooks_.note(text + result.error + "; the orbit goes on without corrections");
       },
       still_orbiting);
 }

@@ -1,11 +1,11 @@
-#include "dex/trace_schema.h"
+#include "trace/trace_schema.h"
 
 #include <cmath>
 #include <set>
 
 #include <nlohmann/json.hpp>
 
-namespace eamos::dex {
+namespace eamos::trace {
 
 namespace {
 
@@ -223,4 +223,4 @@ std::vector<std::string> check_trace(std::istream& in, const TraceCheckOptions& 
   return errors;
 }
 
-}  // namespace eamos::dex
+}  // namespace eamos::trace

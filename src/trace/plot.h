@@ -7,7 +7,7 @@
 #include "dex/runner.h"
 #include "dex/trace.h"
 
-namespace eamos::dex {
+namespace eamos::trace {
 
 /// Top panel: each drone's track in the x/y plane (equal scale, metres), grey on the
 /// ground, solid in the air, start labelled with the drone's name, a black square where
@@ -26,7 +26,7 @@ struct PlotMark {
 };
 
 /// `caption`, when given, is a line under the title (which run of several this is).
-std::string plot_svg(const RunResult& run, const std::vector<TraceEvent>& events,
+std::string plot_svg(const dex::RunResult& run, const std::vector<dex::TraceEvent>& events,
                      const std::vector<PlotMark>& marks = {}, const std::string& caption = "");
 
-}  // namespace eamos::dex
+}  // namespace eamos::trace

@@ -1,4 +1,4 @@
-#include "dex/plot.h"
+#include "trace/plot.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,12 @@
 
 #include "graph/palette.h"
 
-namespace eamos::dex {
+namespace eamos::trace {
+
+using dex::DroneSummary;
+using dex::RunResult;
+using dex::Sample;
+using dex::TraceEvent;
 
 namespace {
 
@@ -714,4 +719,4 @@ std::string plot_svg(const RunResult& run, const std::vector<TraceEvent>& events
   return out.str();
 }
 
-}  // namespace eamos::dex
+}  // namespace eamos::trace

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "dex/plot.h"
-#include "flight.h"
+#include "trace/plot.h"
+#include "dex/flight.h"
 
 namespace eamos {
 namespace {
@@ -39,7 +39,7 @@ TEST(Plot, DrawsTracksAndOneBarPerAction) {
   for (std::size_t i = 1; i < result.drones[0].track.size(); ++i)
     EXPECT_LE(result.drones[0].track[i - 1].t, result.drones[0].track[i].t);
 
-  std::string svg = dex::plot_svg(result, f.events);
+  std::string svg = trace::plot_svg(result, f.events);
   EXPECT_EQ(svg.rfind("<svg", 0), 0u);
   while (!svg.empty() && svg.back() == '\n') svg.pop_back();
   EXPECT_TRUE(svg.ends_with("</svg>"));
@@ -86,7 +86,7 @@ const char* kWaitMission =
 TEST(Plot, DrawsEveryDronesAltitudeOverTime) {
   test::Flight f = test::fly(kWaitMission);
   ASSERT_TRUE(f.result.completed) << f.result.error;
-  std::string svg = dex::plot_svg(f.result, f.events);
+  std::string svg = trace::plot_svg(f.result, f.events);
   EXPECT_EQ(attrs(svg, "class=\"altitude\"", "data-drone"), (std::vector<std::string>{"A", "B"}));
   EXPECT_NE(svg.find(">Altitude over time</text>"), std::string::npos);
   EXPECT_NE(svg.find(">z (m, up)</text>"), std::string::npos);
@@ -95,7 +95,7 @@ TEST(Plot, DrawsEveryDronesAltitudeOverTime) {
 TEST(Plot, DrawsWhoWaitedOnWhomAndHowLong) {
   test::Flight f = test::fly(kWaitMission);
   ASSERT_TRUE(f.result.completed) << f.result.error;
-  std::string svg = dex::plot_svg(f.result, f.events);
+  std::string svg = trace::plot_svg(f.result, f.events);
   // B armed at 0 and took off when A's WaitUntil came true: it waited that long on A.
   double go = f.time_of("start", "B.Takeoff(4)");
   ASSERT_GT(go, 1.0);
@@ -112,7 +112,7 @@ TEST(Plot, DrawsWhoWaitedOnWhomAndHowLong) {
 
 TEST(Plot, LabelsConditionMarksWithoutOverlap) {
   test::Flight f = test::fly(kWaitMission);
-  std::string svg = dex::plot_svg(f.result, f.events);
+  std::string svg = trace::plot_svg(f.result, f.events);
   // A's If and B's WaitUntil (false) at t = 0, later the WaitUntil true: all labelled.
   EXPECT_NE(svg.find(">If → false</text>"), std::string::npos) << svg;
   EXPECT_NE(svg.find(">WaitUntil → true</text>"), std::string::npos);
@@ -136,7 +136,7 @@ TEST(Plot, DrawsTheFailsafePhaseOnTheTimelineTheMapAndTheAltitude) {
       "func SEQ_a() { A.Arm(); A.Takeoff(5); A.Takeoff(200) }\n"
       "func SEQ_b() { B.Arm(); B.Takeoff(8); B.FlyByY(20) }\n");
   ASSERT_FALSE(f.result.completed);
-  std::string svg = dex::plot_svg(f.result, f.events);
+  std::string svg = trace::plot_svg(f.result, f.events);
   EXPECT_EQ(attrs(svg, "<g class=\"failsafe\"", "data-drone"), (std::vector<std::string>{"A", "B"})) << svg;
   std::vector<std::string> until = attrs(svg, "<g class=\"failsafe\"", "data-until");
   std::vector<std::string> from = attrs(svg, "<g class=\"failsafe\"", "data-from");
@@ -156,7 +156,7 @@ TEST(Plot, TenDronesGetTenColours) {
   text += "func INIT() { PAR_all() }\nfunc PAR_all() { " + par + "}\n";
   test::Flight f = test::fly(text);
   ASSERT_TRUE(f.result.completed) << f.result.error;
-  std::string svg = dex::plot_svg(f.result, f.events);
+  std::string svg = trace::plot_svg(f.result, f.events);
   std::vector<std::string> colours = attrs(svg, "class=\"altitude\"", "stroke");
   ASSERT_EQ(colours.size(), 10u);
   std::sort(colours.begin(), colours.end());

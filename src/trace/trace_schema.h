@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace eamos::dex {
+namespace eamos::trace {
 
 struct TraceCheckOptions {
   /// Refuse event kinds this schema version does not define. Readers must not (a newer
@@ -17,4 +17,4 @@ struct TraceCheckOptions {
 /// Every way `in` breaks the trace schema, as "line N: what is wrong"; empty when none.
 std::vector<std::string> check_trace(std::istream& in, const TraceCheckOptions& options = {});
 
-}  // namespace eamos::dex
+}  // namespace eamos::trace

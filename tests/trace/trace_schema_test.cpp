@@ -14,7 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dex/trace_schema.h"
+#include "trace/trace_schema.h"
 #include "support/run_eamos.h"
 
 namespace {
@@ -30,7 +30,7 @@ std::string read_file(const fs::path& p) {
 
 std::vector<std::string> errors_of(const std::string& text) {
   std::istringstream in(text);
-  return eamos::dex::check_trace(in, {.strict = true});
+  return eamos::trace::check_trace(in, {.strict = true});
 }
 
 std::string joined(const std::vector<std::string>& v) {
@@ -166,7 +166,7 @@ TEST(TraceCheck, RefusesAnUnknownDroneOutcomeOrEventKind) {
             "line 4: event \"party\" is not defined by schema version 1\n");
   // A reader (not strict) skips kinds it does not know: a newer eamos may add some.
   std::istringstream in(kHeader + "\n" + kind + "\n" + kEnd + "\n");
-  EXPECT_TRUE(eamos::dex::check_trace(in).empty());
+  EXPECT_TRUE(eamos::trace::check_trace(in).empty());
 }
 
 TEST(TraceCheck, AViolationNeedsItsDroneKindLineAndText) {
