@@ -300,6 +300,10 @@ CLI::App* add_sim_vehicle(CLI::App& app, Options& o) {
   simv->add_option("--sysid", v.sysid, "MAVLink system id")->check(eamos::cli::whole_number(1, 255));
   simv->add_option("--autopilot", v.autopilot, "Whose modes and rules to play: px4 (OFFBOARD) or ardupilot (Copter, GUIDED)")
       ->check(eamos::cli::one_of({"px4", "ardupilot"}));
+  simv->add_option("--east", v.east, "Stand this many metres east of 47.397742 N, 8.545594 E (PX4 SITL's home); "
+                   "give each vehicle its fleet home's x")->check(eamos::cli::number_between(-100000.0, 100000.0));
+  simv->add_option("--north", v.north, "Stand this many metres north of it; the fleet home's y")
+      ->check(eamos::cli::number_between(-100000.0, 100000.0));
   simv->add_option("--battery", v.battery, "Charge at start, %; 0 makes it refuse to arm")->check(eamos::cli::number_between(0.0, 100.0));
   simv->add_option("--speed", v.speed, "Mission time runs X times as fast as the wall clock; the adapter's run must use the same")
       ->check(eamos::cli::positive());

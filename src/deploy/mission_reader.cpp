@@ -427,6 +427,7 @@ class Reader {
         d_.add("/drone/signing_key", why);
     f_.boolean(*d, "signing_setup", "/drone", s.signing_setup, false);
     f_.boolean(*d, "announce_as_gcs", "/drone", s.announce_as_gcs, false);
+    f_.number(*d, "home_tolerance", "/drone", s.home_tolerance_m, 1e-9, 1e6, false);
     vec3(*d, "home", "/drone", s.home);
     f_.number(*d, "battery", "/drone", s.battery_percent, 0, 100);
     int failsafe = 0;

@@ -98,6 +98,8 @@ void write_settings(JsonWriter& w, const fleet::DroneSettings& s, int index) {
   if (!s.connection.empty()) w.member("connection", s.connection);
   if (s.sysid > 0) w.member("sysid", s.sysid);
   if (s.announce_as_gcs) w.member("announce_as_gcs", true);
+  // Only when the fleet sets it: mission files of fleets that do not stay byte for byte.
+  if (s.home_tolerance_m != fleet::kDefaultHomeToleranceM) w.member("home_tolerance", s.home_tolerance_m);
   if (!s.signing_key.empty()) {  // the drone's own folder only, beside its private DDS key
     w.member("signing_key", s.signing_key);
     w.member("signing_setup", s.signing_setup);

@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "diag/log.h"
+#include "mid/home_check.h"
 
 namespace eamos::dex {
 
@@ -226,6 +227,7 @@ class InProcessRun {
  private:
   bool one_mission();
   bool make_drones(const mid::AdapterRegistry& adapters);
+  bool homes_agree();
   void make_engines();
   void seed_boards();
   void subscribe_drones();
@@ -255,7 +257,7 @@ class InProcessRun {
 };
 
 RunResult InProcessRun::run(const mid::AdapterRegistry& adapters) {
-  if (!one_mission() || !make_drones(adapters)) return result_;
+  if (!one_mission() || !make_drones(adapters) || !homes_agree()) return result_;
   for (int d = 0; d < n_; ++d) record_sample(tracks_[d], drones_[d]->state());
   loop_.on_callback_error([this](const std::string& what) {
     diag::Logger{"dex", ""}.error("internal error in the executor: " + what);
@@ -289,6 +291,18 @@ bool InProcessRun::make_drones(const mid::AdapterRegistry& adapters) {
     drones_.push_back(std::move(c.drone));
   }
   return true;
+}
+
+// The vehicles stand where the fleet file puts them, relative to each other (mid/home_check.h),
+// or nothing arms.
+bool InProcessRun::homes_agree() {
+  std::vector<mid::Drone*> connected;
+  std::vector<fleet::DroneSettings> declared;
+  for (int d = 0; d < n_; ++d) connected.push_back(drones_[d].get()), declared.push_back(missions_[d].settings);
+  std::string wrong = mid::check_homes_at_connect(loop_, connected, declared, mid::kHomeFixTimeoutS);
+  if (wrong.empty()) return true;
+  result_.error = "the vehicles do not stand where the fleet file puts them; nothing was armed:\n" + wrong;
+  return false;
 }
 
 void InProcessRun::make_engines() {

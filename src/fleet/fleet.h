@@ -28,6 +28,10 @@ struct SensorModel {
 enum class Failsafe { land, return_home, hover };
 const char* failsafe_name(Failsafe f);
 
+/// How far (m, horizontally) the vehicles may stand from where their declared homes put them,
+/// relative to each other, before the mission refuses to arm (`safety: home_tolerance:`).
+inline constexpr double kDefaultHomeToleranceM = 3.0;
+
 /// Where drones may fly (docs/fleet.md, `geofence:`): inside a polygon of the mission frame's
 /// x/y plane (none: anywhere) and between two altitudes (each optional). `eamos verify`
 /// checks the flown tracks and every motion target against it; in flight every adapter's
@@ -36,6 +40,7 @@ struct Geofence {
   std::vector<std::pair<double, double>> polygon;  ///< (x east, y north), m; empty = no polygon
   std::optional<double> min_altitude_m;
   std::optional<double> max_altitude_m;
+  std::optional<SourceLocation> max_altitude_at;  ///< where the fleet file sets max_altitude
   /// True when (x, y, z) lies inside (a point on the boundary is inside).
   bool contains(double x, double y, double z) const;
   bool contains_xy(double x, double y) const;
@@ -91,6 +96,8 @@ struct DroneSettings {
   bool announce_as_gcs = false;
   SiteLimits site;             ///< the site's rules this drone keeps in flight
   std::optional<Gust> gust;    ///< simulator only
+  /// The fleet's `safety: home_tolerance` (mid/home_check.h).
+  double home_tolerance_m = kDefaultHomeToleranceM;
 };
 
 /// "" when `hex` is a usable signing key (64 hex digits, not all zero), else what is wrong.
@@ -118,6 +125,8 @@ struct Safety {
   std::optional<double> max_climb_mps;
   std::optional<double> max_descent_mps;
   std::optional<Geofence> geofence;        ///< every drone's, unless a drone gives its own
+  /// Vehicles that report a global position must stand as their homes say within this (m).
+  double home_tolerance_m = kDefaultHomeToleranceM;
 };
 
 /// The values a sensor may read in flight (`range: [low, high]`): what `eamos verify`
@@ -135,6 +144,7 @@ struct LimitOverrides {
   std::optional<double> max_descent_mps;
   std::optional<double> max_accel_mps2;
   std::optional<double> max_altitude_m;
+  std::optional<SourceLocation> max_altitude_at;  ///< where the fleet file sets max_altitude
 
   void apply(Limits& limits) const;
 };
@@ -159,6 +169,8 @@ struct Fleet {
   std::map<std::string, SourceLocation> drone_locations;  ///< where each drone is described
   std::shared_ptr<SourceFile> source;        ///< keeps the file text for diagnostics
   Safety safety;                             ///< operating rules for `eamos verify`
+  /// Where a type's `limits:` set max_altitude, per type name (a note for diagnostics).
+  std::map<std::string, SourceLocation> type_max_altitude_at;
 
   /// The geofence `drone` must stay in: its own, else the fleet's; null when neither is set.
   const Geofence* geofence_for(const std::string& drone) const;

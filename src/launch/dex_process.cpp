@@ -11,6 +11,7 @@
 #include "deploy/mission_file.h"
 #include "launch/dex_state.h"
 #include "launch/wall_time.h"
+#include "mid/home_check.h"
 
 namespace eamos::launch {
 
@@ -79,6 +80,8 @@ bool DexProcess::load(const mid::AdapterRegistry& adapters) {
     return false;
   }
   drone_ = std::move(made.drone);
+  // Where the vehicle stands, for the ground's homes check: it comes with this DEX's READY.
+  if (drone_->has_global_frame()) mid::wait_for_fixes(*loop_, {drone_.get()}, mid::kHomeFixTimeoutS);
   return true;
 }
 
@@ -217,6 +220,10 @@ bool DexProcess::ready_when_all_seen() {
   ready.kind = LifecycleKind::ready;
   ready.nonce = nonce_;
   ready.launch_id = o_.launch_id;
+  ready.fix = drone_->global_fix();
+  ready.home_x = mission_.settings.home.x;
+  ready.home_y = mission_.settings.home.y;
+  ready.home_tolerance = mission_.settings.home_tolerance_m;
   node_->write(ready);
   out_ << name() << ": ready\n" << std::flush;
   return true;

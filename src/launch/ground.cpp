@@ -15,6 +15,7 @@
 #include "launch/inbox.h"
 #include "launch/spawn.h"
 #include "launch/wall_time.h"
+#include "mid/home_check.h"
 
 namespace eamos::launch {
 
@@ -33,6 +34,7 @@ struct DroneEntry {
   bool local = false;
   Child child;
   std::optional<std::uint64_t> ready_nonce;
+  mid::HomeReport home;  ///< from its READY: declared home and where its vehicle stands
   std::optional<StatusSample> final_status;
   std::vector<dex::Sample> track;
   std::optional<mid::DroneState> last_state;  ///< newest telemetry of this run
@@ -416,6 +418,10 @@ void Ground::watch_barrier() {
                           " before it was ready; its log (" + d.log + "):\n" + tail_of(d.log, 10));
   bool all = std::all_of(drones_.begin(), drones_.end(), [](const DroneEntry& d) { return d.ready_nonce.has_value(); });
   if (all) {
+    std::vector<mid::HomeReport> homes;
+    for (const auto& d : drones_) homes.push_back(d.home);
+    if (std::string wrong = mid::compare_homes(homes); !wrong.empty())
+      return fail_barrier("the vehicles do not stand where the fleet file puts them; nothing was armed:\n" + wrong);
     send_start();
   } else if (wall_s() > barrier_deadline_) {
     std::string missing;
@@ -541,6 +547,7 @@ void Ground::on_lifecycle(const LifecycleSample& s) {
       out_ << "\n" << std::flush;
     }
     drones_[s.drone].ready_nonce = s.nonce;
+    drones_[s.drone].home = {d.name, {s.home_x, s.home_y, 0.0}, s.fix, s.home_tolerance};
     return;
   }
   if (s.run_id != r_.run_id || stage_ != Stage::running) return;

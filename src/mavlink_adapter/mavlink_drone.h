@@ -69,6 +69,8 @@ class MavlinkDrone final : public mid::AdapterDrone {
   void unsubscribe(mid::SubscriptionId id) override { broker_.unsubscribe(id); }
   void failsafe(fleet::Failsafe what) override;
   void set_message_sink(std::function<void(const std::string&)> sink) override { message_sink_ = std::move(sink); }
+  bool has_global_frame() const override { return true; }
+  std::optional<mid::GlobalFix> global_fix() const override;  // home_fix.cpp
 
   /// The limits deadlines are derived from: the slower of the fleet's and the autopilot's
   /// (known after connect()), and what to warn about at start.

@@ -87,6 +87,12 @@ struct DroneState {
   bool link_lost = false;
 };
 
+/// Where a vehicle stands on the Earth (WGS 84), as its autopilot reports it.
+struct GlobalFix {
+  double lat_deg = 0.0;
+  double lon_deg = 0.0;
+};
+
 /// Identifies one started action of one drone; 0 (kNoAction) is never issued.
 using ActionId = std::uint64_t;
 inline constexpr ActionId kNoAction = 0;
@@ -147,6 +153,13 @@ class Drone {
   /// the loop after the drone already commanded its failsafe. The DEX fails the mission on
   /// it as on a failed action. An empty function stops them. Default: none.
   virtual void set_fault_sink(std::function<void(const ActionEnd&)>) {}
+
+  /// Whether the vehicle tells where it stands on the Earth (an autopilot with GPS); the
+  /// built-in simulator has no such frame. Default: no.
+  virtual bool has_global_frame() const { return false; }
+  /// Its newest global position; empty until the vehicle has reported one (or never, without
+  /// a global frame). The homes check (mid/home_check.h) compares these before arming.
+  virtual std::optional<GlobalFix> global_fix() const { return std::nullopt; }
 };
 
 }  // namespace eamos::mid
