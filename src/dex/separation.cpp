@@ -56,6 +56,17 @@ Prediction predict(Vec pa, Vec va, Vec pb, Vec vb, const fleet::Separation& min,
   return {true, lo};
 }
 
+Prediction predict_to_goal(Vec pa, Vec va, double left_m, Vec pb, Vec vb, const fleet::Separation& min,
+                           double horizon_s) {
+  const double v = speed(va);
+  if (!std::isfinite(left_m) || v < 1e-9 || left_m / v >= horizon_s) return predict(pa, va, pb, vb, min, horizon_s);
+  const double stop_s = left_m / v;
+  if (Prediction moving = predict(pa, va, pb, vb, min, stop_s); moving.conflict) return moving;
+  Prediction still = predict(pa + va * stop_s, Vec{}, pb + vb * stop_s, vb, min, horizon_s - stop_s);
+  still.in_s += stop_s;
+  return still;
+}
+
 SeparationGuard::SeparationGuard(const Mission& mission, mid::EventLoop& loop, SeparationHooks hooks)
     : m_(mission),
       loop_(loop),
@@ -189,7 +200,8 @@ void SeparationGuard::consider(int a, int b) {
   const Track& B = tracks_[b];
   if (!A.airborne || !B.airborne || speed(A.v) < kMovingMps) return;
   ++pairs_;
-  const Prediction p = predict(now_at(A), A.v, now_at(B), B.v, min_, kSeparationHorizonS);
+  const Prediction p =
+      predict_to_goal(now_at(A), A.v, A.drone->motion_distance_left(), now_at(B), B.v, min_, kSeparationHorizonS);
   if (!p.conflict) {
     if (A.unheld_with == b) A.unheld_with = -1;
     return;
@@ -226,6 +238,7 @@ void SeparationGuard::try_resume(int h) {
   if (halted_) return;
   Track& H = tracks_[h];
   const Vec here = now_at(H);
+  const double left = H.drone->motion_distance_left();  // its course ends at its goal
   int blocker = -1;
   const double reach = min_.horizontal_m + kResumeHorizonS * (std::hypot(H.resume_v.x, H.resume_v.y) + fastest_seen_);
   for_neighbours(h, reach, [&](int n) {
@@ -237,9 +250,9 @@ void SeparationGuard::try_resume(int h) {
     // Over twice the horizon: a conflict that just slipped past the horizon as it braked
     // would otherwise let it fly on at once and stop again.
     const double horizon = kResumeHorizonS;
-    if (predict(here, H.hold_v, now_at(N), N.v, min_, horizon).conflict) blocker = n;
+    if (predict_to_goal(here, H.hold_v, left, now_at(N), N.v, min_, horizon).conflict) blocker = n;
     for (double share : {0.25, 0.5, 0.75, 1.0})
-      if (predict(here, H.resume_v * share, now_at(N), N.v, min_, horizon).conflict) blocker = n;
+      if (predict_to_goal(here, H.resume_v * share, left, now_at(N), N.v, min_, horizon).conflict) blocker = n;
   });
   H.blocked_by = blocker;
   if (blocker >= 0) {

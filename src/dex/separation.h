@@ -51,6 +51,11 @@ struct Prediction {
   double in_s = 0.0;
 };
 Prediction predict(Vec pa, Vec va, Vec pb, Vec vb, const fleet::Separation& min, double horizon_s);
+/// As predict(), with a's course ending at its goal `left_m` ahead (a stops there; NaN: no
+/// goal known, the course runs on): a drone that flies towards another and stops short of it
+/// is no conflict.
+Prediction predict_to_goal(Vec pa, Vec va, double left_m, Vec pb, Vec vb, const fleet::Separation& min,
+                           double horizon_s);
 
 struct SeparationHooks {
   TraceSink* trace = nullptr;

@@ -64,6 +64,11 @@ bool AdapterDrone::hold_motion(double climb_m) {
   return true;
 }
 
+double AdapterDrone::motion_distance_left() const {
+  const ActionId id = tracker_.motion();
+  return id == kNoAction ? std::numeric_limits<double>::quiet_NaN() : distance_left(id);
+}
+
 bool AdapterDrone::resume_motion() {
   const ActionId id = held_;
   held_ = kNoAction;

@@ -32,6 +32,7 @@ class AdapterDrone : public Drone {
   /// Give way (drone_api.h): the deadline is paused here, the vehicle held by hold_vehicle().
   bool hold_motion(double climb_m) final;
   bool resume_motion() final;
+  double motion_distance_left() const final;
   bool motion_held() const final { return held_ != kNoAction && tracker_.running(held_); }
   void set_fault_sink(std::function<void(const ActionEnd&)> sink) final { fault_sink_ = std::move(sink); }
 

@@ -143,6 +143,9 @@ class Drone {
   virtual bool resume_motion() { return false; }
   /// Whether a motion is held now.
   virtual bool motion_held() const { return false; }
+  /// How far (m) the running goal-directed motion still has to go, held or not; NaN when
+  /// none runs or the adapter cannot tell. Separation ends a drone's predicted course there.
+  virtual double motion_distance_left() const { return std::numeric_limits<double>::quiet_NaN(); }
 
   /// Where the vehicle's own messages go (an autopilot's STATUSTEXT, what the adapter did
   /// about the vehicle on its own, such as re-arming after an auto-disarm): the DEX puts each

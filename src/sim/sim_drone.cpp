@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "mid/requests.h"
 #include "mid/site_limits.h"
@@ -171,6 +172,14 @@ void SimDrone::resume_vehicle(ActionId id) {
   motion_ = *held_motion_;
   held_motion_.reset();
   update_timers();
+}
+
+double SimDrone::distance_left(ActionId id) const {
+  const Motion& m = held_motion_ ? *held_motion_ : motion_;
+  if (id != motion_owner_ || (m.kind != MotionKind::go && m.kind != MotionKind::land))
+    return std::numeric_limits<double>::quiet_NaN();
+  const Vec3 d = m.target - kin_.position;
+  return std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
 }
 
 void SimDrone::stop_motion() {

@@ -60,6 +60,7 @@ class SimDrone final : public mid::AdapterDrone {
   void stop_action(mid::ActionId id) override;  ///< what cancel and timeouts do to the vehicle
   bool hold_vehicle(mid::ActionId id, double climb_m) override;
   void resume_vehicle(mid::ActionId id) override;
+  double distance_left(mid::ActionId id) const override;
   void stop_motion();                           ///< brake and hold where it is
   /// Ends every running action as `end` says and flies the failsafe `what`.
   void enter_failsafe(fleet::Failsafe what, const mid::ActionEnd& end);

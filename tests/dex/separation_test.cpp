@@ -226,6 +226,29 @@ TEST(Separation, DronesOnSeparateCoursesNeverGiveWay) {
   EXPECT_EQ(count(f, "conflict"), 0);
 }
 
+// A flies straight at B, which hovers, and stops 6 m short of it: its course ends at its goal,
+// so nothing gives way (a course run on past the goal would hold A for ever, then fail over).
+TEST(Separation, ADroneThatStopsShortOfAHoveringOneDoesNotGiveWay) {
+  std::string text = std::string(kTwo) +
+                     "func SEQ_a() { A.Arm(); A.Takeoff(5); A.FlyTo(-6, 0, 5); A.Land(); A.Disarm() }\n"
+                     "func SEQ_b() { B.Arm(); B.Takeoff(5); B.Hover(20); B.Land(); B.Disarm() }\n";
+  Flight f = fly_sampled(text, fleet_of("drones:\n  A: {home: [-30, 0, 0]}\n  B: {home: [0, 0, 0]}\n"));
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_EQ(count(f, "give_way"), 0);
+  EXPECT_FALSE(closest(f).lost);
+}
+
+TEST(SeparationPrediction, ACourseThatEndsShortOfTheOtherIsNoConflict) {
+  fleet::Separation min;  // 2 m, 1 m
+  // 5 m/s toward a drone 20 m away: a conflict in 3 s if it flew on, none if it stops at 10 m.
+  EXPECT_TRUE(dex::predict_to_goal({0, 0, 5}, {5, 0, 0}, NAN, {20, 0, 5}, {}, min, 4.0).conflict);
+  EXPECT_FALSE(dex::predict_to_goal({0, 0, 5}, {5, 0, 0}, 10.0, {20, 0, 5}, {}, min, 4.0).conflict);
+  // The other drone comes to the goal while it waits there: still a conflict, after the stop.
+  dex::Prediction p = dex::predict_to_goal({0, 0, 5}, {5, 0, 0}, 10.0, {20, 0, 5}, {-4, 0, 0}, min, 4.0);
+  EXPECT_TRUE(p.conflict);
+  EXPECT_GE(p.in_s, 2.0);
+}
+
 TEST(SeparationPrediction, CoursesThatMeetWithinTheHorizonAreAConflict) {
   fleet::Separation min;
   // Head-on at 10 m/s each, 30 m apart: within 2 m after 1.4 s.
