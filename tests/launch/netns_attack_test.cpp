@@ -207,8 +207,11 @@ TEST_F(NetnsAttack, WithSecurityOffTheAttackReachesTheDexesAndTheChecksDropWhatI
 
 TEST_F(NetnsAttack, WithSecurityOffForgedTelemetryIsBelieved) {
   // What "C's largest x below 5" in the secure runs is measured against: the same flood
-  // of A at x = 50, with --insecure, sends C towards 40 (nothing can tell it from A's own
-  // telemetry). The mission still completes: C lands where it was sent.
+  // of A at x = 50, with --insecure, is taken for A's own telemetry. C acts on it one of two
+  // ways: it flies by the forged x towards 40 and the mission completes, or its separation
+  // guard, seeing A at 10 and at 50 by turns, holds it for the phantom A until the give-way
+  // bound fails the mission over. Either is the forgery believed: in the secure runs C flies
+  // by A's real x and gives way to nobody.
   domain_ = 185;
   dex_extra_ = " --insecure";
   ASSERT_NO_FATAL_FAILURE(start_relay({}));
@@ -218,7 +221,10 @@ TEST_F(NetnsAttack, WithSecurityOffForgedTelemetryIsBelieved) {
       [&](const std::string& run) { attack("telemetry " + run + " 0 50 1500"); });
   stop_attacker();
   stop_relay();
-  ASSERT_EQ(status, 0) << logs();
+  if (status != 0) {
+    EXPECT_NE(logs().find("C gave way to A for 30.0 s"), std::string::npos) << logs();
+    return;
+  }
   double c_x = max_x(dir_ / "trace.jsonl", "C");
   std::cout << "C's largest x: " << c_x << "\n";
   EXPECT_GT(c_x, 30.0) << logs();
