@@ -431,6 +431,49 @@ TEST_P(Sitl, TheSitesMaxSpeedPacesAFlightAndATargetOutsideTheFenceIsRefused) {
   EXPECT_LT(x_after - x_at_refusal, 0.5) << f.run.out;  // no step toward x = 40
 }
 
+// The mission's fence given to the autopilot itself (geofence `upload: true`), one instance:
+// eamos uploads it before Arm and flies a short hop inside it; then a ground station of the
+// test reads the autopilot's fence and parameters back, independently of eamos: the polygon
+// lies where the fleet file puts it, and the autopilot's fence is switched on.
+TEST_P(Sitl, TheFenceUploadedBeforeArmIsTheAutopilotsOwnPolygonWithItsSwitchOn) {
+  const std::vector<eamos_test::SitlHome> one = {kHomes[0]};
+  auto sitl = start_fleet(one);
+  if (HasFailure()) return;
+  std::ofstream(dir_ / "fence.eamos") << "var Drone1 Quad\nfunc INIT() { Drone1.Arm(); Drone1.Takeoff(3); "
+                                         "Drone1.FlyByX(4); Drone1.Land(); Drone1.Disarm() }\n";
+  const std::vector<std::pair<double, double>> polygon = {{-15, -12}, {25, -12}, {25, 30}, {-15, 30}};
+  std::string fleet = "safety:\n  geofence: {polygon: [[-15, -12], [25, -12], [25, 30], [-15, 30]], "
+                      "max_altitude: 20, upload: true}\n" + fleet_file(*sitl, one);
+  Flight f = fly((dir_ / "fence.eamos").string(), fleet, dir_);
+  EXPECT_EQ(f.run.status, 0) << f.run.out;
+  EXPECT_NE(f.run.out.find("holds the fence itself"), std::string::npos) << f.run.out;
+  bool px4 = GetParam() == Autopilot::px4;
+  std::vector<std::string> params = px4 ? std::vector<std::string>{"GF_ACTION", "GF_MAX_VER_DIST"}
+                                        : std::vector<std::string>{"FENCE_ENABLE", "FENCE_TYPE", "FENCE_ALT_MAX",
+                                                                   "FENCE_ACTION"};
+  std::vector<eamos::mavlink::MissionItemInt> items;
+  std::map<std::string, double> values;
+  std::string error;
+  ASSERT_TRUE(sitl->read_fence(0, params, {"GF_ACTION"}, 30, items, values, error)) << error;
+  ASSERT_EQ(items.size(), polygon.size());
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    double x = 0, y = 0;
+    eamos_test::mission_xy(items[i].x, items[i].y, x, y);
+    EXPECT_EQ(items[i].command, eamos::mavlink::cmd::NAV_FENCE_POLYGON_VERTEX_INCLUSION);
+    EXPECT_NEAR(x, polygon[i].first, 0.3) << i;
+    EXPECT_NEAR(y, polygon[i].second, 0.3) << i;
+  }
+  if (px4) {
+    EXPECT_EQ(values["GF_ACTION"], 5);  // land, the drone's failsafe
+    EXPECT_NEAR(values["GF_MAX_VER_DIST"], 20, 1e-3);
+  } else {
+    EXPECT_EQ(values["FENCE_ENABLE"], 1);
+    EXPECT_EQ(values["FENCE_TYPE"], 5);  // polygon and maximum altitude
+    EXPECT_NEAR(values["FENCE_ALT_MAX"], 20, 1e-3);
+    EXPECT_EQ(values["FENCE_ACTION"], 2);  // land
+  }
+}
+
 // The test stops Drone2's autopilot in flight: its link is lost, the mission fails saying
 // so, and the two others run their failsafe. `extra`: --distributed, where the lost vehicle's
 // DEX is a process of its own that must tell the others.
