@@ -474,6 +474,38 @@ TEST_P(Sitl, TheFenceUploadedBeforeArmIsTheAutopilotsOwnPolygonWithItsSwitchOn) 
   }
 }
 
+// The fence left on the autopilot by a mission with `upload: true` holds by itself: a second
+// mission, whose fleet file has no geofence (eamos' own guard off), flies toward x = 45, and
+// the vehicle does not pass its fence (east edge x = 25). ArduCopter's GUIDED ignores a
+// position target outside its fence: the vehicle stays where it is and the FlyTo times out.
+TEST_P(Sitl, TheAutopilotsOwnFenceKeepsAVehicleInsideWithEamosGuardOff) {
+  // PX4 1.18 SIH (GF_ACTION 5, read back) left OFFBOARD for AUTO.LOITER 5.5 s into the FlyTo,
+  // and its trace then reached x = 47.7 m: not explained yet, so not asserted (docs/adapters.md).
+  if (GetParam() == Autopilot::px4) GTEST_SKIP() << "PX4's own fence acting is not understood yet";
+  const std::vector<eamos_test::SitlHome> one = {kHomes[0]};
+  auto sitl = start_fleet(one);
+  if (HasFailure()) return;
+  std::ofstream(dir_ / "arm.eamos") << "var Drone1 Quad\nfunc INIT() { Drone1.Arm(); Drone1.Disarm() }\n";
+  std::string fenced = "safety:\n  geofence: {polygon: [[-15, -12], [25, -12], [25, 30], [-15, 30]], "
+                       "max_altitude: 20, upload: true}\n" + fleet_file(*sitl, one);
+  Flight upload = fly((dir_ / "arm.eamos").string(), fenced, dir_);
+  ASSERT_EQ(upload.run.status, 0) << upload.run.out;
+  std::ofstream(dir_ / "out.eamos") << "var Drone1 Quad\nfunc INIT() { Drone1.Arm(); Drone1.Takeoff(3); "
+                                       "Drone1.FlyTo(45, 0, 3); Drone1.Land(); Drone1.Disarm() }\n";
+  Flight out = fly((dir_ / "out.eamos").string(), fleet_file(*sitl, one), dir_, {.extra = "--telemetry-hz 10"});
+  EXPECT_NE(out.run.status, 0) << out.run.out;
+  const std::vector<std::string>& a = out.actions["Drone1"];
+  EXPECT_NE(std::find(a.begin(), a.end(), "Drone1.FlyTo(45, 0, 3) failed"), a.end()) << out.run.out;
+  double furthest = 0;
+  std::ifstream in(dir_ / "trace.jsonl");
+  for (std::string line; std::getline(in, line);) {
+    auto e = nlohmann::json::parse(line, nullptr, false);
+    if (!e.is_discarded() && e.value("event", "") == "telemetry") furthest = std::max(furthest, e.value("x", 0.0));
+  }
+  std::cout << "[sitl] furthest east with the autopilot's fence at x = 25: " << furthest << " m\n";
+  EXPECT_LT(furthest, 27) << out.run.out;  // the fence's edge and its margin, not 45
+}
+
 // The test stops Drone2's autopilot in flight: its link is lost, the mission fails saying
 // so, and the two others run their failsafe. `extra`: --distributed, where the lost vehicle's
 // DEX is a process of its own that must tell the others.
