@@ -47,7 +47,7 @@ eamos_export(eamos_graph graph graph amt.h meg.h mdg.h pipeline.h export.h)
 eamos_export(eamos_deploy deploy deploy mission_file.h synthesize.h drone_package.h)
 eamos_export(eamos_mid mid mid drone_api.h event_loop.h adapter_registry.h adapter_drone.h action_tracker.h
              requests.h mover.h state_broker.h location_validator.h timeouts.h vec.h)
-eamos_export(eamos_dex dex dex bridge.h engine.h expr.h failure.h latency.h mission.h observer.h runner.h trace.h
+eamos_export(eamos_dex dex dex bridge.h engine.h expr.h failsafe.h failure.h latency.h mission.h observer.h runner.h trace.h
              trace_writers.h)
 eamos_export(eamos_trace trace trace plot.h trace_schema.h)
 eamos_export(eamos_sim sim sim battery.h motion.h sim_adapter.h sim_drone.h)
@@ -55,7 +55,7 @@ eamos_export(eamos_mavlink mavlink mavlink crc.h enums.h field_def.h fields.h fr
              signing.h url.h)
 eamos_export(eamos_mavlink_adapter mavlink_adapter mavlink_adapter adapter.h autopilot.h autopilot_params.h
              autopilot_texts.h camera.h command_sender.h link_watch.h mavlink_drone.h mavlink_options.h
-             mode_commands.h orbit_flight.h setpoint_stream.h telemetry.h vehicle_clock.h vehicle_link.h)
+             mode_commands.h orbit_flight.h setpoint_pacer.h setpoint_stream.h telemetry.h vehicle_clock.h vehicle_link.h)
 # version.h (EAMOS_VERSION) is generated into the build tree.
 set_target_properties(eamos_version PROPERTIES EXPORT_NAME version
                       INTERFACE_INCLUDE_DIRECTORIES "$<BUILD_INTERFACE:${PROJECT_BINARY_DIR}/generated>")

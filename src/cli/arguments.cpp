@@ -8,8 +8,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <iostream>
 
 #include "diag/diagnostics.h"
+#include "diag/log.h"
 
 namespace eamos::cli {
 
@@ -26,6 +28,18 @@ bool use_color(const std::string& when, int fd) {
   const char* no_color = std::getenv("NO_COLOR");
   const char* term = std::getenv("TERM");
   return isatty(fd) && !(no_color && *no_color) && !(term && std::strcmp(term, "dumb") == 0);
+}
+
+void apply_log_level(const std::string& argument) {
+  if (!argument.empty()) {
+    diag::set_log_level(diag::parse_log_level(argument).value_or(diag::LogLevel::info));
+    setenv(diag::kLogLevelVariable, argument.c_str(), 1);
+    return;
+  }
+  const char* env = std::getenv(diag::kLogLevelVariable);
+  if (env && !diag::parse_log_level(env))
+    std::cerr << "eamos: warning: " << diag::kLogLevelVariable << "='" << env
+              << "' is not a log level; info is used (set it to error, warning, info or debug)\n";
 }
 
 std::string color_argument(const std::vector<std::string>& args) {
@@ -202,7 +216,7 @@ std::string argument_error(const std::vector<std::string>& args, ArgSpot at, con
 
 namespace {
 
-const std::vector<std::string> kValuedAppOptions = {"--color", "--diagnostics-format"};
+const std::vector<std::string> kValuedAppOptions = {"--color", "--diagnostics-format", "--log-level"};
 
 bool looks_like_option(const std::string& t) {
   return t.size() >= 2 && t[0] == '-' && (t[1] == '-' ? t.size() > 2 : std::isalpha(static_cast<unsigned char>(t[1])));
@@ -361,86 +375,111 @@ std::string display(const CLI::Option* o, const std::string& fallback) {
   return o->get_name();
 }
 
+/// The class, not get_name(): an ExtrasError carries the command's name there.
+std::string error_kind(const CLI::ParseError& e) {
+  return dynamic_cast<const CLI::ValidationError*>(&e)   ? "ValidationError"
+         : dynamic_cast<const CLI::RequiredError*>(&e)    ? "RequiredError"
+         : dynamic_cast<const CLI::ArgumentMismatch*>(&e) ? "ArgumentMismatch"
+         : dynamic_cast<const CLI::ExcludesError*>(&e)    ? "ExcludesError"
+         : dynamic_cast<const CLI::RequiresError*>(&e)    ? "RequiresError"
+         : dynamic_cast<const CLI::ExtrasError*>(&e)      ? "ExtrasError"
+         : dynamic_cast<const CLI::ConversionError*>(&e)  ? "ConversionError"
+                                                          : e.get_name();
+}
+
+/// A parse error as CLI11 words it, with the command it happened in.
+struct ParseFailure {
+  CLI::App& app;
+  const std::vector<std::string>& args;
+  std::string what;     ///< CLI11's text
+  CLI::App* sub;        ///< the subcommand on the line, or null
+  std::string command;  ///< "`eamos SUB`" or "eamos"
+};
+
+std::string explain_required(const ParseFailure& f) {
+  std::string name = f.what.substr(0, f.what.find(" is required"));
+  const CLI::Option* o = find_option(f.app, f.args, name);
+  std::string desc = o ? o->get_description() : "";
+  bool positional = o && o->get_lnames().empty() && o->get_snames().empty();
+  std::string needs = positional ? "the " + name + (desc.empty() ? "" : " (" + desc + ")")
+                                 : display(o, name) + (desc.empty() ? "" : " (" + desc + ")");
+  return argument_error(f.args, {static_cast<int>(f.args.size()), 0, 1}, f.command + " needs " + needs);
+}
+
+std::string explain_pair(const ParseFailure& f, bool excludes) {
+  std::string verb = excludes ? " excludes " : " requires ";
+  std::size_t v = f.what.find(verb);
+  std::string a = f.what.substr(0, v), b = v == std::string::npos ? "" : f.what.substr(v + verb.size());
+  const CLI::Option* oa = find_option(f.app, f.args, a);
+  const CLI::Option* ob = find_option(f.app, f.args, b);
+  if (excludes) {
+    ArgSpot at = ob ? option_spot(ob, f.args, "", false) : ArgSpot{};
+    ArgSpot first = oa ? option_spot(oa, f.args, "", false) : ArgSpot{};
+    if (first.index > at.index) at = first;
+    return argument_error(f.args, at, display(oa, a) + " and " + display(ob, b) + " cannot be given together; keep one");
+  }
+  return argument_error(f.args, oa ? option_spot(oa, f.args, "", false) : ArgSpot{},
+                        display(oa, a) + " needs " + display(ob, b) + " too");
+}
+
+/// Every unexpected argument, each with its caret; "" when none of them is on the line.
+std::string explain_extras(const ParseFailure& f) {
+  std::string out;
+  std::string list = f.what.substr(f.what.find(": ") + 2);
+  for (std::size_t i = 0; i < f.args.size(); ++i) {
+    const std::string& arg = f.args[i];
+    if (static_cast<int>(i) == command_index(f.args) || looks_like_option(arg)) continue;
+    std::size_t p = list.find(arg);
+    if (p == std::string::npos) continue;
+    bool word = (p == 0 || list[p - 1] == ' ') && (p + arg.size() == list.size() || list[p + arg.size()] == ' ');
+    if (!word) continue;
+    out += argument_error(f.args, {static_cast<int>(i), 0, arg.size()},
+                          "unexpected argument " + in_quotes(arg) + " of " + f.command + "; `eamos " +
+                              (f.sub ? f.sub->get_name() + " " : "") + "--help` says what it takes");
+  }
+  return out;
+}
+
+/// "" when the option is not found.
+std::string explain_conversion(const ParseFailure& f) {
+  const std::string& what = f.what;
+  std::string name = what.rfind("Could not convert: ", 0) == 0 ? what.substr(19, what.find(" = ") - 19) : "";
+  const CLI::Option* o = name.empty() ? nullptr : find_option(f.app, f.args, name);
+  if (!o) return "";
+  return argument_error(f.args, option_spot(o, f.args),
+                        display(o, name) + ": " + in_quotes(what.substr(what.find(" = ") + 3)) +
+                            " is not a value it takes; `eamos " + (f.sub ? f.sub->get_name() + " " : "") +
+                            "--help` says which");
+}
+
 }  // namespace
 
 std::string explain_parse_error(CLI::App& app, const std::vector<std::string>& args, const CLI::ParseError& e) {
-  // The class, not get_name(): an ExtrasError carries the command's name there.
-  std::string kind = dynamic_cast<const CLI::ValidationError*>(&e)  ? "ValidationError"
-                     : dynamic_cast<const CLI::RequiredError*>(&e)  ? "RequiredError"
-                     : dynamic_cast<const CLI::ArgumentMismatch*>(&e) ? "ArgumentMismatch"
-                     : dynamic_cast<const CLI::ExcludesError*>(&e)  ? "ExcludesError"
-                     : dynamic_cast<const CLI::RequiresError*>(&e)  ? "RequiresError"
-                     : dynamic_cast<const CLI::ExtrasError*>(&e)    ? "ExtrasError"
-                     : dynamic_cast<const CLI::ConversionError*>(&e) ? "ConversionError"
-                                                                     : e.get_name();
-  std::string what = e.what();
+  std::string kind = error_kind(e);
   CLI::App* sub = command_at(app, args);
-  std::string command = sub ? "`eamos " + sub->get_name() + "`" : "eamos";
-  std::size_t colon = what.find(": ");
-  std::string head = colon == std::string::npos ? what : what.substr(0, colon);
-  std::string rest = colon == std::string::npos ? "" : what.substr(colon + 2);
+  ParseFailure f{app, args, e.what(), sub, sub ? "`eamos " + sub->get_name() + "`" : "eamos"};
+  std::size_t colon = f.what.find(": ");
+  std::string head = colon == std::string::npos ? f.what : f.what.substr(0, colon);
+  std::string rest = colon == std::string::npos ? "" : f.what.substr(colon + 2);
   if (kind == "ValidationError") {
     const CLI::Option* o = find_option(app, args, head);
     bool positional = o && o->get_lnames().empty() && o->get_snames().empty();
     ArgSpot at = o ? option_spot(o, args, first_quoted(rest)) : ArgSpot{};
     return argument_error(args, at, positional ? rest : display(o, head) + ": " + rest);
   }
-  if (kind == "RequiredError") {
-    std::string name = what.substr(0, what.find(" is required"));
-    const CLI::Option* o = find_option(app, args, name);
-    std::string desc = o ? o->get_description() : "";
-    bool positional = o && o->get_lnames().empty() && o->get_snames().empty();
-    std::string needs = positional ? "the " + name + (desc.empty() ? "" : " (" + desc + ")")
-                                   : display(o, name) + (desc.empty() ? "" : " (" + desc + ")");
-    return argument_error(args, {static_cast<int>(args.size()), 0, 1}, command + " needs " + needs);
-  }
+  if (kind == "RequiredError") return explain_required(f);
   if (kind == "ArgumentMismatch") {
     const CLI::Option* o = find_option(app, args, head);
     ArgSpot at = o ? option_spot(o, args, "", false) : ArgSpot{};
     if (at.index >= 0) at = {at.index, at.length, 1};
     return argument_error(args, at, display(o, head) + " needs a value");
   }
-  if (kind == "ExcludesError" || kind == "RequiresError") {
-    std::string verb = kind == "ExcludesError" ? " excludes " : " requires ";
-    std::size_t v = what.find(verb);
-    std::string a = what.substr(0, v), b = v == std::string::npos ? "" : what.substr(v + verb.size());
-    const CLI::Option* oa = find_option(app, args, a);
-    const CLI::Option* ob = find_option(app, args, b);
-    if (kind == "ExcludesError") {
-      ArgSpot at = ob ? option_spot(ob, args, "", false) : ArgSpot{};
-      ArgSpot first = oa ? option_spot(oa, args, "", false) : ArgSpot{};
-      if (first.index > at.index) at = first;
-      return argument_error(args, at, display(oa, a) + " and " + display(ob, b) + " cannot be given together; keep one");
-    }
-    return argument_error(args, oa ? option_spot(oa, args, "", false) : ArgSpot{},
-                          display(oa, a) + " needs " + display(ob, b) + " too");
-  }
-  if (kind == "ExtrasError") {
-    std::string out;
-    std::vector<std::string> extras;
-    std::string list = what.substr(what.find(": ") + 2);
-    for (std::size_t i = 0; i < args.size(); ++i) {
-      if (static_cast<int>(i) == command_index(args) || looks_like_option(args[i])) continue;
-      std::size_t p = list.find(args[i]);
-      if (p == std::string::npos) continue;
-      bool word = (p == 0 || list[p - 1] == ' ') && (p + args[i].size() == list.size() || list[p + args[i].size()] == ' ');
-      if (!word) continue;
-      out += argument_error(args, {static_cast<int>(i), 0, args[i].size()},
-                            "unexpected argument " + in_quotes(args[i]) + " of " + command + "; `eamos " +
-                                (sub ? sub->get_name() + " " : "") + "--help` says what it takes");
-    }
-    if (!out.empty()) return out;
-  }
-  if (kind == "ConversionError") {
-    std::string name = what.rfind("Could not convert: ", 0) == 0 ? what.substr(19, what.find(" = ") - 19) : "";
-    const CLI::Option* o = name.empty() ? nullptr : find_option(app, args, name);
-    if (o)
-      return argument_error(args, option_spot(o, args), display(o, name) + ": " +
-                                                             in_quotes(what.substr(what.find(" = ") + 3)) +
-                                                             " is not a value it takes; `eamos " +
-                                                             (sub ? sub->get_name() + " " : "") + "--help` says which");
-  }
-  return argument_error(args, {}, what);
+  if (kind == "ExcludesError" || kind == "RequiresError") return explain_pair(f, kind == "ExcludesError");
+  if (kind == "ExtrasError")
+    if (std::string out = explain_extras(f); !out.empty()) return out;
+  if (kind == "ConversionError")
+    if (std::string out = explain_conversion(f); !out.empty()) return out;
+  return argument_error(args, {}, f.what);
 }
 
 std::string check_outputs(CLI::App& sub, const std::vector<std::string>& args, const std::vector<OutputPath>& outputs,

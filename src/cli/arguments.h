@@ -21,6 +21,10 @@ OutputStyle& output_style();
 bool use_color(const std::string& when, int fd);
 /// The value of --color in argv, before CLI11 parses it ("auto" when absent or malformed).
 std::string color_argument(const std::vector<std::string>& args);
+/// --log-level (empty: not given) for the libraries' log (diag/log.h), exported as
+/// EAMOS_LOG_LEVEL so the processes this one starts log alike; warns of an EAMOS_LOG_LEVEL that
+/// names no level.
+void apply_log_level(const std::string& argument);
 /// "eamos: error: ", in red when colour is on.
 std::string error_prefix();
 

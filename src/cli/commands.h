@@ -87,6 +87,8 @@ struct SimVehicleCommandOptions {
   int sysid = 1;
   std::string autopilot = "px4";  ///< "px4" or "ardupilot": whose modes and rules it plays
   double battery = 100.0;   ///< % at start; 0 makes it refuse to arm
+  double east = 0.0;        ///< m east of PX4 SITL's home where it stands (its fleet home's x)
+  double north = 0.0;       ///< m north of it (its fleet home's y)
   double speed = 1.0;       ///< mission time runs this many times as fast as the wall clock
   double duration = 0.0;    ///< stop after this many mission seconds; 0 = until SIGINT/SIGTERM
   std::string ground_station;  ///< a second link URL for a GCS (QGroundControl); "" = none

@@ -1,4 +1,5 @@
-// eamos: the command-line front of the Mission Compiler (and, later, of the DEX).
+// eamos: the command line. One function per subcommand declares its options into one
+// Options; main parses, checks the output paths, and hands over to the chosen command.
 #include <CLI/CLI.hpp>
 
 #include <unistd.h>
@@ -68,200 +69,336 @@ void add_latency(CLI::App* cmd, eamos::launch::LaunchOptions& l, const std::stri
       ->check(eamos::cli::positive());
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"eamos — write a multidrone mission as a short program; every drone runs its part.",
-               "eamos"};
-  app.set_version_flag("--version", std::string("eamos ") + EAMOS_VERSION);
-  app.require_subcommand(1);
-  // Options of eamos itself (colour, diagnostics format) may also come after the command.
-  app.fallthrough();
+/// Every subcommand's options, as the command line sets them.
+struct Options {
   std::string color = "auto";
-  app.add_option("--color", color,
-                 "Colour in diagnostics: auto (on a terminal, unless NO_COLOR is set), always, never")
-      ->check(eamos::cli::one_of({"auto", "always", "never"}));
+  std::string log_level;
   std::string diagnostics_format = "text";
-  app.add_option("--diagnostics-format", diagnostics_format,
-                 "How errors and warnings of a mission are printed: text (GCC style), json, or sarif (SARIF 2.1.0); "
-                 "`check` prints json and sarif on standard output, other commands on standard error")
-      ->check(eamos::cli::one_of({"text", "json", "sarif"}));
-
-  eamos::cli::CommonOptions o;
-
-  auto* check = app.add_subcommand("check", "Check a mission and print every error and warning");
-  add_common(check, o);
+  eamos::cli::CommonOptions common;  ///< the mission and fleet of check, compile, graph, stats, run, verify
   bool list_caps = false;
-  check->add_flag("--list-capabilities", list_caps, "Also list each drone's actions and properties");
-
-  auto* compile = app.add_subcommand("compile", "Compile a mission into per-drone mission files and deployment folders");
-  add_common(compile, o);
   std::string out_dir;
-  compile->add_option("-o,--output", out_dir, "Output folder")->required();
-  eamos::cli::SecurityOptions security;
-  add_security(compile, security);
+  eamos::cli::SecurityOptions security;  ///< compile's, and run --distributed's
   eamos::deploy::PackageOptions package;
   bool packaged = false;
-  auto* package_flag = compile->add_flag(
-      "--package", packaged, "Also write what each drone's companion computer needs to run its DEX as a systemd service: "
-                   "cyclonedds.xml for a real network, dex.env, eamos-dex@.service, DEPLOY.txt (docs/deploy.md)");
-  compile->add_option("--interface", package.interface,
-                      "With --package: the network interface the drones' DDS uses, written into each dex.env "
-                      "(default: left for you to set there)")
-      ->needs(package_flag);
-  compile->add_option("--domain", package.domain, "With --package: the DDS domain id (0-230) every DEX joins")
-      ->default_val(0)->check(eamos::cli::whole_number(0, 230))->needs(package_flag);
-
-  auto* graph = app.add_subcommand("graph", "Write the AMT, MEG or a drone's MDG as DOT, JSON or SVG");
-  add_common(graph, o);
   std::string kind = "meg", drone, format = "dot", graph_out;
-  graph->add_option("--kind", kind, "amt | meg | mdg")->check(eamos::cli::one_of({"amt", "meg", "mdg"}));
-  graph->add_option("--drone", drone, "Drone whose MDG to write (with --kind mdg)");
-  graph->add_option("--format", format, "dot | json | svg")->check(eamos::cli::one_of({"dot", "json", "svg"}));
-  graph->add_option("-o,--output", graph_out, "Output file (default: standard output)");
-
-  auto* stats = app.add_subcommand("stats", "Nodes and arcs per graph and per drone, as JSON");
-  add_common(stats, o);
   std::string stats_out;
-  stats->add_option("-o,--output", stats_out, "Output file (default: standard output)");
-
-  auto* run = app.add_subcommand("run", "Compile and fly a mission in the built-in simulator; exit 0 only when it completed");
-  add_common(run, o);
-  eamos::cli::RunCommandOptions run_opts;
-  add_report(run, run_opts);
-  auto* realtime = run->add_flag("--realtime", run_opts.realtime, "Run in real time instead of virtual time");
-  run->add_option("--speed", run_opts.speed, "Real time scaled by X (2 = twice as fast)")
-      ->check(eamos::cli::positive())->excludes(realtime);
-  run->add_option("--time-limit", run_opts.time_limit, "Fail a mission still running after this many mission seconds")
-      ->check(eamos::cli::positive());
-
-  auto* verify = app.add_subcommand("verify", "Fly every explored path of a mission in the simulator and report each broken rule (separation, geofence, battery, ...) at its action; exit 1 on any");
-  add_common(verify, o);
-  eamos::cli::VerifyCommandOptions verify_opts;
-  verify->add_option("--paths", verify_opts.paths, "Fly at most N paths (combinations of condition outcomes and timings)")
-      ->check(eamos::cli::whole_number(1, 1000000));
-  verify->add_flag("--jitter", verify_opts.jitter, "Also fly each path with drones 10 % slower and faster");
-  verify->add_option("--time-limit", verify_opts.time_limit, "A path still running after this many mission seconds never ends")
-      ->check(eamos::cli::positive());
-  verify->add_flag("--json", verify_opts.json, "Print the report as JSON");
-  verify->add_option("--plot", verify_opts.plot, "Draw the first path with the violations marked in red as SVG to this file");
-  verify->add_option("--trace", verify_opts.trace, "Write the trace of the path --plot draws, with a violation event per broken rule, as JSON Lines to this file (`eamos monitor` replays it)");
-
+  eamos::cli::RunCommandOptions run;
   bool distributed = false;
-  eamos::launch::LaunchOptions launch_opts;
-  run->add_flag("--distributed", distributed,
-                "One DEX process per drone over Cyclone DDS, as `eamos launch` (real time)");
-  run->add_option("--deploy-dir", launch_opts.dir, "With --distributed: where to write the deployment (default: a temporary folder)");
-  run->add_option("--barrier-timeout", launch_opts.barrier_timeout_s, "With --distributed: seconds to wait for every DEX to be ready")
-      ->check(eamos::cli::positive());
-  run->add_option("--final-state-timeout", launch_opts.final_state_timeout_s,
-                  "With --distributed: seconds to wait for a lost drone to report its final state (then: unknown)")
-      ->check(eamos::cli::non_negative());
-  add_dds(run, launch_opts.dds);
-  add_latency(run, launch_opts, "With --distributed: ");
-  add_security(run, security);
-
-  auto* launch = app.add_subcommand("launch", "Run a deployment folder as one DEX process per drone over Cyclone DDS, with a ground process that starts them together and collects their traces");
-  launch->add_option("deployment", launch_opts.dir, "Deployment folder written by `eamos compile -o`")
-      ->required()->check(eamos::cli::existing_folder("a deployment folder"));
+  eamos::cli::VerifyCommandOptions verify;
+  eamos::launch::LaunchOptions launch;  ///< launch's, and run --distributed's
   eamos::cli::RunCommandOptions launch_report;
-  add_report(launch, launch_report);
-  launch->add_option("--speed", launch_opts.speed, "Mission time runs X times as fast as the wall clock (simulated drones only)")
-      ->check(eamos::cli::positive());
-  launch->add_option("--time-limit", launch_opts.time_limit_s, "Fail a mission still running after this many mission seconds")
-      ->check(eamos::cli::positive());
-  launch->add_option("--barrier-timeout", launch_opts.barrier_timeout_s, "Seconds to wait for every DEX to be ready")
-      ->check(eamos::cli::positive());
-  launch->add_option("--drones", launch_opts.local, "Start only these drones here; the others run their DEX elsewhere")
-      ->delimiter(',');
-  launch->add_flag("--remote-only", launch_opts.remote_only,
-                   "Start no DEX here: every drone's DEX runs elsewhere (`eamos dex` on the drone)")
-      ->excludes("--drones");
-  launch->add_option("--final-state-timeout", launch_opts.final_state_timeout_s,
-                     "Seconds to wait for a lost drone to come back and report its final state (then: unknown)")
-      ->check(eamos::cli::non_negative());
-  add_dds(launch, launch_opts.dds);
-  add_latency(launch, launch_opts, "");
-  launch->add_flag("--insecure", launch_opts.insecure,
-                   "Fly without DDS Security, even when the deployment has credentials (experiments only)");
-
-  auto* dexcmd = app.add_subcommand("dex", "Run one drone's DEX from its deployment folder (the deployment package's entry point)");
-  eamos::launch::DexProcessOptions dex_opts;
-  dexcmd->add_option("folder", dex_opts.folder, "The drone's deployment folder (DIR/<drone>)")
-      ->required()->check(eamos::cli::existing_folder("a drone's deployment folder"));
-  dexcmd->add_option("--speed", dex_opts.speed, "Mission time runs X times as fast as the wall clock; must match the ground's")
-      ->check(eamos::cli::positive());
-  dexcmd->add_option("--time-limit", dex_opts.time_limit_s, "Fail a mission still running after this many mission seconds")
-      ->check(eamos::cli::positive());
-  dexcmd->add_option("--start-timeout", dex_opts.start_timeout_s, "Give up when no start came within this many seconds (default: wait)")
-      ->check(eamos::cli::non_negative());
-  dexcmd->add_option("--trace", dex_opts.trace_file, "Also write this drone's trace as JSON Lines to this file");
-  dexcmd->add_option("--launch-id", dex_opts.launch_id,
-                     "Take a start only from the `eamos launch` with this id (set by the launch that starts the DEX)");
-  add_dds(dexcmd, dex_opts.dds);
-  dexcmd->add_option("--max-trigger-latency", dex_opts.max_trigger_latency_s,
-                     "Fail the mission (failsafe, ABORT to every drone) when a trigger or cancel reaches this drone "
-                     "more than this many mission seconds after it was sent (default: no bound)")
-      ->check(eamos::cli::positive());
-  dexcmd->add_flag("--insecure", dex_opts.insecure,
-                   "Fly without DDS Security, even when the folder has credentials (experiments only)");
-
-  auto* monitor = app.add_subcommand("monitor", "Replay a finished mission's trace in the browser (the URL is printed)");
-  eamos::cli::MonitorCommandOptions monitor_opts;
-  monitor->add_option("trace", monitor_opts.trace, "The trace (JSON Lines) `eamos run --trace` wrote")
-      ->required()->check(eamos::cli::existing_file("a trace"));
-  monitor->add_option("--port", monitor_opts.port, "Port to serve at (0: any free one)")
-      ->default_val(8080)->check(eamos::cli::whole_number(0, 65535));
-  monitor->add_option("--host", monitor_opts.host, "Numeric IP address to serve at (0.0.0.0: every interface; default 127.0.0.1, this machine only)")
-      ->default_val("127.0.0.1");
-  auto* monitor_mission = monitor->add_option("--mission", monitor_opts.mission,
-                      "The mission, for a trace that does not carry it (an older trace): adds the graphs and the text")
-      ->check(eamos::cli::existing_file("a mission file"));
-  monitor->add_option("--fleet", monitor_opts.fleet, "The fleet file, with --mission")
-      ->check(eamos::cli::existing_file("a fleet file"))->needs(monitor_mission);
-
-  auto* gen = app.add_subcommand("gen-stress", "Generate a large valid mission for scaling tests");
+  eamos::launch::DexProcessOptions dex;
+  eamos::cli::MonitorCommandOptions monitor;
   long long nodes = 5000;
   int work_per_step = 4;
   int drones = 20;
   unsigned seed = 1;
   std::string gen_out;
   std::string shape = "squads";
-  gen->add_option("--shape", shape,
+  eamos::cli::SimVehicleCommandOptions sim_vehicle;
+  eamos::lsp::ServerOptions lsp;
+  bool lsp_stdio = true;
+};
+
+/// The subcommands, to tell which one the command line chose.
+struct Commands {
+  CLI::App *check, *compile, *graph, *stats, *run, *verify, *launch, *dex, *monitor, *gen, *sim_vehicle, *lsp;
+};
+
+void add_global(CLI::App& app, Options& o) {
+  app.set_version_flag("--version", std::string("eamos ") + EAMOS_VERSION);
+  app.require_subcommand(1);
+  // Options of eamos itself (colour, diagnostics format) may also come after the command.
+  app.fallthrough();
+  app.add_option("--color", o.color,
+                 "Colour in diagnostics: auto (on a terminal, unless NO_COLOR is set), always, never")
+      ->check(eamos::cli::one_of({"auto", "always", "never"}));
+  app.add_option("--log-level", o.log_level,
+                 "Which messages of eamos's parts (links, transport, executor) reach standard error: error, warning, "
+                 "info (default, or $EAMOS_LOG_LEVEL) or debug; the DEX processes a launch starts inherit it")
+      ->check(eamos::cli::one_of({"error", "warning", "info", "debug"}));
+  app.add_option("--diagnostics-format", o.diagnostics_format,
+                 "How errors and warnings of a mission are printed: text (GCC style), json, or sarif (SARIF 2.1.0); "
+                 "`check` prints json and sarif on standard output, other commands on standard error")
+      ->check(eamos::cli::one_of({"text", "json", "sarif"}));
+}
+
+CLI::App* add_check(CLI::App& app, Options& o) {
+  auto* check = app.add_subcommand("check", "Check a mission and print every error and warning");
+  add_common(check, o.common);
+  check->add_flag("--list-capabilities", o.list_caps, "Also list each drone's actions and properties");
+  return check;
+}
+
+CLI::App* add_compile(CLI::App& app, Options& o) {
+  auto* compile = app.add_subcommand("compile", "Compile a mission into per-drone mission files and deployment folders");
+  add_common(compile, o.common);
+  compile->add_option("-o,--output", o.out_dir, "Output folder")->required();
+  add_security(compile, o.security);
+  auto* package_flag = compile->add_flag(
+      "--package", o.packaged, "Also write what each drone's companion computer needs to run its DEX as a systemd service: "
+                   "cyclonedds.xml for a real network, dex.env, eamos-dex@.service, DEPLOY.txt (docs/deploy.md)");
+  compile->add_option("--interface", o.package.interface,
+                      "With --package: the network interface the drones' DDS uses, written into each dex.env "
+                      "(default: left for you to set there)")
+      ->needs(package_flag);
+  compile->add_option("--domain", o.package.domain, "With --package: the DDS domain id (0-230) every DEX joins")
+      ->default_val(0)->check(eamos::cli::whole_number(0, 230))->needs(package_flag);
+  return compile;
+}
+
+CLI::App* add_graph(CLI::App& app, Options& o) {
+  auto* graph = app.add_subcommand("graph", "Write the AMT, MEG or a drone's MDG as DOT, JSON or SVG");
+  add_common(graph, o.common);
+  graph->add_option("--kind", o.kind, "amt | meg | mdg")->check(eamos::cli::one_of({"amt", "meg", "mdg"}));
+  graph->add_option("--drone", o.drone, "Drone whose MDG to write (with --kind mdg)");
+  graph->add_option("--format", o.format, "dot | json | svg")->check(eamos::cli::one_of({"dot", "json", "svg"}));
+  graph->add_option("-o,--output", o.graph_out, "Output file (default: standard output)");
+  return graph;
+}
+
+CLI::App* add_stats(CLI::App& app, Options& o) {
+  auto* stats = app.add_subcommand("stats", "Nodes and arcs per graph and per drone, as JSON");
+  add_common(stats, o.common);
+  stats->add_option("-o,--output", o.stats_out, "Output file (default: standard output)");
+  return stats;
+}
+
+CLI::App* add_run(CLI::App& app, Options& o) {
+  auto* run = app.add_subcommand("run", "Compile and fly a mission in the built-in simulator; exit 0 only when it completed");
+  add_common(run, o.common);
+  add_report(run, o.run);
+  auto* realtime = run->add_flag("--realtime", o.run.realtime, "Run in real time instead of virtual time");
+  run->add_option("--speed", o.run.speed, "Real time scaled by X (2 = twice as fast)")
+      ->check(eamos::cli::positive())->excludes(realtime);
+  run->add_option("--time-limit", o.run.time_limit, "Fail a mission still running after this many mission seconds")
+      ->check(eamos::cli::positive());
+  return run;
+}
+
+// `run --distributed`: the options of `launch` it takes, each marked so in the help.
+void add_run_distributed(CLI::App* run, Options& o) {
+  run->add_flag("--distributed", o.distributed,
+                "One DEX process per drone over Cyclone DDS, as `eamos launch` (real time)");
+  run->add_option("--deploy-dir", o.launch.dir, "With --distributed: where to write the deployment (default: a temporary folder)");
+  run->add_option("--barrier-timeout", o.launch.barrier_timeout_s, "With --distributed: seconds to wait for every DEX to be ready")
+      ->check(eamos::cli::positive());
+  run->add_option("--final-state-timeout", o.launch.final_state_timeout_s,
+                  "With --distributed: seconds to wait for a lost drone to report its final state (then: unknown)")
+      ->check(eamos::cli::non_negative());
+  add_dds(run, o.launch.dds);
+  add_latency(run, o.launch, "With --distributed: ");
+  add_security(run, o.security);
+}
+
+CLI::App* add_verify(CLI::App& app, Options& o) {
+  auto* verify = app.add_subcommand("verify", "Fly every explored path of a mission in the simulator and report each broken rule (separation, geofence, battery, ...) at its action; exit 1 on any");
+  add_common(verify, o.common);
+  eamos::cli::VerifyCommandOptions& v = o.verify;
+  verify->add_option("--paths", v.paths, "Fly at most N paths (combinations of condition outcomes and timings)")
+      ->check(eamos::cli::whole_number(1, 1000000));
+  verify->add_flag("--jitter", v.jitter, "Also fly each path with drones 10 % slower and faster");
+  verify->add_option("--time-limit", v.time_limit, "A path still running after this many mission seconds never ends")
+      ->check(eamos::cli::positive());
+  verify->add_flag("--json", v.json, "Print the report as JSON");
+  verify->add_option("--plot", v.plot, "Draw the first path with the violations marked in red as SVG to this file");
+  verify->add_option("--trace", v.trace, "Write the trace of the path --plot draws, with a violation event per broken rule, as JSON Lines to this file (`eamos monitor` replays it)");
+  return verify;
+}
+
+CLI::App* add_launch(CLI::App& app, Options& o) {
+  auto* launch = app.add_subcommand("launch", "Run a deployment folder as one DEX process per drone over Cyclone DDS, with a ground process that starts them together and collects their traces");
+  eamos::launch::LaunchOptions& l = o.launch;
+  launch->add_option("deployment", l.dir, "Deployment folder written by `eamos compile -o`")
+      ->required()->check(eamos::cli::existing_folder("a deployment folder"));
+  add_report(launch, o.launch_report);
+  launch->add_option("--speed", l.speed, "Mission time runs X times as fast as the wall clock (simulated drones only)")
+      ->check(eamos::cli::positive());
+  launch->add_option("--time-limit", l.time_limit_s, "Fail a mission still running after this many mission seconds")
+      ->check(eamos::cli::positive());
+  launch->add_option("--barrier-timeout", l.barrier_timeout_s, "Seconds to wait for every DEX to be ready")
+      ->check(eamos::cli::positive());
+  launch->add_option("--drones", l.local, "Start only these drones here; the others run their DEX elsewhere")
+      ->delimiter(',');
+  launch->add_flag("--remote-only", l.remote_only,
+                   "Start no DEX here: every drone's DEX runs elsewhere (`eamos dex` on the drone)")
+      ->excludes("--drones");
+  launch->add_option("--final-state-timeout", l.final_state_timeout_s,
+                     "Seconds to wait for a lost drone to come back and report its final state (then: unknown)")
+      ->check(eamos::cli::non_negative());
+  add_dds(launch, l.dds);
+  add_latency(launch, l, "");
+  launch->add_flag("--insecure", l.insecure,
+                   "Fly without DDS Security, even when the deployment has credentials (experiments only)");
+  return launch;
+}
+
+CLI::App* add_dex(CLI::App& app, Options& o) {
+  auto* dexcmd = app.add_subcommand("dex", "Run one drone's DEX from its deployment folder (the deployment package's entry point)");
+  eamos::launch::DexProcessOptions& d = o.dex;
+  dexcmd->add_option("folder", d.folder, "The drone's deployment folder (DIR/<drone>)")
+      ->required()->check(eamos::cli::existing_folder("a drone's deployment folder"));
+  dexcmd->add_option("--speed", d.speed, "Mission time runs X times as fast as the wall clock; must match the ground's")
+      ->check(eamos::cli::positive());
+  dexcmd->add_option("--time-limit", d.time_limit_s, "Fail a mission still running after this many mission seconds")
+      ->check(eamos::cli::positive());
+  dexcmd->add_option("--start-timeout", d.start_timeout_s, "Give up when no start came within this many seconds (default: wait)")
+      ->check(eamos::cli::non_negative());
+  dexcmd->add_option("--trace", d.trace_file, "Also write this drone's trace as JSON Lines to this file");
+  dexcmd->add_option("--launch-id", d.launch_id,
+                     "Take a start only from the `eamos launch` with this id (set by the launch that starts the DEX)");
+  add_dds(dexcmd, d.dds);
+  dexcmd->add_option("--max-trigger-latency", d.max_trigger_latency_s,
+                     "Fail the mission (failsafe, ABORT to every drone) when a trigger or cancel reaches this drone "
+                     "more than this many mission seconds after it was sent (default: no bound)")
+      ->check(eamos::cli::positive());
+  dexcmd->add_flag("--insecure", d.insecure,
+                   "Fly without DDS Security, even when the folder has credentials (experiments only)");
+  return dexcmd;
+}
+
+CLI::App* add_monitor(CLI::App& app, Options& o) {
+  auto* monitor = app.add_subcommand("monitor", "Replay a finished mission's trace in the browser (the URL is printed)");
+  eamos::cli::MonitorCommandOptions& m = o.monitor;
+  monitor->add_option("trace", m.trace, "The trace (JSON Lines) `eamos run --trace` wrote")
+      ->required()->check(eamos::cli::existing_file("a trace"));
+  monitor->add_option("--port", m.port, "Port to serve at (0: any free one)")
+      ->default_val(8080)->check(eamos::cli::whole_number(0, 65535));
+  monitor->add_option("--host", m.host, "Numeric IP address to serve at (0.0.0.0: every interface; default 127.0.0.1, this machine only)")
+      ->default_val("127.0.0.1");
+  auto* monitor_mission = monitor->add_option("--mission", m.mission,
+                      "The mission, for a trace that does not carry it (an older trace): adds the graphs and the text")
+      ->check(eamos::cli::existing_file("a mission file"));
+  monitor->add_option("--fleet", m.fleet, "The fleet file, with --mission")
+      ->check(eamos::cli::existing_file("a fleet file"))->needs(monitor_mission);
+  return monitor;
+}
+
+CLI::App* add_gen_stress(CLI::App& app, Options& o) {
+  auto* gen = app.add_subcommand("gen-stress", "Generate a large valid mission for scaling tests");
+  gen->add_option("--shape", o.shape,
                   "squads: squads of ten, each its own barriers; show: every drone in every PAR; cross: squads that "
                   "wait on, branch on and fly to other squads' drones")
       ->check(eamos::cli::one_of({"squads", "show", "cross"}));
-  gen->add_option("--work", work_per_step, "Work items per drone between two barriers")->check(eamos::cli::whole_number(1, 1000));
-  gen->add_option("--nodes", nodes, "Approximate number of MEG nodes")->check(eamos::cli::whole_number(10, 50'000'000));
-  gen->add_option("--drones", drones, "Number of drones")->check(eamos::cli::whole_number(1, 100000));
-  gen->add_option("--seed", seed, "Seed of the generator (same seed, same mission)");
-  gen->add_option("-o,--output", gen_out, "Output file (default: standard output)");
+  gen->add_option("--work", o.work_per_step, "Work items per drone between two barriers")->check(eamos::cli::whole_number(1, 1000));
+  gen->add_option("--nodes", o.nodes, "Approximate number of MEG nodes")->check(eamos::cli::whole_number(10, 50'000'000));
+  gen->add_option("--drones", o.drones, "Number of drones")->check(eamos::cli::whole_number(1, 100000));
+  gen->add_option("--seed", o.seed, "Seed of the generator (same seed, same mission)");
+  gen->add_option("-o,--output", o.gen_out, "Output file (default: standard output)");
+  return gen;
+}
 
+CLI::App* add_sim_vehicle(CLI::App& app, Options& o) {
   auto* simv = app.add_subcommand("sim-vehicle", "Run a PX4-like MAVLink vehicle on the built-in simulator (for the mavlink adapter)");
-  eamos::cli::SimVehicleCommandOptions simv_opts;
-  auto* udp = simv->add_option("--udp", simv_opts.udp_port, "Send to 127.0.0.1:PORT, like PX4 SITL (whose instance i sends to 14540 + i)")
+  eamos::cli::SimVehicleCommandOptions& v = o.sim_vehicle;
+  auto* udp = simv->add_option("--udp", v.udp_port, "Send to 127.0.0.1:PORT, like PX4 SITL (whose instance i sends to 14540 + i)")
       ->check(eamos::cli::whole_number(1, 65535));
-  simv->add_option("--gcs", simv_opts.ground_station,
+  simv->add_option("--gcs", v.ground_station,
                    "Also stream to a ground station so QGroundControl shows the vehicle, e.g. udpout://127.0.0.1:14550");
-  simv->add_option("--connection", simv_opts.connection, "Any link URL instead: udp://:PORT, udpout://HOST:PORT or tcp://HOST:PORT")
+  simv->add_option("--connection", v.connection, "Any link URL instead: udp://:PORT, udpout://HOST:PORT or tcp://HOST:PORT")
       ->excludes(udp);
-  simv->add_option("--sysid", simv_opts.sysid, "MAVLink system id")->check(eamos::cli::whole_number(1, 255));
-  simv->add_option("--autopilot", simv_opts.autopilot, "Whose modes and rules to play: px4 (OFFBOARD) or ardupilot (Copter, GUIDED)")
+  simv->add_option("--sysid", v.sysid, "MAVLink system id")->check(eamos::cli::whole_number(1, 255));
+  simv->add_option("--autopilot", v.autopilot, "Whose modes and rules to play: px4 (OFFBOARD) or ardupilot (Copter, GUIDED)")
       ->check(eamos::cli::one_of({"px4", "ardupilot"}));
-  simv->add_option("--battery", simv_opts.battery, "Charge at start, %; 0 makes it refuse to arm")->check(eamos::cli::number_between(0.0, 100.0));
-  simv->add_option("--speed", simv_opts.speed, "Mission time runs X times as fast as the wall clock; the adapter's run must use the same")
+  simv->add_option("--east", v.east, "Stand this many metres east of 47.397742 N, 8.545594 E (PX4 SITL's home); "
+                   "give each vehicle its fleet home's x")->check(eamos::cli::number_between(-100000.0, 100000.0));
+  simv->add_option("--north", v.north, "Stand this many metres north of it; the fleet home's y")
+      ->check(eamos::cli::number_between(-100000.0, 100000.0));
+  simv->add_option("--battery", v.battery, "Charge at start, %; 0 makes it refuse to arm")->check(eamos::cli::number_between(0.0, 100.0));
+  simv->add_option("--speed", v.speed, "Mission time runs X times as fast as the wall clock; the adapter's run must use the same")
       ->check(eamos::cli::positive());
-  simv->add_option("--duration", simv_opts.duration, "Stop after this many mission seconds (default: until interrupted)")
+  simv->add_option("--duration", v.duration, "Stop after this many mission seconds (default: until interrupted)")
       ->check(eamos::cli::non_negative());
+  return simv;
+}
 
+CLI::App* add_lsp(CLI::App& app, Options& o) {
   auto* lsp = app.add_subcommand("lsp", "Serve the Language Server Protocol on standard input and output, for editors "
                                        "(docs/editors.md): diagnostics as you type, hover, go-to-definition, completion, outline");
-  eamos::lsp::ServerOptions lsp_opts;
-  lsp->add_option("--fleet", lsp_opts.fleet,
+  lsp->add_option("--fleet", o.lsp.fleet,
                   "Fleet file (YAML) to check every mission against, as `eamos check --fleet`; the client's "
                   "initializationOptions {\"fleet\": PATH} replace it");
-  bool lsp_stdio = true;
-  lsp->add_flag("--stdio", lsp_stdio, "Talk over standard input and output (the only transport; editors pass it)");
+  lsp->add_flag("--stdio", o.lsp_stdio, "Talk over standard input and output (the only transport; editors pass it)");
+  return lsp;
+}
+
+/// Every subcommand on `app`, in the order `eamos --help` lists them.
+Commands add_commands(CLI::App& app, Options& o) {
+  Commands c{};
+  c.check = add_check(app, o);
+  c.compile = add_compile(app, o);
+  c.graph = add_graph(app, o);
+  c.stats = add_stats(app, o);
+  c.run = add_run(app, o);
+  c.verify = add_verify(app, o);
+  add_run_distributed(c.run, o);
+  c.launch = add_launch(app, o);
+  c.dex = add_dex(app, o);
+  c.monitor = add_monitor(app, o);
+  c.gen = add_gen_stress(app, o);
+  c.sim_vehicle = add_sim_vehicle(app, o);
+  c.lsp = add_lsp(app, o);
+  return c;
+}
+
+/// Every file the chosen command writes, checked before it compiles or flies anything: a
+/// run must not end in "cannot write" after the flight. False (said on stderr) on the first
+/// command whose outputs are unusable.
+bool outputs_usable(const Commands& c, const std::vector<std::string>& args, const Options& o) {
+  auto out = [](CLI::App* sub, const char* name, bool folder = false) {
+    return eamos::cli::OutputPath{sub->get_option_no_throw(name), folder};
+  };
+  std::vector<std::pair<CLI::App*, std::vector<eamos::cli::OutputPath>>> outputs = {
+      {c.compile, {out(c.compile, "--output", true)}},
+      {c.graph, {out(c.graph, "--output")}},
+      {c.stats, {out(c.stats, "--output")}},
+      {c.gen, {out(c.gen, "--output")}},
+      {c.run, {out(c.run, "--trace"), out(c.run, "--summary"), out(c.run, "--plot"), out(c.run, "--deploy-dir", true)}},
+      {c.verify, {out(c.verify, "--plot"), out(c.verify, "--trace")}},
+      {c.launch, {out(c.launch, "--trace"), out(c.launch, "--summary"), out(c.launch, "--plot")}},
+      {c.dex, {out(c.dex, "--trace")}},
+  };
+  std::vector<std::string> inputs = {o.common.mission, o.common.fleet, o.monitor.trace, o.monitor.mission};
+  for (const auto& [sub, paths] : outputs) {
+    if (!*sub) continue;
+    if (std::string bad = eamos::cli::check_outputs(*sub, args, paths, inputs); !bad.empty()) {
+      std::cerr << bad;
+      return false;
+    }
+  }
+  return true;
+}
+
+/// Runs the command the line chose; its exit status.
+int dispatch(const Commands& c, Options& o) {
+  if (*c.check) return eamos::cli::cmd_check(o.common, o.list_caps);
+  if (*c.compile) return eamos::cli::cmd_compile(o.common, o.out_dir, o.security, o.packaged ? &o.package : nullptr);
+  if (*c.graph) return eamos::cli::cmd_graph(o.common, o.kind, o.drone, o.format, o.graph_out);
+  if (*c.stats) return eamos::cli::cmd_stats(o.common, o.stats_out);
+  if (*c.run && o.distributed) {
+    o.launch.speed = o.run.speed > 0 ? o.run.speed : 1.0;
+    o.launch.time_limit_s = o.run.time_limit;
+    return eamos::cli::cmd_run_distributed(o.common, o.run, o.launch, o.security);
+  }
+  if (*c.run) return eamos::cli::cmd_run(o.common, o.run);
+  if (*c.verify) return eamos::cli::cmd_verify(o.common, o.verify);
+  if (*c.launch) return eamos::cli::cmd_launch(o.launch, o.launch_report);
+  if (*c.dex) return eamos::cli::cmd_dex(o.dex);
+  if (*c.sim_vehicle) return eamos::cli::cmd_sim_vehicle(o.sim_vehicle);
+  if (*c.monitor) return eamos::cli::cmd_monitor(o.monitor);
+  if (*c.gen) return eamos::cli::cmd_gen_stress(o.shape, o.nodes, o.drones, o.work_per_step, o.seed, o.gen_out);
+  if (*c.lsp) return eamos::lsp::serve_stdio(o.lsp);
+  return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"eamos — write a multidrone mission as a short program; every drone runs its part.",
+               "eamos"};
+  Options o;
+  add_global(app, o);
+  Commands c = add_commands(app, o);
 
   std::vector<std::string> args(argv + 1, argv + argc);
   eamos::cli::OutputStyle& style = eamos::cli::output_style();
@@ -278,58 +415,18 @@ int main(int argc, char** argv) {
     std::cerr << eamos::cli::explain_parse_error(app, args, e);
     return 1;
   }
-  style.color_stderr = eamos::cli::use_color(color, STDERR_FILENO);
-  style.diagnostics = diagnostics_format;
-
-  // Every file a command writes is checked before it compiles or flies anything: a run must
-  // not end in "cannot write" after the flight.
-  auto out = [](CLI::App* sub, const char* name, bool folder = false) {
-    return eamos::cli::OutputPath{sub->get_option_no_throw(name), folder};
-  };
-  std::vector<std::pair<CLI::App*, std::vector<eamos::cli::OutputPath>>> outputs = {
-      {compile, {out(compile, "--output", true)}},
-      {graph, {out(graph, "--output")}},
-      {stats, {out(stats, "--output")}},
-      {gen, {out(gen, "--output")}},
-      {run, {out(run, "--trace"), out(run, "--summary"), out(run, "--plot"), out(run, "--deploy-dir", true)}},
-      {verify, {out(verify, "--plot"), out(verify, "--trace")}},
-      {launch, {out(launch, "--trace"), out(launch, "--summary"), out(launch, "--plot")}},
-      {dexcmd, {out(dexcmd, "--trace")}},
-  };
-  std::vector<std::string> inputs = {o.mission, o.fleet, monitor_opts.trace, monitor_opts.mission};
-  for (const auto& [sub, paths] : outputs) {
-    if (!*sub) continue;
-    if (std::string bad = eamos::cli::check_outputs(*sub, args, paths, inputs); !bad.empty()) {
-      std::cerr << bad;
-      return 1;
-    }
-  }
+  style.color_stderr = eamos::cli::use_color(o.color, STDERR_FILENO);
+  style.diagnostics = o.diagnostics_format;
+  eamos::cli::apply_log_level(o.log_level);
+  if (!outputs_usable(c, args, o)) return 1;
 
   // A flight's live log goes out line by line also into a pipe (`| tee log`): what a person
   // watches is now, not a buffer later, and a killed process loses at most half a line.
-  if (*run || *launch || *dexcmd || *simv || *monitor) std::setvbuf(stdout, nullptr, _IOLBF, BUFSIZ);
-
+  if (*c.run || *c.launch || *c.dex || *c.sim_vehicle || *c.monitor) std::setvbuf(stdout, nullptr, _IOLBF, BUFSIZ);
   try {
-    if (*check) return eamos::cli::cmd_check(o, list_caps);
-    if (*compile) return eamos::cli::cmd_compile(o, out_dir, security, packaged ? &package : nullptr);
-    if (*graph) return eamos::cli::cmd_graph(o, kind, drone, format, graph_out);
-    if (*stats) return eamos::cli::cmd_stats(o, stats_out);
-    if (*run && distributed) {
-      launch_opts.speed = run_opts.speed > 0 ? run_opts.speed : 1.0;
-      launch_opts.time_limit_s = run_opts.time_limit;
-      return eamos::cli::cmd_run_distributed(o, run_opts, launch_opts, security);
-    }
-    if (*run) return eamos::cli::cmd_run(o, run_opts);
-    if (*verify) return eamos::cli::cmd_verify(o, verify_opts);
-    if (*launch) return eamos::cli::cmd_launch(launch_opts, launch_report);
-    if (*dexcmd) return eamos::cli::cmd_dex(dex_opts);
-    if (*simv) return eamos::cli::cmd_sim_vehicle(simv_opts);
-    if (*monitor) return eamos::cli::cmd_monitor(monitor_opts);
-    if (*gen) return eamos::cli::cmd_gen_stress(shape, nodes, drones, work_per_step, seed, gen_out);
-    if (*lsp) return eamos::lsp::serve_stdio(lsp_opts);
+    return dispatch(c, o);
   } catch (const std::exception& e) {
     std::cerr << eamos::cli::error_prefix() << e.what() << "\n";
     return 1;
   }
-  return 1;
 }

@@ -209,8 +209,8 @@ void ProgressDisplay::record(const dex::TraceEvent& e) {
   apply(e);
   dirty_ = true;
   // What a person must not miss stays on the screen as a line of the live log.
-  bool notable = e.event == "failsafe" || e.event == "vehicle" || e.event == "error" ||
-                 (e.event == "end" && e.outcome == "failed");
+  bool notable = e.event == "failsafe" || e.event == "vehicle" || e.event == "error" || e.event == "conflict" ||
+                 e.event == "give_way" || e.event == "resume" || (e.event == "end" && e.outcome == "failed");
   if (e.event == "mission") {
     ended_ = true;
     completed_ = e.outcome == "completed";

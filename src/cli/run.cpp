@@ -82,14 +82,75 @@ int interrupted_before_start() {
   return 1;
 }
 
+/// Where a run's events go: the terminal (status lines or log lines), the trace file, the
+/// plot's memory, the live monitor. Held in place: the tee points at the others.
+struct RunSinks {
+  dex::TeeTrace tee;
+  dex::LiveLog live{std::cout};
+  std::unique_ptr<ProgressDisplay> progress;
+  std::ofstream trace_file;
+  std::unique_ptr<dex::JsonlTrace> jsonl;
+  dex::MemoryTrace memory;  ///< the plot is drawn from the whole trace after the run
+  std::unique_ptr<monitor::MonitorServer> server;
+  std::unique_ptr<monitor::LiveSink> live_monitor;
+};
+
+/// Only a run with --monitor has a server at all: without it nothing of civetweb is touched.
+bool open_monitor(const RunCommandOptions& r, const nlohmann::json& view, const dex::Mission& mission,
+                  RunSinks& sinks) {
+  if (r.monitor.empty()) return true;
+  sinks.server = std::make_unique<monitor::MonitorServer>();
+  if (!start_monitor(*sinks.server, r.monitor, view)) return false;
+  sinks.live_monitor = std::make_unique<monitor::LiveSink>(*sinks.server, mission.fleet);
+  std::cout << "eamos: monitor at " << sinks.server->url() << "\n" << std::flush;
+  return true;
+}
+
+bool open_sinks(const RunCommandOptions& r, const graph::Compilation& c, const std::vector<dex::Mission>& missions,
+                RunSinks& sinks) {
+  // On a terminal, a status line per drone redrawn in place; through a pipe, the log lines.
+  if (r.log && stdout_is_terminal()) sinks.progress = std::make_unique<ProgressDisplay>(std::cout, missions);
+  if (sinks.progress) sinks.tee.add(sinks.progress.get());
+  else if (r.log) sinks.tee.add(&sinks.live);
+  if (!r.trace.empty()) {
+    sinks.trace_file.open(r.trace, std::ios::trunc);
+    if (!sinks.trace_file) {
+      std::cerr << error_prefix() << "cannot write trace '" << r.trace << "'\n";
+      return false;
+    }
+    sinks.jsonl = std::make_unique<dex::JsonlTrace>(sinks.trace_file, missions[0].fleet);
+    // Said when it happens, not at the end: the flight goes on, without its record.
+    report_trace_write_errors(*sinks.jsonl, r.trace);
+    sinks.jsonl->write_header(deploy::trace_header(c, missions[0].hash, r.telemetry_hz));
+    sinks.tee.add(sinks.jsonl.get());
+  }
+  if (!r.plot.empty()) sinks.tee.add(&sinks.memory);
+  if (sinks.live_monitor) sinks.tee.add(sinks.live_monitor.get());
+  return true;
+}
+
+dex::RunOptions run_options(const RunCommandOptions& r, dex::RunInterrupt& interrupt, const RunSinks& sinks) {
+  dex::RunOptions options;
+  options.time_limit_s = r.time_limit;
+  options.keep_tracks = !r.plot.empty();  // only the plot draws them
+  options.interrupt = &interrupt;
+  // Samples cost a copy of every drone's state per tick: only when a trace file or the
+  // terminal's status lines (their clock) take them.
+  options.telemetry_hz = sinks.jsonl || sinks.progress || sinks.live_monitor ? r.telemetry_hz : 0.0;
+  if (r.realtime || r.speed > 0) {
+    options.clock.mode = mid::ClockMode::real_time;
+    options.clock.speed = r.speed > 0 ? r.speed : 1.0;
+  }
+  return options;
+}
+
 }  // namespace
 
 int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   // Ctrl-C or SIGTERM lands the drones instead of killing the process under them. Taken from
   // the very start, before any thread exists (an adapter's would inherit the old mask): a
   // signal while compiling or drawing the monitor's graphs (with --monitor, Graphviz runs
-  // for seconds on a loaded machine) used to kill the process with the default action
-  // (status 143), unlike one a moment later.
+  // for seconds on a loaded machine) must not kill the process with the default action.
   dex::RunInterrupt interrupt;
   MonitorHold hold;
   SignalWatch signals([&interrupt, &hold](const char* name) {
@@ -111,64 +172,22 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   nlohmann::json view;
   if (!r.monitor.empty()) view = live_view(c, o.mission, o.fleet);
   if (hold.was_interrupted()) return interrupted_before_start();
-  // Only a run with --monitor has a server at all: without it nothing of civetweb is touched.
-  std::unique_ptr<monitor::MonitorServer> server;
-  std::unique_ptr<monitor::LiveSink> live_monitor;
-  if (!r.monitor.empty()) {
-    server = std::make_unique<monitor::MonitorServer>();
-    if (!start_monitor(*server, r.monitor, view)) return 1;
-    live_monitor = std::make_unique<monitor::LiveSink>(*server, missions[0].fleet);
-    std::cout << "eamos: monitor at " << server->url() << "\n" << std::flush;
-  }
+  RunSinks sinks;
+  if (!open_monitor(r, view, missions[0], sinks)) return 1;
   // A signal from here on is the run's (RunInterrupt keeps it until the run starts).
   mid::AdapterRegistry adapters;
   sim::register_adapter(adapters);
   mavlink_adapter::register_adapter(adapters, {.real_time = r.realtime || r.speed > 0,
                                                .speed = r.speed > 0 ? r.speed : 1.0});
-
-  dex::TeeTrace tee;
-  dex::LiveLog live(std::cout);
-  // On a terminal, a status line per drone redrawn in place; through a pipe, the log lines.
-  std::unique_ptr<ProgressDisplay> progress;
-  if (r.log && stdout_is_terminal()) progress = std::make_unique<ProgressDisplay>(std::cout, missions);
-  if (progress) tee.add(progress.get());
-  else if (r.log) tee.add(&live);
-  std::ofstream trace_file;
-  std::unique_ptr<dex::JsonlTrace> jsonl;
-  if (!r.trace.empty()) {
-    trace_file.open(r.trace, std::ios::trunc);
-    if (!trace_file) {
-      std::cerr << error_prefix() << "cannot write trace '" << r.trace << "'\n";
-      return 1;
-    }
-    jsonl = std::make_unique<dex::JsonlTrace>(trace_file, missions[0].fleet);
-    // Said when it happens, not at the end: the flight goes on, without its record.
-    report_trace_write_errors(*jsonl, r.trace);
-    jsonl->write_header(deploy::trace_header(c, missions[0].hash, r.telemetry_hz));
-    tee.add(jsonl.get());
-  }
-  dex::MemoryTrace memory;  // the plot is drawn from the whole trace after the run
-  if (!r.plot.empty()) tee.add(&memory);
-  if (live_monitor) tee.add(live_monitor.get());
-  dex::RunOptions options;
-  options.time_limit_s = r.time_limit;
-  options.keep_tracks = !r.plot.empty();  // only the plot draws them
-  options.interrupt = &interrupt;
-  // Samples cost a copy of every drone's state per tick: only when a trace file or the
-  // terminal's status lines (their clock) take them.
-  options.telemetry_hz = jsonl || progress || live_monitor ? r.telemetry_hz : 0.0;
-  if (r.realtime || r.speed > 0) {
-    options.clock.mode = mid::ClockMode::real_time;
-    options.clock.speed = r.speed > 0 ? r.speed : 1.0;
-  }
-  dex::RunResult result = dex::run_in_process(missions, adapters, &tee, options);
-  if (progress) progress->finish();
-  if (!report_run(r, result, memory.events)) return 1;
+  if (!open_sinks(r, c, missions, sinks)) return 1;
+  dex::RunResult result = dex::run_in_process(missions, adapters, &sinks.tee, run_options(r, interrupt, sinks));
+  if (sinks.progress) sinks.progress->finish();
+  if (!report_run(r, result, sinks.memory.events)) return 1;
   // A completed mission whose trace was cut is not a run to take as recorded.
-  bool trace_cut = jsonl && !jsonl->write_error().empty();
+  bool trace_cut = sinks.jsonl && !sinks.jsonl->write_error().empty();
   if (trace_cut)
-    std::cerr << "eamos: error: the trace '" << r.trace << "' is incomplete (" << jsonl->write_error() << ")\n";
-  if (live_monitor && !hold.was_interrupted()) hold_monitor(*server, hold);
+    std::cerr << "eamos: error: the trace '" << r.trace << "' is incomplete (" << sinks.jsonl->write_error() << ")\n";
+  if (sinks.live_monitor && !hold.was_interrupted()) hold_monitor(*sinks.server, hold);
   return result.completed && !trace_cut ? 0 : 1;
 }
 

@@ -28,6 +28,8 @@ int cmd_sim_vehicle(const SimVehicleCommandOptions& o) {
   sim_vehicle::VehicleOptions options;
   options.sysid = static_cast<uint8_t>(o.sysid);
   options.battery_percent = o.battery;
+  options.east_m = o.east;
+  options.north_m = o.north;
   options.dialect = o.autopilot == "ardupilot" ? &sim_vehicle::ardupilot_dialect() : &sim_vehicle::px4_dialect();
   sim_vehicle::SimVehicle vehicle(loop, options);
   if (std::string error = vehicle.open(*endpoint.endpoint); !error.empty()) {

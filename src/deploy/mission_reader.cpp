@@ -258,6 +258,7 @@ class Reader {
     settings(file);
     type(file);
     drone_list(file, "reads", "", m_.reads);
+    separation(file);
     drone_sets(file);
     nodes(file);
     arcs(file);
@@ -308,6 +309,22 @@ class Reader {
       m_.fleet.push_back(name);
     }
     return ok;
+  }
+
+  /// `separation` and `priorities`: optional, the defaults when absent (mission_writer.cpp).
+  void separation(const json& file) {
+    if (const json* s = f_.member(file, "separation", "", false); s && f_.object(*s, "/separation")) {
+      f_.number(*s, "horizontal", "/separation", m_.separation.horizontal_m, 1e-9, kAny);
+      f_.number(*s, "vertical", "/separation", m_.separation.vertical_m, 1e-9, kAny);
+    }
+    const json* list = f_.member(file, "priorities", "", false);
+    if (!list || !f_.array(*list, "/priorities")) return;
+    if (list->size() != m_.fleet.size())
+      return d_.add("/priorities", "holds " + std::to_string(list->size()) + " priorities for a fleet of " +
+                                       std::to_string(m_.fleet.size()));
+    m_.priorities.assign(list->size(), 0);
+    for (std::size_t i = 0; i < list->size(); ++i)
+      f_.integer_value((*list)[i], at("/priorities", i), m_.priorities[i], 1, 1000000);
   }
 
   /// `drone_sets`: each a list of [first, last] drone index ranges, ascending and apart.
@@ -410,6 +427,7 @@ class Reader {
         d_.add("/drone/signing_key", why);
     f_.boolean(*d, "signing_setup", "/drone", s.signing_setup, false);
     f_.boolean(*d, "announce_as_gcs", "/drone", s.announce_as_gcs, false);
+    f_.number(*d, "home_tolerance", "/drone", s.home_tolerance_m, 1e-9, 1e6, false);
     vec3(*d, "home", "/drone", s.home);
     f_.number(*d, "battery", "/drone", s.battery_percent, 0, 100);
     int failsafe = 0;

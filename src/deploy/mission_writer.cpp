@@ -99,6 +99,8 @@ void write_settings(JsonWriter& w, const fleet::DroneSettings& s, int index) {
   if (!s.connection.empty()) w.member("connection", s.connection);
   if (s.sysid > 0) w.member("sysid", s.sysid);
   if (s.announce_as_gcs) w.member("announce_as_gcs", true);
+  // Only when the fleet sets it: mission files of fleets that do not stay byte for byte.
+  if (s.home_tolerance_m != fleet::kDefaultHomeToleranceM) w.member("home_tolerance", s.home_tolerance_m);
   if (!s.signing_key.empty()) {  // the drone's own folder only, beside its private DDS key
     w.member("signing_key", s.signing_key);
     w.member("signing_setup", s.signing_setup);
@@ -135,6 +137,27 @@ void write_settings(JsonWriter& w, const fleet::DroneSettings& s, int index) {
   for (const auto& [action, seconds] : s.timeouts_s) w.member(action, seconds);
   w.end_object();
   w.end_object();
+}
+
+/// `separation` (min_separation, when not the default) and `priorities` (when any drone
+/// sets `priority:`): written only then, so a mission without them keeps its file and hash.
+void write_separation(JsonWriter& w, const Compilation& c) {
+  const fleet::Separation& s = c.fleet.safety.min_separation;
+  if (s.horizontal_m != fleet::Separation{}.horizontal_m || s.vertical_m != fleet::Separation{}.vertical_m) {
+    w.key("separation");
+    w.begin_object();
+    w.member("horizontal", s.horizontal_m);
+    w.member("vertical", s.vertical_m);
+    w.end_object();
+  }
+  bool any = false;
+  for (const fleet::DroneSettings& d : c.settings) any |= d.priority > 0;
+  if (!any) return;
+  w.key("priorities");
+  w.begin_array();
+  for (std::size_t d = 0; d < c.settings.size(); ++d)
+    w.value(c.settings[d].priority > 0 ? c.settings[d].priority : static_cast<int>(d) + 1);
+  w.end_array();
 }
 
 void write_type(JsonWriter& w, const fleet::DroneType& t) {
@@ -364,6 +387,7 @@ bool write_drone_mission(std::ostream& out, const Compilation& c, int drone, con
   const graph::Mdg& g = c.mdgs[drone];
   w.key("reads");
   write_drone_names(w, c, g.reads);
+  write_separation(w, c);
   write_mdg(w, c, g);
   if (!w.flush()) return false;
   tee.stop_digest();
@@ -400,6 +424,7 @@ std::string mission_hash(const Compilation& c) {
       w.end_array();
     }
     w.end_array();
+    write_separation(w, c);
     w.member("init", c.meg.init);
     w.member("end", c.meg.end);
     w.key("nodes");

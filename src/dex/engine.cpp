@@ -3,27 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "dex/engine_do.h"
+#include "dex/epoch.h"
+
 namespace eamos::dex {
-
-namespace {
-bool is_do(lang::ControlKind k) {
-  return k == lang::ControlKind::DoUntilSync || k == lang::ControlKind::DoWhileSync ||
-         k == lang::ControlKind::DoUntilAsync || k == lang::ControlKind::DoWhileAsync;
-}
-/// Do*: whether the condition's value `v` says "do" (While: true, Until: false).
-bool says_do(lang::ControlKind k, bool v) {
-  bool is_while = k == lang::ControlKind::DoWhileSync || k == lang::ControlKind::DoWhileAsync;
-  return is_while ? v : !v;
-}
-
-// A body's epoch counts its runs in the high bits and a Repeat's iterations in the low
-// ones. A trigger from an earlier run is stale (that run was cancelled or is over); one
-// from an earlier iteration of the same run is not: at a back arc everything of the
-// iteration has ended except async work, which goes on in parallel and keeps its triggers.
-constexpr int kIterationBits = 32;
-long long run_of(long long epoch) { return epoch >> kIterationBits; }
-long long next_run(long long epoch) { return (run_of(epoch) + 1) << kIterationBits; }
-}  // namespace
 
 using graph::ArcKind;
 using graph::Branch;
@@ -447,30 +430,6 @@ void Engine::activate_repeat(int node, bool by_back_arc) {
   end(node, again ? Branch::repeat : Branch::exit);
 }
 
-void Engine::activate_do(int node) {
-  const Node& n = m_.nodes[node];
-  State& s = state_[node];
-  // Started again while its do-branch still runs (a Do*Async in a loop): one condition,
-  // one run; the earlier run is cancelled on every drone, without its done-branch.
-  if (s.watchers > 0) {
-    stop_watching(node);
-    cancel_do_run(node);
-  }
-  bool v = condition_value(node);
-  bool async = n.control == ControlKind::DoUntilAsync || n.control == ControlKind::DoWhileAsync;
-  if (says_do(n.control, v)) {
-    s.watchers = 1;
-    s.last_value = static_cast<int>(v);  // traced just now: log again only on a change
-    ++active_;
-    watched_.push_back(node);
-    epoch_[n.meg] = next_run(epoch_[n.meg]);  // a new run of the do-branch
-    end(node, Branch::do_);
-  } else {
-    end(node, Branch::skip);
-  }
-  if (async) end(node, Branch::continue_);
-}
-
 // Wait* and Pause*: "go" once the awaited state holds (Until: true, While: false).
 void Engine::evaluate_watch(int node) {
   const Node& n = m_.nodes[node];
@@ -483,28 +442,6 @@ void Engine::evaluate_watch(int node) {
   }
 }
 
-void Engine::flip_do(int node) {
-  stop_watching(node);
-  cancel_do_run(node);
-  end(node, Branch::done);
-}
-
-// Ends the running do-branch of `node` on every drone.
-void Engine::cancel_do_run(int node) {
-  const Node& n = m_.nodes[node];
-  epoch_[n.meg] = next_run(epoch_[n.meg]);  // the cancelled run is over: anything still in flight from it is stale
-  cancel_local(n.cancels);
-  Message msg{Message::Kind::cancel, m_.hash, m_.self, n.meg, Branch::any};
-  msg.body_epoch = epoch_[n.meg];
-  msg.sent = loop_.now();
-  if (n.scope >= 0) {
-    msg.scope = n.scope;
-    msg.epoch = epoch_of(n.scope);
-  }
-  for (int d = 0; d < static_cast<int>(m_.fleet.size()); ++d)
-    if (d != m_.self && hooks_.transport) hooks_.transport->send(d, msg);
-}
-
 void Engine::properties_changed(int drone) {
   if (halted_ || watched_.empty()) return;
   std::vector<int> now = watched_;  // ending a watch edits watched_
@@ -513,11 +450,8 @@ void Engine::properties_changed(int drone) {
     const Node& n = m_.nodes[node];
     const std::vector<int>& reads = n.condition_reads;
     if (std::find(reads.begin(), reads.end(), drone) == reads.end()) continue;
-    if (!is_do(n.control)) {
-      evaluate_watch(node);
-      continue;
-    }
-    if (!says_do(n.control, condition_value(node))) flip_do(node);
+    if (is_do(n.control)) recheck_do(node);
+    else evaluate_watch(node);
   }
   drain();
 }

@@ -109,10 +109,8 @@ class Engine {
   void activate_action(int node);
   void activate_pause(int node);
   void activate_repeat(int node, bool by_back_arc);
-  void activate_do(int node);
   void schedule_iteration(int node);
   bool take_instance(int node, std::uint64_t id);
-  void cancel_do_run(int node);
   void arrive(int node);
   void pass_barrier_when_complete(int node);
   void announce(int node);
@@ -124,7 +122,6 @@ class Engine {
   /// The trace's "node" event of a node that is not an action (docs/trace.md).
   void trace_node(const Node& n, const char* outcome, graph::Branch branch);
   void evaluate_watch(int node);
-  void flip_do(int node);
   void cancel_local(const std::vector<int>& nodes);
   void stop_watching(int node);
   void on_action_end(int node, std::uint64_t instance, const mid::ActionEnd& e);
@@ -152,6 +149,18 @@ class Engine {
   std::map<int, long long> epoch_;
   void refresh(int node);
   long long epoch_of(int scope) const;
+
+  // The Do family (engine_do.cpp): a Do condition runs its do-branch at most once at a time
+  // and watches its condition while the run goes on.
+  /// Starts a run of the do-branch (cancelling one still going) or skips it.
+  void activate_do(int node);
+  /// The condition of a running Do may have changed: flips it when it no longer says "do".
+  void recheck_do(int node);
+  /// Ends the run (its watch and, on every drone, its do-branch) and starts the done-branch.
+  void flip_do(int node);
+  /// Cancels the running do-branch of `node` on every drone; a new epoch makes its late
+  /// messages stale.
+  void cancel_do_run(int node);
 };
 
 }  // namespace eamos::dex

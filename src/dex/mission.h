@@ -58,6 +58,10 @@ struct Mission {
   std::vector<Node> nodes;
   std::vector<Arc> arcs;
   std::vector<std::vector<int>> drone_sets;  ///< sorted drone lists named by Node::waits and notify
+  /// The fleet's `safety: min_separation`, which every drone keeps in flight (dex/separation.h).
+  fleet::Separation separation;
+  /// Each drone's `priority:` by fleet index (docs/fleet.md); empty: declaration order.
+  std::vector<int> priorities;
 
   /// Index of the node with MEG id `meg` held by `drone`, or -1.
   int find(int meg, int drone) const;

@@ -1,10 +1,14 @@
 #include "dex/runner.h"
 
+#include "dex/separation.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <iostream>
 #include <unordered_map>
+
+#include "diag/log.h"
+#include "mid/home_check.h"
 
 namespace eamos::dex {
 
@@ -105,29 +109,6 @@ void sample_fleet(mid::EventLoop& loop, TelemetryRecorder& recorder,
   });
 }
 
-/// Runs the loop on after an abandoned mission until every drone's failsafe is over
-/// (failsafe_over). The first look comes after the callbacks already queued, the ends of
-/// the actions the failsafes cancelled among them, so those are traced; later looks every
-/// 0.1 mission s stop the loop at once: a real-time loop would otherwise wait for input
-/// until its limit, and a MAVLink drone's heartbeats never leave it idle.
-void wait_for_failsafes(mid::EventLoop& loop, const std::vector<std::unique_ptr<mid::Drone>>& drones,
-                        const std::vector<Mission>& missions) {
-  const double since = loop.now();
-  mid::TimerId next = mid::kNoTimer;
-  std::function<void()> look = [&] {
-    for (std::size_t d = 0; d < drones.size(); ++d)
-      if (!failsafe_over(drones[d]->state(), missions[d].settings.failsafe, loop.now() - since)) {
-        next = loop.after(0.1, look);
-        return;
-      }
-    next = mid::kNoTimer;
-    loop.stop();
-  };
-  next = loop.after(0.0, look);
-  loop.run_until(since + kFailsafeWaitLimitS);
-  loop.cancel(next);  // it refers to this frame
-}
-
 }  // namespace
 
 TraceEvent message_event(const Mission& receiver, const Message& m, int to, double received) {
@@ -181,36 +162,6 @@ TraceEvent mission_end_event(const RunResult& r) {
   return e;
 }
 
-bool command_failsafe(mid::Drone& drone, const fleet::DroneSettings& settings) {
-  mid::DroneState s = drone.state();
-  if (down_and_disarmed(s)) return false;  // already safe; an armed drone on the ground is disarmed
-  drone.failsafe(settings.failsafe);
-  return true;
-}
-
-void record_failsafe(const fleet::DroneSettings& settings, double t, const std::string& reason, TraceSink* trace) {
-  if (!trace) return;
-  TraceEvent e;
-  e.t = t;
-  e.drone = settings.name;
-  e.event = "failsafe";
-  e.name = fleet::failsafe_name(settings.failsafe);
-  e.reason = reason;
-  trace->record(e);
-}
-
-bool failsafe_over(const mid::DroneState& s, fleet::Failsafe failsafe, double waited_s) {
-  if (down_and_disarmed(s) || s.link_lost || waited_s >= kFailsafeWaitLimitS) return true;
-  // On the ground every failsafe disarms: that is still to come for an armed drone there.
-  return failsafe == fleet::Failsafe::hover && !s.landed;
-}
-
-void enter_failsafe(mid::Drone& drone, const fleet::DroneSettings& settings, double t, const std::string& reason,
-                    TraceSink* trace) {
-  // Command first: a trace write (a DDS sample, a pipe) may block, the drone must not wait.
-  if (command_failsafe(drone, settings)) record_failsafe(settings, t, reason, trace);
-}
-
 void RunInterrupt::request(const std::string& reason) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (over_) return;
@@ -258,132 +209,228 @@ void record_sample(std::vector<Sample>& track, const mid::DroneState& s) {
   track.push_back(now);
 }
 
-RunResult run_in_process(const std::vector<Mission>& missions, const mid::AdapterRegistry& adapters,
-                         TraceSink* trace, const RunOptions& options) {
-  RunResult result;
-  int n = static_cast<int>(missions.size());
-  for (int d = 0; d < n; ++d)
-    if (missions[d].hash != missions[0].hash || missions[d].self != d) {
-      result.error = "mission files do not belong to one mission (hash or drone order differs)";
-      return result;
-    }
-  mid::EventLoop loop(options.clock);
-  std::vector<std::unique_ptr<mid::Drone>> drones;
-  for (const Mission& m : missions) {
-    mid::CreateResult c = adapters.create(m.settings.adapter, m.settings, m.type, loop);
-    if (c.status != mid::CreateStatus::success) {
-      result.error = m.settings.name + ": " + c.message;
-      return result;
-    }
-    drones.push_back(std::move(c.drone));
-  }
-  std::vector<std::vector<Sample>> tracks(n);
-  for (int d = 0; d < n; ++d) record_sample(tracks[d], drones[d]->state());
 
-  std::vector<std::unique_ptr<Engine>> engines;
-  bool end_reached = false;
-  bool failed = false;
-  double finished_at = 0.0;
-  // Checked whenever an engine settles idle and after every delivered message: the mission
-  // completes at that instant, not at the next event that happens to come by.
-  std::function<void()> check_done;
-  InProcessTransport transport(loop, engines, missions, trace, [&] { check_done(); });
-  check_done = [&] {
-    if (!end_reached || failed || result.completed || transport.in_flight() > 0) return;
-    for (const auto& e : engines)
-      if (e->busy()) return;
-    result.completed = true;
-    finished_at = loop.now();
-    loop.stop();
-  };
-  // The mission is over without completing: start nothing more, land (or whatever the
-  // fleet file says) every drone still in the air. Every drone is commanded before any
-  // failsafe is recorded: a trace write may block.
-  bool abandoned = false;
-  auto abandon = [&] {
-    if (abandoned) return;
-    abandoned = true;
-    for (auto& e : engines) e->halt();
-    std::vector<bool> commanded(n);
-    for (int d = 0; d < n; ++d) commanded[d] = command_failsafe(*drones[d], missions[d].settings);
-    for (int d = 0; d < n; ++d)
-      if (commanded[d]) record_failsafe(missions[d].settings, loop.now(), result.error, trace);
-  };
-  // Interrupted (Ctrl-C) or a failure inside the executor itself rather than in an action.
-  auto stop_mission = [&](const std::string& why) {
-    if (failed || result.completed || abandoned) return;
-    failed = true;
-    finished_at = loop.now();
-    result.error = why;
-    abandon();
-    loop.stop();
-  };
-  auto fail = [&](const Failure& f) {
-    if (failed || abandoned) return;
-    failed = true;
-    finished_at = loop.now();
-    result.failure = f;
-    result.error = failure_text(f);
-    abandon();
-    loop.stop();  // a real-time loop would otherwise wait out the time limit; failsafes run below
-  };
-  loop.on_callback_error([&](const std::string& what) {
-    std::cerr << "eamos: internal error in the executor: " << what << "\n";
+namespace {
+
+/// One run of a whole mission in this process: its loop, drones, engines and transport, and
+/// how it ends (completed, failed, interrupted, out of time). run_in_process is its one user.
+class InProcessRun {
+ public:
+  InProcessRun(const std::vector<Mission>& missions, TraceSink* trace, const RunOptions& options)
+      : missions_(missions), trace_(trace), options_(options), n_(static_cast<int>(missions.size())),
+        loop_(options.clock), tracks_(missions.size()),
+        transport_(loop_, engines_, missions, trace, [this] { check_done(); }),
+        telemetry_(trace, options.telemetry_hz) {}
+
+  RunResult run(const mid::AdapterRegistry& adapters);
+
+ private:
+  bool one_mission();
+  bool make_drones(const mid::AdapterRegistry& adapters);
+  bool homes_agree();
+  void make_engines();
+  void seed_boards();
+  void subscribe_drones();
+  void fly();
+  void check_done();
+  void stop_mission(const std::string& why);
+  void fail(const Failure& f);
+  void abandon();
+  void summarise();
+
+  const std::vector<Mission>& missions_;
+  TraceSink* trace_;
+  const RunOptions& options_;
+  const int n_;
+  RunResult result_;
+  mid::EventLoop loop_;
+  std::vector<std::unique_ptr<mid::Drone>> drones_;
+  std::vector<std::vector<Sample>> tracks_;
+  std::vector<std::unique_ptr<Engine>> engines_;
+  InProcessTransport transport_;
+  TelemetryRecorder telemetry_;
+  bool end_reached_ = false;
+  bool failed_ = false;
+  bool abandoned_ = false;
+  double finished_at_ = 0.0;
+  std::unique_ptr<SeparationGuard> separation_;  ///< last: it holds timers on loop_
+};
+
+RunResult InProcessRun::run(const mid::AdapterRegistry& adapters) {
+  if (!one_mission() || !make_drones(adapters) || !homes_agree()) return result_;
+  for (int d = 0; d < n_; ++d) record_sample(tracks_[d], drones_[d]->state());
+  loop_.on_callback_error([this](const std::string& what) {
+    diag::Logger{"dex", ""}.error("internal error in the executor: " + what);
     stop_mission("internal error in the executor: " + what);
   });
-  for (int d = 0; d < n; ++d) {
+  make_engines();
+  seed_boards();
+  subscribe_drones();
+  fly();
+  summarise();
+  trace_mission_end(trace_, result_);
+  return result_;
+}
+
+bool InProcessRun::one_mission() {
+  for (int d = 0; d < n_; ++d)
+    if (missions_[d].hash != missions_[0].hash || missions_[d].self != d) {
+      result_.error = "mission files do not belong to one mission (hash or drone order differs)";
+      return false;
+    }
+  return true;
+}
+
+bool InProcessRun::make_drones(const mid::AdapterRegistry& adapters) {
+  for (const Mission& m : missions_) {
+    mid::CreateResult c = adapters.create(m.settings.adapter, m.settings, m.type, loop_);
+    if (c.status != mid::CreateStatus::success) {
+      result_.error = m.settings.name + ": " + c.message;
+      return false;
+    }
+    drones_.push_back(std::move(c.drone));
+  }
+  return true;
+}
+
+// The vehicles stand where the fleet file puts them, relative to each other (mid/home_check.h),
+// or nothing arms.
+bool InProcessRun::homes_agree() {
+  std::vector<mid::Drone*> connected;
+  std::vector<fleet::DroneSettings> declared;
+  for (int d = 0; d < n_; ++d) connected.push_back(drones_[d].get()), declared.push_back(missions_[d].settings);
+  std::string wrong = mid::check_homes_at_connect(loop_, connected, declared, mid::kHomeFixTimeoutS);
+  if (wrong.empty()) return true;
+  result_.error = "the vehicles do not stand where the fleet file puts them; nothing was armed:\n" + wrong;
+  return false;
+}
+
+void InProcessRun::make_engines() {
+  for (int d = 0; d < n_; ++d) {
     EngineHooks hooks;
-    hooks.transport = &transport;
-    hooks.trace = trace;
-    hooks.on_failure = fail;
-    hooks.on_end = [&] { end_reached = true; };  // the lead's engine settles next: check_done then
-    hooks.on_idle = [&] { check_done(); };
-    hooks.observer = options.observer;
-    engines.push_back(std::make_unique<Engine>(missions[d], *drones[d], loop, hooks));
+    hooks.transport = &transport_;
+    hooks.trace = trace_;
+    hooks.on_failure = [this](const Failure& f) { fail(f); };
+    hooks.on_end = [this] { end_reached_ = true; };  // the lead's engine settles next: check_done then
+    hooks.on_idle = [this] { check_done(); };
+    hooks.observer = options_.observer;
+    engines_.push_back(std::make_unique<Engine>(missions_[d], *drones_[d], loop_, hooks));
   }
-  // Each drone's broker feeds its own engine directly and every other drone through the
-  // transport (the OutBridge side of telemetry); a first publication seeds every board.
-  // Before anything runs, every engine holds the initial state of every drone it reads, as
-  // a DEX does after the start barrier: a condition at t = 0 never reads a value that is
-  // not there yet. One shared copy per drone: a fleet of k is k copies, not k².
-  for (int d = 0; d < n; ++d) {
-    auto initial = std::make_shared<const Telemetry>(Telemetry{missions[d].hash, d, drones[d]->state()});
-    for (int to : transport.readers_of(d))
-      if (to != d) engines[to]->receive(initial);
+}
+
+// Before anything runs, every engine holds the initial state of every drone it reads, as
+// a DEX does after the start barrier: a condition at t = 0 never reads a value that is not
+// there yet. One shared copy per drone: a fleet of k is k copies, not k².
+void InProcessRun::seed_boards() {
+  for (int d = 0; d < n_; ++d) {
+    auto initial = std::make_shared<const Telemetry>(Telemetry{missions_[d].hash, d, drones_[d]->state()});
+    for (int to : transport_.readers_of(d))
+      if (to != d) engines_[to]->receive(initial);
   }
-  for (int d = 0; d < n; ++d) {
-    drones[d]->subscribe([&, d](const mid::DroneState& s) {
-      if (options.keep_tracks) record_sample(tracks[d], s);
-      engines[d]->properties_changed(d);
-      if (!transport.readers_of(d).empty())
-        transport.publish(std::make_shared<const Telemetry>(Telemetry{missions[d].hash, d, s}));
+}
+
+// Each drone's broker feeds its own engine directly and every other drone through the
+// transport (the OutBridge side of telemetry).
+void InProcessRun::subscribe_drones() {
+  if (options_.keep_separation) {
+    separation_ = std::make_unique<SeparationGuard>(
+        missions_[0], loop_, SeparationHooks{trace_, [this](const std::string& why) { stop_mission(why); }});
+    for (int d = 0; d < n_; ++d) {
+      separation_->fly(d, *drones_[d], missions_[d].settings.limits);
+      separation_->update(d, drones_[d]->state());
+    }
+  }
+  for (int d = 0; d < n_; ++d) {
+    drones_[d]->subscribe([this, d](const mid::DroneState& s) {
+      if (options_.keep_tracks) record_sample(tracks_[d], s);
+      if (separation_) separation_->update(d, s);
+      engines_[d]->properties_changed(d);
+      if (!transport_.readers_of(d).empty())
+        transport_.publish(std::make_shared<const Telemetry>(Telemetry{missions_[d].hash, d, s}));
     });
   }
-  if (options.interrupt) options.interrupt->attach(loop, stop_mission);
-  TelemetryRecorder telemetry(trace, options.telemetry_hz);
-  if (telemetry.enabled()) sample_fleet(loop, telemetry, drones, 0);
-  for (auto& e : engines) e->start();
+}
 
+void InProcessRun::fly() {
+  if (options_.interrupt) options_.interrupt->attach(loop_, [this](const std::string& why) { stop_mission(why); });
+  if (telemetry_.enabled()) sample_fleet(loop_, telemetry_, drones_, 0);
+  for (auto& e : engines_) e->start();
   // Endless motions (an Orbit nobody preempts) keep the loop busy: bound the run.
-  loop.run_until(options.time_limit_s);
-  if (!result.completed && !failed) {
-    finished_at = loop.now();
+  loop_.run_until(options_.time_limit_s);
+  if (!result_.completed && !failed_) {
+    finished_at_ = loop_.now();
     char limit[32];
-    std::snprintf(limit, sizeof limit, "%g", options.time_limit_s);
-    result.error = std::string("mission did not complete within ") + limit +
-                   " s of mission time; raise --time-limit if it is meant to run longer";
+    std::snprintf(limit, sizeof limit, "%g", options_.time_limit_s);
+    result_.error = std::string("mission did not complete within ") + limit +
+                    " s of mission time; raise --time-limit if it is meant to run longer";
     abandon();
   }
-  if (failed || !result.completed) wait_for_failsafes(loop, drones, missions);
-  if (options.interrupt) options.interrupt->detach();
-  result.duration = finished_at;
-  for (int d = 0; d < n; ++d) {
-    if (!options.keep_tracks) record_sample(tracks[d], drones[d]->state());
-    result.drones.push_back({missions[d].settings.name, drones[d]->state(), std::move(tracks[d])});
-    result.activations += engines[d]->activations();
+  if (abandoned_) {
+    std::vector<FailsafeDrone> fleet;
+    for (int d = 0; d < n_; ++d) fleet.push_back({engines_[d].get(), drones_[d].get(), &missions_[d].settings});
+    FailsafeWait wait(loop_, std::move(fleet), 0.1, [this] { loop_.stop(); });
+    wait.start();
+    loop_.run_until(loop_.now() + kFailsafeWaitLimitS);
   }
-  trace_mission_end(trace, result);
-  return result;
+  if (options_.interrupt) options_.interrupt->detach();
+}
+
+// Checked whenever an engine settles idle and after every delivered message: the mission
+// completes at that instant, not at the next event that happens to come by.
+void InProcessRun::check_done() {
+  if (!end_reached_ || failed_ || result_.completed || transport_.in_flight() > 0) return;
+  for (const auto& e : engines_)
+    if (e->busy()) return;
+  result_.completed = true;
+  finished_at_ = loop_.now();
+  loop_.stop();
+}
+
+// Interrupted (Ctrl-C) or a failure inside the executor itself rather than in an action.
+void InProcessRun::stop_mission(const std::string& why) {
+  if (failed_ || result_.completed || abandoned_) return;
+  failed_ = true;
+  finished_at_ = loop_.now();
+  result_.error = why;
+  abandon();
+  loop_.stop();
+}
+
+void InProcessRun::fail(const Failure& f) {
+  if (failed_ || abandoned_) return;
+  failed_ = true;
+  finished_at_ = loop_.now();
+  result_.failure = f;
+  result_.error = failure_text(f);
+  abandon();
+  loop_.stop();  // a real-time loop would otherwise wait out the time limit; failsafes run in fly()
+}
+
+// The mission is over without completing: start nothing more, and every drone still in the
+// air runs its failsafe.
+void InProcessRun::abandon() {
+  if (abandoned_) return;
+  abandoned_ = true;
+  if (separation_) separation_->halt();
+  std::vector<FailsafeDrone> fleet;
+  for (int d = 0; d < n_; ++d) fleet.push_back({engines_[d].get(), drones_[d].get(), &missions_[d].settings});
+  abandon_drones(fleet, loop_.now(), result_.error, trace_);
+}
+
+void InProcessRun::summarise() {
+  result_.duration = finished_at_;
+  for (int d = 0; d < n_; ++d) {
+    if (!options_.keep_tracks) record_sample(tracks_[d], drones_[d]->state());
+    result_.drones.push_back({missions_[d].settings.name, drones_[d]->state(), std::move(tracks_[d])});
+    result_.activations += engines_[d]->activations();
+  }
+}
+
+}  // namespace
+
+RunResult run_in_process(const std::vector<Mission>& missions, const mid::AdapterRegistry& adapters,
+                         TraceSink* trace, const RunOptions& options) {
+  return InProcessRun(missions, trace, options).run(adapters);
 }
 
 }  // namespace eamos::dex

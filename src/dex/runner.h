@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "dex/engine.h"
+#include "dex/failsafe.h"
 #include "dex/latency.h"
 #include "dex/mission.h"
 #include "dex/observer.h"
@@ -53,6 +54,9 @@ struct RunOptions {
   /// flight) in the result, for verify's checks and the plot. Off, a track holds the
   /// drone's first and last state only: a 1,000-drone show flies 18 million samples.
   bool keep_tracks = true;
+  /// Keep the fleet's min_separation in flight: drones give way (dex/separation.h). Off for
+  /// `eamos verify`, which flies the mission as written to find where it plans drones too close.
+  bool keep_separation = true;
 };
 
 /// One drone's position and phase at a moment its broker published a change of them.
@@ -63,32 +67,6 @@ struct Sample {
   bool landed;
   double battery;  ///< %
 };
-
-/// What a failsafe ends in, and what needs none: down with its motors off.
-inline bool down_and_disarmed(const mid::DroneState& s) { return s.landed && !s.armed; }
-
-/// Mission seconds a run waits at most for a drone's failsafe to end once the mission is
-/// abandoned; past it the drone is reported as it is then (a failsafe landing or return
-/// that has not ended in ten minutes is stuck, and waiting longer only hides that).
-inline constexpr double kFailsafeWaitLimitS = 600.0;
-
-/// Whether a drone in state `s`, whose fleet failsafe is `failsafe`, needs no more waiting
-/// `waited_s` mission seconds after its mission was abandoned: down with its motors off, in
-/// the air with `hover` (it holds where it is from the moment it is told: there is no end to
-/// wait for), its link lost (nothing can reach or watch it; its autopilot's own link-loss
-/// failsafe flies it), or waited kFailsafeWaitLimitS. In-process runs and each DEX end so.
-bool failsafe_over(const mid::DroneState& s, fleet::Failsafe failsafe, double waited_s);
-
-/// The mission was abandoned: makes `drone` safe with its fleet failsafe when it is in the air
-/// or armed on the ground, then records a `failsafe` event (at mission time `t`) in `trace`
-/// (may be null). A drone already landed and disarmed is left alone. In-process and
-/// distributed runs both end this way.
-void enter_failsafe(mid::Drone& drone, const fleet::DroneSettings& settings, double t, const std::string& reason,
-                    TraceSink* trace);
-/// enter_failsafe in two steps, for callers with more to do between commanding and
-/// recording (a trace write can block): true when a failsafe was commanded.
-bool command_failsafe(mid::Drone& drone, const fleet::DroneSettings& settings);
-void record_failsafe(const fleet::DroneSettings& settings, double t, const std::string& reason, TraceSink* trace);
 
 /// Appends `s` to `track` when position or phase differ from the last sample.
 void record_sample(std::vector<Sample>& track, const mid::DroneState& s);

@@ -11,7 +11,7 @@ namespace eamos::dex {
 struct TraceEvent {
   double t = 0.0;           ///< mission seconds
   std::string drone;
-  std::string event;        ///< start | end | condition | sensor | node | failsafe | error | vehicle (its own words) | telemetry | message | mission
+  std::string event;        ///< start | end | condition | sensor | node | failsafe | error | vehicle (its own words) | telemetry | message | mission | conflict | give_way | resume
   std::string name;         ///< action or control structure
   int line = 0;
   std::string text;         ///< "Drone1.Takeoff(3)", "Drone1.Sensor1() >= 100"
@@ -30,9 +30,19 @@ struct TraceEvent {
   int from = -1;            ///< sender (drone index; -1 the ground)
   int to = -1;              ///< receiver (drone index; -1 every drone)
   double sent = 0.0;        ///< the sender's mission time when it sent it (t: when it arrived)
+  // events "conflict", "give_way", "resume" (dex/separation.h): the other drone of the
+  // pair and how far apart the two are now (m, straight line).
+  std::string other;
+  std::optional<double> distance;
   // event "telemetry": the drone's state at t.
   std::optional<mid::DroneState> state;
 };
+
+/// conflict, give_way and resume (dex/separation.h): `other` names the other drone, `to`
+/// holds its index (how it crosses DDS) and `distance` how far apart the two are.
+inline bool is_separation_event(const std::string& event) {
+  return event == "conflict" || event == "give_way" || event == "resume";
+}
 
 class TraceSink {
  public:

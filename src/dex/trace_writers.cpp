@@ -77,6 +77,9 @@ nlohmann::ordered_json trace_event_json(const TraceEvent& e, const std::vector<s
     if (!e.branch.empty()) j["branch"] = e.branch;
     if (e.node >= 0) j["node"] = e.node;
     if (e.instance >= 0) j["instance"] = e.instance;
+    if (!e.other.empty()) j["other"] = e.other;
+    else if (is_separation_event(e.event) && e.to >= 0) j["other"] = drone_name(e.to);
+    if (e.distance) j["distance"] = *e.distance;
   }
   return j;
 }
@@ -107,6 +110,12 @@ void LiveLog::record(const TraceEvent& e) {
   if (!e.failure.empty()) out_ << " [" << e.failure << "]";
   if (e.value) out_ << "  → " << (*e.value ? "true" : "false");
   if (e.reading) out_ << "  = " << *e.reading;
+  if (!e.other.empty()) out_ << " " << e.other;
+  if (e.distance) {
+    char d[32];
+    std::snprintf(d, sizeof d, " %.1f m apart", *e.distance);
+    out_ << d;
+  }
   if (!e.reason.empty()) out_ << "  (" << e.reason << ")";
   if (e.line > 0) out_ << "   line " << e.line;
   // Live: a line is out when it happened, also through a pipe (`eamos run | tee`, a test

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 
 namespace eamos {
 
@@ -118,24 +119,52 @@ const char* severity_colour(Severity s) {
 }
 
 // Control bytes and tabs would break the caret alignment or the terminal; the caret line
-// repeats tabs so it still lines up under the column.
+// repeats tabs so it still lines up under the column. A byte that is not valid UTF-8 is shown
+// as \xNN: echoed raw it would garble the terminal, or the log it is written to.
 std::string printable_line(std::string_view line) {
   std::string out;
   out.reserve(line.size());
-  for (unsigned char c : line) out += (c == '\t' || c >= 0x20) && c != 0x7f ? char(c) : '?';
+  for (std::size_t i = 0; i < line.size();) {
+    unsigned char c = static_cast<unsigned char>(line[i]);
+    std::size_t n = utf8_sequence_length(line, i);
+    if (n == 0) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+      ++i;
+    } else if (n > 1) {
+      out += line.substr(i, n);
+      i += n;
+    } else {
+      out += (c == '\t' || c >= 0x20) && c != 0x7f ? char(c) : '?';
+      ++i;
+    }
+  }
   return out;
 }
 
-// A UTF-8 continuation byte takes no column of its own on the screen.
-bool continuation(char c) { return (static_cast<unsigned char>(c) & 0xC0) == 0x80; }
+/// Screen columns the byte at `i` takes in printable_line: 0 inside a UTF-8 character, 4
+/// for an escaped byte, else 1.
+int columns_of(std::string_view line, std::size_t i) {
+  unsigned char c = static_cast<unsigned char>(line[i]);
+  if ((c & 0xC0) == 0x80) {  // a continuation: inside a character, unless nothing valid starts it
+    std::size_t start = i;
+    while (start > 0 && i - start < 3 && (static_cast<unsigned char>(line[start]) & 0xC0) == 0x80) --start;
+    std::size_t n = utf8_sequence_length(line, start);
+    return n > 1 && start + n > i ? 0 : 4;
+  }
+  return utf8_sequence_length(line, i) == 0 ? 4 : 1;
+}
 
 std::string caret_line(std::string_view line, int col, int length, const Paint& paint) {
   std::string pad;
   for (int i = 0; i + 1 < col && static_cast<std::size_t>(i) < line.size(); ++i)
-    if (!continuation(line[i])) pad += line[i] == '\t' ? '\t' : ' ';
+    pad += line[i] == '\t' ? std::string(1, '\t') : std::string(columns_of(line, i), ' ');
   std::string mark = "^";
+  if (col >= 1 && static_cast<std::size_t>(col - 1) < line.size())
+    mark += std::string(std::max(0, columns_of(line, col - 1) - 1), '~');
   for (int i = col; i < col - 1 + length && static_cast<std::size_t>(i) < line.size(); ++i)
-    if (!continuation(line[i])) mark += '~';
+    mark += std::string(columns_of(line, i), '~');
   return pad + paint("1;32", mark);
 }
 

@@ -52,4 +52,30 @@ bool read_source_file(const std::string& path, SourceFile& out, std::string& err
   return true;
 }
 
+std::size_t utf8_sequence_length(std::string_view text, std::size_t pos) {
+  auto byte = [&](std::size_t i) { return static_cast<unsigned char>(text[i]); };
+  unsigned char b = byte(pos);
+  if (b < 0x80) return 1;
+  std::size_t n = b >= 0xC2 && b <= 0xDF ? 2 : b >= 0xE0 && b <= 0xEF ? 3 : b >= 0xF0 && b <= 0xF4 ? 4 : 0;
+  if (n == 0 || pos + n > text.size()) return 0;
+  for (std::size_t i = 1; i < n; ++i)
+    if ((byte(pos + i) & 0xC0) != 0x80) return 0;
+  unsigned char second = byte(pos + 1);
+  if (b == 0xE0 && second < 0xA0) return 0;  // overlong
+  if (b == 0xED && second >= 0xA0) return 0;  // a UTF-16 surrogate
+  if (b == 0xF0 && second < 0x90) return 0;  // overlong
+  if (b == 0xF4 && second >= 0x90) return 0;  // past U+10FFFF
+  return n;
+}
+
+std::size_t first_invalid_utf8(std::string_view text, std::size_t pos, std::size_t end) {
+  end = std::min(end, text.size());
+  while (pos < end) {
+    std::size_t n = utf8_sequence_length(text, pos);
+    if (n == 0) return pos;
+    pos += n;
+  }
+  return std::string_view::npos;
+}
+
 }  // namespace eamos

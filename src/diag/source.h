@@ -29,6 +29,13 @@ struct SourceFile {
   SourceLocation location_of(std::size_t offset) const;
 };
 
+/// Bytes of the UTF-8 sequence that starts at `pos` (1 for ASCII); 0 when the bytes there
+/// are not valid UTF-8: a stray continuation byte, a truncated or overlong sequence, a
+/// surrogate, a code point past U+10FFFF.
+std::size_t utf8_sequence_length(std::string_view text, std::size_t pos);
+/// Offset of the first byte in [pos, end) that is not valid UTF-8, or std::string_view::npos.
+std::size_t first_invalid_utf8(std::string_view text, std::size_t pos, std::size_t end);
+
 /// Reads a whole file; returns false and sets `error` (strerror text) on failure.
 bool read_source_file(const std::string& path, SourceFile& out, std::string& error);
 

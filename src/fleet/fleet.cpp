@@ -81,6 +81,7 @@ DroneSettings Fleet::settings_for(const std::string& drone, const std::string& t
   if (!o || !o->adapter) s.adapter = type.adapter;
   s.limits = type.limits;
   s.tolerance = type.tolerance;
+  s.home_tolerance_m = safety.home_tolerance_m;
   if (o) o->limits.apply(s.limits);
   if (const Geofence* g = geofence_for(drone)) s.site.geofence = *g;
   s.site.max_speed_mps = safety.max_speed_mps;

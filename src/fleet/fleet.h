@@ -28,6 +28,10 @@ struct SensorModel {
 enum class Failsafe { land, return_home, hover };
 const char* failsafe_name(Failsafe f);
 
+/// How far (m, horizontally) the vehicles may stand from where their declared homes put them,
+/// relative to each other, before the mission refuses to arm (`safety: home_tolerance:`).
+inline constexpr double kDefaultHomeToleranceM = 3.0;
+
 /// Where drones may fly (docs/fleet.md, `geofence:`): inside a polygon of the mission frame's
 /// x/y plane (none: anywhere) and between two altitudes (each optional). `eamos verify`
 /// checks the flown tracks and every motion target against it; in flight every adapter's
@@ -39,6 +43,7 @@ struct Geofence {
   /// `upload: true`: the mavlink adapter also gives the fence to the autopilot (its own
   /// polygon fence, FENCE_* / GF_*), so the vehicle holds it without the companion computer.
   bool upload = false;
+  std::optional<SourceLocation> max_altitude_at;  ///< where the fleet file sets max_altitude
   /// True when (x, y, z) lies inside (a point on the boundary is inside).
   bool contains(double x, double y, double z) const;
   bool contains_xy(double x, double y) const;
@@ -79,6 +84,10 @@ struct DroneSettings {
   std::string connection;                    ///< adapter URL, e.g. udp://:14540; "" for sim
   int sysid = 0;                             ///< MAVLink system id; 0 = not set
   double battery_percent = 100.0;            ///< charge at mission start
+  /// Who gives way when two drones would come too close (docs/fleet.md `priority:`): the
+  /// lower number goes first, ties to the drone declared first; 0 = not set, which ranks as
+  /// the drone's place in the declaration order (1, 2, …).
+  int priority = 0;
   std::map<std::string, double> timeouts_s;  ///< per action name; overrides derived ones
   /// MAVLink 2 signing (docs/fleet.md `signing:`): the link's secret key as 64 hex digits;
   /// "" = frames unsigned. A secret: only the drone's own deployment folder holds it.
@@ -90,6 +99,8 @@ struct DroneSettings {
   bool announce_as_gcs = false;
   SiteLimits site;             ///< the site's rules this drone keeps in flight
   std::optional<Gust> gust;    ///< simulator only
+  /// The fleet's `safety: home_tolerance` (mid/home_check.h).
+  double home_tolerance_m = kDefaultHomeToleranceM;
 };
 
 /// "" when `hex` is a usable signing key (64 hex digits, not all zero), else what is wrong.
@@ -117,6 +128,8 @@ struct Safety {
   std::optional<double> max_climb_mps;
   std::optional<double> max_descent_mps;
   std::optional<Geofence> geofence;        ///< every drone's, unless a drone gives its own
+  /// Vehicles that report a global position must stand as their homes say within this (m).
+  double home_tolerance_m = kDefaultHomeToleranceM;
 };
 
 /// The values a sensor may read in flight (`range: [low, high]`): what `eamos verify`
@@ -134,6 +147,7 @@ struct LimitOverrides {
   std::optional<double> max_descent_mps;
   std::optional<double> max_accel_mps2;
   std::optional<double> max_altitude_m;
+  std::optional<SourceLocation> max_altitude_at;  ///< where the fleet file sets max_altitude
 
   void apply(Limits& limits) const;
 };
@@ -158,6 +172,8 @@ struct Fleet {
   std::map<std::string, SourceLocation> drone_locations;  ///< where each drone is described
   std::shared_ptr<SourceFile> source;        ///< keeps the file text for diagnostics
   Safety safety;                             ///< operating rules for `eamos verify`
+  /// Where a type's `limits:` set max_altitude, per type name (a note for diagnostics).
+  std::map<std::string, SourceLocation> type_max_altitude_at;
 
   /// The geofence `drone` must stay in: its own, else the fleet's; null when neither is set.
   const Geofence* geofence_for(const std::string& drone) const;

@@ -14,7 +14,8 @@ namespace {
 
 const std::vector<std::string> kRootKeys = {"types", "drones", "safety"};
 const std::vector<std::string> kSafetyKeys = {"min_separation", "battery_reserve", "max_speed",
-                                              "max_climb",      "max_descent",     "geofence"};
+                                              "max_climb",      "max_descent",     "geofence",
+                                              "home_tolerance"};
 const std::vector<std::string> kSeparationKeys = {"horizontal", "vertical"};
 const std::vector<std::string> kGeofenceKeys = {"polygon", "min_altitude", "max_altitude", "upload"};
 const std::vector<std::string> kTypeKeys = {"adapter", "capabilities", "sensors", "limits", "tolerance"};
@@ -23,7 +24,8 @@ const std::vector<std::string> kDroneKeys = {"home",     "battery",  "sensors",
                                              "limits",   "failsafe", "adapter",
                                              "connection", "sysid",  "timeouts",
                                              "geofence", "signing",  "announce_as_gcs",
-                                             "gust"};
+                                             "gust",
+                                             "priority"};
 const std::vector<std::string> kGustKeys = {"at", "for", "velocity"};
 const std::vector<std::string> kSigningKeys = {"key", "key_file", "setup"};
 const std::vector<std::string> kLimitKeys = {"max_speed", "max_climb", "max_descent",
@@ -139,6 +141,7 @@ void FleetParser::type(const std::string& name, const YAML::Node& node) {
         LimitOverrides given;
         limits(v, where, given);
         given.apply(t.limits);
+        if (given.max_altitude_at) out_.type_max_altitude_at[name] = *given.max_altitude_at;
       }
       if (key == "tolerance") tolerance(v, where, t.tolerance);
       if (key == "sensors" && r_.whole_number(v, "sensors of " + where, sensor_count) &&
@@ -204,7 +207,10 @@ void FleetParser::limits(const YAML::Node& node, const std::string& where, Limit
     if (key == "max_climb") out.max_climb_mps = value;
     if (key == "max_descent") out.max_descent_mps = value;
     if (key == "max_accel") out.max_accel_mps2 = value;
-    if (key == "max_altitude") out.max_altitude_m = value;
+    if (key == "max_altitude") {
+      out.max_altitude_m = value;
+      out.max_altitude_at = location_of(kv.second.Mark());
+    }
   }
 }
 
@@ -249,6 +255,11 @@ void FleetParser::drone(const std::string& name, const YAML::Node& node) {
       if (key == "sysid" && r_.whole_number(v, what, sysid)) {
         if (sysid >= 1 && sysid <= 255) s.sysid = static_cast<int>(sysid);
         else r_.error(v, what + " must be a MAVLink system id from 1 to 255; got " + describe(v));
+      }
+      long long priority = 0;
+      if (key == "priority" && r_.whole_number(v, what, priority)) {
+        if (priority >= 1 && priority <= 1000000) s.priority = static_cast<int>(priority);
+        else r_.error(v, what + " must be a whole number from 1 (goes first) to 1000000; got " + describe(v));
       }
       if (key == "timeouts") timeouts(v, where, s);
       if (key == "geofence") geofence(v, where, o.geofence);
@@ -388,6 +399,7 @@ void FleetParser::safety(const YAML::Node& node) {
         s.battery_reserve_percent = value;
     }
     if (key == "max_speed" && positive(v, "max_speed of safety", value)) s.max_speed_mps = value;
+    if (key == "home_tolerance" && positive(v, "home_tolerance of safety", value)) s.home_tolerance_m = value;
     if (key == "max_climb" && positive(v, "max_climb of safety", value)) s.max_climb_mps = value;
     if (key == "max_descent" && positive(v, "max_descent of safety", value)) s.max_descent_mps = value;
     if (key == "geofence") geofence(v, "safety", s.geofence);
@@ -481,6 +493,7 @@ void FleetParser::geofence(const YAML::Node& node, const std::string& where, std
     if (key == "min_altitude" && r_.number(kv.second, "min_altitude of " + what, value)) g.min_altitude_m = value;
     if (key == "max_altitude" && r_.number(kv.second, "max_altitude of " + what, value)) {
       g.max_altitude_m = value;
+      g.max_altitude_at = location_of(kv.second.Mark());
       max_node = kv.second;
     }
   }

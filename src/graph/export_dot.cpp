@@ -1,5 +1,6 @@
 #include <sstream>
 
+#include "diag/xml.h"
 #include "graph/export.h"
 #include "graph/palette.h"
 
@@ -17,18 +18,6 @@ std::string escape(const std::string& s) {
     if (c == '"' || c == '\\') out += '\\';
     out += c;
   }
-  return out;
-}
-
-std::string escape_html(const std::string& s) {
-  std::string out;
-  for (char c : s) switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
   return out;
 }
 
@@ -111,7 +100,7 @@ void legend(std::ostringstream& out, const Compilation& c) {
   for (const auto& r : rows)
     out << "      <tr><td align=\"left\"><b>" << r[0] << "</b></td><td align=\"left\">" << r[1] << "</td></tr>\n";
   for (int d = 0; d < c.drone_count(); ++d)
-    out << "      <tr><td align=\"left\"><font color=\"" << drone_colour(d) << "\"><b>&#9632; " << escape_html(c.drone_name(d))
+    out << "      <tr><td align=\"left\"><font color=\"" << drone_colour(d) << "\"><b>&#9632; " << diag::xml_escape(c.drone_name(d))
         << "</b></font></td><td align=\"left\">its nodes</td></tr>\n";
   out << "    </table>>];\n  }\n";
 }

@@ -35,4 +35,10 @@ std::string drone_colour(int d) {
   return hsv(20.0 + k * 137.508, 0.75, k % 2 == 0 ? 0.62 : 0.45);
 }
 
+std::vector<std::string> drone_palette(int count) {
+  std::vector<std::string> colours;
+  for (int d = 0; d < count; ++d) colours.push_back(drone_colour(d));
+  return colours;
+}
+
 }  // namespace eamos::graph

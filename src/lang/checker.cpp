@@ -7,6 +7,8 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "lang/altitude.h"
+#include "lang/arming.h"
 #include "lang/concurrency.h"
 #include "lang/exact_compare.h"
 #include "lang/loop_time.h"
@@ -154,9 +156,11 @@ CheckedMission Checker::run() {
     for (auto& s : f.body) check_statement(f, s);
   check_call_graph();
   check_loops_take_time(m_, diags_);
+  if (!diags_.has_errors()) check_literal_altitudes(m_, fleet_, diags_);
   if (!diags_.has_errors()) {
     check_unused();
     warn_concurrent_motion(m_, out_.drone_types, diags_);
+    check_armed_before_motion(m_, out_.drone_types, diags_);
     warn_exact_comparisons(m_, diags_);
   }
   return std::move(out_);
@@ -401,6 +405,7 @@ void Checker::check_control(Statement& s) {
   }
 }
 
+// long: one case per expression kind, each with its own diagnostic; split, the rules would scatter.
 ValueType Checker::type_of(Expr& e) {
   switch (e.kind) {
     case ExprKind::number: return e.type = ValueType::number;

@@ -60,6 +60,20 @@ SourceLocation Lexer::location_of(std::size_t offset) {
   return {static_cast<int>(line_) + 1, static_cast<int>(offset - starts[line_]) + 1};
 }
 
+void Lexer::report_invalid_utf8(std::size_t at) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "0x%02x", static_cast<unsigned char>(file_.text[at]));
+  diags_.error(&file_, file_.location_of(at),
+               std::string("invalid UTF-8: byte ") + buf +
+                   " does not begin or continue a UTF-8 character; save the file as UTF-8 or remove the byte");
+}
+
+// One error per comment: a comment in another encoding (Latin-1) has many such bytes.
+void Lexer::check_utf8(std::size_t begin, std::size_t end) {
+  std::size_t bad = first_invalid_utf8(file_.text, begin, end);
+  if (bad != std::string_view::npos) report_invalid_utf8(bad);
+}
+
 bool Lexer::skip_space_and_comments() {
   bool crossed_newline = false;
   while (!at_end()) {
@@ -70,7 +84,9 @@ bool Lexer::skip_space_and_comments() {
     } else if (c == ' ' || c == '\t' || c == '\r') {
       ++pos_;
     } else if (c == '/' && peek(1) == '/') {
+      std::size_t begin = pos_;
       while (!at_end() && peek() != '\n') ++pos_;
+      check_utf8(begin, pos_);
     } else if (c == '/' && peek(1) == '*') {
       std::size_t begin = pos_;
       std::size_t close = file_.text.find("*/", pos_ + 2);
@@ -79,6 +95,7 @@ bool Lexer::skip_space_and_comments() {
       if (close == std::string::npos)
         diags_.error(&file_, file_.location_of(begin),
                      "comment not terminated; close it with '*/'");
+      check_utf8(begin, stop);
       pos_ = stop;
     } else {
       break;
@@ -216,6 +233,11 @@ Token Lexer::lex_operator(std::size_t begin) {
     std::snprintf(buf, sizeof buf, "0x%02x", first);
     shown = std::string("byte ") + buf;
     if (first >= 0x80) fix = "; only ASCII is allowed outside comments (a typographic dash or quote?)";
+  }
+  std::size_t bad = first_invalid_utf8(file_.text, begin, pos_);
+  if (bad != std::string_view::npos) {
+    report_invalid_utf8(bad);
+    return make(TokenKind::invalid, begin, pos_);
   }
   diags_.error(&file_, file_.location_of(begin), "unexpected " + shown + fix);
   return make(TokenKind::invalid, begin, pos_);

@@ -18,6 +18,8 @@ class Lexer {
  private:
   /// Skips blanks and comments; returns true when a newline (or a comment spanning one)
   /// was crossed, which may insert a semicolon.
+  void check_utf8(std::size_t begin, std::size_t end);
+  void report_invalid_utf8(std::size_t at);
   bool skip_space_and_comments();
   Token make(TokenKind kind, std::size_t begin, std::size_t end);
   SourceLocation location_of(std::size_t offset);

@@ -391,6 +391,7 @@ std::unique_ptr<Expr> Parser::parse_unary() {
 
 // primary = int | decimal | "true" | "false" | drone "." property "(" ")"
 //         | identifier | "(" expr ")"
+// long: one case per kind of primary expression, the grammar rule read top to bottom.
 std::unique_ptr<Expr> Parser::parse_primary() {
   auto e = std::make_unique<Expr>();
   e->loc = tok_.loc;

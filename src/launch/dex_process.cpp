@@ -11,6 +11,7 @@
 #include "deploy/mission_file.h"
 #include "launch/dex_state.h"
 #include "launch/wall_time.h"
+#include "mid/home_check.h"
 
 namespace eamos::launch {
 
@@ -41,11 +42,30 @@ void on_dex_signal(int signal) {
 
 int DexProcess::run(const mid::AdapterRegistry& adapters) {
   nonce_ = process_nonce();
-  std::string error;
+  if (!load(adapters) || !open_dds()) return 1;
+  std::signal(SIGINT, on_dex_signal);
+  std::signal(SIGTERM, on_dex_signal);
+  if (!wait_for_start() || !begin()) {
+    node_->flush(1.0);
+    return 1;
+  }
+  loop_->run_until(o_.time_limit_s + 1000.0);
+  dds_trace_->flush();
+  node_->flush(1.0);
+  if (phase_ == Phase::completed) {
+    out_ << name() << ": mission completed\n";
+    return 0;
+  }
+  err_ << "eamos dex: " << name() << ": mission failed: " << error_ << "\n";
+  return 1;
+}
+
+// The drone's mission file, its loop and its drone from the Adapter Space.
+bool DexProcess::load(const mid::AdapterRegistry& adapters) {
   std::vector<std::string> defects;
   if (!deploy::read_mission_file(o_.folder + "/mission.json", mission_, defects)) {
     for (const std::string& d : defects) err_ << d << "\n";
-    return 1;
+    return false;
   }
   mid::ClockOptions clock;
   clock.mode = mid::ClockMode::real_time;
@@ -57,10 +77,17 @@ int DexProcess::run(const mid::AdapterRegistry& adapters) {
   mid::CreateResult made = adapters.create(mission_.settings.adapter, mission_.settings, mission_.type, *loop_);
   if (made.status != mid::CreateStatus::success) {
     err_ << "eamos dex: error: " << name() << ": " << made.message << "\n";
-    return 1;
+    return false;
   }
   drone_ = std::move(made.drone);
+  // Where the vehicle stands, for the ground's homes check: it comes with this DEX's READY.
+  if (drone_->has_global_frame()) mid::wait_for_fixes(*loop_, {drone_.get()}, mid::kHomeFixTimeoutS);
+  return true;
+}
 
+// The drone's DDS participant; every sample is handed to the loop's thread (the inbox),
+// and what the wait for the start needs is also noted on the listener's thread.
+bool DexProcess::open_dds() {
   transport::DdsHandlers h;
   h.trigger = [this](TriggerSample s) { inbox_.deliver([this, s = std::move(s)] { on_trigger(s); }); };
   h.telemetry = [this](TelemetrySample s) {
@@ -93,26 +120,13 @@ int DexProcess::run(const mid::AdapterRegistry& adapters) {
   dds.mission_hash = mission_.hash;
   dds.self = mission_.self;
   if (!o_.insecure) dds.security_folder = o_.folder + "/security";
+  std::string error;
   node_ = transport::DdsNode::open(dds, std::move(h), error);
   if (!node_) {
     err_ << "eamos dex: error: " << error << "\n";
-    return 1;
+    return false;
   }
-  std::signal(SIGINT, on_dex_signal);
-  std::signal(SIGTERM, on_dex_signal);
-  if (!wait_for_start() || !begin()) {
-    node_->flush(1.0);
-    return 1;
-  }
-  loop_->run_until(o_.time_limit_s + 1000.0);
-  dds_trace_->flush();
-  node_->flush(1.0);
-  if (phase_ == Phase::completed) {
-    out_ << name() << ": mission completed\n";
-    return 0;
-  }
-  err_ << "eamos dex: " << name() << ": mission failed: " << error_ << "\n";
-  return 1;
+  return true;
 }
 
 void DexProcess::on_lifecycle_waiting(const LifecycleSample& s) {
@@ -179,58 +193,9 @@ bool DexProcess::wait_for_start() {
       err_ << "eamos dex: error: " << name() << ": the ground gave up before the start: " << *gave_up << "\n";
       return false;
     }
-    if (!ready_sent) {
-      // Every other drone, not only those whose telemetry this mission reads: a sample
-      // from each shows the channel to it is up (with DDS Security, its handshake done). A
-      // handshake that failed (it times out under heavy loss and Cyclone does not retry
-      // it) would otherwise leave a trigger to that drone undelivered and the mission
-      // waiting for ever, with no liveliness ever lost: such a DEX stays unready and the
-      // ground's barrier refuses to start.
-      std::map<int, TelemetrySample> seen = inbox_.latest();
-      bool all = true;
-      for (int d = 0; d < static_cast<int>(mission_.fleet.size()); ++d)
-        if (d != mission_.self && !seen.count(d)) all = false;
-      if (all) {
-        LifecycleSample ready;
-        ready.mission_hash = mission_.hash;
-        ready.drone = mission_.self;
-        ready.kind = LifecycleKind::ready;
-        ready.nonce = nonce_;
-        ready.launch_id = o_.launch_id;
-        node_->write(ready);
-        ready_sent = true;
-        out_ << name() << ": ready\n" << std::flush;
-      }
-    }
-    for (const LifecycleSample& s : starts) {
-      bool mine = s.drone == transport::kGround && static_cast<int>(s.nonces.size()) > mission_.self &&
-                  s.nonces[mission_.self] == nonce_ && (o_.launch_id == 0 || s.launch_id == o_.launch_id);
-      std::string elsewhere = mine ? flown_elsewhere() : "";
-      if (!elsewhere.empty()) {
-        err_ << "eamos dex: error: " << name() << ": refusing run " << s.run_id << ": " << elsewhere << "\n";
-        refuse(s, elsewhere);
-        node_->flush(1.0);
-        return false;
-      }
-      if (mine) {
-        if (s.speed != o_.speed) {
-          err_ << "eamos dex: error: " << name() << ": the ground started run " << s.run_id << " at speed "
-               << s.speed << ", this DEX runs at " << o_.speed << "; start it with --speed " << s.speed << "\n";
-          LifecycleSample abort{mission_.hash, mission_.self, LifecycleKind::abort, s.run_id};
-          abort.reason = name() + " runs at another speed than the ground";
-          node_->write(abort);
-          node_->flush(1.0);
-          return false;
-        }
-        start_ = s;
-        return true;
-      }
-      // A start that names another process for this drone: the run began (or was
-      // abandoned) without this process. A restarted DEX never joins a run in progress.
-      if (refused.insert(s.run_id).second)
-        err_ << name() << ": not joining run " << s.run_id
-             << ": it was started with another process for this drone (this DEX was restarted?)\n";
-    }
+    if (!ready_sent) ready_sent = ready_when_all_seen();
+    for (const LifecycleSample& s : starts)
+      if (std::optional<bool> taken = take_start(s, refused)) return *taken;
     if (wall_s() > deadline) {
       err_ << "eamos dex: error: " << name() << ": no start within " << o_.start_timeout_s
            << " s; is `eamos launch` running on domain " << o_.dds.domain << "?\n";
@@ -239,7 +204,75 @@ bool DexProcess::wait_for_start() {
   }
 }
 
+// READY once a telemetry sample came from every other drone, not only those whose telemetry
+// this mission reads: a sample from each shows the channel to it is up (with DDS Security,
+// its handshake done). A handshake that failed (it times out under heavy loss and Cyclone
+// does not retry it) would otherwise leave a trigger to that drone undelivered and the
+// mission waiting for ever, with no liveliness ever lost: such a DEX stays unready and the
+// ground's barrier refuses to start.
+bool DexProcess::ready_when_all_seen() {
+  std::map<int, TelemetrySample> seen = inbox_.latest();
+  for (int d = 0; d < static_cast<int>(mission_.fleet.size()); ++d)
+    if (d != mission_.self && !seen.count(d)) return false;
+  LifecycleSample ready;
+  ready.mission_hash = mission_.hash;
+  ready.drone = mission_.self;
+  ready.kind = LifecycleKind::ready;
+  ready.nonce = nonce_;
+  ready.launch_id = o_.launch_id;
+  ready.fix = drone_->global_fix();
+  ready.home_x = mission_.settings.home.x;
+  ready.home_y = mission_.settings.home.y;
+  ready.home_tolerance = mission_.settings.home_tolerance_m;
+  node_->write(ready);
+  out_ << name() << ": ready\n" << std::flush;
+  return true;
+}
+
+std::optional<bool> DexProcess::take_start(const LifecycleSample& s, std::set<std::uint64_t>& refused) {
+  bool mine = s.drone == transport::kGround && static_cast<int>(s.nonces.size()) > mission_.self &&
+              s.nonces[mission_.self] == nonce_ && (o_.launch_id == 0 || s.launch_id == o_.launch_id);
+  std::string elsewhere = mine ? flown_elsewhere() : "";
+  if (!elsewhere.empty()) {
+    err_ << "eamos dex: error: " << name() << ": refusing run " << s.run_id << ": " << elsewhere << "\n";
+    refuse(s, elsewhere);
+    node_->flush(1.0);
+    return false;
+  }
+  if (mine) {
+    if (s.speed != o_.speed) {
+      err_ << "eamos dex: error: " << name() << ": the ground started run " << s.run_id << " at speed "
+           << s.speed << ", this DEX runs at " << o_.speed << "; start it with --speed " << s.speed << "\n";
+      LifecycleSample abort{mission_.hash, mission_.self, LifecycleKind::abort, s.run_id};
+      abort.reason = name() + " runs at another speed than the ground";
+      node_->write(abort);
+      node_->flush(1.0);
+      return false;
+    }
+    start_ = s;
+    return true;
+  }
+  // A start that names another process for this drone: the run began (or was
+  // abandoned) without this process. A restarted DEX never joins a run in progress.
+  if (refused.insert(s.run_id).second)
+    err_ << name() << ": not joining run " << s.run_id
+         << ": it was started with another process for this drone (this DEX was restarted?)\n";
+  return std::nullopt;
+}
+
 bool DexProcess::begin() {
+  if (!reach_start_instant()) return false;
+  transport_ = std::make_unique<transport::DdsTransport>(*node_, start_.run_id);
+  open_traces();
+  make_engine();
+  watch_run();
+  publish_status(true);
+  engine_->start();
+  tick();
+  return true;
+}
+
+bool DexProcess::reach_start_instant() {
   // Mission time 0 is the start instant the ground chose, the same on every drone, also
   // for a DEX that got START late: its loop runs from that instant, catching up.
   double lease = o_.dds.lease_s;
@@ -267,7 +300,11 @@ bool DexProcess::begin() {
       return false;
     }
   }
-  transport_ = std::make_unique<transport::DdsTransport>(*node_, start_.run_id);
+  return true;
+}
+
+// This drone's trace: to the ground over DDS, the live log, and its own file if asked.
+void DexProcess::open_traces() {
   dds_trace_ = std::make_unique<DdsTraceSink>(*node_, *loop_, mission_.hash, start_.run_id, mission_.self);
   tee_.add(dds_trace_.get());
   if (o_.log) {
@@ -287,6 +324,9 @@ bool DexProcess::begin() {
       err_ << name() << ": cannot write trace '" << o_.trace_file << "'\n";
     }
   }
+}
+
+void DexProcess::make_engine() {
   dex::EngineHooks hooks;
   hooks.transport = transport_.get();
   hooks.trace = &tee_;
@@ -301,12 +341,17 @@ bool DexProcess::begin() {
   // went idle (StatusSample::since), which is the mission's duration.
   hooks.on_idle = [this] { publish_status(); };
   engine_ = std::make_unique<dex::Engine>(mission_, *drone_, *loop_, hooks);
+  start_separation();
   phase_ = Phase::running;
   inbox_.attach(*loop_, [this](const TelemetrySample& s) { seed_telemetry(s); });
   drone_->subscribe([this](const mid::DroneState& s) {
+    separation_->update(mission_.self, s);
     engine_->properties_changed(mission_.self);
     transport_->publish(std::make_shared<const dex::Telemetry>(dex::Telemetry{mission_.hash, mission_.self, s}));
   });
+}
+
+void DexProcess::watch_run() {
   // A loop that could not run for longer than the lease (the process was stopped, the
   // machine starved it) has been given up by the others and must not replay what fell due
   // meanwhile, every overdue action at once with back-dated times: it abandons first.
@@ -317,10 +362,15 @@ bool DexProcess::begin() {
                 " s of mission time; raise --time-limit if it is meant to run longer",
             std::nullopt, true);
   });
-  publish_status(true);
-  engine_->start();
-  tick();
-  return true;
+}
+
+void DexProcess::start_separation() {
+  dex::SeparationHooks hooks;
+  hooks.trace = &tee_;
+  hooks.on_stuck = [this](const std::string& why) { abandon(why, std::nullopt, true); };
+  separation_ = std::make_unique<dex::SeparationGuard>(mission_, *loop_, hooks);
+  separation_->fly(mission_.self, *drone_, mission_.settings.limits);
+  separation_->update(mission_.self, drone_->state());
 }
 
 int run_dex_process(const DexProcessOptions& options, const mid::AdapterRegistry& adapters,

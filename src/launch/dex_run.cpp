@@ -87,6 +87,7 @@ void DexProcess::seed_telemetry(const TelemetrySample& s) {
   // state every DEX publishes while it waits) or this run (a drone that started first).
   if (s.telemetry.mission_hash != mission_.hash || s.telemetry.from == mission_.self) return;
   if (s.run_id != 0 && s.run_id != start_.run_id) return;
+  separation_->update(s.telemetry.from, s.telemetry.state);
   engine_->receive(std::make_shared<const dex::Telemetry>(s.telemetry));
 }
 
@@ -96,6 +97,7 @@ void DexProcess::on_telemetry(const TelemetrySample& s) {
   // Once running, only this run's telemetry: run 0 now comes from a DEX that was started
   // again and stands at home, not from the drone that flies.
   if (s.run_id != start_.run_id) return;
+  separation_->update(s.telemetry.from, s.telemetry.state);
   engine_->receive(std::make_shared<const dex::Telemetry>(s.telemetry));
 }
 
@@ -235,25 +237,28 @@ void DexProcess::complete() {
 
 void DexProcess::abandon(const std::string& reason, const std::optional<dex::Failure>& failure, bool broadcast) {
   if (phase_ != Phase::running) return;
-  phase_ = Phase::failsafe;  // failed once the failsafe has ended (wait_for_failsafe)
+  phase_ = Phase::failsafe;  // failed once the failsafe has ended (on_failsafe_over)
   error_ = reason;
-  // Safety first, words second: this drone's failsafe, then the ABORT that starts everyone
-  // else's (a DDS write may block), and only then the log and the trace.
-  engine_->halt();
-  bool commanded = dex::command_failsafe(*drone_, mission_.settings);
-  if (broadcast) {
-    LifecycleSample abort{mission_.hash, mission_.self, LifecycleKind::abort, start_.run_id};
-    abort.reason = reason;
-    abort.failure = failure;
-    abort.t = loop_->now();
-    node_->write(abort);
-  }
-  err_ << name() << ": " << reason << "\n";
-  if (commanded) dex::record_failsafe(mission_.settings, loop_->now(), reason, &tee_);
-  failsafe_since_ = loop_->now();
-  // Looked at from the next turn of the loop, after the callbacks already queued: the ends
-  // of the actions the failsafe cancelled are among them and must reach the trace.
-  loop_->after(0.0, [this] { wait_for_failsafe(); });
+  // This drone's failsafe, then the ABORT that starts everyone else's, and only then the
+  // log and the trace (dex::abandon_drones).
+  if (separation_) separation_->halt();
+  std::vector<dex::FailsafeDrone> self = {{engine_.get(), drone_.get(), &mission_.settings}};
+  dex::abandon_drones(self, loop_->now(), reason, &tee_, [&] {
+    if (broadcast) {
+      LifecycleSample abort{mission_.hash, mission_.self, LifecycleKind::abort, start_.run_id};
+      abort.reason = reason;
+      abort.failure = failure;
+      abort.t = loop_->now();
+      node_->write(abort);
+    }
+    err_ << name() << ": " << reason << "\n";
+  });
+  // Stay up (and alive for the others) until the failsafe is over as dex::failsafe_over
+  // says, the rule `eamos run` follows too. Down alone is not over: a DEX that ended at the
+  // touchdown left its vehicle armed on the ground (seen on PX4 SITL) and reported it so.
+  failsafe_wait_ = std::make_unique<dex::FailsafeWait>(*loop_, std::move(self), 0.1 * o_.speed,
+                                                       [this] { on_failsafe_over(); });
+  failsafe_wait_->start();
 }
 
 void DexProcess::on_stall(double stalled_s) {
@@ -270,18 +275,11 @@ void DexProcess::on_internal_error(const std::string& what) {
   abandon("internal error in the DEX of " + name() + ": " + what, std::nullopt, true);
 }
 
-void DexProcess::wait_for_failsafe() {
-  // Stay up (and alive for the others) until the failsafe is over as dex::failsafe_over
-  // says, the rule `eamos run` follows too. Down alone is not over: a DEX that ended at the
-  // touchdown left its vehicle armed on the ground (seen on PX4 SITL) and reported it so.
-  if (dex::failsafe_over(drone_->state(), mission_.settings.failsafe, loop_->now() - failsafe_since_)) {
-    // Its final state: the ground reports this one, not the one at the abort.
-    phase_ = Phase::failed;
-    publish_status(true);
-    loop_->stop();
-    return;
-  }
-  loop_->after(0.1 * o_.speed, [this] { wait_for_failsafe(); });
+void DexProcess::on_failsafe_over() {
+  // Its final state: the ground reports this one, not the one at the abort.
+  phase_ = Phase::failed;
+  publish_status(true);
+  loop_->stop();
 }
 
 }  // namespace eamos::launch

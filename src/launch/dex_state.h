@@ -15,7 +15,9 @@
 #include <vector>
 
 #include "dex/engine.h"
+#include "dex/failsafe.h"
 #include "dex/mission.h"
+#include "dex/separation.h"
 #include "dex/trace_writers.h"
 #include "launch/dex_process.h"
 #include "launch/termination.h"
@@ -76,7 +78,14 @@ class DexProcess {
 
  private:
   // --- before the start (main thread) ---
+  bool load(const mid::AdapterRegistry& adapters);
+  bool open_dds();
   bool wait_for_start();
+  /// Writes READY when every other drone has been heard from; whether it did.
+  bool ready_when_all_seen();
+  /// A START seen while waiting: true when it starts this process's run, false when this
+  /// process must give up, nothing when it is not this process's (noted in `refused`).
+  std::optional<bool> take_start(const LifecycleSample& s, std::set<std::uint64_t>& refused);
   void on_lifecycle_waiting(const LifecycleSample& s);
   /// Notes (DDS thread) a status of this drone from another process in a run: another DEX
   /// flies this drone, and a START naming this process must be refused.
@@ -87,11 +96,18 @@ class DexProcess {
   void refuse(const LifecycleSample& start, const std::string& why);
   // --- the mission (loop thread) ---
   bool begin();
+  /// Waits until the start instant; false when the run was refused or aborted meanwhile.
+  bool reach_start_instant();
+  void open_traces();
+  void make_engine();
+  /// The run's own faults: a stalled loop, the time limit.
+  void watch_run();
   void on_trigger(const TriggerSample& s);
   /// True when `event` (a trigger or cancel that arrived) came later than
   /// --max-trigger-latency: the mission is then abandoned and the message not obeyed.
   bool too_late(const dex::TraceEvent& event);
   void on_telemetry(const TelemetrySample& s);
+  void start_separation();
   void seed_telemetry(const TelemetrySample& s);
   void on_lifecycle(const LifecycleSample& s);
   /// A START of another run: refused when it names this process (it runs one already).
@@ -124,7 +140,8 @@ class DexProcess {
   bool others_idle(bool running_only, FleetCounters& c, std::string& why) const;
   void complete();
   void abandon(const std::string& reason, const std::optional<dex::Failure>& failure, bool broadcast);
-  void wait_for_failsafe();
+  /// Every failsafe of this drone's abandoned mission is over (dex::FailsafeWait).
+  void on_failsafe_over();
   void on_internal_error(const std::string& what);
   /// The loop found itself `stalled_s` wall seconds behind (EventLoop::on_stall).
   void on_stall(double stalled_s);
@@ -161,6 +178,7 @@ class DexProcess {
   std::unique_ptr<dex::LiveLog> live_;
   dex::TeeTrace tee_;
   std::unique_ptr<dex::Engine> engine_;
+  std::unique_ptr<dex::SeparationGuard> separation_;  ///< give-ways of this drone (dex/separation.h)
   Phase phase_ = Phase::waiting;
   bool end_reached_ = false;
   std::uint64_t received_ = 0;
@@ -171,7 +189,7 @@ class DexProcess {
   std::string error_;
   std::set<std::string> foreign_;
   std::set<std::uint64_t> stale_runs_;
-  double failsafe_since_ = 0.0;
+  std::unique_ptr<dex::FailsafeWait> failsafe_wait_;  ///< from the abandon on
   std::set<std::pair<int, std::uint64_t>> seen_triggers_;  ///< (sender, seq) of every accepted trigger
   std::set<std::string> rejected_;                        ///< what was logged as ignored
   std::optional<LifecycleSample> pending_finished_;       ///< a FINISHED this DEX does not agree with (yet)

@@ -15,6 +15,7 @@
 #include "launch/inbox.h"
 #include "launch/spawn.h"
 #include "launch/wall_time.h"
+#include "mid/home_check.h"
 
 namespace eamos::launch {
 
@@ -33,6 +34,7 @@ struct DroneEntry {
   bool local = false;
   Child child;
   std::optional<std::uint64_t> ready_nonce;
+  mid::HomeReport home;  ///< from its READY: declared home and where its vehicle stands
   std::optional<StatusSample> final_status;
   std::vector<dex::Sample> track;
   std::optional<mid::DroneState> last_state;  ///< newest telemetry of this run
@@ -130,6 +132,15 @@ class Ground {
   int run();
 
  private:
+  bool prepare();
+  bool open_dds();
+  bool fly();
+  void report_outcome();
+  void report_drones();
+  int exit_status();
+  void poll_children();
+  void watch_barrier();
+  void watch_flight();
   double mission_now() const { return (unix_ns() - start_at_ns_) / 1e9 * o_.speed; }
   void record_lifecycle(const LifecycleSample& s);
   bool start_processes();
@@ -205,24 +216,37 @@ std::uint64_t random_id() {
 
 int Ground::run() {
   launch_id_ = random_id();
+  if (!prepare() || !open_dds()) return 1;
+  if (!fly()) return 1;
+  report_outcome();
+  report_drones();
+  return exit_status();
+}
+
+// The deployment: its manifest, the drones to start here, the trace's header.
+bool Ground::prepare() {
   std::string error;
   if (!read_manifest(o_.dir, hash_, drones_, error)) {
     err_ << "eamos launch: error: " << error << "\n";
-    return 1;
+    return false;
   }
   std::set<std::string> names;
   for (auto& d : drones_) names.insert(d.name);
   for (const std::string& n : o_.local)
     if (!names.count(n)) {
       err_ << "eamos launch: error: --drones names '" << n << "', which is not a drone of this mission\n";
-      return 1;
+      return false;
     }
   r_.header = load_header(o_.dir, hash_, drones_, o_.telemetry_hz, err_);
   for (auto& d : drones_) r_.fleet.push_back(d.name);
   for (auto& d : drones_)
     d.local = !o_.remote_only &&
               (o_.local.empty() || std::find(o_.local.begin(), o_.local.end(), d.name) != o_.local.end());
+  return true;
+}
 
+// Discovery: the ground's DDS participant, every sample handed to the loop's thread.
+bool Ground::open_dds() {
   transport::DdsHandlers h;
   h.lifecycle = [this](LifecycleSample s) { inbox_.deliver([this, s] { on_lifecycle(s); }); };
   h.status = [this](StatusSample s) { inbox_.deliver([this, s] { on_status(s); }); };
@@ -238,14 +262,20 @@ int Ground::run() {
   dds.mission_hash = hash_;
   dds.self = transport::kGroundParticipant;
   if (!o_.insecure) dds.security_folder = o_.dir + "/ground-station/security";
+  std::string error;
   node_ = transport::DdsNode::open(dds, std::move(h), error);
   if (!node_) {
     err_ << "eamos launch: error: " << error << "\n";
-    return 1;
+    return false;
   }
   // A sample that makes a handler throw is dropped; the ground keeps collecting the report.
   loop_.on_callback_error([this](const std::string& what) { err_ << "ground: dropped an input: " << what << "\n"; });
   inbox_.attach(loop_, [](const TelemetrySample&) {});
+  return true;
+}
+
+// From the DEX processes' start to their end: the barrier, the run and its end (tick).
+bool Ground::fly() {
   // waitpid needs SIGCHLD at its default; Ctrl-C or a TERM aborts the run (every drone
   // runs its failsafe) instead of killing the ground in the middle of it.
   std::signal(SIGCHLD, SIG_DFL);
@@ -254,7 +284,7 @@ int Ground::run() {
   if (!start_processes()) {
     stop_all(SIGTERM);
     node_.reset();
-    return 1;
+    return false;
   }
   barrier_deadline_ = wall_s() + o_.barrier_timeout_s;
   tick();
@@ -262,8 +292,11 @@ int Ground::run() {
   node_.reset();
   for (auto& d : drones_)
     if (d.local) reap(d.child, 5.0);
+  return true;
+}
 
-  // The report, in the shape `eamos run` gives.
+// The report, in the shape `eamos run` gives: how and when the mission ended.
+void Ground::report_outcome() {
   std::stable_sort(r_.events.begin(), r_.events.end(),
                    [](const dex::TraceEvent& a, const dex::TraceEvent& b) { return a.t < b.t; });
   dex::RunResult& run = r_.run;
@@ -281,6 +314,10 @@ int Ground::run() {
   dex::TraceEvent end = dex::mission_end_event(run);
   if (live_) live_->record(end);
   r_.events.push_back(end);
+}
+
+void Ground::report_drones() {
+  dex::RunResult& run = r_.run;
   for (auto& d : drones_) {
     // A drone without a final status (lost and not back, its DEX died) is reported as
     // unknown, with what was last seen of it.
@@ -297,9 +334,13 @@ int Ground::run() {
                                    : "its DEX ended without reporting it")
            << "\n";
   }
-  int status = run.completed ? 0 : 1;
+}
+
+// 0 when the mission completed and every DEX started here exited cleanly.
+int Ground::exit_status() {
+  int status = r_.run.completed ? 0 : 1;
   for (auto& d : drones_)
-    if (d.local && d.child.exit_status && *d.child.exit_status != 0 && run.completed) {
+    if (d.local && d.child.exit_status && *d.child.exit_status != 0 && r_.run.completed) {
       err_ << "ground: the DEX of " << d.name << " exited with status " << *d.child.exit_status << "; its log:\n"
            << tail_of(d.log, 10);
       status = 1;
@@ -347,45 +388,62 @@ bool Ground::start_processes() {
 void Ground::tick() {
   // The next tick first: should anything below throw, the ground still ticks and ends.
   loop_.after(0.05, [this] { tick(); });
-  for (auto& d : drones_) {
-    if (!d.local || d.child.exit_status) continue;
-    poll(d.child);
-    if (d.child.exit_status)
-      out_ << "ground: the DEX of " << d.name << " exited with status " << *d.child.exit_status << "\n" << std::flush;
-  }
+  poll_children();
   if (g_signal != 0 && stage_ != Stage::done) {
     // A second time: stop the DEXes now (a DEX takes SIGTERM as "abandon the mission",
     // which it already does), leaving each drone in the failsafe it was commanded.
     if (interrupted_) stop_all(SIGKILL);
     interrupt();
   }
-  if (stage_ == Stage::barrier) {
-    for (auto& d : drones_)
-      if (d.local && d.child.exit_status && !d.ready_nonce)
-        return fail_barrier("the DEX of " + d.name + " exited with status " + std::to_string(*d.child.exit_status) +
-                            " before it was ready; its log (" + d.log + "):\n" + tail_of(d.log, 10));
-    bool all = std::all_of(drones_.begin(), drones_.end(), [](const DroneEntry& d) { return d.ready_nonce.has_value(); });
-    if (all) {
-      send_start();
-    } else if (wall_s() > barrier_deadline_) {
-      std::string missing;
-      for (auto& d : drones_)
-        if (!d.ready_nonce) missing += (missing.empty() ? "" : ", ") + d.name;
-      char secs[32];
-      std::snprintf(secs, sizeof secs, "%g", o_.barrier_timeout_s);
-      return fail_barrier(std::string("start barrier timed out after ") + secs + " s; not ready: " + missing);
-    }
-  } else if (stage_ == Stage::running) {
-    if (wall_s() > wall_guard_) {
-      error_ = "the DEX processes did not report an end in time";
-      stop_all(SIGKILL);
-      stage_ = Stage::done;
-    } else if (all_done()) {
-      if (!finish_at_) finish_at_ = wall_s() + 0.3;  // the last trace samples may still be on the way
-      if (wall_s() > *finish_at_) stage_ = Stage::done;
-    }
-  }
+  if (stage_ == Stage::barrier) watch_barrier();
+  else if (stage_ == Stage::running) watch_flight();
   if (stage_ == Stage::done) loop_.stop();
+}
+
+void Ground::poll_children() {
+  for (auto& d : drones_) {
+    if (!d.local || d.child.exit_status) continue;
+    poll(d.child);
+    if (d.child.exit_status)
+      out_ << "ground: the DEX of " << d.name << " exited with status " << *d.child.exit_status << "\n" << std::flush;
+  }
+}
+
+// The start barrier: START once every drone is READY; a DEX that died first or a barrier
+// past its deadline fails the launch before anything moved.
+void Ground::watch_barrier() {
+  for (auto& d : drones_)
+    if (d.local && d.child.exit_status && !d.ready_nonce)
+      return fail_barrier("the DEX of " + d.name + " exited with status " + std::to_string(*d.child.exit_status) +
+                          " before it was ready; its log (" + d.log + "):\n" + tail_of(d.log, 10));
+  bool all = std::all_of(drones_.begin(), drones_.end(), [](const DroneEntry& d) { return d.ready_nonce.has_value(); });
+  if (all) {
+    std::vector<mid::HomeReport> homes;
+    for (const auto& d : drones_) homes.push_back(d.home);
+    if (std::string wrong = mid::compare_homes(homes); !wrong.empty())
+      return fail_barrier("the vehicles do not stand where the fleet file puts them; nothing was armed:\n" + wrong);
+    send_start();
+  } else if (wall_s() > barrier_deadline_) {
+    std::string missing;
+    for (auto& d : drones_)
+      if (!d.ready_nonce) missing += (missing.empty() ? "" : ", ") + d.name;
+    char secs[32];
+    std::snprintf(secs, sizeof secs, "%g", o_.barrier_timeout_s);
+    fail_barrier(std::string("start barrier timed out after ") + secs + " s; not ready: " + missing);
+  }
+}
+
+// The flight: done once every drone has its final state (all_done), or when the DEXes
+// overran the wall-clock guard.
+void Ground::watch_flight() {
+  if (wall_s() > wall_guard_) {
+    error_ = "the DEX processes did not report an end in time";
+    stop_all(SIGKILL);
+    stage_ = Stage::done;
+  } else if (all_done()) {
+    if (!finish_at_) finish_at_ = wall_s() + 0.3;  // the last trace samples may still be on the way
+    if (wall_s() > *finish_at_) stage_ = Stage::done;
+  }
 }
 
 bool Ground::all_done() {
@@ -489,6 +547,7 @@ void Ground::on_lifecycle(const LifecycleSample& s) {
       out_ << "\n" << std::flush;
     }
     drones_[s.drone].ready_nonce = s.nonce;
+    drones_[s.drone].home = {d.name, {s.home_x, s.home_y, 0.0}, s.fix, s.home_tolerance};
     return;
   }
   if (s.run_id != r_.run_id || stage_ != Stage::running) return;

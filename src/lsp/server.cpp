@@ -152,20 +152,7 @@ std::optional<int> Server::dispatch(const std::string& body) {
     reply_error(nullptr, kInvalidRequest, "the id must be an integer or a string");
     return {};
   }
-  if (!msg.contains("jsonrpc") || msg["jsonrpc"] != "2.0") {
-    reply_error(id, kInvalidRequest, "\"jsonrpc\" must be \"2.0\"");
-    return {};
-  }
-  if (!msg.contains("method")) {
-    // A response to a request of ours: this server sends none, so there is nothing to match.
-    if (has_id && (msg.contains("result") || msg.contains("error"))) return {};
-    reply_error(id, kInvalidRequest, "no \"method\": a request or notification must name one");
-    return {};
-  }
-  if (!msg["method"].is_string()) {
-    reply_error(id, kInvalidRequest, "\"method\" must be a string");
-    return {};
-  }
+  if (!takes(msg, id, has_id)) return {};
   std::string method = msg["method"].get<std::string>();
   // JSON-RPC leaves params out when there are none; some clients send null instead (shutdown).
   json params = msg.contains("params") && !msg["params"].is_null() ? msg["params"] : json::object();
@@ -191,6 +178,24 @@ std::optional<int> Server::dispatch(const std::string& body) {
     if (has_id) reply_error(id, kInternalError, "eamos lsp failed on " + method + "; please report it with the file");
   }
   return {};
+}
+
+bool Server::takes(const json& msg, const json& id, bool has_id) {
+  if (!msg.contains("jsonrpc") || msg["jsonrpc"] != "2.0") {
+    reply_error(id, kInvalidRequest, "\"jsonrpc\" must be \"2.0\"");
+    return false;
+  }
+  if (!msg.contains("method")) {
+    // A response to a request of ours: this server sends none, so there is nothing to match.
+    if (has_id && (msg.contains("result") || msg.contains("error"))) return false;
+    reply_error(id, kInvalidRequest, "no \"method\": a request or notification must name one");
+    return false;
+  }
+  if (!msg["method"].is_string()) {
+    reply_error(id, kInvalidRequest, "\"method\" must be a string");
+    return false;
+  }
+  return true;
 }
 
 void Server::request(const json& id, const std::string& method, const json& params) {

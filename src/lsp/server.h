@@ -40,6 +40,9 @@ class Server {
 
  private:
   std::optional<int> dispatch(const std::string& body);
+  /// Whether `msg` (with `id`, when `has_id`) is a request or notification this server takes
+  /// (jsonrpc 2.0, a string method); when not, the error is replied and `msg` dropped.
+  bool takes(const nlohmann::json& msg, const nlohmann::json& id, bool has_id);
   void request(const nlohmann::json& id, const std::string& method, const nlohmann::json& params);
   void notification(const std::string& method, const nlohmann::json& params);
   nlohmann::json initialize(const nlohmann::json& params);

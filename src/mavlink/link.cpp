@@ -11,9 +11,22 @@
 #include <cstdio>
 #include <cstring>
 
+#include "diag/log.h"
+
 namespace eamos::mavlink {
 
 namespace {
+
+// From the catch handlers of the receive thread: nothing may leave it, not even a bad_alloc.
+void report(diag::LogLevel level, std::string_view before, const std::string& url, std::string_view after,
+            const char* what) noexcept {
+  try {
+    std::string text = std::string(before) + url + std::string(after);
+    if (what) (text += ": ") += what;
+    diag::log(level, "mavlink", "", text);
+  } catch (...) {
+  }
+}
 
 std::string sys_error(const std::string& what) { return what + ": " + std::strerror(errno); }
 
@@ -121,9 +134,9 @@ OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame, double re
     try {
       l->receive_loop();
     } catch (const std::exception& e) {
-      std::fprintf(stderr, "eamos: MAVLink receive thread of '%s' stopped: %s\n", l->endpoint_.url.c_str(), e.what());
+      report(diag::LogLevel::error, "MAVLink receive thread of '", l->endpoint_.url, "' stopped", e.what());
     } catch (...) {
-      std::fprintf(stderr, "eamos: MAVLink receive thread of '%s' stopped\n", l->endpoint_.url.c_str());
+      report(diag::LogLevel::error, "MAVLink receive thread of '", l->endpoint_.url, "' stopped", nullptr);
     }
   });
   return {std::move(link), ""};
@@ -189,9 +202,9 @@ void Link::receive_loop() {
     try {
       handle_bytes(std::span(buffer.data(), static_cast<size_t>(n)), listen ? &from : nullptr);
     } catch (const std::exception& e) {  // drop this datagram, keep the link
-      std::fprintf(stderr, "eamos: dropped MAVLink input from '%s': %s\n", endpoint_.url.c_str(), e.what());
+      report(diag::LogLevel::warning, "dropped MAVLink input from '", endpoint_.url, "'", e.what());
     } catch (...) {
-      std::fprintf(stderr, "eamos: dropped MAVLink input from '%s'\n", endpoint_.url.c_str());
+      report(diag::LogLevel::warning, "dropped MAVLink input from '", endpoint_.url, "'", nullptr);
     }
   }
 }

@@ -9,8 +9,6 @@ namespace {
 // Every id used below is in the table (the round-trip tests cover each one).
 const MessageDef& def_of(uint32_t id) { return *find_message(id); }
 
-std::string param_name(int i) { return "param" + std::to_string(i + 1); }
-
 // Text from the vehicle goes into logs, traces and JSON: anything but printable ASCII (a
 // hostile or broken sender's bytes, invalid UTF-8) becomes '?'.
 std::string printable(std::string text) {
@@ -19,387 +17,397 @@ std::string printable(std::string text) {
   return text;
 }
 
-}  // namespace
+// How a char[N] field is read: PX4 ends a STATUSTEXT with a newline, which is no text.
+enum class Text { as_is, trim_end };
 
-Message pack(const Heartbeat& m) {
-  FieldWriter w(def_of(msg::HEARTBEAT));
-  w.set("type", m.type);
-  w.set("autopilot", m.autopilot);
-  w.set("base_mode", m.base_mode);
-  w.set("custom_mode", m.custom_mode);
-  w.set("system_status", m.system_status);
-  w.set("mavlink_version", m.mavlink_version);
+// Pack's side of a message's field list (Layout<M>::fields): struct members into the payload.
+class Writer {
+ public:
+  explicit Writer(uint32_t id) : w_(def_of(id)) {}
+  template <typename T>
+  void operator()(std::string_view name, const T& value) { w_.set(name, value); }
+  template <typename T, size_t N>
+  void operator()(std::string_view name, const std::array<T, N>& values) {
+    for (size_t i = 0; i < N; ++i) w_.set(name, values[i], static_cast<int>(i));
+  }
+  void operator()(std::string_view name, const std::string& text, Text = Text::as_is) { w_.set_chars(name, text); }
+  /// Fields named prefix1, prefix2, ... (COMMAND_LONG's param1..param7), one per element.
+  template <typename T, size_t N>
+  void numbered(std::string_view prefix, const std::array<T, N>& values) {
+    for (size_t i = 0; i < N; ++i) w_.set(std::string(prefix) + std::to_string(i + 1), values[i]);
+  }
+  Message take() { return w_.take(); }
+
+ private:
+  FieldWriter w_;
+};
+
+// Unpack's side of the same list: the payload into struct members. Text from the vehicle is
+// made printable (it goes into logs, traces and JSON).
+class Reader {
+ public:
+  explicit Reader(const Message& m) : r_(def_of(m.id), m) {}
+  template <typename T>
+  void operator()(std::string_view name, T& value) { value = r_.get<T>(name); }
+  template <typename T, size_t N>
+  void operator()(std::string_view name, std::array<T, N>& values) {
+    for (size_t i = 0; i < N; ++i) values[i] = r_.get<T>(name, static_cast<int>(i));
+  }
+  void operator()(std::string_view name, std::string& text, Text mode = Text::as_is) {
+    std::string raw = r_.get_chars(name);
+    if (mode == Text::trim_end)
+      while (!raw.empty() && static_cast<unsigned char>(raw.back()) <= 0x20) raw.pop_back();
+    text = printable(std::move(raw));
+  }
+  template <typename T, size_t N>
+  void numbered(std::string_view prefix, std::array<T, N>& values) {
+    for (size_t i = 0; i < N; ++i) values[i] = r_.get<T>(std::string(prefix) + std::to_string(i + 1));
+  }
+
+ private:
+  FieldReader r_;
+};
+
+// Each message's fields, named once: `fields` is called with a const struct and a Writer by
+// pack, and with a fresh struct and a Reader by unpack. A member not listed keeps its default.
+template <typename M>
+struct Layout;
+
+template <typename M>
+Message pack_fields(const M& m) {
+  Writer w(Layout<M>::id);
+  Layout<M>::fields(m, w);
   return w.take();
 }
 
-std::optional<Heartbeat> unpack_heartbeat(const Message& m) {
-  if (m.id != msg::HEARTBEAT) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  return Heartbeat{r.get<uint8_t>("type"), r.get<uint8_t>("autopilot"),
-                   r.get<uint8_t>("base_mode"), r.get<uint32_t>("custom_mode"),
-                   r.get<uint8_t>("system_status"), r.get<uint8_t>("mavlink_version")};
-}
-
-Message pack(const ParamRequestRead& m) {
-  FieldWriter w(def_of(msg::PARAM_REQUEST_READ));
-  w.set("target_system", m.target_system);
-  w.set("target_component", m.target_component);
-  w.set_chars("param_id", m.param_id);
-  w.set("param_index", m.param_index);
-  return w.take();
-}
-
-std::optional<ParamRequestRead> unpack_param_request_read(const Message& m) {
-  if (m.id != msg::PARAM_REQUEST_READ) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  return ParamRequestRead{r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component"),
-                          printable(r.get_chars("param_id")), r.get<int16_t>("param_index")};
-}
-
-Message pack(const ParamValue& m) {
-  FieldWriter w(def_of(msg::PARAM_VALUE));
-  w.set_chars("param_id", m.param_id);
-  w.set("param_value", m.param_value);
-  w.set("param_type", m.param_type);
-  w.set("param_count", m.param_count);
-  w.set("param_index", m.param_index);
-  return w.take();
-}
-
-std::optional<ParamValue> unpack_param_value(const Message& m) {
-  if (m.id != msg::PARAM_VALUE) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  return ParamValue{printable(r.get_chars("param_id")), r.get<float>("param_value"),
-                    r.get<uint8_t>("param_type"), r.get<uint16_t>("param_count"),
-                    r.get<uint16_t>("param_index")};
-}
-
-Message pack(const ParamSet& m) {
-  FieldWriter w(def_of(msg::PARAM_SET));
-  w.set("target_system", m.target_system);
-  w.set("target_component", m.target_component);
-  w.set_chars("param_id", m.param_id);
-  w.set("param_value", m.param_value);
-  w.set("param_type", m.param_type);
-  return w.take();
-}
-
-std::optional<ParamSet> unpack_param_set(const Message& m) {
-  if (m.id != msg::PARAM_SET) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  return ParamSet{r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component"),
-                  printable(r.get_chars("param_id")), r.get<float>("param_value"),
-                  r.get<uint8_t>("param_type")};
-}
-
-Message pack(const SysStatus& m) {
-  FieldWriter w(def_of(msg::SYS_STATUS));
-  w.set("onboard_control_sensors_present", m.sensors_present);
-  w.set("onboard_control_sensors_enabled", m.sensors_enabled);
-  w.set("onboard_control_sensors_health", m.sensors_health);
-  w.set("load", m.load);
-  w.set("voltage_battery", m.voltage_battery);
-  w.set("current_battery", m.current_battery);
-  w.set("battery_remaining", m.battery_remaining);
-  w.set("drop_rate_comm", m.drop_rate_comm);
-  w.set("errors_comm", m.errors_comm);
-  return w.take();
-}
-
-std::optional<SysStatus> unpack_sys_status(const Message& m) {
-  if (m.id != msg::SYS_STATUS) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  return SysStatus{r.get<uint32_t>("onboard_control_sensors_present"),
-                   r.get<uint32_t>("onboard_control_sensors_enabled"),
-                   r.get<uint32_t>("onboard_control_sensors_health"),
-                   r.get<uint16_t>("load"),
-                   r.get<uint16_t>("voltage_battery"),
-                   r.get<int16_t>("current_battery"),
-                   r.get<int8_t>("battery_remaining"),
-                   r.get<uint16_t>("drop_rate_comm"),
-                   r.get<uint16_t>("errors_comm")};
-}
-
-Message pack(const LocalPositionNed& m) {
-  FieldWriter w(def_of(msg::LOCAL_POSITION_NED));
-  w.set("time_boot_ms", m.time_boot_ms);
-  w.set("x", m.x);
-  w.set("y", m.y);
-  w.set("z", m.z);
-  w.set("vx", m.vx);
-  w.set("vy", m.vy);
-  w.set("vz", m.vz);
-  return w.take();
-}
-
-std::optional<LocalPositionNed> unpack_local_position_ned(const Message& m) {
-  if (m.id != msg::LOCAL_POSITION_NED) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  return LocalPositionNed{r.get<uint32_t>("time_boot_ms"), r.get<float>("x"),
-                          r.get<float>("y"), r.get<float>("z"), r.get<float>("vx"),
-                          r.get<float>("vy"), r.get<float>("vz")};
-}
-
-Message pack(const GlobalPositionInt& m) {
-  FieldWriter w(def_of(msg::GLOBAL_POSITION_INT));
-  w.set("time_boot_ms", m.time_boot_ms);
-  w.set("lat", m.lat);
-  w.set("lon", m.lon);
-  w.set("alt", m.alt);
-  w.set("relative_alt", m.relative_alt);
-  w.set("vx", m.vx);
-  w.set("vy", m.vy);
-  w.set("vz", m.vz);
-  w.set("hdg", m.hdg);
-  return w.take();
-}
-
-std::optional<GlobalPositionInt> unpack_global_position_int(const Message& m) {
-  if (m.id != msg::GLOBAL_POSITION_INT) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  return GlobalPositionInt{r.get<uint32_t>("time_boot_ms"), r.get<int32_t>("lat"),
-                           r.get<int32_t>("lon"), r.get<int32_t>("alt"),
-                           r.get<int32_t>("relative_alt"), r.get<int16_t>("vx"),
-                           r.get<int16_t>("vy"), r.get<int16_t>("vz"),
-                           r.get<uint16_t>("hdg")};
-}
-
-Message pack(const HilStateQuaternion& m) {
-  FieldWriter w(def_of(msg::HIL_STATE_QUATERNION));
-  w.set("time_usec", m.time_usec);
-  for (int k = 0; k < 4; ++k) w.set("attitude_quaternion", m.attitude_quaternion[k], k);
-  w.set("lat", m.lat);
-  w.set("lon", m.lon);
-  w.set("alt", m.alt);
-  w.set("vx", m.vx);
-  w.set("vy", m.vy);
-  w.set("vz", m.vz);
-  return w.take();
-}
-
-std::optional<HilStateQuaternion> unpack_hil_state_quaternion(const Message& m) {
-  if (m.id != msg::HIL_STATE_QUATERNION) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  HilStateQuaternion out{r.get<uint64_t>("time_usec"), {}, r.get<int32_t>("lat"), r.get<int32_t>("lon"),
-                         r.get<int32_t>("alt"), r.get<int16_t>("vx"), r.get<int16_t>("vy"), r.get<int16_t>("vz")};
-  for (int k = 0; k < 4; ++k) out.attitude_quaternion[k] = r.get<float>("attitude_quaternion", k);
+template <typename M>
+std::optional<M> unpack_fields(const Message& m) {
+  if (m.id != Layout<M>::id) return std::nullopt;
+  M out;
+  Reader r(m);
+  Layout<M>::fields(out, r);
   return out;
 }
 
-Message pack(const Attitude& m) {
-  FieldWriter w(def_of(msg::ATTITUDE));
-  w.set("time_boot_ms", m.time_boot_ms);
-  w.set("roll", m.roll);
-  w.set("pitch", m.pitch);
-  w.set("yaw", m.yaw);
-  return w.take();
-}
+template <>
+struct Layout<Heartbeat> {
+  static constexpr uint32_t id = msg::HEARTBEAT;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("type", m.type);
+    v("autopilot", m.autopilot);
+    v("base_mode", m.base_mode);
+    v("custom_mode", m.custom_mode);
+    v("system_status", m.system_status);
+    v("mavlink_version", m.mavlink_version);
+  }
+};
 
-std::optional<Attitude> unpack_attitude(const Message& m) {
-  if (m.id != msg::ATTITUDE) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  return Attitude{r.get<uint32_t>("time_boot_ms"), r.get<float>("roll"), r.get<float>("pitch"), r.get<float>("yaw")};
-}
+template <>
+struct Layout<ParamRequestRead> {
+  static constexpr uint32_t id = msg::PARAM_REQUEST_READ;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("target_system", m.target_system);
+    v("target_component", m.target_component);
+    v("param_id", m.param_id);
+    v("param_index", m.param_index);
+  }
+};
 
-Message pack(const OrbitExecutionStatus& m) {
-  FieldWriter w(def_of(msg::ORBIT_EXECUTION_STATUS));
-  w.set("time_usec", m.time_usec);
-  w.set("radius", m.radius);
-  w.set("frame", m.frame);
-  w.set("x", m.x);
-  w.set("y", m.y);
-  w.set("z", m.z);
-  return w.take();
-}
+template <>
+struct Layout<ParamValue> {
+  static constexpr uint32_t id = msg::PARAM_VALUE;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("param_id", m.param_id);
+    v("param_value", m.param_value);
+    v("param_type", m.param_type);
+    v("param_count", m.param_count);
+    v("param_index", m.param_index);
+  }
+};
 
-std::optional<OrbitExecutionStatus> unpack_orbit_execution_status(const Message& m) {
-  if (m.id != msg::ORBIT_EXECUTION_STATUS) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  return OrbitExecutionStatus{r.get<uint64_t>("time_usec"), r.get<float>("radius"), r.get<uint8_t>("frame"),
-                              r.get<int32_t>("x"), r.get<int32_t>("y"), r.get<float>("z")};
-}
+template <>
+struct Layout<ParamSet> {
+  static constexpr uint32_t id = msg::PARAM_SET;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("target_system", m.target_system);
+    v("target_component", m.target_component);
+    v("param_id", m.param_id);
+    v("param_value", m.param_value);
+    v("param_type", m.param_type);
+  }
+};
 
-Message pack(const CommandLong& m) {
-  FieldWriter w(def_of(msg::COMMAND_LONG));
-  w.set("target_system", m.target_system);
-  w.set("target_component", m.target_component);
-  w.set("command", m.command);
-  w.set("confirmation", m.confirmation);
-  for (int i = 0; i < 7; ++i) w.set(param_name(i), m.param[i]);
-  return w.take();
-}
+template <>
+struct Layout<SysStatus> {
+  static constexpr uint32_t id = msg::SYS_STATUS;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("onboard_control_sensors_present", m.sensors_present);
+    v("onboard_control_sensors_enabled", m.sensors_enabled);
+    v("onboard_control_sensors_health", m.sensors_health);
+    v("load", m.load);
+    v("voltage_battery", m.voltage_battery);
+    v("current_battery", m.current_battery);
+    v("battery_remaining", m.battery_remaining);
+    v("drop_rate_comm", m.drop_rate_comm);
+    v("errors_comm", m.errors_comm);
+  }
+};
 
-std::optional<CommandLong> unpack_command_long(const Message& m) {
-  if (m.id != msg::COMMAND_LONG) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  CommandLong c{r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component"),
-                r.get<uint16_t>("command"), r.get<uint8_t>("confirmation"), {}};
-  for (int i = 0; i < 7; ++i) c.param[i] = r.get<float>(param_name(i));
-  return c;
-}
+template <>
+struct Layout<Attitude> {
+  static constexpr uint32_t id = msg::ATTITUDE;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("time_boot_ms", m.time_boot_ms);
+    v("roll", m.roll);
+    v("pitch", m.pitch);
+    v("yaw", m.yaw);
+  }
+};
 
-Message pack(const CommandInt& m) {
-  FieldWriter w(def_of(msg::COMMAND_INT));
-  w.set("target_system", m.target_system);
-  w.set("target_component", m.target_component);
-  w.set("frame", m.frame);
-  w.set("command", m.command);
-  w.set("current", m.current);
-  w.set("autocontinue", m.autocontinue);
-  for (int i = 0; i < 4; ++i) w.set(param_name(i), m.param[i]);
-  w.set("x", m.x);
-  w.set("y", m.y);
-  w.set("z", m.z);
-  return w.take();
-}
+template <>
+struct Layout<LocalPositionNed> {
+  static constexpr uint32_t id = msg::LOCAL_POSITION_NED;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("time_boot_ms", m.time_boot_ms);
+    v("x", m.x);
+    v("y", m.y);
+    v("z", m.z);
+    v("vx", m.vx);
+    v("vy", m.vy);
+    v("vz", m.vz);
+  }
+};
 
-std::optional<CommandInt> unpack_command_int(const Message& m) {
-  if (m.id != msg::COMMAND_INT) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  CommandInt c{r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component"),
-               r.get<uint8_t>("frame"), r.get<uint16_t>("command"),
-               r.get<uint8_t>("current"), r.get<uint8_t>("autocontinue"), {},
-               r.get<int32_t>("x"), r.get<int32_t>("y"), r.get<float>("z")};
-  for (int i = 0; i < 4; ++i) c.param[i] = r.get<float>(param_name(i));
-  return c;
-}
+template <>
+struct Layout<GlobalPositionInt> {
+  static constexpr uint32_t id = msg::GLOBAL_POSITION_INT;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("time_boot_ms", m.time_boot_ms);
+    v("lat", m.lat);
+    v("lon", m.lon);
+    v("alt", m.alt);
+    v("relative_alt", m.relative_alt);
+    v("vx", m.vx);
+    v("vy", m.vy);
+    v("vz", m.vz);
+    v("hdg", m.hdg);
+  }
+};
 
-Message pack(const CommandAck& m) {
-  FieldWriter w(def_of(msg::COMMAND_ACK));
-  w.set("command", m.command);
-  w.set("result", m.result);
-  w.set("progress", m.progress);
-  w.set("result_param2", m.result_param2);
-  w.set("target_system", m.target_system);
-  w.set("target_component", m.target_component);
-  return w.take();
-}
+template <>
+struct Layout<HilStateQuaternion> {
+  static constexpr uint32_t id = msg::HIL_STATE_QUATERNION;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("time_usec", m.time_usec);
+    v("attitude_quaternion", m.attitude_quaternion);
+    v("lat", m.lat);
+    v("lon", m.lon);
+    v("alt", m.alt);
+    v("vx", m.vx);
+    v("vy", m.vy);
+    v("vz", m.vz);
+  }
+};
 
-std::optional<CommandAck> unpack_command_ack(const Message& m) {
-  if (m.id != msg::COMMAND_ACK) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  return CommandAck{r.get<uint16_t>("command"), r.get<uint8_t>("result"),
-                    r.get<uint8_t>("progress"), r.get<int32_t>("result_param2"),
-                    r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component")};
-}
+template <>
+struct Layout<OrbitExecutionStatus> {
+  static constexpr uint32_t id = msg::ORBIT_EXECUTION_STATUS;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("time_usec", m.time_usec);
+    v("radius", m.radius);
+    v("frame", m.frame);
+    v("x", m.x);
+    v("y", m.y);
+    v("z", m.z);
+  }
+};
 
-Message pack(const SetPositionTargetLocalNed& m) {
-  FieldWriter w(def_of(msg::SET_POSITION_TARGET_LOCAL_NED));
-  w.set("time_boot_ms", m.time_boot_ms);
-  w.set("target_system", m.target_system);
-  w.set("target_component", m.target_component);
-  w.set("coordinate_frame", m.coordinate_frame);
-  w.set("type_mask", m.type_mask);
-  w.set("x", m.x);
-  w.set("y", m.y);
-  w.set("z", m.z);
-  w.set("vx", m.vx);
-  w.set("vy", m.vy);
-  w.set("vz", m.vz);
-  w.set("afx", m.afx);
-  w.set("afy", m.afy);
-  w.set("afz", m.afz);
-  w.set("yaw", m.yaw);
-  w.set("yaw_rate", m.yaw_rate);
-  return w.take();
-}
+template <>
+struct Layout<CommandLong> {
+  static constexpr uint32_t id = msg::COMMAND_LONG;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("target_system", m.target_system);
+    v("target_component", m.target_component);
+    v("command", m.command);
+    v("confirmation", m.confirmation);
+    v.numbered("param", m.param);
+  }
+};
 
-std::optional<SetPositionTargetLocalNed> unpack_set_position_target_local_ned(
-    const Message& m) {
-  if (m.id != msg::SET_POSITION_TARGET_LOCAL_NED) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  return SetPositionTargetLocalNed{
-      r.get<uint32_t>("time_boot_ms"), r.get<uint8_t>("target_system"),
-      r.get<uint8_t>("target_component"), r.get<uint8_t>("coordinate_frame"),
-      r.get<uint16_t>("type_mask"), r.get<float>("x"), r.get<float>("y"), r.get<float>("z"),
-      r.get<float>("vx"), r.get<float>("vy"), r.get<float>("vz"), r.get<float>("afx"),
-      r.get<float>("afy"), r.get<float>("afz"), r.get<float>("yaw"),
-      r.get<float>("yaw_rate")};
-}
+template <>
+struct Layout<CommandInt> {
+  static constexpr uint32_t id = msg::COMMAND_INT;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("target_system", m.target_system);
+    v("target_component", m.target_component);
+    v("frame", m.frame);
+    v("command", m.command);
+    v("current", m.current);
+    v("autocontinue", m.autocontinue);
+    v.numbered("param", m.param);
+    v("x", m.x);
+    v("y", m.y);
+    v("z", m.z);
+  }
+};
 
-Message pack(const ExtendedSysState& m) {
-  FieldWriter w(def_of(msg::EXTENDED_SYS_STATE));
-  w.set("vtol_state", m.vtol_state);
-  w.set("landed_state", m.landed_state);
-  return w.take();
-}
+template <>
+struct Layout<CommandAck> {
+  static constexpr uint32_t id = msg::COMMAND_ACK;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("command", m.command);
+    v("result", m.result);
+    v("progress", m.progress);
+    v("result_param2", m.result_param2);
+    v("target_system", m.target_system);
+    v("target_component", m.target_component);
+  }
+};
 
-std::optional<ExtendedSysState> unpack_extended_sys_state(const Message& m) {
-  if (m.id != msg::EXTENDED_SYS_STATE) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  return ExtendedSysState{r.get<uint8_t>("vtol_state"), r.get<uint8_t>("landed_state")};
-}
+template <>
+struct Layout<SetPositionTargetLocalNed> {
+  static constexpr uint32_t id = msg::SET_POSITION_TARGET_LOCAL_NED;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("time_boot_ms", m.time_boot_ms);
+    v("target_system", m.target_system);
+    v("target_component", m.target_component);
+    v("coordinate_frame", m.coordinate_frame);
+    v("type_mask", m.type_mask);
+    v("x", m.x);
+    v("y", m.y);
+    v("z", m.z);
+    v("vx", m.vx);
+    v("vy", m.vy);
+    v("vz", m.vz);
+    v("afx", m.afx);
+    v("afy", m.afy);
+    v("afz", m.afz);
+    v("yaw", m.yaw);
+    v("yaw_rate", m.yaw_rate);
+  }
+};
 
-Message pack(const BatteryStatus& m) {
-  FieldWriter w(def_of(msg::BATTERY_STATUS));
-  w.set("id", m.id);
-  w.set("battery_function", m.battery_function);
-  w.set("type", m.type);
-  w.set("temperature", m.temperature);
-  for (int i = 0; i < 10; ++i) w.set("voltages", m.voltages[i], i);
-  w.set("current_battery", m.current_battery);
-  w.set("current_consumed", m.current_consumed);
-  w.set("energy_consumed", m.energy_consumed);
-  w.set("battery_remaining", m.battery_remaining);
-  w.set("time_remaining", m.time_remaining);
-  w.set("charge_state", m.charge_state);
-  return w.take();
-}
+template <>
+struct Layout<ExtendedSysState> {
+  static constexpr uint32_t id = msg::EXTENDED_SYS_STATE;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("vtol_state", m.vtol_state);
+    v("landed_state", m.landed_state);
+  }
+};
 
-std::optional<BatteryStatus> unpack_battery_status(const Message& m) {
-  if (m.id != msg::BATTERY_STATUS) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  BatteryStatus b;
-  b.id = r.get<uint8_t>("id");
-  b.battery_function = r.get<uint8_t>("battery_function");
-  b.type = r.get<uint8_t>("type");
-  b.temperature = r.get<int16_t>("temperature");
-  for (int i = 0; i < 10; ++i) b.voltages[i] = r.get<uint16_t>("voltages", i);
-  b.current_battery = r.get<int16_t>("current_battery");
-  b.current_consumed = r.get<int32_t>("current_consumed");
-  b.energy_consumed = r.get<int32_t>("energy_consumed");
-  b.battery_remaining = r.get<int8_t>("battery_remaining");
-  b.time_remaining = r.get<int32_t>("time_remaining");
-  b.charge_state = r.get<uint8_t>("charge_state");
-  return b;
-}
+template <>
+struct Layout<BatteryStatus> {
+  static constexpr uint32_t id = msg::BATTERY_STATUS;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("id", m.id);
+    v("battery_function", m.battery_function);
+    v("type", m.type);
+    v("temperature", m.temperature);
+    v("voltages", m.voltages);
+    v("current_battery", m.current_battery);
+    v("current_consumed", m.current_consumed);
+    v("energy_consumed", m.energy_consumed);
+    v("battery_remaining", m.battery_remaining);
+    v("time_remaining", m.time_remaining);
+    v("charge_state", m.charge_state);
+  }
+};
 
-Message pack(const Statustext& m) {
-  FieldWriter w(def_of(msg::STATUSTEXT));
-  w.set("severity", m.severity);
-  w.set_chars("text", m.text);
-  w.set("id", m.id);
-  w.set("chunk_seq", m.chunk_seq);
-  return w.take();
-}
+template <>
+struct Layout<Statustext> {
+  static constexpr uint32_t id = msg::STATUSTEXT;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("severity", m.severity);
+    v("text", m.text, Text::trim_end);
+    v("id", m.id);
+    v("chunk_seq", m.chunk_seq);
+  }
+};
 
-std::optional<Statustext> unpack_statustext(const Message& m) {
-  if (m.id != msg::STATUSTEXT) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  // PX4 ends a text with a newline: trailing control characters and blanks are no text.
-  std::string text = r.get_chars("text");
-  while (!text.empty() && static_cast<unsigned char>(text.back()) <= 0x20) text.pop_back();
-  return Statustext{r.get<uint8_t>("severity"), printable(text), r.get<uint16_t>("id"),
-                    r.get<uint8_t>("chunk_seq")};
-}
+template <>
+struct Layout<SetupSigning> {
+  static constexpr uint32_t id = msg::SETUP_SIGNING;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("target_system", m.target_system);
+    v("target_component", m.target_component);
+    v("secret_key", m.secret_key);
+    v("initial_timestamp", m.initial_timestamp);
+  }
+};
+}  // namespace
 
-Message pack(const SetupSigning& m) {
-  FieldWriter w(def_of(msg::SETUP_SIGNING));
-  w.set("target_system", m.target_system);
-  w.set("target_component", m.target_component);
-  for (int i = 0; i < 32; ++i) w.set("secret_key", m.secret_key[i], i);
-  w.set("initial_timestamp", m.initial_timestamp);
-  return w.take();
-}
+Message pack(const Heartbeat& m) { return pack_fields(m); }
+std::optional<Heartbeat> unpack_heartbeat(const Message& m) { return unpack_fields<Heartbeat>(m); }
 
-std::optional<SetupSigning> unpack_setup_signing(const Message& m) {
-  if (m.id != msg::SETUP_SIGNING) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  SetupSigning s{r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component"), {},
-                 r.get<uint64_t>("initial_timestamp")};
-  for (int i = 0; i < 32; ++i) s.secret_key[i] = r.get<uint8_t>("secret_key", i);
-  return s;
-}
+Message pack(const ParamRequestRead& m) { return pack_fields(m); }
+std::optional<ParamRequestRead> unpack_param_request_read(const Message& m) { return unpack_fields<ParamRequestRead>(m); }
+
+Message pack(const ParamValue& m) { return pack_fields(m); }
+std::optional<ParamValue> unpack_param_value(const Message& m) { return unpack_fields<ParamValue>(m); }
+
+Message pack(const ParamSet& m) { return pack_fields(m); }
+std::optional<ParamSet> unpack_param_set(const Message& m) { return unpack_fields<ParamSet>(m); }
+
+Message pack(const SysStatus& m) { return pack_fields(m); }
+std::optional<SysStatus> unpack_sys_status(const Message& m) { return unpack_fields<SysStatus>(m); }
+
+Message pack(const Attitude& m) { return pack_fields(m); }
+std::optional<Attitude> unpack_attitude(const Message& m) { return unpack_fields<Attitude>(m); }
+
+Message pack(const LocalPositionNed& m) { return pack_fields(m); }
+std::optional<LocalPositionNed> unpack_local_position_ned(const Message& m) { return unpack_fields<LocalPositionNed>(m); }
+
+Message pack(const GlobalPositionInt& m) { return pack_fields(m); }
+std::optional<GlobalPositionInt> unpack_global_position_int(const Message& m) { return unpack_fields<GlobalPositionInt>(m); }
+
+Message pack(const HilStateQuaternion& m) { return pack_fields(m); }
+std::optional<HilStateQuaternion> unpack_hil_state_quaternion(const Message& m) { return unpack_fields<HilStateQuaternion>(m); }
+
+Message pack(const OrbitExecutionStatus& m) { return pack_fields(m); }
+std::optional<OrbitExecutionStatus> unpack_orbit_execution_status(const Message& m) { return unpack_fields<OrbitExecutionStatus>(m); }
+
+Message pack(const CommandLong& m) { return pack_fields(m); }
+std::optional<CommandLong> unpack_command_long(const Message& m) { return unpack_fields<CommandLong>(m); }
+
+Message pack(const CommandInt& m) { return pack_fields(m); }
+std::optional<CommandInt> unpack_command_int(const Message& m) { return unpack_fields<CommandInt>(m); }
+
+Message pack(const CommandAck& m) { return pack_fields(m); }
+std::optional<CommandAck> unpack_command_ack(const Message& m) { return unpack_fields<CommandAck>(m); }
+
+Message pack(const SetPositionTargetLocalNed& m) { return pack_fields(m); }
+std::optional<SetPositionTargetLocalNed> unpack_set_position_target_local_ned(const Message& m) { return unpack_fields<SetPositionTargetLocalNed>(m); }
+
+Message pack(const ExtendedSysState& m) { return pack_fields(m); }
+std::optional<ExtendedSysState> unpack_extended_sys_state(const Message& m) { return unpack_fields<ExtendedSysState>(m); }
+
+Message pack(const BatteryStatus& m) { return pack_fields(m); }
+std::optional<BatteryStatus> unpack_battery_status(const Message& m) { return unpack_fields<BatteryStatus>(m); }
+
+Message pack(const Statustext& m) { return pack_fields(m); }
+std::optional<Statustext> unpack_statustext(const Message& m) { return unpack_fields<Statustext>(m); }
+
+Message pack(const SetupSigning& m) { return pack_fields(m); }
+std::optional<SetupSigning> unpack_setup_signing(const Message& m) { return unpack_fields<SetupSigning>(m); }
 
 Message pack(const CameraCapture& m) {
   FieldWriter w(def_of(m.message_id));

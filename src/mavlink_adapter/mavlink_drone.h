@@ -71,6 +71,8 @@ class MavlinkDrone final : public mid::AdapterDrone {
   void unsubscribe(mid::SubscriptionId id) override { broker_.unsubscribe(id); }
   void failsafe(fleet::Failsafe what) override;
   void set_message_sink(std::function<void(const std::string&)> sink) override { message_sink_ = std::move(sink); }
+  bool has_global_frame() const override { return true; }
+  std::optional<mid::GlobalFix> global_fix() const override;  // home_fix.cpp
 
   /// The limits deadlines are derived from: the slower of the fleet's and the autopilot's
   /// (known after connect()), and what to warn about at start.
@@ -124,6 +126,9 @@ class MavlinkDrone final : public mid::AdapterDrone {
   double deadline_clock_rate() const override { return clock_.deadline_rate(); }
   void hold_here();
   void check_goal();
+  // giving way (mavlink_drone_give_way.cpp)
+  bool hold_vehicle(mid::ActionId id, double climb_m) override;
+  void resume_vehicle(mid::ActionId id) override;
   /// Ends every running action `failed` for `why`, dropping the motion's goal and orbit.
   void fail_all(mid::FailureReason why, const std::string& reason);
   /// Ends the motion the adapter flies (if any) `failed`, dropping its goal and orbit.

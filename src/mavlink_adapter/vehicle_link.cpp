@@ -6,10 +6,10 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
-#include <iostream>
 #include <map>
 #include <optional>
 
+#include "diag/log.h"
 #include "mavlink/enums.h"
 
 namespace eamos::mavlink_adapter {
@@ -71,8 +71,8 @@ VehicleLink::~VehicleLink() {
 
 void VehicleLink::close() {
   if (link_ && link_->foreign_datagrams() > 0)
-    std::cerr << "mavlink: " << settings_.name << ": " << link_->foreign_datagrams()
-              << " datagram(s) from other addresses than the vehicle's were ignored in all\n";
+    diag::Logger{"mavlink", settings_.name}.warning(std::to_string(link_->foreign_datagrams()) +
+                                                    " datagram(s) from other addresses than the vehicle's were ignored in all");
   link_.reset();  // joins the receive thread: nothing new gets posted
 }
 
@@ -174,7 +174,7 @@ void VehicleLink::read_limits(FirstHeartbeat& first, std::unique_lock<std::mutex
       });
   lock.unlock();
   limits_ = combine_limits(*autopilot_, mid::flight_limits(settings_), values);
-  for (const std::string& w : limits_.warnings) std::cerr << "eamos: warning: " << settings_.name << ": " << w << "\n";
+  for (const std::string& w : limits_.warnings) diag::Logger{"mavlink", settings_.name}.warning(w);
 }
 
 // setup: true: SETUP_SIGNING to the vehicle (again every half second) until its first signed
@@ -196,8 +196,8 @@ std::string VehicleLink::give_key(FirstHeartbeat& first, std::unique_lock<std::m
            std::to_string(static_cast<int>(options_.connect_timeout_s)) +
            " s; does its autopilot support MAVLink 2 signing (ArduPilot does; PX4 needs MAV_SIGN_CFG)?";
   link_->require_signed(true);
-  std::cerr << "eamos: " << settings_.name << ": system " << int(sysid_)
-            << " took the signing key; unsigned frames are dropped from now on\n";
+  diag::Logger{"mavlink", settings_.name}.info("system " + std::to_string(sysid_) +
+                                               " took the signing key; unsigned frames are dropped from now on");
   return "";
 }
 
@@ -234,8 +234,8 @@ void VehicleLink::note_rejected(const char* what) {
   ++rejected_frames_;
   // The first few, then every thousandth: a flood of bad frames must not flood the log.
   if (rejected_frames_ <= 10 || rejected_frames_ % 1000 == 0)
-    std::cerr << "mavlink: " << settings_.name << ": dropped a frame of system " << int(sysid_) << ": " << what
-              << " (" << rejected_frames_ << " dropped so far)\n";
+    diag::Logger{"mavlink", settings_.name}.warning("dropped a frame of system " + std::to_string(sysid_) + ": " + what +
+                                                    " (" + std::to_string(rejected_frames_) + " dropped so far)");
 }
 
 void VehicleLink::note_foreign() {
@@ -247,7 +247,7 @@ void VehicleLink::note_foreign() {
   if (!first && !thousandth) return;
   std::string text = "ignored " + std::to_string(n) + " datagram(s) from other addresses than system " +
                      std::to_string(sysid_) + "'s (not the vehicle: someone else is sending to this port)";
-  std::cerr << "mavlink: " << settings_.name << ": " << text << "\n";
+  diag::Logger{"mavlink", settings_.name}.warning(text);
   if (first) note_(text);
 }
 

@@ -1,5 +1,6 @@
 #include "mid/action_tracker.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -48,7 +49,10 @@ ActionId ActionTracker::begin(const ActionRequest& request, fleet::ActionClass a
 }
 
 void ActionTracker::arm(ActionId id, double delay_s, bool probe) {
-  actions_.at(id).deadline = loop_.after(delay_s, [this, id, probe] {
+  Running& r = actions_.at(id);
+  r.due = loop_.now() + delay_s;
+  r.due_probe = probe;
+  r.deadline = loop_.after(delay_s, [this, id, probe] {
     auto it = actions_.find(id);
     if (it == actions_.end()) return;
     it->second.deadline = kNoTimer;  // firing now; end() must not cancel it
@@ -94,6 +98,29 @@ std::string ActionTracker::deadline_text(const Running& r) {
   std::snprintf(rate, sizeof rate, "%.2f", r.clock_rate);
   return "deadline " + seconds_text(r.timeout_s * r.clock_rate) + " of the vehicle's clock after start (" +
          seconds_text(r.timeout_s) + " of mission time: the vehicle's clock ran at " + rate + " of it)";
+}
+
+bool ActionTracker::pause(ActionId id) {
+  auto it = actions_.find(id);
+  if (it == actions_.end() || it->second.paused) return false;
+  Running& r = it->second;
+  r.paused = true;
+  r.paused_left = -1.0;  // no deadline armed: nothing to re-arm
+  if (r.deadline != kNoTimer) {
+    r.paused_left = std::max(0.0, r.due - loop_.now());
+    loop_.cancel(r.deadline);
+    r.deadline = kNoTimer;
+  }
+  return true;
+}
+
+bool ActionTracker::unpause(ActionId id) {
+  auto it = actions_.find(id);
+  if (it == actions_.end() || !it->second.paused) return false;
+  Running& r = it->second;
+  r.paused = false;
+  if (r.paused_left >= 0.0) arm(id, r.paused_left, r.due_probe);
+  return true;
 }
 
 ActionId ActionTracker::refuse(const ActionRequest&, EndCallback on_end, ActionEnd why) {

@@ -53,6 +53,12 @@ class ActionTracker {
   /// Ends a running action as `e` says.
   bool end(ActionId id, ActionEnd e);
 
+  /// Stops the clock of a running action's deadline (it is held for another drone); false
+  /// when it is not running or already paused.
+  bool pause(ActionId id);
+  /// Starts it again where it stopped: the deadline moves on by the time paused.
+  bool unpause(ActionId id);
+
   bool running(ActionId id) const { return actions_.count(id) != 0; }
   /// The running motion action; kNoAction when none.
   ActionId motion() const { return motion_; }
@@ -75,6 +81,10 @@ class ActionTracker {
     double granted_s = 0.0;     ///< time given beyond timeout_s while the vehicle closed in
     double window_from_m = 0.0; ///< distance left when the current window began (NaN: unknown)
     double clock_rate = 1.0;    ///< vehicle seconds per mission second timeout_s allowed for
+    double due = 0.0;           ///< mission time the armed timer fires
+    bool due_probe = false;     ///< ... and whether it starts a closing window
+    bool paused = false;        ///< pause(): the deadline's clock stands still
+    double paused_left = -1.0;  ///< paused: seconds that were left to `due`; -1 none armed
   };
 
   /// Arms the timer for a window's start (`probe`) or for the deadline itself.

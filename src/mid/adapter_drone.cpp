@@ -53,6 +53,26 @@ bool AdapterDrone::cancel(ActionId id) {
   return true;
 }
 
+bool AdapterDrone::hold_motion(double climb_m) {
+  const ActionId id = tracker_.motion();
+  if (id == kNoAction || motion_held() || !failsafe_reason_.empty()) return false;
+  const ActionRequest* r = tracker_.request(id);
+  if (!r || !goal_position(*r, {}, {})) return false;  // Hover, Orbit: no goal to resume
+  if (!hold_vehicle(id, climb_m)) return false;
+  tracker_.pause(id);
+  held_ = id;
+  return true;
+}
+
+bool AdapterDrone::resume_motion() {
+  const ActionId id = held_;
+  held_ = kNoAction;
+  if (id == kNoAction || !tracker_.running(id) || !failsafe_reason_.empty()) return false;
+  tracker_.unpause(id);
+  resume_vehicle(id);
+  return true;
+}
+
 void AdapterDrone::after_for(ActionId id, double delay_s, std::function<void()> fn) {
   clear_action_timer(id);
   action_timers_[id] = loop_.after(delay_s, [this, id, fn = std::move(fn)] {

@@ -29,6 +29,10 @@ class AdapterDrone : public Drone {
   ActionId start(const ActionRequest& request, EndCallback on_end) final;
   /// Stops the vehicle's part (stop_action) and ends the action `cancelled`.
   bool cancel(ActionId id) final;
+  /// Give way (drone_api.h): the deadline is paused here, the vehicle held by hold_vehicle().
+  bool hold_motion(double climb_m) final;
+  bool resume_motion() final;
+  bool motion_held() const final { return held_ != kNoAction && tracker_.running(held_); }
   void set_fault_sink(std::function<void(const ActionEnd&)> sink) final { fault_sink_ = std::move(sink); }
 
  protected:
@@ -47,6 +51,12 @@ class AdapterDrone : public Drone {
   /// What cancel() and a timeout do to the vehicle for a running action (its timer is
   /// already cleared); the action's end is reported by the caller.
   virtual void stop_action(ActionId id) = 0;
+  /// Stops the vehicle for running motion `id` where it can stop, `climb_m` higher, keeping
+  /// the motion's goal for resume_vehicle(); false when this vehicle cannot hold it.
+  virtual bool hold_vehicle(ActionId, double /*climb_m*/) { return false; }
+  /// Flies the held motion `id` on to its goal.
+  virtual void resume_vehicle(ActionId) {}
+
   /// Where the vehicle stands against what a running action waits for, said when it times
   /// out ("" when there is nothing to say).
   virtual std::string timeout_detail(ActionId) const { return ""; }
@@ -87,6 +97,7 @@ class AdapterDrone : public Drone {
 
  private:
   std::map<ActionId, TimerId> action_timers_;  ///< ends of payload, system, Hover(s), …
+  ActionId held_ = kNoAction;  ///< the motion held by hold_motion(), while it runs
   void left_fence(const std::string& where);
 
   std::string name_;                      ///< for the fault's words

@@ -87,6 +87,12 @@ struct DroneState {
   bool link_lost = false;
 };
 
+/// Where a vehicle stands on the Earth (WGS 84), as its autopilot reports it.
+struct GlobalFix {
+  double lat_deg = 0.0;
+  double lon_deg = 0.0;
+};
+
 /// Identifies one started action of one drone; 0 (kNoAction) is never issued.
 using ActionId = std::uint64_t;
 inline constexpr ActionId kNoAction = 0;
@@ -126,6 +132,18 @@ class Drone {
   /// home and land, or hover. After it the drone refuses new actions.
   virtual void failsafe(fleet::Failsafe what) = 0;
 
+  /// Give way to another drone (dex/separation.h): stop the running goal-directed motion
+  /// (FlyTo, FlyBy*, Takeoff, ReturnHome, Land) where the vehicle can stop, `climb_m` higher
+  /// (negative: lower; 0: at its altitude), and keep the action running: it neither ends nor
+  /// times out while held. False when no such motion runs, it is already held, or the
+  /// vehicle cannot hold it (the autopilot flies it in a mode of its own).
+  virtual bool hold_motion(double /*climb_m*/) { return false; }
+  /// The held motion flies on to its own goal; its deadline moves on by the time it was
+  /// held. False when nothing is held.
+  virtual bool resume_motion() { return false; }
+  /// Whether a motion is held now.
+  virtual bool motion_held() const { return false; }
+
   /// Where the vehicle's own messages go (an autopilot's STATUSTEXT, what the adapter did
   /// about the vehicle on its own, such as re-arming after an auto-disarm): the DEX puts each
   /// in the trace. Called on the loop's thread; an empty function stops them. Default: none.
@@ -135,6 +153,13 @@ class Drone {
   /// the loop after the drone already commanded its failsafe. The DEX fails the mission on
   /// it as on a failed action. An empty function stops them. Default: none.
   virtual void set_fault_sink(std::function<void(const ActionEnd&)>) {}
+
+  /// Whether the vehicle tells where it stands on the Earth (an autopilot with GPS); the
+  /// built-in simulator has no such frame. Default: no.
+  virtual bool has_global_frame() const { return false; }
+  /// Its newest global position; empty until the vehicle has reported one (or never, without
+  /// a global frame). The homes check (mid/home_check.h) compares these before arming.
+  virtual std::optional<GlobalFix> global_fix() const { return std::nullopt; }
 };
 
 }  // namespace eamos::mid

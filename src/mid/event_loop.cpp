@@ -4,8 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <iostream>
 #include <thread>
+
+#include "diag/log.h"
 
 namespace eamos::mid {
 
@@ -138,9 +139,9 @@ void EventLoop::run_callback(std::function<void()>& fn) noexcept {
 void EventLoop::report_error(const std::string& what) noexcept {
   try {
     if (on_error_) return on_error_(what);
-    std::cerr << "eamos: error in an event callback: " << what << "\n";
+    diag::Logger{"mid", ""}.error("error in an event callback: " + what);
   } catch (...) {
-    std::fputs("eamos: error while handling an error in an event callback\n", stderr);
+    diag::Logger{"mid", ""}.error("error while handling an error in an event callback");
   }
 }
 

@@ -1,6 +1,9 @@
 #include "monitor/mission_view.h"
 
+#include <algorithm>
+
 #include "graph/export.h"
+#include "graph/palette.h"
 
 namespace eamos::monitor {
 
@@ -9,6 +12,10 @@ namespace {
 // Beyond these `dot` takes longer than a person waits, and the picture is unreadable anyway.
 constexpr std::size_t max_graph_nodes = 1500;
 constexpr int max_mdg_pictures = 24;
+// The page's drone colours come from here (graph/palette.h), never from a rule of its own. A
+// replay without a mission learns its drones from the events, so colours for at least this
+// many are sent; past them (such a replay of more drones) the page repeats them.
+constexpr int min_palette = 256;
 
 nlohmann::json drone_json(const graph::Compilation& c, int d) {
   const fleet::DroneSettings& s = c.settings[d];
@@ -86,6 +93,7 @@ nlohmann::json mission_view(const graph::Compilation& c, const ViewInput& in, co
   j["fleet"] = in.fleet_text;
   j["drones"] = nlohmann::json::array();
   for (int d = 0; d < c.drone_count(); ++d) j["drones"].push_back(drone_json(c, d));
+  j["palette"] = graph::drone_palette(std::max(c.drone_count(), min_palette));
   j["nodes"] = nodes_json(c);
   j["arcs"] = arcs_json(c);
   std::string note;
@@ -97,7 +105,8 @@ nlohmann::json mission_view(const graph::Compilation& c, const ViewInput& in, co
 nlohmann::json bare_view(const ViewInput& in, const std::string& why) {
   return {{"mission", in.mission_name}, {"live", in.live}, {"source", ""}, {"fleet", in.fleet_text},
           {"drones", nlohmann::json::array()}, {"nodes", nlohmann::json::array()},
-          {"arcs", nlohmann::json::array()}, {"graphs", nlohmann::json::array()}, {"graph_note", why}};
+          {"arcs", nlohmann::json::array()}, {"graphs", nlohmann::json::array()}, {"graph_note", why},
+          {"palette", graph::drone_palette(min_palette)}};
 }
 
 }  // namespace eamos::monitor

@@ -84,6 +84,7 @@ void SimDrone::finish_payload(ActionId id, const std::string& name) {
 
 void SimDrone::start_motion(ActionId id, const mid::ActionRequest& r) {
   motion_owner_ = id;
+  held_motion_.reset();
   const Vec3 here = kin_.position;
   Motion m;
   m.ground_z = ground_z();
@@ -142,8 +143,33 @@ void SimDrone::start_motion(ActionId id, const mid::ActionRequest& r) {
 void SimDrone::stop_action(ActionId id) {
   if (id == motion_owner_) {
     motion_owner_ = mid::kNoAction;
+    held_motion_.reset();
     stop_motion();
   }
+  update_timers();
+}
+
+bool SimDrone::hold_vehicle(ActionId id, double climb_m) {
+  if (id != motion_owner_ || (motion_.kind != MotionKind::go && motion_.kind != MotionKind::land)) return false;
+  held_motion_ = motion_;
+  // Where braking at full deceleration ends: a hold at the current point would overshoot
+  // it and fly back, towards the drone it gives way to.
+  const Vec3& v = kin_.velocity;
+  const double accel = settings_.limits.max_accel_mps2;
+  const double stop = accel > 0 ? std::sqrt(v.x * v.x + v.y * v.y) / (2.0 * accel) : 0.0;
+  motion_ = Motion{};
+  motion_.kind = MotionKind::hold;
+  motion_.ground_z = ground_z();
+  motion_.target = {kin_.position.x + v.x * stop, kin_.position.y + v.y * stop,
+                    std::max(ground_z(), kin_.position.z + climb_m)};
+  update_timers();
+  return true;
+}
+
+void SimDrone::resume_vehicle(ActionId id) {
+  if (id != motion_owner_ || !held_motion_) return;
+  motion_ = *held_motion_;
+  held_motion_.reset();
   update_timers();
 }
 
@@ -184,6 +210,7 @@ void SimDrone::enter_failsafe(fleet::Failsafe what, const mid::ActionEnd& end) {
   refuse_from_now(end.reason);
   end_all(end);
   motion_owner_ = mid::kNoAction;
+  held_motion_.reset();
   if (landed_) {
     // On the ground every failsafe means the same: motors off.
     stop_motion();

@@ -6,6 +6,7 @@
 // Deterministic: the same calls at the same mission times give the same states.
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 
 #include "fleet/catalog.h"
@@ -57,6 +58,8 @@ class SimDrone final : public mid::AdapterDrone {
   void finish_payload(mid::ActionId id, const std::string& name);
 
   void stop_action(mid::ActionId id) override;  ///< what cancel and timeouts do to the vehicle
+  bool hold_vehicle(mid::ActionId id, double climb_m) override;
+  void resume_vehicle(mid::ActionId id) override;
   void stop_motion();                           ///< brake and hold where it is
   /// Ends every running action as `end` says and flies the failsafe `what`.
   void enter_failsafe(fleet::Failsafe what, const mid::ActionEnd& end);
@@ -91,6 +94,8 @@ class SimDrone final : public mid::AdapterDrone {
 
   Motion motion_;
   mid::ActionId motion_owner_ = mid::kNoAction;  ///< the action motion_ flies for; none in failsafe
+  /// The owner's motion while it gives way (hold_vehicle): flown on by resume_vehicle.
+  std::optional<Motion> held_motion_;
   mid::StateBroker broker_;
 
   mid::TimerId step_timer_ = mid::kNoTimer;

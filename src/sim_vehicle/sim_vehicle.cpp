@@ -28,10 +28,11 @@ fleet::DroneSettings vehicle_settings(uint8_t sysid, double battery) {
 constexpr double kHomeLat = 47.397742, kHomeLon = 8.545594;
 constexpr double kMetresPerDegree = 111'111.0;
 
-/// degE7 (lat, lon) of a point of the vehicle's frame (x east, y north of home).
-std::pair<int32_t, int32_t> lat_lon_e7(double x, double y) {
-  double lat = kHomeLat + y / kMetresPerDegree;
-  double lon = kHomeLon + x / (kMetresPerDegree * std::cos(kHomeLat * M_PI / 180.0));
+/// degE7 (lat, lon) of a point of the vehicle's frame (x east, y north of home), its home
+/// standing `east` and `north` metres from PX4's.
+std::pair<int32_t, int32_t> lat_lon_e7(double x, double y, double east, double north) {
+  double lat = kHomeLat + (y + north) / kMetresPerDegree;
+  double lon = kHomeLon + (x + east) / (kMetresPerDegree * std::cos(kHomeLat * M_PI / 180.0));
   return {static_cast<int32_t>(std::lround(lat * 1e7)), static_cast<int32_t>(std::lround(lon * 1e7))};
 }
 
@@ -220,8 +221,8 @@ void SimVehicle::on_command_int(const ml::CommandInt& c) {
   std::optional<Vec3> centre;
   if (c.x != INT32_MAX || c.y != INT32_MAX) {
     if (!ml::is_global_frame(c.frame)) return ack(c.command, ml::result::DENIED);
-    centre = Vec3{(c.y / 1e7 - kHomeLon) * kMetresPerDegree * std::cos(kHomeLat * M_PI / 180.0),
-                  (c.x / 1e7 - kHomeLat) * kMetresPerDegree, 0.0};
+    centre = Vec3{(c.y / 1e7 - kHomeLon) * kMetresPerDegree * std::cos(kHomeLat * M_PI / 180.0) - options_.east_m,
+                  (c.x / 1e7 - kHomeLat) * kMetresPerDegree - options_.north_m, 0.0};
   }
   ack(c.command, start_orbit(as_long, centre));
 }
@@ -485,7 +486,7 @@ ml::Message SimVehicle::telemetry(uint32_t id) const {
     case ml::msg::GLOBAL_POSITION_INT: {
       ml::GlobalPositionInt g;
       g.time_boot_ms = static_cast<uint32_t>(s.t * 1000.0);
-      std::tie(g.lat, g.lon) = lat_lon_e7(s.x, s.y);
+      std::tie(g.lat, g.lon) = lat_lon_e7(s.x, s.y, options_.east_m, options_.north_m);
       g.vx = static_cast<int16_t>(std::lround(v.y * 100.0));
       g.vy = static_cast<int16_t>(std::lround(v.x * 100.0));
       g.vz = static_cast<int16_t>(std::lround(-v.z * 100.0));
@@ -505,7 +506,7 @@ ml::Message SimVehicle::telemetry(uint32_t id) const {
       o.time_usec = static_cast<uint64_t>(s.t * 1e6);
       o.radius = static_cast<float>(-orbit_.direction * orbit_.radius);
       o.frame = 0;
-      std::tie(o.x, o.y) = lat_lon_e7(orbit_.centre.x, orbit_.centre.y);
+      std::tie(o.x, o.y) = lat_lon_e7(orbit_.centre.x, orbit_.centre.y, options_.east_m, options_.north_m);
       o.z = static_cast<float>(options_.home_amsl_m + orbit_.centre.z);
       return ml::pack(o);
     }

@@ -77,6 +77,10 @@ struct VehicleOptions {
   uint8_t sysid = 1;
   double battery_percent = 100.0;  ///< charge at start (0: arming is refused)
   double home_amsl_m = 488.0;      ///< ground altitude above mean sea level (PX4 SITL's Zurich)
+  /// Where it stands (its home, its local origin): this far east and north (m) of PX4 SITL's
+  /// default home, 47.397742° N, 8.545594° E, as a fleet's vehicles stand apart on a field.
+  double east_m = 0.0;
+  double north_m = 0.0;
   /// Where its home is above the local frame's origin (negative: below), as GLOBAL_POSITION_INT's
   /// relative_alt tells. PX4 sets home where the vehicle stood when it armed, and its EKF's
   /// altitude drifts on the ground meanwhile: on SITL 0.2 m lower than the ground 15 s later.

@@ -41,7 +41,8 @@ class Generator {
 
  private:
   /// Every drone in every step: arm, take off, fly FlyTo after FlyTo between fleet-wide
-  /// barriers, land. Each drone keeps to its own column (x = 4 · index), so no two meet.
+  /// barriers, land. Each drone keeps to its own row (y = 5 · index, through its home), so
+  /// no two meet and none gives way (dex/separation.h).
   std::string show() {
     std::vector<std::string> steps;
     nodes_ = 3;
@@ -51,7 +52,7 @@ class Generator {
         std::string body;
         for (int i = 0; i < o_.work_per_step; ++i) {
           nodes_ += 1;
-          body += "  " + drone(d) + ".FlyTo(" + std::to_string(4 * d) + ", " + std::to_string(rng_.below(20)) +
+          body += "  " + drone(d) + ".FlyTo(" + std::to_string(rng_.below(20)) + ", " + std::to_string(5 * d) +
                   ", " + std::to_string(5 + rng_.below(10)) + ")\n";
         }
         return body;
@@ -170,8 +171,8 @@ class Generator {
       }
       default:
         nodes_ += 1;
-        return "  " + D + ".FlyTo(" + std::to_string(5 * d) + ", " + O + ".Y() - " + O + ".Y() + " +
-               std::to_string(rng_.below(20)) + ", 6)\n";
+        return "  " + D + ".FlyTo(" + O + ".X() - " + O + ".X() + " + std::to_string(rng_.below(20)) + ", " +
+               std::to_string(5 * d) + ", 6)\n";
     }
   }
 
@@ -181,8 +182,8 @@ class Generator {
     switch (rng_.below(4)) {
       case 0:
         nodes_ += 2;
-        return "  " + D + ".FlyBy(" + std::to_string(rng_.below(7) - 3) + ", " +
-               std::to_string(rng_.below(7) - 3) + ", 0)\n  " + D + ".Hover(1)\n";
+        return "  " + D + ".FlyBy(" + std::to_string(rng_.below(7) - 3) + ", 0, " +
+               std::to_string(rng_.below(3)) + ")\n  " + D + ".Hover(1)\n";
       case 1: {
         nodes_ += 5;
         std::string a = helper(D + ".FlyByX(2)");

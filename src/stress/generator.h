@@ -7,6 +7,9 @@
 //   show: the all-to-all boundary);
 // - cross: squads whose drones wait on, branch on and fly to the positions of drones of
 //   other squads (cross-drone conditions, waits and arguments).
+// Every drone flies only along its own row (y = 5 · index, through its default home) and up
+// and down, so the drones of a generated mission never come near each other: none has to
+// give way in flight (dex/separation.h), and a run measures the executor, not a standoff.
 #include <string>
 
 namespace eamos::stress {

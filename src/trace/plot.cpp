@@ -7,6 +7,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "diag/xml.h"
 #include "graph/palette.h"
 
 namespace eamos::trace {
@@ -46,18 +47,7 @@ const char* outcome_colour(const std::string& outcome) {
   return "#56B4E9";  // still running when the run ended
 }
 
-std::string xml(const std::string& s) {
-  std::string out;
-  for (char c : s) switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
-    }
-  return out;
-}
+std::string xml(const std::string& s) { return diag::xml_escape(s); }
 
 /// Fixed-point number without trailing zeros ("12.5", "3", "-0.25").
 std::string num(double v, int decimals = 2) {
@@ -652,6 +642,27 @@ void map_marks(std::ostream& out, const MapFrame& f, const std::vector<PlotMark>
   out << "</g>\n";
 }
 
+/// Separation kept in flight: an orange ring where a drone gave way (title: to whom, how far
+/// apart) and a dot where it flew on, at its position then in its track.
+void map_give_ways(std::ostream& out, const MapFrame& f, const RunResult& run, const std::vector<TraceEvent>& events) {
+  out << "<g class=\"give-ways\" stroke=\"#ff8c00\" stroke-width=\"2\">\n";
+  for (const TraceEvent& e : events) {
+    if (e.event != "give_way" && e.event != "resume") continue;
+    const DroneSummary* d = nullptr;
+    for (const DroneSummary& s : run.drones) d = s.name == e.drone ? &s : d;
+    if (!d || d->track.empty()) continue;
+    const Sample* at = &d->track.front();
+    for (const Sample& s : d->track) at = s.t <= e.t ? &s : at;
+    const bool gave = e.event == "give_way";
+    out << "<circle class=\"" << (gave ? "give-way" : "resume") << "\" data-drone=\"" << xml(e.drone)
+        << "\" data-other=\"" << xml(e.other) << "\" cx=\"" << num(f.to_x(at->x)) << "\" cy=\"" << num(f.to_y(at->y))
+        << "\" r=\"" << (gave ? 8 : 3) << "\" fill=\"" << (gave ? "none" : "#ff8c00") << "\"><title>" << xml(e.drone)
+        << (gave ? " gives way to " : " flies on after ") << xml(e.other) << " at " << num(e.t) << " s"
+        << (e.distance ? ", " + num(*e.distance) + " m apart" : "") << "</title></circle>\n";
+  }
+  out << "</g>\n";
+}
+
 void timeline_marks(std::ostream& out, const std::vector<PlotMark>& marks, double top, double bottom, double until) {
   if (marks.empty()) return;
   out << "<g class=\"violation-times\" stroke=\"#d62728\" stroke-width=\"1.5\">\n";
@@ -688,6 +699,7 @@ std::string plot_svg(const RunResult& run, const std::vector<TraceEvent>& events
     map_track(body, frame, run.drones[d], static_cast<int>(d), failsafe_from);
   }
   map_marks(body, frame, marks);
+  map_give_ways(body, frame, run, events);
   map_legend(body, run, frame.top);
   y = frame.bottom + 64;
 

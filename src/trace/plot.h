@@ -11,7 +11,8 @@ namespace eamos::trace {
 
 /// Top panel: each drone's track in the x/y plane (equal scale, metres), grey on the
 /// ground, solid in the air, start labelled with the drone's name, a black square where
-/// it armed, a green diamond where it landed, the failsafe's part dashed red. Middle panel:
+/// it armed, a green diamond where it landed, the failsafe's part dashed red, an orange ring
+/// where it gave way to another drone and a dot where it flew on. Middle panel:
 /// every drone's altitude over mission time. Bottom panel: one row per drone over mission
 /// time, a bar per action start (`data-action` attribute) from start to end, coloured by
 /// outcome; a labelled tick per condition decision (in lanes, never overlapping); each

@@ -113,6 +113,7 @@ void check_violation(const json& j, LineCheck& c, const std::set<std::string>& f
 
 const std::set<std::string> kOutcomes = {"succeeded", "preempted", "cancelled", "failed"};
 
+// long: the schema of docs/trace.md as a table, one branch per event, read side by side with the doc.
 void check_event(const json& j, const std::string& event, LineCheck& c, const std::set<std::string>& fleet,
                  bool strict) {
   if (event == "start" || event == "end" || event == "condition" || event == "sensor") {
@@ -143,6 +144,13 @@ void check_event(const json& j, const std::string& event, LineCheck& c, const st
   } else if (event == "failsafe") {
     c.drone("drone", fleet);
     c.one_of("name", {"land", "return_home", "hover"});
+    c.string("reason");
+  } else if (event == "conflict" || event == "give_way" || event == "resume") {
+    c.drone("drone", fleet);
+    c.string("name");
+    c.integer("line", 0);
+    c.drone("other", fleet);
+    if (c.number("distance") && j["distance"].get<double>() < 0) c.fail("\"distance\" is negative");
     c.string("reason");
   } else if (event == "vehicle") {
     c.drone("drone", fleet);

@@ -1,7 +1,5 @@
 #include "transport/dds_node.h"
 
-#include <iostream>
-
 #include <dds/dds.h>
 
 #include <algorithm>
@@ -12,6 +10,7 @@
 #include <sstream>
 #include <vector>
 
+#include "diag/log.h"
 #include "loopback_config.h"
 #include "transport/wire_convert.h"
 
@@ -55,9 +54,12 @@ dds_qos_t* durable_qos(bool keep_all, double lease_s) {
 void log_dropped(const char* topic, const char* what) noexcept {
   static std::atomic<std::uint64_t> dropped{0};
   std::uint64_t n = ++dropped;
-  if (n <= 20 || n % 1000 == 0)
-    std::fprintf(stderr, "eamos: dropped a DDS sample of %s (%llu so far): %s\n", topic,
-                 static_cast<unsigned long long>(n), what);
+  if (n > 20 && n % 1000 != 0) return;
+  try {
+    diag::Logger{"transport", ""}.warning(std::string("dropped a DDS sample of ") + topic + " (" + std::to_string(n) +
+                                          " so far): " + what);
+  } catch (...) {  // Cyclone's thread must get control back whatever happens here
+  }
 }
 
 /// Takes every sample the reader holds. Each is checked as it is converted (from_wire):
@@ -420,7 +422,7 @@ void DdsNode::dropped(const char* topic, const std::string& why) {
   std::string line = std::string("dropped a ") + topic + " sample: " + why + " (" + std::to_string(n) +
                      " dropped so far)";
   if (handlers_.dropped) handlers_.dropped(line);
-  else std::cerr << "eamos: " << line << "\n";
+  else diag::Logger{"transport", ""}.warning(line);
 }
 
 int DdsNode::sender_of(int reader, std::uint64_t publication_handle) {

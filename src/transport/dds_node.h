@@ -56,7 +56,7 @@ struct DdsHandlers {
   /// the mission, drone and process (nonce) it belonged to.
   std::function<void(const std::string& mission_hash, int drone, std::uint64_t nonce)> lost;
   /// A received sample broke a rule of from_wire and was dropped: one log line saying
-  /// which topic and why (rate-limited). Unset: the line goes to stderr.
+  /// which topic and why (rate-limited). Unset: the line goes to the log (diag/log.h).
   std::function<void(const std::string& line)> dropped;
   /// What received samples are checked against: the mission's drone count.
   WireLimits limits;

@@ -46,6 +46,12 @@ struct LifecycleSample {
   std::vector<std::uint64_t> nonces;    ///< start: per drone, the process that was ready
   std::string reason;                   ///< abort, refused
   std::optional<dex::Failure> failure;  ///< abort caused by a failed action
+  /// ready: the drone's declared home (x, y) and where its vehicle stands on the Earth, if it
+  /// reports that; the ground compares the drones' (mid/home_check.h) before the start.
+  std::optional<mid::GlobalFix> fix;
+  double home_x = 0.0;
+  double home_y = 0.0;
+  double home_tolerance = fleet::kDefaultHomeToleranceM;
 };
 
 /// failsafe: abandoned, the failsafe runs; failed: abandoned, the failsafe ended (final state).

@@ -55,6 +55,9 @@ class Check {
   void one_of(const char* field, long long v, long long count) {
     if (v < 0 || v >= count) fail(std::string(field) + " " + std::to_string(v) + " is not a known value");
   }
+  void within(const char* field, double v, double bound) {
+    if (!(std::abs(v) <= bound)) fail(std::string(field) + " is not between -" + std::to_string(bound) + " and " + std::to_string(bound));
+  }
   void finite(const char* field, double v) {
     if (!std::isfinite(v)) fail(std::string(field) + " is " + (std::isnan(v) ? "NaN" : "infinite"));
   }
@@ -255,6 +258,12 @@ eamos_wire_Lifecycle to_wire(const LifecycleSample& s) {
   w.failed_line = s.failure ? s.failure->line : 0;
   w.failed_kind = s.failure ? static_cast<int32_t>(s.failure->kind) : 0;
   w.failed_detail = borrow(s.failure ? s.failure->detail : empty);
+  w.has_fix = s.fix.has_value();
+  w.fix_lat = s.fix ? s.fix->lat_deg : 0.0;
+  w.fix_lon = s.fix ? s.fix->lon_deg : 0.0;
+  w.home_x = s.home_x;
+  w.home_y = s.home_y;
+  w.home_tolerance = s.home_tolerance;
   return w;
 }
 
@@ -287,6 +296,15 @@ bool from_wire(const eamos_wire_Lifecycle& w, const WireLimits& limits, Lifecycl
   if (!failed_drone.empty() && check.ok())
     s.failure = dex::Failure{failed_drone, failed_action, w.failed_line, s.reason,
                              static_cast<mid::FailureReason>(w.failed_kind), failed_detail};
+  check.within("fix_lat", w.fix_lat, 90.0);
+  check.within("fix_lon", w.fix_lon, 180.0);
+  check.within("home_x", w.home_x, 1e7);
+  check.within("home_y", w.home_y, 1e7);
+  check.within("home_tolerance", w.home_tolerance, 1e7);
+  if (w.has_fix && check.ok()) s.fix = mid::GlobalFix{w.fix_lat, w.fix_lon};
+  s.home_x = w.home_x;
+  s.home_y = w.home_y;
+  s.home_tolerance = w.home_tolerance > 0 ? w.home_tolerance : fleet::kDefaultHomeToleranceM;
   return check.ok();
 }
 
@@ -345,8 +363,11 @@ eamos_wire_TraceRecord to_wire(const TraceSample& s) {
   w.text = borrow(e.text);
   w.outcome = borrow(e.outcome);
   w.value = e.value ? (*e.value ? 1 : 0) : -1;
-  w.has_reading = e.reading.has_value();
-  w.reading = e.reading.value_or(0.0);
+  // A give-way's distance travels in `reading` and its other drone in `to`: the wire type
+  // stays as it is (dex::is_separation_event).
+  const std::optional<double>& number = dex::is_separation_event(e.event) ? e.distance : e.reading;
+  w.has_reading = number.has_value();
+  w.reading = number.value_or(0.0);
   w.reason = borrow(e.reason);
   w.failure = borrow(e.failure);
   w.detail = borrow(e.detail);
@@ -396,6 +417,11 @@ bool from_wire(const eamos_wire_TraceRecord& w, const WireLimits& limits, TraceS
     check.drone("from", w.from);
     check.drone("to", w.to);
     check.finite("sent", w.sent);
+  }
+  if (dex::is_separation_event(e.event)) {
+    check.drone("to", w.to);
+    e.distance = e.reading;
+    e.reading.reset();
   }
   e.from = w.from;
   e.to = w.to;

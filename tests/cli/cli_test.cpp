@@ -50,6 +50,26 @@ TEST_F(Cli, CheckAcceptsListing2AndPrintsItsWarning) {
   EXPECT_NE(r.out.find("warning: drone 'Drone2' may run two motion actions"), std::string::npos);
 }
 
+TEST_F(Cli, LogLevelTakesTheFourLevelsOnly) {
+  EXPECT_EQ(eamos("--log-level debug check " + kListing2).status, 0);
+  EXPECT_EQ(eamos("check " + kListing2 + " --log-level error").status, 0);
+  Output r = eamos("--log-level loud check " + kListing2);
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("--log-level"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("debug"), std::string::npos) << "the message names the levels: " << r.out;
+}
+
+TEST_F(Cli, AnEamosLogLevelThatNamesNoLevelIsAWarningAndTheCommandRuns) {
+  setenv("EAMOS_LOG_LEVEL", "loud", 1);
+  Output r = eamos("check " + kListing2);
+  Output given = eamos("--log-level info check " + kListing2);
+  unsetenv("EAMOS_LOG_LEVEL");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("eamos: warning: EAMOS_LOG_LEVEL='loud' is not a log level; info is used"), std::string::npos)
+      << r.out;
+  EXPECT_EQ(given.out.find("EAMOS_LOG_LEVEL"), std::string::npos) << "--log-level replaces the variable: " << given.out;
+}
+
 TEST_F(Cli, CheckFailsWithExitOneAndEveryErrorGccStyle) {
   fs::path m = dir_ / "bad.eamos";
   std::ofstream(m) << "var A Quad\nfunc INIT() {\n  A.Tkeoff(3)\n  B.Land()\n}\n";

@@ -114,6 +114,29 @@ TEST_F(MissionReader, RefusesNumbersOutOfRangeAndNullForANumber) {
   EXPECT_NE(found.find("error: /nodes/0/line: -"), std::string::npos) << found;
 }
 
+TEST_F(MissionReader, ReadsTheSeparationAndPrioritiesAndRefusesAPriorityOutOfRange) {
+  std::string list;
+  for (std::size_t d = 0; d < doc_["fleet"].size(); ++d) list += (d ? "," : "") + std::to_string(doc_["fleet"].size() - d);
+  std::string with = reseal(replace_once(
+      text_, "\"reads\":", "\"separation\":{\"horizontal\":4.0,\"vertical\":2.5},\"priorities\":[" + list + "],\"reads\":"));
+  dex::Mission m;
+  std::vector<std::string> errors;
+  ASSERT_TRUE(deploy::read_mission(with, "Drone1/mission.json", m, errors)) << errors.front();
+  EXPECT_EQ(m.separation.horizontal_m, 4.0);
+  EXPECT_EQ(m.separation.vertical_m, 2.5);
+  ASSERT_EQ(m.priorities.size(), doc_["fleet"].size());
+  EXPECT_EQ(m.priorities.back(), 1);
+  std::string bad = reseal(replace_once(with, "\"priorities\":[", "\"priorities\":[0,"));
+  EXPECT_NE(defects(bad).find("error: /priorities: holds"), std::string::npos) << defects(bad);
+  bad = reseal(replace_once(with, "\"vertical\":2.5", "\"vertical\":-1"));
+  EXPECT_NE(defects(bad).find("error: /separation/vertical: -1"), std::string::npos) << defects(bad);
+  // Without them: the defaults, every drone ranked by its place.
+  dex::Mission plain;
+  ASSERT_TRUE(deploy::read_mission(text_, "Drone1/mission.json", plain, errors));
+  EXPECT_EQ(plain.separation.horizontal_m, 2.0);
+  EXPECT_TRUE(plain.priorities.empty());
+}
+
 TEST_F(MissionReader, RefusesAWholeNumberWrittenAsAFraction) {
   std::string edited = reseal(replace_once(text_, "{\"index\":0,\"meg\":0,", "{\"index\":0,\"meg\":0.5,"));
   EXPECT_NE(defects(edited).find("error: /nodes/0/meg: expected a whole number, found number"), std::string::npos);

@@ -185,6 +185,16 @@ TEST(Errors, BatteryAndSysidOutOfRangeAreErrors) {
   EXPECT_TRUE(contains(p.diags.items()[1].message, "from 1 to 255"));
 }
 
+TEST(Errors, PriorityThatIsNotAWholeNumberFromOneUpIsAnErrorAtItsLine) {
+  auto p = parse("drones:\n  Drone1:\n    priority: 0\n  Drone2:\n    priority: 1.5\n  Drone3:\n    priority: 2\n");
+  ASSERT_EQ(p.diags.error_count(), 2u) << p.diags.format();
+  EXPECT_EQ(p.diags.items()[0].loc.line, 3);
+  EXPECT_TRUE(contains(p.diags.items()[0].message, "from 1 (goes first)")) << p.diags.items()[0].message;
+  EXPECT_EQ(p.diags.items()[1].loc.line, 5);
+  EXPECT_EQ(p.fleet.drones.at("Drone3").priority, 2);
+  EXPECT_EQ(p.fleet.drones.at("Drone1").priority, 0);  // the error leaves it unset
+}
+
 TEST(Errors, TimeoutForUnknownActionSuggestsTheNearest) {
   auto p = parse("drones:\n  Drone1:\n    timeouts: {Takeof: 40, Land: -1}\n");
   ASSERT_EQ(p.diags.error_count(), 2u);

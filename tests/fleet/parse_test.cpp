@@ -51,6 +51,14 @@ TEST(Parse, EmptyFileIsAnEmptyFleet) {
   }
 }
 
+TEST(Parse, HomeToleranceOfSafetyReachesEveryDronesSettings) {
+  auto p = parse("safety:\n  home_tolerance: 5.5\ndrones:\n  A: {home: [0, 5, 0]}\n");
+  ASSERT_TRUE(p.ok) << p.diags.format();
+  EXPECT_EQ(p.fleet.settings_for("A", "Quad", 0).home_tolerance_m, 5.5);
+  EXPECT_EQ(parse("drones:\n  A: {}\n").fleet.settings_for("A", "Quad", 0).home_tolerance_m, 3.0);
+  EXPECT_FALSE(parse("safety:\n  home_tolerance: 0\n").ok);
+}
+
 TEST(Parse, CapabilitySubsetRemovesOtherActions) {
   auto p = parse("types:\n  Scout:\n    capabilities: [Arm, FlyTo, Hover]\n    sensors: 2\n");
   ASSERT_TRUE(p.ok) << p.diags.format();

@@ -343,7 +343,7 @@ TEST_F(Distributed, FailedActionOnOneDroneFailsTheMissionOnEveryDrone) {
   ASSERT_TRUE(summary.contains("failure")) << summary.dump(2);
   EXPECT_EQ(summary["failure"]["drone"], "Late");
   EXPECT_EQ(summary["failure"]["action"], "Takeoff");
-  EXPECT_EQ(summary["failure"]["line"], 20);
+  EXPECT_EQ(summary["failure"]["line"], 23);
   EXPECT_EQ(summary["failure"]["kind"], "refused");  // carried by the ABORT across processes
   EXPECT_NE(summary["error"].get<std::string>().find("arm before Takeoff"), std::string::npos);
   // Lead, in the air on another process, got the ABORT and landed.

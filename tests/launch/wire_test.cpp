@@ -117,6 +117,28 @@ TEST(Wire, AnAbortWithAnUnknownFailureKindIsRefused) {
   EXPECT_NE(refusal<LifecycleSample>(w).find("failed_kind 99 is not a known value"), std::string::npos);
 }
 
+TEST(Wire, ReadyCarriesWhereTheVehicleStandsAndItsDeclaredHome) {
+  LifecycleSample s;
+  s.kind = LifecycleKind::ready;
+  s.fix = mid::GlobalFix{47.397742, 8.545594};
+  s.home_x = 0;
+  s.home_y = 5;
+  s.home_tolerance = 4;
+  LifecycleSample back = back_from<LifecycleSample>(to_wire(s));
+  ASSERT_TRUE(back.fix);
+  EXPECT_EQ(back.fix->lat_deg, 47.397742);
+  EXPECT_EQ(back.fix->lon_deg, 8.545594);
+  EXPECT_EQ(back.home_y, 5);
+  EXPECT_EQ(back.home_tolerance, 4);
+  EXPECT_FALSE(back_from<LifecycleSample>(to_wire(LifecycleSample{})).fix);
+}
+
+TEST(Wire, AReadyWithALatitudeBeyondThePolesIsRefused) {
+  LifecycleSample s;
+  s.fix = mid::GlobalFix{91.0, 0.0};
+  EXPECT_NE(refusal<LifecycleSample>(to_wire(s)).find("fix_lat"), std::string::npos);
+}
+
 TEST(Wire, LifecycleWithoutFailureHasNone) {
   LifecycleSample s;
   s.kind = LifecycleKind::finished;

@@ -38,10 +38,14 @@ int run(const std::string& args, std::string& output) {
   return r.status;
 }
 
-pid_t spawn_vehicle(int port, int sysid, const char* duration = "400", const char* battery = "100") {
+/// `north`: where it stands, metres north of the others' reference point; the fleet files
+/// here put drone i's home at 5·(i-1) m north (the default), so the vehicles stand there.
+pid_t spawn_vehicle(int port, int sysid, const char* duration = "400", const char* battery = "100",
+                    double north = -1) {
+  if (north < 0) north = 5.0 * (sysid - 1);
   std::vector<std::string> args = {EAMOS_BINARY, "sim-vehicle", "--udp", std::to_string(port),
                                    "--sysid", std::to_string(sysid), "--speed", "4",
-                                   "--duration", duration, "--battery", battery};
+                                   "--duration", duration, "--battery", battery, "--north", std::to_string(north)};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -202,6 +206,73 @@ TEST(MavlinkRun, ADistributedRefusalEndsWithEveryDroneDisarmed) {
     EXPECT_EQ(summary["drones"][d].value("armed", true), false) << d << "\n" << summary.dump(2) << "\n" << out;
     EXPECT_EQ(summary["drones"][d].value("landed", false), true) << d << "\n" << summary.dump(2);
   }
+  fs::remove_all(dir);
+}
+
+// Three vehicles standing on one spot while the fleet file puts their homes 5 m apart (the
+// default homes, 0, 5 and 10 m north): every drone's mission frame would be shifted, routes
+// meant to be apart would cross. The run is refused before anything arms, naming where
+// each misplaced vehicle stands and where its home says.
+void expect_homes_refused(const std::string& out, const fs::path& trace) {
+  EXPECT_NE(out.find("the vehicles do not stand where the fleet file puts them; nothing was armed"), std::string::npos)
+      << out;
+  EXPECT_NE(out.find("Drone2 stands at [0.0, 0.0] in the mission frame"), std::string::npos) << out;
+  EXPECT_NE(out.find("its home in the fleet file is [0.0, 5.0]: 5.0 m apart, more than home_tolerance 3 m"),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find("Drone3 stands at [0.0, 0.0]"), std::string::npos) << out;
+  EXPECT_NE(out.find("its home in the fleet file is [0.0, 10.0]: 10.0 m apart"), std::string::npos) << out;
+  EXPECT_EQ(out.find("Drone1 stands"), std::string::npos) << out;  // the one the others are measured from
+  // The trace holds its header and the mission's failure, nothing that ran.
+  std::ifstream in(trace);
+  for (std::string line; std::getline(in, line);) {
+    std::string event = nlohmann::json::parse(line).value("event", "");
+    EXPECT_TRUE(event == "header" || event == "mission") << "something ran: " << line;
+  }
+}
+
+TEST(MavlinkHomes, VehiclesOnOneSpotWhileTheFleetPutsThemApartAreRefusedBeforeArming) {
+  fs::path dir = fs::temp_directory_path() / ("eamos-mavlink-homes-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::string fleet = read_text(fs::path(EAMOS_TEST_DATA) / "data/listing2-mavlink.yaml");
+  for (size_t at; (at = fleet.find(":2532")) != std::string::npos;) fleet.replace(at, 5, ":2542");
+  std::ofstream(dir / "fleet.yaml") << fleet;
+  std::vector<pid_t> vehicles;
+  for (int i = 1; i <= 3; ++i) vehicles.push_back(spawn_vehicle(25420 + i, i, "60", "100", 0.0));
+  std::string out;
+  int status = run("run " + std::string(EAMOS_SOURCE_DIR) + "/examples/listing2.eamos --fleet " +
+                       (dir / "fleet.yaml").string() + " --speed 4 --trace " + (dir / "trace.jsonl").string(),
+                   out);
+  for (pid_t pid : vehicles) {
+    kill(pid, SIGTERM);
+    waitpid(pid, nullptr, 0);
+  }
+  EXPECT_EQ(status, 1) << out;
+  expect_homes_refused(out, dir / "trace.jsonl");
+  fs::remove_all(dir);
+}
+
+// The same field with one DEX per drone (domain 78, used by no other test): each DEX reports
+// where its vehicle stands with its READY, and the ground refuses the start barrier.
+TEST(MavlinkHomes, OneDexPerDroneTheGroundRefusesTheStartWhenTheVehiclesStandElsewhere) {
+  fs::path dir = fs::temp_directory_path() / ("eamos-mavlink-homes-dist-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::string fleet = read_text(fs::path(EAMOS_TEST_DATA) / "data/listing2-mavlink.yaml");
+  for (size_t at; (at = fleet.find(":2532")) != std::string::npos;) fleet.replace(at, 5, ":2543");
+  std::ofstream(dir / "fleet.yaml") << fleet;
+  std::vector<pid_t> vehicles;
+  for (int i = 1; i <= 3; ++i) vehicles.push_back(spawn_vehicle(25430 + i, i, "60", "100", 0.0));
+  std::string out;
+  int status = run("run " + std::string(EAMOS_SOURCE_DIR) + "/examples/listing2.eamos --fleet " +
+                       (dir / "fleet.yaml").string() + " --distributed --domain 78 --speed 4 --deploy-dir " +
+                       (dir / "deploy").string() + " --trace " + (dir / "trace.jsonl").string(),
+                   out);
+  for (pid_t pid : vehicles) {
+    kill(pid, SIGTERM);
+    waitpid(pid, nullptr, 0);
+  }
+  EXPECT_EQ(status, 1) << out;
+  expect_homes_refused(out, dir / "trace.jsonl");
   fs::remove_all(dir);
 }
 

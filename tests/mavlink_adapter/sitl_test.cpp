@@ -381,6 +381,25 @@ void Sitl::fly_refused(const std::string& extra) {
   EXPECT_TRUE(failsafes.contains("Drone1") && failsafes.contains("Drone3")) << f.run.out;
 }
 
+// Three PX4 vehicles standing on one spot while the fleet file puts their homes 5 m apart
+// (kHomes): refused before anything arms, naming where each misplaced vehicle stands and
+// where its home says. PX4 only: the check reads GLOBAL_POSITION_INT, which both autopilots
+// send alike, and SITL boots are kept few.
+TEST_P(Sitl, VehiclesOnOneSpotWhileTheFleetPutsThemFiveMetresApartAreRefusedBeforeArming) {
+  if (GetParam() != Autopilot::px4) GTEST_SKIP() << "run on PX4 SITL only";
+  const std::vector<eamos_test::SitlHome> one_spot = {{0, 0}, {0, 0}, {0, 0}};
+  auto sitl = start_fleet(one_spot);
+  if (HasFailure()) return;
+  Flight f = fly(mission_path("three_hops.eamos"), fleet_file(*sitl, kHomes), dir_);
+  EXPECT_EQ(f.run.status, 1) << f.run.out;
+  EXPECT_NE(f.run.out.find("the vehicles do not stand where the fleet file puts them; nothing was armed"),
+            std::string::npos)
+      << f.run.out;
+  EXPECT_NE(f.run.out.find("its home in the fleet file is [0.0, 5.0]"), std::string::npos) << f.run.out;
+  EXPECT_NE(f.run.out.find("its home in the fleet file is [0.0, 10.0]"), std::string::npos) << f.run.out;
+  EXPECT_TRUE(f.actions.empty()) << f.run.out;  // not even an Arm ran
+}
+
 TEST_P(Sitl, ARefusedActionFailsTheMissionWithTheAutopilotsAnswerInTheSummary) { fly_refused(""); }
 
 TEST_P(Sitl, ARefusedActionOfOneDexPerDroneReachesTheSummaryWithTheAutopilotsAnswer) { fly_refused("--distributed"); }

@@ -10,6 +10,8 @@
 #include <thread>
 #include <vector>
 
+#include "diag/log.h"
+
 namespace eamos::mid {
 namespace {
 
@@ -87,6 +89,24 @@ TEST(EventLoop, ThrowingErrorHandlerDoesNotEndTheLoopEither) {
   loop.at(2.0, [&] { later = true; });
   loop.run_until_idle();
   EXPECT_TRUE(later);
+}
+
+// Without a handler (or when the handler throws) the error goes to the log, as an error of
+// the mid layer, and the loop goes on.
+TEST(EventLoop, AnErrorNobodyHandlesIsLoggedAsAnErrorOfTheMidLayer) {
+  std::vector<std::string> lines;
+  diag::LogSink saved = diag::set_log_sink([&](std::string_view line) { lines.emplace_back(line); });
+  EventLoop loop;
+  loop.at(1.0, [] { throw std::runtime_error("bad sample"); });
+  loop.run_until_idle();
+  EventLoop second;
+  second.on_callback_error([](const std::string&) { throw std::runtime_error("handler"); });
+  second.at(1.0, [] { throw std::runtime_error("callback"); });
+  second.run_until_idle();
+  diag::set_log_sink(std::move(saved));
+  EXPECT_EQ(lines, (std::vector<std::string>{
+                       "eamos mid: error: error in an event callback: bad sample",
+                       "eamos mid: error: error while handling an error in an event callback"}));
 }
 
 TEST(EventLoop, CancelledTimerNeverRuns) {

@@ -10,6 +10,9 @@
 #include <iostream>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <regex>
+#include <set>
 #include <filesystem>
 #include <string>
 #include <thread>
@@ -146,6 +149,27 @@ TEST(MonitorBrowser, ReplayOfAVerifyTraceMarksTheViolationInRedInItsLane) {
   fs::remove_all(dir);
 }
 
+TEST(MonitorBrowser, ReplayShowsWhoGaveWayToWhomInItsLane) {
+  if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
+  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-give-way-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  std::string trace = (dir / "crossing.jsonl").string();
+  auto run = eamos_test::run_eamos("run -q tests/launch/missions/separation_crossing.eamos --fleet "
+                                   "tests/launch/missions/separation_crossing.yaml --trace " + trace);
+  ASSERT_EQ(run.status, 0) << run.out;
+  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0"});
+  ASSERT_GT(monitor.pid, 0);
+  std::string url = read_url(monitor, "replaying");
+  ASSERT_FALSE(url.empty()) << monitor.seen;
+  std::string output;
+  bool passed = run_browser("giveway", url, output);
+  int status = -1;
+  stop(monitor, status);
+  EXPECT_TRUE(passed) << output;
+  EXPECT_EQ(status, 0) << monitor.seen;
+  fs::remove_all(dir);
+}
+
 TEST(MonitorBrowser, AThousandDroneReplayDrawsItsLanesOnACanvas) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
   fs::path dir = fs::temp_directory_path() / ("eamos-monitor-scale-" + std::to_string(getpid()));
@@ -164,6 +188,54 @@ TEST(MonitorBrowser, AThousandDroneReplayDrawsItsLanesOnACanvas) {
   stop(monitor, status);
   EXPECT_TRUE(passed) << output;
   EXPECT_EQ(status, 0) << monitor.seen;
+  fs::remove_all(dir);
+}
+
+// Each drone's altitude line in a `--plot` SVG: drone name -> "#RRGGBB".
+std::map<std::string, std::string> plot_colours(const fs::path& svg_file) {
+  std::ifstream in(svg_file);
+  std::string svg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  static const std::regex line("<polyline class=\"altitude\" data-drone=\"([^\"]+)\" points=\"[^\"]*\" "
+                               "fill=\"none\" stroke=\"(#[0-9A-Fa-f]{6})\"");
+  std::map<std::string, std::string> colours;
+  for (std::sregex_iterator m(svg.begin(), svg.end(), line), end; m != end; ++m) colours[(*m)[1]] = (*m)[2];
+  return colours;
+}
+
+// The page has no colour rule of its own: past eight drones it once repeated a palette of
+// sixteen while the SVGs went on with new hues, so drone 9 had two colours.
+TEST(MonitorBrowser, EachOfTwentyDronesHasTheSameColourInThePageAsInThePlot) {
+  if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
+  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-palette-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  std::string mission = (dir / "fleet.eamos").string(), trace = (dir / "fleet.jsonl").string();
+  ASSERT_EQ(eamos_test::run_eamos("gen-stress --drones 20 --nodes 60 -o " + mission).status, 0);
+  auto run = eamos_test::run_eamos("run " + mission + " -q --trace " + trace + " --plot " + (dir / "plot.svg").string() +
+                                   " > /dev/null");
+  ASSERT_EQ(run.status, 0) << run.out;
+  std::map<std::string, std::string> plot = plot_colours(dir / "plot.svg");
+  ASSERT_EQ(plot.size(), 20u);
+  std::set<std::string> distinct;
+  for (const auto& [drone, colour] : plot) distinct.insert(colour);
+  EXPECT_EQ(distinct.size(), 20u) << "every drone of the plot has a colour of its own";
+
+  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0", "--mission", mission});
+  ASSERT_GT(monitor.pid, 0);
+  std::string url = read_url(monitor, "replaying");
+  ASSERT_FALSE(url.empty()) << monitor.seen;
+  std::string output;
+  bool passed = run_browser("palette", url, output);
+  int status = -1;
+  stop(monitor, status);
+  ASSERT_TRUE(passed) << output;
+  std::size_t at = output.find("colours: ");
+  ASSERT_NE(at, std::string::npos) << output;
+  nlohmann::json page = nlohmann::json::parse(output.substr(at + 9, output.find('\n', at) - at - 9), nullptr, false);
+  ASSERT_TRUE(page.is_object()) << output;
+  for (const auto& [drone, colour] : plot) {
+    ASSERT_TRUE(page.contains(drone)) << drone << " is not in the page's list: " << output;
+    EXPECT_EQ(page[drone].get<std::string>(), colour) << drone;
+  }
   fs::remove_all(dir);
 }
 

@@ -113,6 +113,6 @@ def test_a_file_of_bytes_that_are_not_text_gives_diagnostics_not_an_exception(tm
     c = eamos.compile(path)
     assert not c.ok
     assert [(d.line, d.column) for d in c.errors] == [(2, 30), (3, 1)]
-    assert "unexpected byte 0xff" in c.errors[0].message
-    # The source line's bytes that are not UTF-8 come as U+FFFD.
-    assert "Takeoff(\ufffd\ufffd)" in c.errors[0].text
+    assert "invalid UTF-8: byte 0xff" in c.errors[0].message
+    # The source line's bytes that are not UTF-8 are shown escaped, never raw.
+    assert "Takeoff(\\xff\\xfe)" in c.errors[0].text

@@ -92,15 +92,17 @@ def test_without_tracks_each_drone_keeps_its_first_and_last_state_and_the_run_is
 
 
 def test_a_failed_action_fails_the_run_with_the_responsible_line():
-    # Takeoff without Arm: the simulated drone refuses it.
-    c = eamos.compile_text("var Drone1 Quad\nfunc INIT() { SEQ_fly() }\nfunc SEQ_fly() { Drone1.Takeoff(3) }\n",
+    # Takeoff without Arm (armed only above 100 % battery, never): the simulated drone refuses it.
+    c = eamos.compile_text("var Drone1 Quad\nfunc INIT() { SEQ_fly() }\nfunc SEQ_fly() {\n"
+                           "  If(Drone1.Battery() > 100, SEQ_arm, SEQ_stay)\n  Drone1.Takeoff(3)\n}\n"
+                           "func SEQ_arm() { Drone1.Arm() }\nfunc SEQ_stay() { PauseFor(0) }\n",
                            name="disarmed.eamos")
     events = []
     r = c.run(events.append)
     assert not r.completed
     assert r.failure is not None
-    assert (r.failure.drone, r.failure.action, r.failure.line, r.failure.kind) == ("Drone1", "Takeoff", 3, "refused")
-    assert "Takeoff (line 3) failed" in r.error
+    assert (r.failure.drone, r.failure.action, r.failure.line, r.failure.kind) == ("Drone1", "Takeoff", 5, "refused")
+    assert "Takeoff (line 5) failed" in r.error
     assert (events[-1]["event"], events[-1]["outcome"]) == ("mission", "failed")
 
 

@@ -4,8 +4,6 @@
 // monitor cannot command a drone. Text from the trace is only ever set as textContent.
 'use strict';
 
-const PALETTE = ['#0072B2', '#D55E00', '#009E73', '#CC79A7', '#E69F00', '#56B4E9', '#F0E442', '#000000',
-                 '#7f3c8d', '#11a579', '#3969ac', '#f2b701', '#e73f74', '#80ba5a', '#e68310', '#008695'];
 const STATE_FILL = {
   waiting: '#fff59d', running: '#90caf9', succeeded: '#a5d6a7', failed: '#ef9a9a', preempted: '#ffcc80',
   cancelled: '#bdbdbd', released: '#b2ebf2', true: '#a5d6a7', false: '#cfd8dc', 'not-run': '#f5f5f5',
@@ -38,7 +36,7 @@ function resetDerived() {
     drones: [], droneIndex: new Map(), bars: [], openBars: new Map(), conds: [], telemetry: new Map(),
     messages: [], nodeHistory: new Map(), end: 0, outcome: '', failures: [], eventTimes: [], violations: [],
     nodeKey: new Map(), nodes: new Map(), lastIngested: 0, missionReason: '', missionT: null, failMarks: [],
-    waitSpans: new Map(),
+    waitSpans: new Map(), giveWays: [],
   };
   const m = S.mission || {};
   for (const d of Array.isArray(m.drones) ? m.drones : []) addDrone(str(d.name), d);
@@ -54,10 +52,18 @@ function addDrone(name, info) {
   if (!name || D.droneIndex.has(name)) return D.droneIndex.get(name);
   const i = D.drones.length;
   const home = info && Array.isArray(info.home) ? info.home.map(v => num(v, 0)) : null;
-  D.drones.push({ name, index: i, home, geofence: info ? info.geofence : null, colour: PALETTE[i % PALETTE.length] });
+  D.drones.push({ name, index: i, home, geofence: info ? info.geofence : null, colour: droneColour(i) });
   D.droneIndex.set(name, i);
   S.structureDirty = true;
   return i;
+}
+
+// Drone i's colour in every picture of eamos: the server sends the palette (graph/palette.h)
+// with the mission, so the page and the SVGs cannot disagree.
+function droneColour(i) {
+  const p = S.mission && Array.isArray(S.mission.palette) ? S.mission.palette : [];
+  const c = p.length ? p[i % p.length] : null;
+  return typeof c === 'string' && /^#[0-9A-Fa-f]{6}$/.test(c) ? c : '#555555';
 }
 
 // The MEG nodes an event is about: its "node" field, else (older traces) drone + line + name.
@@ -83,7 +89,8 @@ function ingest(e) {
   D.end = Math.max(D.end, t);
   // "Next event" steps through the mission's story, not through telemetry samples,
   // messages or graph-node bookkeeping.
-  if (['start', 'end', 'condition', 'failsafe', 'mission', 'violation'].includes(e.event)) D.eventTimes.push(t);
+  if (['start', 'end', 'condition', 'failsafe', 'mission', 'violation', 'give_way', 'resume'].includes(e.event))
+    D.eventTimes.push(t);
   if (e.drone && e.drone !== '*' && e.event !== 'message') addDrone(str(e.drone));
   const key = str(e.drone) + '|' + str(e.name) + '|' + e.line + '|' + (e.node ?? '') + '|' + (e.instance ?? '');
   if (e.event === 'start') {
@@ -129,6 +136,11 @@ function ingest(e) {
                         x: num(e.x, NaN), y: num(e.y, NaN) });
     D.failures.push({ t, kind: 'violation', drone: str(e.drone), text: str(e.kind) + ' violation', line: e.line | 0,
                       reason: str(e.text), nodes: [] });
+    S.itemsDirty = true;
+  } else if (e.event === 'conflict' || e.event === 'give_way' || e.event === 'resume') {
+    // Separation kept in flight (docs/faults.md): who held for whom, and when it flew on.
+    D.giveWays.push({ t, event: e.event, drone: str(e.drone), other: str(e.other), distance: num(e.distance, NaN),
+                      reason: str(e.reason) });
     S.itemsDirty = true;
   } else if (e.event === 'failsafe' || e.event === 'error') {
     D.failures.push({ t, kind: e.event, drone: str(e.drone), text: e.event + ' ' + str(e.name), line: e.line | 0,
@@ -413,7 +425,7 @@ function buildLanes() {
   lanes.hidden = !useDom;
   $('lanes-canvas').hidden = useDom;
   lanes.dataset.drones = String(D.drones.length);
-  for (const item of [...D.bars, ...D.conds, ...D.violations, ...D.failMarks]) item.el = null;
+  for (const item of [...D.bars, ...D.conds, ...D.violations, ...D.failMarks, ...D.giveWays]) item.el = null;
   for (const w of D.waitSpans ? D.waitSpans.values() : []) w.el = null;
   D.waitSpans = new Map();
   for (const tr of D.triggerList || []) tr.el = null;
@@ -458,7 +470,29 @@ function addLaneItems() {
   for (const c of D.conds) if (!c.el) makeCond(c);
   buildViolationMarks();
   buildFailMarks();
+  buildGiveWayMarks();
   updateTriggers();
+}
+
+// An orange mark in the lane of the drone that gave way (⏸) and flew on (▶); a conflict it
+// could not hold for is a ⚠. The other drone and their distance are its title.
+function buildGiveWayMarks() {
+  const glyph = { conflict: '⚠', give_way: '⏸', resume: '▶' };
+  for (const w of D.giveWays) {
+    const d = D.drones[D.droneIndex.get(w.drone)];
+    if (w.el || !d || !d.track || (w.event === 'conflict' && !w.reason.includes('cannot be held'))) continue;
+    const mark = el('div', 'give-way', glyph[w.event]);
+    mark.dataset.drone = w.drone;
+    mark.dataset.event = w.event;
+    mark.dataset.other = w.other;
+    mark.dataset.t = String(w.t);
+    const apart = isFinite(w.distance) ? ` ${w.distance.toFixed(1)} m apart` : '';
+    mark.title = `${w.drone} ${w.event.replace('_', ' ')} ${w.other} at ${w.t.toFixed(2)} s,${apart} (${w.reason})`;
+    mark.addEventListener('click', () => select({ nodes: [], line: 0, drone: w.drone, text: mark.title, t: w.t,
+                                                   outcome: w.event, reason: w.reason }));
+    w.el = mark;
+    d.track.appendChild(mark);
+  }
 }
 
 function makeBar(b, i) {
@@ -678,6 +712,11 @@ function renderLanes() {
     put(v.el, 'left', px(v.t) + 'px');
     flag(v.el, 'future', v.t > now + 1e-9);
   }
+  for (const w of D.giveWays) {
+    if (!w.el) continue;
+    put(w.el, 'left', px(w.t) + 'px');
+    flag(w.el, 'future', w.t > now + 1e-9);
+  }
   const failedNow = new Set();
   for (const f of D.failMarks) {
     if (f.t <= now + 1e-9) failedNow.add(f.drone);
@@ -809,6 +848,7 @@ function renderMap() {
     }
   }
   drawViolations(g, X, Y, many);
+  drawGiveWays(g, X, Y, many);
   drawFailures(g, X, Y);
   renderSide(B);
   const hasTelemetry = D.telemetry.size > 0;
@@ -831,6 +871,29 @@ function drawFailures(g, X, Y) {
     if (!p) continue;
     const x = X(p.x), y = Y(p.y);
     g.beginPath(); g.moveTo(x - 6, y - 6); g.lineTo(x + 6, y + 6); g.moveTo(x + 6, y - 6); g.lineTo(x - 6, y + 6); g.stroke();
+  }
+  g.lineWidth = 1;
+}
+
+// Each drone holding for another now: an orange ring on it and a dashed line to the drone it
+// gives way to, until it flies on.
+function drawGiveWays(g, X, Y, many) {
+  const holding = new Map();
+  for (const w of D.giveWays) {
+    if (w.t > S.clock + 1e-9) continue;
+    if (w.event === 'give_way') holding.set(w.drone, w);
+    if (w.event === 'resume') holding.delete(w.drone);
+  }
+  g.strokeStyle = '#ff8c00'; g.lineWidth = 2;
+  for (const w of holding.values()) {
+    const a = D.drones[D.droneIndex.get(w.drone)], b = D.drones[D.droneIndex.get(w.other)];
+    const p = a && positionAt(a, S.clock), q = b && positionAt(b, S.clock);
+    if (!p) continue;
+    g.beginPath(); g.arc(X(p.x), Y(p.y), 11, 0, 2 * Math.PI); g.stroke();
+    if (q) { g.setLineDash([4, 3]); g.beginPath(); g.moveTo(X(p.x), Y(p.y)); g.lineTo(X(q.x), Y(q.y)); g.stroke();
+             g.setLineDash([]); }
+    if (!many) { g.fillStyle = '#ff8c00'; g.font = '11px sans-serif';
+                 g.fillText('gives way to ' + w.other, X(p.x) + 13, Y(p.y) + 16); }
   }
   g.lineWidth = 1;
 }

@@ -1,6 +1,6 @@
 // Drives Debian's chromium headless against a running `eamos monitor` / `eamos run --monitor`
 // and checks what the page shows, through its DOM. Called by tests/monitor/browser_test.cpp:
-//   node monitor_check.js replay|live|live20|launch|v1|scale|violation|failed|waits URL SCREENSHOT_DIR CHROMIUM
+//   node monitor_check.js replay|live|live20|launch|v1|scale|violation|failed|waits|giveway|palette URL SCREENSHOT_DIR CHROMIUM
 // Prints "ok: ..." lines and exits 0, or prints "FAIL: what" and exits 1.
 'use strict';
 const fs = require('fs');
@@ -235,6 +235,24 @@ async function scale(browser) {
   await page.screenshot({ path: path.join(shots, 'replay-1000-drones.png') });
 }
 
+// Each drone's colour as the page draws it (its swatch in the drone list), printed as one
+// "colours: {...}" line of JSON for the test to compare with the SVGs eamos writes.
+async function palette(browser) {
+  const page = await open(browser, '');
+  await page.waitForSelector('body[data-finished="true"]', { timeout: 15000, polling: 100 });
+  await page.evaluate(() => window.eamosMonitor.setClock(1e9));
+  const colours = await page.evaluate(() => {
+    const hex = rgb => '#' + (rgb.match(/\d+/g) || []).slice(0, 3).map(v => Number(v).toString(16).padStart(2, '0'))
+      .join('').toUpperCase();
+    const out = {};
+    for (const li of document.querySelectorAll('#drone-list li'))
+      out[li.dataset.drone] = hex(getComputedStyle(li.querySelector('.swatch')).backgroundColor);
+    return out;
+  });
+  check(Object.keys(colours).length === 20, `20 drones in the list (${Object.keys(colours).length})`);
+  console.log('colours: ' + JSON.stringify(colours));
+}
+
 async function live(browser) {
   const page = await open(browser, '');
   await page.waitForFunction(() => document.querySelectorAll('.lane').length === 3, { timeout: 15000, polling: 100 });
@@ -370,6 +388,24 @@ async function failedLive(browser) {
 
 // Four drones at the end of each PAR wait for the slowest: one span per pause, and the labels
 // neither overlap nor overflow their spans (tests/monitor/missions/par4.eamos).
+// `eamos run --trace` of tests/launch/missions/separation_crossing.eamos: B gives way to A
+// and flies on; its lane holds an orange ⏸ and ▶ naming A and their distance, A's lane none,
+// and while B holds the map says so.
+async function giveWay(browser) {
+  const page = await open(browser, '?t=0');
+  await page.waitForSelector('body[data-finished="true"]', { timeout: 15000, polling: 100 });
+  const marks = await page.evaluate(() => [...document.querySelectorAll('.give-way')].map(m => ({
+    lane: m.closest('.lane') ? m.closest('.lane').dataset.drone : '', event: m.dataset.event, other: m.dataset.other,
+    t: Number(m.dataset.t), title: m.title, text: m.textContent, colour: getComputedStyle(m).backgroundColor })));
+  const events = marks.map(m => m.lane + ':' + m.event + ':' + m.text).join(' ');
+  check(events === 'B:give_way:⏸ B:resume:▶', 'B\'s lane has its give-way and its resume, A\'s none: ' + events);
+  const g = marks[0] || {};
+  check(g.other === 'A' && (g.title || '').includes('give way A') && (g.title || '').includes('m apart'),
+        'the give-way names A and the distance: ' + g.title);
+  check(g.colour === 'rgb(255, 140, 0)', 'the mark is orange: ' + g.colour);
+  await page.screenshot({ path: path.join(shots, 'replay-give-way.png'), fullPage: true });
+}
+
 async function waits(browser) {
   const page = await open(browser, '?t=9.2');
   await page.waitForSelector('body[data-finished="true"]', { timeout: 15000, polling: 100 });
@@ -402,9 +438,11 @@ async function waits(browser) {
     else if (mode === 'launch') await launchLive(browser);
     else if (mode === 'v1') await v1(browser);
     else if (mode === 'scale') await scale(browser);
+    else if (mode === 'palette') await palette(browser);
     else if (mode === 'violation') await violation(browser);
     else if (mode === 'failed') await failedLive(browser);
     else if (mode === 'waits') await waits(browser);
+    else if (mode === 'giveway') await giveWay(browser);
     else failures.push('unknown mode ' + mode);
   } finally {
     await browser.close();

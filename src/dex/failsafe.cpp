@@ -1,0 +1,70 @@
+#include "dex/failsafe.h"
+
+namespace eamos::dex {
+
+bool command_failsafe(mid::Drone& drone, const fleet::DroneSettings& settings) {
+  mid::DroneState s = drone.state();
+  if (down_and_disarmed(s)) return false;  // already safe; an armed drone on the ground is disarmed
+  drone.failsafe(settings.failsafe);
+  return true;
+}
+
+void record_failsafe(const fleet::DroneSettings& settings, double t, const std::string& reason, TraceSink* trace) {
+  if (!trace) return;
+  TraceEvent e;
+  e.t = t;
+  e.drone = settings.name;
+  e.event = "failsafe";
+  e.name = fleet::failsafe_name(settings.failsafe);
+  e.reason = reason;
+  trace->record(e);
+}
+
+bool failsafe_over(const mid::DroneState& s, fleet::Failsafe failsafe, double waited_s) {
+  if (down_and_disarmed(s) || s.link_lost || waited_s >= kFailsafeWaitLimitS) return true;
+  // On the ground every failsafe disarms: that is still to come for an armed drone there.
+  return failsafe == fleet::Failsafe::hover && !s.landed;
+}
+
+void enter_failsafe(mid::Drone& drone, const fleet::DroneSettings& settings, double t, const std::string& reason,
+                    TraceSink* trace) {
+  // Command first: a trace write (a DDS sample, a pipe) may block, the drone must not wait.
+  if (command_failsafe(drone, settings)) record_failsafe(settings, t, reason, trace);
+}
+
+void abandon_drones(const std::vector<FailsafeDrone>& drones, double t, const std::string& reason,
+                    TraceSink* trace, const std::function<void()>& between) {
+  for (const FailsafeDrone& d : drones) d.engine->halt();
+  std::vector<bool> commanded(drones.size());
+  for (std::size_t i = 0; i < drones.size(); ++i) commanded[i] = command_failsafe(*drones[i].drone, *drones[i].settings);
+  if (between) between();
+  for (std::size_t i = 0; i < drones.size(); ++i)
+    if (commanded[i]) record_failsafe(*drones[i].settings, t, reason, trace);
+}
+
+FailsafeWait::FailsafeWait(mid::EventLoop& loop, std::vector<FailsafeDrone> drones, double period_s,
+                           std::function<void()> on_over)
+    : loop_(loop), drones_(std::move(drones)), period_s_(period_s), on_over_(std::move(on_over)) {}
+
+FailsafeWait::~FailsafeWait() { loop_.cancel(next_); }
+
+void FailsafeWait::start() {
+  since_ = loop_.now();
+  loop_.cancel(next_);
+  next_ = loop_.after(0.0, [this] { look(); });
+}
+
+// A look that finds a drone still in its failsafe comes back later rather than waiting on
+// the loop: a real-time loop would otherwise wait for input until its limit, and a MAVLink
+// drone's heartbeats never leave it idle.
+void FailsafeWait::look() {
+  next_ = mid::kNoTimer;
+  for (const FailsafeDrone& d : drones_)
+    if (!failsafe_over(d.drone->state(), d.settings->failsafe, loop_.now() - since_)) {
+      next_ = loop_.after(period_s_, [this] { look(); });
+      return;
+    }
+  on_over_();
+}
+
+}  // namespace eamos::dex

@@ -1,0 +1,288 @@
+#include "dex/separation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace eamos::dex {
+
+namespace {
+
+Vec operator-(Vec a, Vec b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+Vec operator+(Vec a, Vec b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+Vec operator*(Vec a, double k) { return {a.x * k, a.y * k, a.z * k}; }
+double speed(Vec v) { return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z); }
+
+/// The times in [0, horizon] at which |p + v t| < r (one dimension or the plane's norm),
+/// as [lo, hi]; false when there are none.
+bool within(double p0, double p1, double v0, double v1, double r, double horizon, double& lo, double& hi) {
+  const double a = v0 * v0 + v1 * v1, b = 2 * (p0 * v0 + p1 * v1), c = p0 * p0 + p1 * p1 - r * r;
+  if (a < 1e-12) {
+    if (c >= 0) return false;
+    lo = 0, hi = horizon;
+    return true;
+  }
+  const double disc = b * b - 4 * a * c;
+  if (disc <= 0) return false;
+  const double root = std::sqrt(disc);
+  lo = std::max(0.0, (-b - root) / (2 * a));
+  hi = std::min(horizon, (-b + root) / (2 * a));
+  return lo < hi;
+}
+
+std::string metres(double m) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f m", m);
+  return text;
+}
+
+std::string seconds(double s) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f s", s);
+  return text;
+}
+
+}  // namespace
+
+Prediction predict(Vec pa, Vec va, Vec pb, Vec vb, const fleet::Separation& min, double horizon_s) {
+  const Vec dp = pb - pa, dv = vb - va;
+  double h_lo, h_hi, v_lo, v_hi;
+  if (!within(dp.x, dp.y, dv.x, dv.y, min.horizontal_m, horizon_s, h_lo, h_hi)) return {};
+  if (!within(dp.z, 0.0, dv.z, 0.0, min.vertical_m, horizon_s, v_lo, v_hi)) return {};
+  const double lo = std::max(h_lo, v_lo), hi = std::min(h_hi, v_hi);
+  if (lo >= hi) return {};
+  // Already too close: only a pair still closing in is one that holding can help.
+  if (lo <= 0.0 && dp.x * dv.x + dp.y * dv.y + dp.z * dv.z >= 0.0) return {};
+  return {true, lo};
+}
+
+SeparationGuard::SeparationGuard(const Mission& mission, mid::EventLoop& loop, SeparationHooks hooks)
+    : m_(mission),
+      loop_(loop),
+      hooks_(std::move(hooks)),
+      min_(mission.separation),
+      tracks_(mission.fleet.size()) {
+  // Wide enough that one ring of cells covers two drones at 10 m/s closing in over the
+  // horizon; faster drones widen the look-up, not the cells.
+  cell_m_ = min_.horizontal_m + 2 * kSeparationHorizonS * 10.0;
+}
+
+SeparationGuard::~SeparationGuard() { halt(); }
+
+void SeparationGuard::fly(int d, mid::Drone& drone, const fleet::Limits& limits) {
+  tracks_[d].drone = &drone;
+  tracks_[d].max_speed = limits.max_speed_mps;
+  fastest_seen_ = std::max(fastest_seen_, limits.max_speed_mps);
+}
+
+void SeparationGuard::halt() {
+  halted_ = true;
+  for (Track& k : tracks_) {
+    loop_.cancel(k.bound);
+    k.bound = mid::kNoTimer;
+  }
+}
+
+Vec SeparationGuard::now_at(const Track& k) const {
+  // Telemetry is a little old when it is read: carried forward along its course.
+  const double age = std::clamp(loop_.now() - k.t, 0.0, kSeparationHorizonS);
+  return k.p + k.v * age;
+}
+
+bool SeparationGuard::outranks(int a, int b) const {
+  auto rank = [this](int d) {
+    int p = d < static_cast<int>(m_.priorities.size()) ? m_.priorities[d] : 0;
+    return p > 0 ? p : d + 1;
+  };
+  return rank(a) != rank(b) ? rank(a) < rank(b) : a < b;
+}
+
+bool SeparationGuard::holding(int d) {
+  Track& k = tracks_[d];
+  if (k.waits_for < 0) return false;
+  if (k.drone && k.drone->motion_held()) return true;
+  // The held action ended meanwhile (preempted, cancelled, a failsafe): nothing to resume.
+  k.waits_for = -1;
+  loop_.cancel(k.bound);
+  k.bound = mid::kNoTimer;
+  return false;
+}
+
+long long SeparationGuard::cell_of(const Vec& p) const {
+  const long long ix = static_cast<long long>(std::floor(p.x / cell_m_));
+  const long long iy = static_cast<long long>(std::floor(p.y / cell_m_));
+  return (ix << 32) ^ (iy & 0xffffffffLL);
+}
+
+void SeparationGuard::place(int d) {
+  Track& k = tracks_[d];
+  const long long cell = cell_of(k.p);
+  if (k.in_grid && (!k.airborne || cell != k.cell)) {
+    std::vector<int>& members = grid_[k.cell];
+    members.erase(std::find(members.begin(), members.end(), d));
+    if (members.empty()) grid_.erase(k.cell);
+    k.in_grid = false;
+  }
+  if (k.airborne && !k.in_grid) {
+    grid_[cell].push_back(d);
+    k.cell = cell;
+    k.in_grid = true;
+  }
+}
+
+template <typename Fn>
+void SeparationGuard::for_neighbours(int d, double reach_m, Fn fn) {
+  const Track& k = tracks_[d];
+  const long long rings = std::max(1LL, static_cast<long long>(std::ceil(reach_m / cell_m_)));
+  const long long ix = static_cast<long long>(std::floor(k.p.x / cell_m_));
+  const long long iy = static_cast<long long>(std::floor(k.p.y / cell_m_));
+  for (long long x = ix - rings; x <= ix + rings; ++x)
+    for (long long y = iy - rings; y <= iy + rings; ++y) {
+      auto it = grid_.find((x << 32) ^ (y & 0xffffffffLL));
+      if (it == grid_.end()) continue;
+      // By index, not by copy: giving way and resuming never move a drone between cells
+      // (only update() does), so the list stays as it is while `fn` runs.
+      const std::vector<int>& members = it->second;
+      for (std::size_t i = 0; i < members.size(); ++i)
+        if (members[i] != d) fn(members[i]);
+    }
+}
+
+void SeparationGuard::update(int d, const mid::DroneState& s) {
+  if (d < 0 || d >= static_cast<int>(tracks_.size())) return;
+  Track& k = tracks_[d];
+  const Vec p{s.x, s.y, s.z};
+  if (!k.known) k.v = {};
+  else if (s.t > k.t + 1e-6) k.v = (p - k.p) * (1.0 / (s.t - k.t));
+  else if (s.t < k.t) return;  // an older sample overtaken by a newer one
+  k.known = true;
+  k.p = p;
+  k.t = s.t;
+  k.airborne = !s.landed && !s.link_lost;
+  fastest_seen_ = std::max(fastest_seen_, std::hypot(k.v.x, k.v.y));
+  place(d);
+  if (halted_ || !k.airborne || loop_.now() - k.checked_at < kSeparationCheckS) return;
+  k.checked_at = loop_.now();
+  check(d);
+}
+
+void SeparationGuard::check(int d) {
+  const Track& k = tracks_[d];
+  const bool own = k.drone != nullptr;
+  const double reach = min_.horizontal_m + kSeparationHorizonS * (std::hypot(k.v.x, k.v.y) + fastest_seen_);
+  if (own && holding(d)) try_resume(d);
+  for_neighbours(d, reach, [&](int n) {
+    // A drone this process flies looks at its own pairs when its own state comes in; a pair
+    // with a drone flown elsewhere is looked at from that drone's telemetry too.
+    if (own) consider(d, n);
+    if (!tracks_[n].drone) return;
+    if (!own) consider(n, d);
+    // A held drone stands still and publishes seldom: whoever moves near it looks again.
+    if (holding(n)) try_resume(n);
+  });
+}
+
+// From drone a's side (this process flies it): does it give way to b?
+void SeparationGuard::consider(int a, int b) {
+  if (halted_ || holding(a)) return;
+  Track& A = tracks_[a];
+  const Track& B = tracks_[b];
+  if (!A.airborne || !B.airborne || speed(A.v) < kMovingMps) return;
+  ++pairs_;
+  const Prediction p = predict(now_at(A), A.v, now_at(B), B.v, min_, kSeparationHorizonS);
+  if (!p.conflict) {
+    if (A.unheld_with == b) A.unheld_with = -1;
+    return;
+  }
+  const bool b_moving = speed(B.v) >= kMovingMps;
+  if (b_moving && outranks(a, b) && p.in_s > kLastMomentS) return;
+  give_way(a, b, p);
+}
+
+void SeparationGuard::give_way(int a, int b, const Prediction& p) {
+  Track& A = tracks_[a];
+  const std::string course = "would come within " + metres(min_.horizontal_m) + " horizontally and " +
+                             metres(min_.vertical_m) + " vertically in " + seconds(p.in_s);
+  if (!A.drone->hold_motion(0.0)) {
+    if (A.unheld_with != b) trace(a, b, "conflict", course + "; its action cannot be held");
+    A.unheld_with = b;
+    return;
+  }
+  trace(a, b, "conflict", course);
+  A.waits_for = b;
+  A.held_since = loop_.now();
+  // Its course once it flies on: the way it was going, at full speed (it was perhaps still
+  // speeding up), so that it resumes only when the way is clear for the fastest it may fly.
+  const double h = std::hypot(A.v.x, A.v.y), full = std::max(A.max_speed, h);
+  A.hold_v = A.v;
+  A.resume_v = h > 1e-9 ? Vec{A.v.x * full / h, A.v.y * full / h, A.v.z} : A.v;
+  A.blocked_by = b;
+  trace(a, b, "give_way", "holds for " + m_.fleet[b]);
+  const double since = A.held_since;
+  A.bound = loop_.after(kMaxGiveWayS, [this, a, since] { too_long(a, since); });
+}
+
+void SeparationGuard::try_resume(int h) {
+  if (halted_) return;
+  Track& H = tracks_[h];
+  const Vec here = now_at(H);
+  int blocker = -1;
+  const double reach = min_.horizontal_m + kResumeHorizonS * (std::hypot(H.resume_v.x, H.resume_v.y) + fastest_seen_);
+  for_neighbours(h, reach, [&](int n) {
+    if (blocker >= 0 || !tracks_[n].airborne) return;
+    ++pairs_;
+    const Track& N = tracks_[n];
+    // It speeds up from a stop: its course at the speed it had when it gave way, and at a
+    // quarter, half, three quarters and all of its full speed.
+    // Over twice the horizon: a conflict that just slipped past the horizon as it braked
+    // would otherwise let it fly on at once and stop again.
+    const double horizon = kResumeHorizonS;
+    if (predict(here, H.hold_v, now_at(N), N.v, min_, horizon).conflict) blocker = n;
+    for (double share : {0.25, 0.5, 0.75, 1.0})
+      if (predict(here, H.resume_v * share, now_at(N), N.v, min_, horizon).conflict) blocker = n;
+  });
+  H.blocked_by = blocker;
+  if (blocker >= 0) {
+    // Two held drones, both stopped, each in the other's way: neither will ever fly on.
+    const Track& B = tracks_[blocker];
+    if (B.drone && B.blocked_by == h && holding(blocker) && speed(H.v) < kMovingMps && speed(B.v) < kMovingMps &&
+        hooks_.on_stuck)
+      hooks_.on_stuck(m_.fleet[blocker] + " and " + m_.fleet[h] + " give way to each other " +
+                      metres(distance(h, blocker)) + " apart: neither can fly on without losing separation");
+    return;
+  }
+  if (!H.drone->resume_motion()) return;
+  const int other = H.waits_for;
+  H.waits_for = -1;
+  loop_.cancel(H.bound);
+  H.bound = mid::kNoTimer;
+  trace(h, other, "resume", "held " + seconds(loop_.now() - H.held_since));
+}
+
+void SeparationGuard::too_long(int h, double since) {
+  Track& H = tracks_[h];
+  H.bound = mid::kNoTimer;
+  if (halted_ || !holding(h) || H.held_since != since || !hooks_.on_stuck) return;
+  hooks_.on_stuck(m_.fleet[h] + " gave way to " + m_.fleet[H.waits_for] + " for " + seconds(kMaxGiveWayS) +
+                  " and its course is still not clear (" + metres(distance(h, H.waits_for)) + " apart)");
+}
+
+double SeparationGuard::distance(int a, int b) const {
+  return speed(now_at(tracks_[a]) - now_at(tracks_[b]));
+}
+
+void SeparationGuard::trace(int d, int other, const char* event, const std::string& reason) {
+  if (!hooks_.trace) return;
+  TraceEvent e;
+  e.t = loop_.now();
+  e.drone = m_.fleet[d];
+  e.event = event;
+  e.name = "separation";
+  e.other = other >= 0 ? m_.fleet[other] : "";
+  e.to = other;
+  if (other >= 0) e.distance = std::round(distance(d, other) * 1000.0) / 1000.0;
+  e.reason = reason;
+  hooks_.trace->record(e);
+}
+
+}  // namespace eamos::dex

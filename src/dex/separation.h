@@ -1,0 +1,127 @@
+#pragma once
+// Separation kept in flight (docs/faults.md, "Separation in flight"): each DEX reads the
+// positions of the drones near its own (their telemetry), predicts every pair's straight
+// courses over a short horizon and, where two would come closer than the fleet's
+// min_separation (horizontally and vertically at once), makes one of them give way: it
+// holds its goal-directed motion where it can stop (the Uniform Space's hold_motion, on the
+// simulator and on MAVLink alike) and flies on once its own course is clear again. A hold
+// that cannot clear (two held drones each in the other's course, or longer than kMaxGiveWayS) fails
+// the mission, so the failsafe takes over before anyone collides.
+//
+// Who gives way, per pair, decided the same way by every DEX from the same telemetry:
+//  - a drone that stands still cannot help by holding: the one moving gives way to it;
+//  - of two moving drones, the one of lower priority (Mission::priorities, else the later
+//    declared) gives way;
+//  - one that would lose separation within kLastMomentS gives way whatever its priority:
+//    the other may be unable to hold (an Orbit, a Takeoff the autopilot flies) or late.
+//
+// "Near" is a grid of cells over the horizontal plane: a drone's pairs are looked up in
+// the cells its reach spans, so a fleet of a thousand drones in one process costs each
+// drone the few drones around it, not the whole fleet.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "dex/mission.h"
+#include "dex/trace.h"
+#include "mid/drone_api.h"
+#include "mid/event_loop.h"
+
+namespace eamos::dex {
+
+inline constexpr double kSeparationHorizonS = 3.0;  ///< how far ahead courses are predicted
+inline constexpr double kResumeHorizonS = 6.0;     ///< a held drone's course must be clear this far ahead
+inline constexpr double kSeparationCheckS = 0.2;    ///< a drone's pairs are looked at at most this often
+inline constexpr double kMaxGiveWayS = 30.0;        ///< a longer hold fails the mission
+inline constexpr double kLastMomentS = 1.5;         ///< this close to a loss, priority no longer counts
+inline constexpr double kMovingMps = 0.3;           ///< slower counts as standing still
+
+struct Vec {
+  double x = 0, y = 0, z = 0;
+};
+
+/// Where two straight courses (positions and velocities now) lose separation within
+/// `horizon_s`: `conflict` and the seconds until it (`in_s`, 0 when already too close and
+/// still closing in). Two drones already too close that do not close in are not a conflict:
+/// holding either would not part them.
+struct Prediction {
+  bool conflict = false;
+  double in_s = 0.0;
+};
+Prediction predict(Vec pa, Vec va, Vec pb, Vec vb, const fleet::Separation& min, double horizon_s);
+
+struct SeparationHooks {
+  TraceSink* trace = nullptr;
+  /// A give-way that cannot clear: abandon the mission with this reason (failsafe first).
+  std::function<void(const std::string&)> on_stuck;
+};
+
+class SeparationGuard {
+ public:
+  /// `mission`: any drone's mission of the run (the fleet, its separation and priorities).
+  SeparationGuard(const Mission& mission, mid::EventLoop& loop, SeparationHooks hooks);
+  ~SeparationGuard();
+  SeparationGuard(const SeparationGuard&) = delete;
+  SeparationGuard& operator=(const SeparationGuard&) = delete;
+
+  /// Drone `d` is flown by this process (in one process: every drone; a DEX: its own).
+  void fly(int d, mid::Drone& drone, const fleet::Limits& limits);
+  /// Drone `d`'s newest state: its own broker's or its telemetry.
+  void update(int d, const mid::DroneState& s);
+  /// The mission is over: no more give-ways, nothing resumed (the failsafe flies now).
+  void halt();
+
+  /// Pairs predicted so far: what the grid saves (tests).
+  std::uint64_t pairs_predicted() const { return pairs_; }
+
+ private:
+  struct Track {
+    bool known = false;
+    bool airborne = false;
+    double t = 0.0;
+    Vec p, v;
+    long long cell = 0;
+    bool in_grid = false;
+    double checked_at = -1e300;
+    // drones this process flies
+    mid::Drone* drone = nullptr;
+    double max_speed = 0.0;  ///< m/s, horizontally: its limits
+    int waits_for = -1;      ///< giving way to this drone; -1 none
+    int unheld_with = -1;    ///< a conflict it could not hold for, recorded once
+    int blocked_by = -1;     ///< held: the drone its course was last found blocked by
+    double held_since = 0.0;
+    Vec hold_v;              ///< its velocity when it gave way
+    Vec resume_v;            ///< the same way at full speed: its course once it resumes
+    mid::TimerId bound = mid::kNoTimer;
+  };
+
+  Vec now_at(const Track& k) const;
+  bool outranks(int a, int b) const;
+  bool holding(int d);
+  long long cell_of(const Vec& p) const;
+  void place(int d);
+  template <typename Fn>
+  void for_neighbours(int d, double reach_m, Fn fn);
+  void check(int d);
+  void consider(int a, int b);
+  void give_way(int a, int b, const Prediction& p);
+  void try_resume(int h);
+  void too_long(int h, double since);
+  double distance(int a, int b) const;
+  void trace(int d, int other, const char* event, const std::string& reason);
+
+  const Mission& m_;
+  mid::EventLoop& loop_;
+  SeparationHooks hooks_;
+  fleet::Separation min_;
+  double cell_m_;
+  double fastest_seen_ = 0.0;  ///< m/s, any drone so far: how far a neighbour can reach
+  std::vector<Track> tracks_;
+  std::unordered_map<long long, std::vector<int>> grid_;
+  bool halted_ = false;
+  std::uint64_t pairs_ = 0;
+};
+
+}  // namespace eamos::dex

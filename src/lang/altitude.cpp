@@ -1,0 +1,97 @@
+#include "lang/altitude.h"
+
+#include <cstdio>
+#include <optional>
+#include <string>
+
+namespace eamos::lang {
+namespace {
+
+std::optional<double> literal(const Expr* e) {
+  if (!e) return std::nullopt;
+  if (e->kind == ExprKind::number) return e->number;
+  if (e->kind == ExprKind::unary && e->op == Op::neg)
+    if (auto v = literal(e->lhs.get())) return -*v;
+  return std::nullopt;
+}
+
+std::string metres(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g m", v);
+  return buf;
+}
+
+struct Setting {
+  std::optional<SourceLocation> at;
+  std::string whose;  ///< for the note: "drone 'A'" or "type 'Quad'"
+};
+
+/// Where the fleet file sets the limits' max_altitude that applies to `drone`, if it does.
+Setting limit_location(const fleet::Fleet& fleet, const DroneDecl& drone) {
+  if (auto o = fleet.overrides.find(drone.name); o != fleet.overrides.end() && o->second.limits.max_altitude_at)
+    return {o->second.limits.max_altitude_at, "drone '" + drone.name + "'"};
+  if (auto t = fleet.type_max_altitude_at.find(drone.type); t != fleet.type_max_altitude_at.end())
+    return {t->second, "type '" + drone.type + "'"};
+  return {};
+}
+
+class AltitudeCheck {
+ public:
+  AltitudeCheck(const Mission& m, const fleet::Fleet& fleet, Diagnostics& diags) : m_(m), fleet_(fleet), diags_(diags) {}
+
+  void statement(const Statement& s) {
+    if (s.kind != StatementKind::action || s.drone_index < 0) return;
+    bool takeoff = s.callee == "Takeoff" && s.args.size() == 1;
+    bool fly_to = s.callee == "FlyTo" && s.args.size() == 3;
+    if (!takeoff && !fly_to) return;
+    const Expr* arg = s.args.back().get();
+    std::optional<double> value = literal(arg);
+    if (!value) return;
+    const DroneDecl& drone = m_.drones[s.drone_index];
+    fleet::DroneSettings settings = fleet_.settings_for(drone.name, drone.type, s.drone_index);
+    double ground = settings.home.z;
+    double z = takeoff ? ground + *value : *value;
+    double ceiling = settings.limits.max_altitude_m;
+    if (z > ground + ceiling + 1e-9) {
+      std::string over = takeoff ? "takeoff altitude " + metres(*value) : "target z = " + metres(z);
+      report(s, arg,
+             s.drone + "." + s.callee + ": " + over + " is above " + s.drone + "'s max_altitude of " +
+                 metres(ceiling) + " over its home (z = " + metres(ground) + "), and the drone refuses it; " +
+                 "fly at most " + metres(takeoff ? ceiling : ground + ceiling) + " or raise max_altitude in the fleet file",
+             limit_location(fleet_, drone).at, "");
+      return;
+    }
+    const fleet::Geofence* fence = fleet_.geofence_for(drone.name);
+    if (fence && fence->max_altitude_m && z > *fence->max_altitude_m + 1e-9)
+      report(s, arg,
+             s.drone + "." + s.callee + ": target z = " + metres(z) + " is above the geofence's max_altitude of " +
+                 metres(*fence->max_altitude_m) + "; fly at most " + metres(*fence->max_altitude_m) +
+                 " or raise the geofence's max_altitude in the fleet file",
+             fence->max_altitude_at, "the geofence of " + s.drone + " ends here");
+  }
+
+ private:
+  void report(const Statement& s, const Expr* arg, std::string message, std::optional<SourceLocation> at,
+              std::string note) {
+    diags_.error(m_.file, arg->loc, std::move(message));
+    if (note.empty()) {
+      const DroneDecl& drone = m_.drones[s.drone_index];
+      note = "max_altitude of " + limit_location(fleet_, drone).whose + ", which " + drone.name + " flies by, is set here";
+    }
+    if (at && fleet_.source) diags_.note(fleet_.source.get(), *at, note);
+  }
+
+  const Mission& m_;
+  const fleet::Fleet& fleet_;
+  Diagnostics& diags_;
+};
+
+}  // namespace
+
+void check_literal_altitudes(const Mission& mission, const fleet::Fleet& fleet, Diagnostics& diags) {
+  AltitudeCheck check(mission, fleet, diags);
+  for (const Function& f : mission.functions)
+    for (const Statement& s : f.body) check.statement(s);
+}
+
+}  // namespace eamos::lang

@@ -1,0 +1,244 @@
+// Separation kept in flight, in one process on the simulator: drones whose courses would
+// bring them closer than the fleet's min_separation give way (hold, then fly on), and a
+// give-way that cannot clear ends in the failsafe, never in a collision.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "trace/plot.h"
+#include "dex/separation.h"
+#include "trace/trace_schema.h"
+#include "dex/flight.h"
+
+namespace eamos::test {
+namespace {
+
+fleet::Fleet fleet_of(const std::string& yaml) {
+  fleet::Fleet f;
+  Diagnostics diags;
+  EXPECT_TRUE(fleet::parse_fleet(std::make_shared<SourceFile>("f.yaml", yaml), f, diags)) << diags.format();
+  return f;
+}
+
+/// Flies with telemetry in the trace at the simulator's own rate, so every step of every
+/// drone is there to measure.
+Flight fly_sampled(const std::string& text, const fleet::Fleet& fleet) {
+  Flight f;
+  std::vector<dex::Mission> missions = missions_of(text, fleet);
+  if (missions.empty()) return f;
+  mid::AdapterRegistry adapters;
+  sim::register_adapter(adapters);
+  dex::MemoryTrace memory;
+  std::ostringstream out;
+  dex::JsonlTrace jsonl(out, missions[0].fleet);
+  dex::TeeTrace tee;
+  tee.add(&memory);
+  tee.add(&jsonl);
+  dex::RunOptions options;
+  options.time_limit_s = 600;
+  options.telemetry_hz = 20;
+  f.result = dex::run_in_process(missions, adapters, &tee, options);
+  f.events = memory.events;
+  f.jsonl = out.str();
+  return f;
+}
+
+struct Closest {
+  double horizontal = 1e9;  ///< of the pair that came nearest while too close vertically
+  bool lost = false;        ///< some pair was too close both ways at once
+  std::string pair;
+};
+
+/// The closest any two airborne drones came, from the trace's telemetry (every drone at
+/// every tick: a sample is left out only when nothing changed).
+Closest closest(const Flight& f, const fleet::Separation& min = {}) {
+  std::map<std::string, mid::DroneState> last;
+  Closest c;
+  auto measure = [&] {
+    for (auto a = last.begin(); a != last.end(); ++a)
+      for (auto b = std::next(a); b != last.end(); ++b) {
+        if (a->second.landed || b->second.landed) continue;
+        double h = std::hypot(a->second.x - b->second.x, a->second.y - b->second.y);
+        double v = std::fabs(a->second.z - b->second.z);
+        if (v >= min.vertical_m) continue;
+        if (h < c.horizontal) c.horizontal = h, c.pair = a->first + "/" + b->first;
+        if (h < min.horizontal_m) c.lost = true;
+      }
+  };
+  double t = -1;
+  for (const dex::TraceEvent& e : f.events) {
+    if (e.event != "telemetry" || !e.state) continue;
+    if (e.t != t) measure();
+    t = e.t;
+    last[e.drone] = *e.state;
+  }
+  measure();
+  return c;
+}
+
+int count(const Flight& f, const std::string& event, const std::string& drone = "") {
+  int n = 0;
+  for (const dex::TraceEvent& e : f.events) n += e.event == event && (drone.empty() || e.drone == drone);
+  return n;
+}
+
+const dex::TraceEvent* first(const Flight& f, const std::string& event) {
+  for (const dex::TraceEvent& e : f.events)
+    if (e.event == event) return &e;
+  return nullptr;
+}
+
+void expect_valid_trace(const Flight& f) {
+  std::istringstream in(f.jsonl);
+  // The test's trace has no header line: check the events alone, after one of our own.
+  std::string header =
+      R"({"t":0,"event":"header","schema":"eamos-trace","version":1,"mission":"t","mission_hash":"h","source":"t.eamos","fleet":"f.yaml","telemetry_hz":20,"drones":[)";
+  std::vector<std::string> names;
+  for (const auto& d : f.result.drones) names.push_back(d.name);
+  for (std::size_t i = 0; i < names.size(); ++i)
+    header += std::string(i ? "," : "") + R"({"name":")" + names[i] + R"(","index":)" + std::to_string(i) +
+              R"(,"type":"Quad","home":[0,0,0]})";
+  header += "]}\n";
+  std::istringstream whole(header + f.jsonl);
+  std::vector<std::string> errors = trace::check_trace(whole, {.strict = true});
+  EXPECT_TRUE(errors.empty()) << errors.front();
+}
+
+const char* kTwo = "var A Quad\nvar B Quad\nfunc INIT() { PAR_go() }\nfunc PAR_go() { SEQ_a(); SEQ_b() }\n";
+const char* kThree =
+    "var A Quad\nvar B Quad\nvar C Quad\nfunc INIT() { PAR_go() }\nfunc PAR_go() { SEQ_a(); SEQ_b(); SEQ_c() }\n";
+
+std::string crossing(const std::string& a, const std::string& b) {
+  return std::string(kTwo) + "func SEQ_a() { A.Arm(); A.Takeoff(5); A.FlyTo(" + a + ", 0, 5); A.Land(); A.Disarm() }\n" +
+         "func SEQ_b() { B.Arm(); B.Takeoff(5); B.FlyTo(0, " + b + ", 5); B.Land(); B.Disarm() }\n";
+}
+
+const char* kCrossingFleet = "drones:\n  A: {home: [-30, 0, 0]}\n  B: {home: [0, -30, 0]}\n";
+
+TEST(Separation, CrossingPathsTheLaterDeclaredDroneGivesWayAndBothComplete) {
+  Flight f = fly_sampled(crossing("30", "30"), fleet_of(kCrossingFleet));
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  Closest c = closest(f);
+  EXPECT_FALSE(c.lost) << c.pair << " came within " << c.horizontal << " m";
+  EXPECT_EQ(count(f, "give_way", "B"), 1);
+  EXPECT_EQ(count(f, "give_way", "A"), 0);
+  EXPECT_EQ(count(f, "resume", "B"), 1);
+  const dex::TraceEvent* g = first(f, "give_way");
+  ASSERT_NE(g, nullptr);
+  EXPECT_EQ(g->other, "A");
+  ASSERT_TRUE(g->distance.has_value());
+  EXPECT_GT(*g->distance, 2.0);
+  EXPECT_NE(f.jsonl.find(R"("event":"give_way")"), std::string::npos);
+  EXPECT_NE(f.jsonl.find(R"("other":"A")"), std::string::npos);
+  expect_valid_trace(f);
+  // The plot rings where B gave way and dots where it flew on.
+  std::string svg = trace::plot_svg(f.result, f.events);
+  EXPECT_NE(svg.find(R"(<circle class="give-way" data-drone="B" data-other="A")"), std::string::npos);
+  EXPECT_NE(svg.find(R"(<circle class="resume" data-drone="B" data-other="A")"), std::string::npos);
+}
+
+TEST(Separation, APriorityInTheFleetFileDecidesWhoGivesWay) {
+  Flight f = fly_sampled(crossing("30", "30"),
+                         fleet_of("drones:\n  A: {home: [-30, 0, 0]}\n  B: {home: [0, -30, 0], priority: 1}\n"
+                                  "  # A ranks 1 by its place too: a tie goes to the drone declared first\n"));
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_EQ(count(f, "give_way", "B"), 1);
+  Flight g = fly_sampled(crossing("30", "30"),
+                         fleet_of("drones:\n  A: {home: [-30, 0, 0], priority: 5}\n  B: {home: [0, -30, 0]}\n"));
+  ASSERT_TRUE(g.result.completed) << g.result.error;
+  EXPECT_EQ(count(g, "give_way", "A"), 1);
+  EXPECT_EQ(count(g, "give_way", "B"), 0);
+  EXPECT_FALSE(closest(g).lost);
+}
+
+TEST(Separation, HeadOnSwapEndsInTheFailsafeApartWithTheReason) {
+  std::string text = std::string(kTwo) +
+                     "func SEQ_a() { A.Arm(); A.Takeoff(5); A.FlyTo(20, 0, 5); A.Land(); A.Disarm() }\n"
+                     "func SEQ_b() { B.Arm(); B.Takeoff(5); B.FlyTo(-20, 0, 5); B.Land(); B.Disarm() }\n";
+  Flight f = fly_sampled(text, fleet_of("drones:\n  A: {home: [-20, 0, 0]}\n  B: {home: [20, 0, 0]}\n"));
+  ASSERT_FALSE(f.result.completed);
+  EXPECT_NE(f.result.error.find("give way to each other"), std::string::npos) << f.result.error;
+  EXPECT_FALSE(closest(f).lost);
+  EXPECT_GE(count(f, "give_way"), 2);
+  EXPECT_EQ(count(f, "failsafe"), 2);
+  for (const auto& d : f.result.drones) EXPECT_TRUE(d.state.landed) << d.name;
+}
+
+std::string hover_on_path(double hover_s) {
+  return std::string(kTwo) + "func SEQ_a() { A.Arm(); A.Takeoff(5); A.FlyTo(30, 0, 5); A.Land(); A.Disarm() }\n" +
+         "func SEQ_b() { B.Arm(); B.Takeoff(5); B.Hover(" + std::to_string(hover_s) +
+         "); B.FlyTo(0, 15, 5); B.Land(); B.Disarm() }\n";
+}
+
+TEST(Separation, ADroneHoveringOnAnothersPathIsWaitedForPastTheDeadline) {
+  // A's FlyTo of 60 m may take 1.5 × 6 s + 10 s = 19 s; it waits 20 s and more for B.
+  Flight f = fly_sampled(hover_on_path(25), fleet_of("drones:\n  A: {home: [-30, 0, 0]}\n  B: {home: [0, 0, 0]}\n"));
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_FALSE(closest(f).lost);
+  EXPECT_EQ(count(f, "give_way", "A"), 1);
+  EXPECT_EQ(count(f, "resume", "A"), 1);
+  double held = 0, gave = 0;
+  for (const auto& e : f.events) {
+    if (e.event == "give_way") gave = e.t;
+    if (e.event == "resume") held = e.t - gave;
+  }
+  EXPECT_GT(held, 19.0);
+}
+
+TEST(Separation, AGiveWayLongerThanItsBoundEndsInTheFailsafe) {
+  Flight f = fly_sampled(hover_on_path(60), fleet_of("drones:\n  A: {home: [-30, 0, 0]}\n  B: {home: [0, 0, 0]}\n"));
+  ASSERT_FALSE(f.result.completed);
+  EXPECT_NE(f.result.error.find("A gave way to B for 30.0 s"), std::string::npos) << f.result.error;
+  EXPECT_FALSE(closest(f).lost);
+  EXPECT_EQ(count(f, "failsafe"), 2);
+}
+
+TEST(Separation, ThreeConvergingDronesPassOneAtATime) {
+  std::string text = std::string(kThree) +
+                     "func SEQ_a() { A.Arm(); A.Takeoff(5); A.FlyTo(30, 0, 5); A.Land(); A.Disarm() }\n"
+                     "func SEQ_b() { B.Arm(); B.Takeoff(5); B.FlyTo(0, 30, 5); B.Land(); B.Disarm() }\n"
+                     "func SEQ_c() { C.Arm(); C.Takeoff(5); C.FlyTo(21, 21, 5); C.Land(); C.Disarm() }\n";
+  Flight f = fly_sampled(
+      text, fleet_of("drones:\n  A: {home: [-30, 0, 0]}\n  B: {home: [0, -30, 0]}\n  C: {home: [-21, -21, 0]}\n"));
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  Closest c = closest(f);
+  EXPECT_FALSE(c.lost) << c.pair << " came within " << c.horizontal << " m";
+  EXPECT_EQ(count(f, "give_way", "A"), 0);
+  EXPECT_GE(count(f, "give_way", "B") + count(f, "give_way", "C"), 2);
+  EXPECT_EQ(count(f, "give_way"), count(f, "resume"));
+}
+
+TEST(Separation, AWiderMinSeparationFromTheFleetIsKept) {
+  Flight f = fly_sampled(crossing("30", "30"),
+                         fleet_of(std::string(kCrossingFleet) + "safety:\n  min_separation: {horizontal: 8, vertical: 2}\n"));
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  fleet::Separation wide{8, 2};
+  Closest c = closest(f, wide);
+  EXPECT_FALSE(c.lost) << c.pair << " came within " << c.horizontal << " m";
+  EXPECT_GE(c.horizontal, 8.0);
+}
+
+TEST(Separation, DronesOnSeparateCoursesNeverGiveWay) {
+  Flight f = fly_sampled(crossing("30", "-40"), fleet_of("drones:\n  A: {home: [-30, 0, 0]}\n  B: {home: [10, -30, 0]}\n"));
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  EXPECT_EQ(count(f, "conflict"), 0);
+}
+
+TEST(SeparationPrediction, CoursesThatMeetWithinTheHorizonAreAConflict) {
+  fleet::Separation min;
+  // Head-on at 10 m/s each, 30 m apart: within 2 m after 1.4 s.
+  dex::Prediction p = dex::predict({0, 0, 5}, {10, 0, 0}, {30, 0, 5}, {-10, 0, 0}, min, 3.0);
+  EXPECT_TRUE(p.conflict);
+  EXPECT_NEAR(p.in_s, 1.4, 1e-9);
+  // The same 1 m apart vertically is apart.
+  EXPECT_FALSE(dex::predict({0, 0, 5}, {10, 0, 0}, {30, 0, 6}, {-10, 0, 0}, min, 3.0).conflict);
+  // Beyond the horizon.
+  EXPECT_FALSE(dex::predict({0, 0, 5}, {10, 0, 0}, {90, 0, 5}, {-10, 0, 0}, min, 3.0).conflict);
+  // Already too close, but parting: holding would not help.
+  EXPECT_FALSE(dex::predict({0, 0, 5}, {-1, 0, 0}, {1, 0, 5}, {1, 0, 0}, min, 3.0).conflict);
+}
+
+}  // namespace
+}  // namespace eamos::test
