@@ -264,6 +264,71 @@ struct Layout<CommandInt> {
 };
 
 template <>
+struct Layout<MissionCount> {
+  static constexpr uint32_t id = msg::MISSION_COUNT;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("target_system", m.target_system);
+    v("target_component", m.target_component);
+    v("count", m.count);
+    v("mission_type", m.mission_type);
+    v("opaque_id", m.opaque_id);
+  }
+};
+
+template <>
+struct Layout<MissionRequestList> {
+  static constexpr uint32_t id = msg::MISSION_REQUEST_LIST;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("target_system", m.target_system);
+    v("target_component", m.target_component);
+    v("mission_type", m.mission_type);
+  }
+};
+
+template <>
+struct Layout<MissionAck> {
+  static constexpr uint32_t id = msg::MISSION_ACK;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("target_system", m.target_system);
+    v("target_component", m.target_component);
+    v("type", m.type);
+    v("mission_type", m.mission_type);
+    v("opaque_id", m.opaque_id);
+  }
+};
+
+template <>
+struct Layout<MissionItemInt> {
+  static constexpr uint32_t id = msg::MISSION_ITEM_INT;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("target_system", m.target_system);
+    v("target_component", m.target_component);
+    v("seq", m.seq);
+    v("frame", m.frame);
+    v("command", m.command);
+    v("current", m.current);
+    v("autocontinue", m.autocontinue);
+    v.numbered("param", m.param);
+    v("x", m.x);
+    v("y", m.y);
+    v("z", m.z);
+    v("mission_type", m.mission_type);
+  }
+};
+
+template <typename M, typename V>
+void mission_request_fields(M& m, V& v) {
+  v("target_system", m.target_system);
+  v("target_component", m.target_component);
+  v("seq", m.seq);
+  v("mission_type", m.mission_type);
+}
+
+template <>
 struct Layout<CommandAck> {
   static constexpr uint32_t id = msg::COMMAND_ACK;
   template <typename M, typename V>
@@ -435,97 +500,34 @@ std::optional<CameraCapture> unpack_camera_capture(const Message& m) {
   return c;
 }
 
-Message pack(const MissionCount& m) {
-  FieldWriter w(def_of(msg::MISSION_COUNT));
-  w.set("target_system", m.target_system);
-  w.set("target_component", m.target_component);
-  w.set("count", m.count);
-  w.set("mission_type", m.mission_type);
-  w.set("opaque_id", m.opaque_id);
-  return w.take();
+Message pack(const MissionCount& m) { return pack_fields(m); }
+std::optional<MissionCount> unpack_mission_count(const Message& m) { return unpack_fields<MissionCount>(m); }
+
+Message pack(const MissionRequestList& m) { return pack_fields(m); }
+std::optional<MissionRequestList> unpack_mission_request_list(const Message& m) {
+  return unpack_fields<MissionRequestList>(m);
 }
 
-std::optional<MissionCount> unpack_mission_count(const Message& m) {
-  if (m.id != msg::MISSION_COUNT) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  return MissionCount{r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component"),
-                      r.get<uint16_t>("count"), r.get<uint8_t>("mission_type"), r.get<uint32_t>("opaque_id")};
-}
+Message pack(const MissionAck& m) { return pack_fields(m); }
+std::optional<MissionAck> unpack_mission_ack(const Message& m) { return unpack_fields<MissionAck>(m); }
 
+Message pack(const MissionItemInt& m) { return pack_fields(m); }
+std::optional<MissionItemInt> unpack_mission_item_int(const Message& m) { return unpack_fields<MissionItemInt>(m); }
+
+// MISSION_REQUEST and MISSION_REQUEST_INT share their fields; `legacy` says which id.
 Message pack(const MissionRequest& m) {
-  FieldWriter w(def_of(m.legacy ? msg::MISSION_REQUEST : msg::MISSION_REQUEST_INT));
-  w.set("target_system", m.target_system);
-  w.set("target_component", m.target_component);
-  w.set("seq", m.seq);
-  w.set("mission_type", m.mission_type);
+  Writer w(m.legacy ? msg::MISSION_REQUEST : msg::MISSION_REQUEST_INT);
+  mission_request_fields(m, w);
   return w.take();
 }
 
 std::optional<MissionRequest> unpack_mission_request(const Message& m) {
   if (m.id != msg::MISSION_REQUEST_INT && m.id != msg::MISSION_REQUEST) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  return MissionRequest{r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component"),
-                        r.get<uint16_t>("seq"), r.get<uint8_t>("mission_type"), m.id == msg::MISSION_REQUEST};
-}
-
-Message pack(const MissionRequestList& m) {
-  FieldWriter w(def_of(msg::MISSION_REQUEST_LIST));
-  w.set("target_system", m.target_system);
-  w.set("target_component", m.target_component);
-  w.set("mission_type", m.mission_type);
-  return w.take();
-}
-
-std::optional<MissionRequestList> unpack_mission_request_list(const Message& m) {
-  if (m.id != msg::MISSION_REQUEST_LIST) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  return MissionRequestList{r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component"),
-                            r.get<uint8_t>("mission_type")};
-}
-
-Message pack(const MissionAck& m) {
-  FieldWriter w(def_of(msg::MISSION_ACK));
-  w.set("target_system", m.target_system);
-  w.set("target_component", m.target_component);
-  w.set("type", m.type);
-  w.set("mission_type", m.mission_type);
-  w.set("opaque_id", m.opaque_id);
-  return w.take();
-}
-
-std::optional<MissionAck> unpack_mission_ack(const Message& m) {
-  if (m.id != msg::MISSION_ACK) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  return MissionAck{r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component"),
-                    r.get<uint8_t>("type"), r.get<uint8_t>("mission_type"), r.get<uint32_t>("opaque_id")};
-}
-
-Message pack(const MissionItemInt& m) {
-  FieldWriter w(def_of(msg::MISSION_ITEM_INT));
-  w.set("target_system", m.target_system);
-  w.set("target_component", m.target_component);
-  w.set("seq", m.seq);
-  w.set("frame", m.frame);
-  w.set("command", m.command);
-  w.set("current", m.current);
-  w.set("autocontinue", m.autocontinue);
-  for (int i = 0; i < 4; ++i) w.set(param_name(i), m.param[i]);
-  w.set("x", m.x);
-  w.set("y", m.y);
-  w.set("z", m.z);
-  w.set("mission_type", m.mission_type);
-  return w.take();
-}
-
-std::optional<MissionItemInt> unpack_mission_item_int(const Message& m) {
-  if (m.id != msg::MISSION_ITEM_INT) return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  MissionItemInt c{r.get<uint8_t>("target_system"), r.get<uint8_t>("target_component"), r.get<uint16_t>("seq"),
-                   r.get<uint8_t>("frame"), r.get<uint16_t>("command"), r.get<uint8_t>("current"),
-                   r.get<uint8_t>("autocontinue"), {}, r.get<int32_t>("x"), r.get<int32_t>("y"),
-                   r.get<float>("z"), r.get<uint8_t>("mission_type")};
-  for (int i = 0; i < 4; ++i) c.param[i] = r.get<float>(param_name(i));
-  return c;
+  MissionRequest out;
+  Reader r(m);
+  mission_request_fields(out, r);
+  out.legacy = m.id == msg::MISSION_REQUEST;
+  return out;
 }
 
 }  // namespace eamos::mavlink

@@ -159,6 +159,7 @@ TEST(MavlinkFenceUpload, LostCountsAreSentAgainUntilTheVehicleAnswers) {
 // and the vehicle stays disarmed.
 struct Refusal {
   const char* name;
+  int port;  ///< each case its own: ctest runs them side by side
   std::function<void(sim_vehicle::VehicleOptions&)> vehicle;
   const char* reason;
 };
@@ -169,10 +170,10 @@ class MavlinkFenceRefused : public ::testing::TestWithParam<Refusal> {};
 TEST_P(MavlinkFenceRefused, ArmFailsWithTheReasonAndTheVehicleStaysDisarmed) {
   sim_vehicle::VehicleOptions o;
   GetParam().vehicle(o);
-  test::VehicleThread vehicle(25495, kSpeed, o);
+  test::VehicleThread vehicle(GetParam().port, kSpeed, o);
   MavlinkOptions options;
   options.fence_reply_s = 0.25;
-  Flight f(25495, options, [](fleet::DroneSettings& s) { with_fence(s); });
+  Flight f(GetParam().port, options, [](fleet::DroneSettings& s) { with_fence(s); });
   ASSERT_TRUE(f.drone) << f.created.message;
   mid::ActionEnd e = f.fly("Arm");
   EXPECT_EQ(e.outcome, mid::Outcome::failed);
@@ -191,14 +192,14 @@ TEST_P(MavlinkFenceRefused, ArmFailsWithTheReasonAndTheVehicleStaysDisarmed) {
 INSTANTIATE_TEST_SUITE_P(
     Vehicles, MavlinkFenceRefused,
     ::testing::Values(
-        Refusal{"NoRoom", [](sim_vehicle::VehicleOptions& o) { o.fence_capacity = 3; },
+        Refusal{"NoRoom", 25495, [](sim_vehicle::VehicleOptions& o) { o.fence_capacity = 3; },
                 "PX4 refused the fence: MAV_MISSION_NO_SPACE"},
-        Refusal{"NoFence", [](sim_vehicle::VehicleOptions& o) { o.fence_capacity = 0; },
+        Refusal{"NoFence", 25496, [](sim_vehicle::VehicleOptions& o) { o.fence_capacity = 0; },
                 "PX4 never sent its request for the first fence corner (MISSION_REQUEST_INT) after "
                 "MISSION_COUNT in 5 tries"},
-        Refusal{"ReadBackDiffers", [](sim_vehicle::VehicleOptions& o) { o.fence_read_back_shift_e7 = 1000; },
+        Refusal{"ReadBackDiffers", 25497, [](sim_vehicle::VehicleOptions& o) { o.fence_read_back_shift_e7 = 1000; },
                 "the fence read back from PX4 differs: fence item 0 lies at"},
-        Refusal{"ParameterKept", [](sim_vehicle::VehicleOptions& o) { o.read_only_params = {"GF_ACTION"}; },
+        Refusal{"ParameterKept", 25498, [](sim_vehicle::VehicleOptions& o) { o.read_only_params = {"GF_ACTION"}; },
                 "PX4 kept GF_ACTION at 0 when set to 5"}),
     [](const ::testing::TestParamInfo<Refusal>& info) { return std::string(info.param.name); });
 
