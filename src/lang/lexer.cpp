@@ -212,8 +212,13 @@ Token Lexer::lex_operator(std::size_t begin) {
       break;
     default: break;
   }
-  // Swallow a whole run of unknown bytes as one token: binary garbage gives one error per
-  // run, not one per byte.
+  return lex_unknown(begin);
+}
+
+// Swallows a whole run of unknown bytes as one token: binary garbage gives one error per run,
+// not one per byte.
+Token Lexer::lex_unknown(std::size_t begin) {
+  char c = peek();
   while (!at_end()) {
     unsigned char u = static_cast<unsigned char>(peek());
     bool known = std::isalnum(u) || std::isspace(u) || std::string_view("(){},.;+-*/!<>_\"").find(char(u)) != std::string_view::npos;

@@ -26,6 +26,7 @@ class Lexer {
   Token lex_number(std::size_t begin);
   Token lex_identifier(std::size_t begin);
   Token lex_operator(std::size_t begin);
+  Token lex_unknown(std::size_t begin);
   bool at_end() const { return pos_ >= file_.text.size(); }
   char peek(std::size_t ahead = 0) const;
 

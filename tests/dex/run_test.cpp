@@ -81,12 +81,14 @@ TEST(Run, DoWhileSyncCancelsDoBranchWhenConditionFlips) {
 }
 
 TEST(Run, TakeoffWhileDisarmedFailsTheMissionNamingDroneActionAndLine) {
-  Flight f = fly(std::string(kTwo) + "func INIT() {\n  A.Takeoff(5)\n}\n");
+  // The Arm runs only above 100 % battery, never: check warns, the drone refuses at run time.
+  Flight f = fly(std::string(kTwo) + "func INIT() {\n  If(A.Battery() > 100, SEQ_arm, SEQ_stay)\n  A.Takeoff(5)\n}\n"
+                                     "func SEQ_arm() { A.Arm() }\nfunc SEQ_stay() { PauseFor(0) }\n");
   EXPECT_FALSE(f.result.completed);
   ASSERT_TRUE(f.result.failure.has_value());
   EXPECT_EQ(f.result.failure->drone, "A");
   EXPECT_EQ(f.result.failure->action, "Takeoff");
-  EXPECT_EQ(f.result.failure->line, 4);
+  EXPECT_EQ(f.result.failure->line, 5);
 }
 
 TEST(Run, SameMissionGivesByteIdenticalTrace) {

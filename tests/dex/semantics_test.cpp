@@ -216,7 +216,8 @@ TEST(Semantics, AbandonedMissionTracesAFailsafeForEveryDroneNotYetSafe) {
   Flight f = fly("package p\nvar A Quad\nvar B Quad\nvar C Quad\n"
                  "func INIT() { PAR_all() }\n"
                  "func PAR_all() { SEQ_a(); SEQ_b(); C.Arm() }\n"
-                 "func SEQ_a() { PauseFor(3); A.Takeoff(3) }\n"
+                 "func SEQ_a() { PauseFor(3); If(A.Battery() > 100, SEQ_arm, SEQ_stay); A.Takeoff(3) }\n"
+                 "func SEQ_arm() { A.Arm() }\nfunc SEQ_stay() { PauseFor(0) }\n"
                  "func SEQ_b() { B.Arm(); B.Takeoff(5); B.Orbit() }\n");
   ASSERT_TRUE(f.result.failure.has_value());
   EXPECT_EQ(f.result.failure->drone, "A");

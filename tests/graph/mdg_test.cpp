@@ -138,7 +138,8 @@ TEST(Mdg, FleetWideBarrierCostsArcsLinearInTheFleetAndOneSharedDroneSet) {
 TEST(Mdg, DoConditionListsTheNodesItCancelsOnEachDrone) {
   auto c = compile_text(
       "var A Quad\nvar B Quad\n"
-      "func INIT() { DoWhileSync(A.Battery() > 30, PAR_do, SEQ_done) }\n"
+      "func INIT() { PAR_arm(); DoWhileSync(A.Battery() > 30, PAR_do, SEQ_done) }\n"
+      "func PAR_arm() { A.Arm(); B.Arm() }\n"
       "func PAR_do() { A.Orbit(); B.Orbit() }\nfunc SEQ_done() { A.Land() }\n");
   ASSERT_TRUE(c);
   int cond = node(*c, "DoWhileSync A.Battery() > 30");

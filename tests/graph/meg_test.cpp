@@ -77,7 +77,7 @@ TEST(Meg, WaitUntilStartsBranchOnGoAndEndsInTerminal) {
 
 TEST(Meg, RepeatLoopsBackFromRepeatTerminalToCondition) {
   for (const char* kind : {"RepeatUntil", "RepeatWhile"}) {
-    auto c = compile_text(mission(std::string("func INIT() { ") + kind +
+    auto c = compile_text(mission(std::string("func INIT() { A.Arm(); ") + kind +
                                   "(A.Z() > 9, SEQ_r, SEQ_n) }\nfunc SEQ_r() { A.FlyByZ(1) }\n"
                                   "func SEQ_n() { A.Land() }\n"));
     ASSERT_TRUE(c);
@@ -95,7 +95,7 @@ TEST(Meg, RepeatLoopsBackFromRepeatTerminalToCondition) {
 
 TEST(Meg, RepeatForCarriesItsIterationLimit) {
   auto c = compile_text(mission(
-      "func INIT() { RepeatFor(A.Z() < 9, SEQ_r, SEQ_n, 4) }\nfunc SEQ_r() { A.FlyByZ(1) }\n"
+      "func INIT() { A.Arm(); RepeatFor(A.Z() < 9, SEQ_r, SEQ_n, 4) }\nfunc SEQ_r() { A.FlyByZ(1) }\n"
       "func SEQ_n() { A.Land() }\n"));
   ASSERT_TRUE(c);
   int cond = node(*c, "RepeatFor A.Z() < 9 ×4");
@@ -130,7 +130,7 @@ TEST(Meg, PauseForIsATimerOnTheDroneThatRanBefore) {
 
 TEST(Meg, DoSyncCancelsDoBranchAndWaitsForOneOfItsTerminals) {
   for (const char* kind : {"DoUntilSync", "DoWhileSync"}) {
-    auto c = compile_text(mission(std::string("func INIT() { ") + kind +
+    auto c = compile_text(mission(std::string("func INIT() { A.Arm(); ") + kind +
                                   "(A.Battery() < 30, SEQ_do, SEQ_done); B.Arm() }\n"
                                   "func SEQ_do() { A.Orbit(); A.Hover(5) }\nfunc SEQ_done() { A.ReturnHome() }\n"));
     ASSERT_TRUE(c);
@@ -155,7 +155,7 @@ TEST(Meg, DoSyncCancelsDoBranchAndWaitsForOneOfItsTerminals) {
 
 TEST(Meg, DoAsyncLetsTheSequenceContinueAtOnce) {
   for (const char* kind : {"DoUntilAsync", "DoWhileAsync"}) {
-    auto c = compile_text(mission(std::string("func INIT() { ") + kind +
+    auto c = compile_text(mission(std::string("func INIT() { A.Arm(); ") + kind +
                                   "(A.Battery() < 30, SEQ_do, SEQ_done); B.Arm() }\n"
                                   "func SEQ_do() { A.Orbit() }\nfunc SEQ_done() { A.Land() }\n"));
     ASSERT_TRUE(c);

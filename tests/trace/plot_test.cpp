@@ -133,7 +133,7 @@ TEST(Plot, DrawsTheFailsafePhaseOnTheTimelineTheMapAndTheAltitude) {
       "var A Quad\nvar B Quad\n"
       "func INIT() { PAR_go() }\n"
       "func PAR_go() { SEQ_a(); SEQ_b() }\n"
-      "func SEQ_a() { A.Arm(); A.Takeoff(5); A.Takeoff(200) }\n"
+      "func SEQ_a() { A.Arm(); A.Takeoff(5); A.Takeoff(A.Z() + 195) }\n"
       "func SEQ_b() { B.Arm(); B.Takeoff(8); B.FlyByY(20) }\n");
   ASSERT_FALSE(f.result.completed);
   std::string svg = trace::plot_svg(f.result, f.events);
