@@ -29,6 +29,7 @@ MessageDef make(uint32_t id, std::string_view name, std::vector<FieldDef> declar
 }
 
 // Fields in common.xml's declaration order.
+// long: one table, a message per entry, read against common.xml line by line
 std::vector<MessageDef> build_table() {
   std::vector<MessageDef> t;
   t.push_back(make(msg::HEARTBEAT, "HEARTBEAT",

@@ -557,6 +557,27 @@ struct FenceRead {
   std::map<std::string, float> params;
 };
 
+// Asks for what has not come yet: the count, the items, the parameters.
+void ask_fence(FenceRead& r, uint8_t vehicle, const std::vector<std::string>& params,
+               const std::function<void(const ml::Message&)>& send) {
+  ml::Heartbeat hb;
+  hb.type = 6;       // MAV_TYPE_GCS
+  hb.autopilot = 8;  // MAV_AUTOPILOT_INVALID
+  send(ml::pack(hb));
+  std::unique_lock lock(r.mutex);
+  int count = r.count;
+  std::vector<uint16_t> missing;
+  for (int k = 0; k < count; ++k)
+    if (!r.items.contains(static_cast<uint16_t>(k))) missing.push_back(static_cast<uint16_t>(k));
+  std::vector<std::string> unread;
+  for (const std::string& p : params)
+    if (!r.params.contains(p)) unread.push_back(p);
+  lock.unlock();
+  if (count < 0) send(ml::pack(ml::MissionRequestList{vehicle, 1, ml::mission_type::FENCE}));
+  for (uint16_t k : missing) send(ml::pack(ml::MissionRequest{vehicle, 1, k, ml::mission_type::FENCE}));
+  for (const std::string& p : unread) send(ml::pack(ml::ParamRequestRead{vehicle, 1, p, -1}));
+}
+
 }  // namespace
 
 bool SitlFleet::read_fence(int i, const std::vector<std::string>& params, const std::vector<std::string>& integer,
@@ -582,24 +603,6 @@ bool SitlFleet::read_fence(int i, const std::vector<std::string>& params, const 
   }
   ml::Encoder encoder{250, 190, 0};
   auto send = [&](const ml::Message& m) { opened.link->send(encoder.encode(m)); };
-  auto ask = [&] {
-    ml::Heartbeat hb;
-    hb.type = 6;        // MAV_TYPE_GCS
-    hb.autopilot = 8;   // MAV_AUTOPILOT_INVALID
-    send(ml::pack(hb));
-    std::unique_lock lock(r.mutex);
-    int count = r.count;
-    std::vector<uint16_t> missing;
-    for (int k = 0; k < count; ++k)
-      if (!r.items.contains(static_cast<uint16_t>(k))) missing.push_back(static_cast<uint16_t>(k));
-    std::vector<std::string> unread;
-    for (const std::string& p : params)
-      if (!r.params.contains(p)) unread.push_back(p);
-    lock.unlock();
-    if (count < 0) send(ml::pack(ml::MissionRequestList{vehicle, 1, ml::mission_type::FENCE}));
-    for (uint16_t k : missing) send(ml::pack(ml::MissionRequest{vehicle, 1, k, ml::mission_type::FENCE}));
-    for (const std::string& p : unread) send(ml::pack(ml::ParamRequestRead{vehicle, 1, p, -1}));
-  };
   auto done = [&] {
     if (r.count < 0 || static_cast<int>(r.items.size()) < r.count) return false;
     for (const std::string& p : params)
@@ -612,7 +615,7 @@ bool SitlFleet::read_fence(int i, const std::vector<std::string>& params, const 
     std::unique_lock lock(r.mutex);
     while (!(ok = done()) && now_s() < deadline) {
       lock.unlock();
-      ask();
+      ask_fence(r, vehicle, params, send);
       lock.lock();
       r.changed.wait_for(lock, std::chrono::milliseconds(300), done);
     }
@@ -627,15 +630,10 @@ bool SitlFleet::read_fence(int i, const std::vector<std::string>& params, const 
   items.clear();
   for (auto& [seq, item] : r.items) items.push_back(item);
   for (const std::string& p : params) {
-    bool is_int = std::find(integer.begin(), integer.end(), p) != integer.end();
-    float wire = r.params[p];
-    if (options_.autopilot == Autopilot::px4 && is_int) {
-      int32_t v = 0;
-      std::memcpy(&v, &wire, sizeof v);
-      values[p] = v;
-    } else {
-      values[p] = wire;
-    }
+    bool bytewise = options_.autopilot == Autopilot::px4 && std::find(integer.begin(), integer.end(), p) != integer.end();
+    int32_t v = 0;
+    std::memcpy(&v, &r.params[p], sizeof v);
+    values[p] = bytewise ? v : r.params[p];
   }
   return true;
 }
