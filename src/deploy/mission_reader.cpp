@@ -482,6 +482,7 @@ class Reader {
     const std::string gw = "/drone/site/geofence";
     optional_number(*g, "min_altitude", gw, fence.min_altitude_m, -kAny);
     optional_number(*g, "max_altitude", gw, fence.max_altitude_m, -kAny);
+    f_.boolean(*g, "upload", gw, fence.upload, false);
     if (polygon(*g, gw, fence)) out.geofence = std::move(fence);
   }
 

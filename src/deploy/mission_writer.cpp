@@ -72,6 +72,7 @@ void write_site(JsonWriter& w, const fleet::SiteLimits& site) {
     w.end_array();
     write_optional(w, "min_altitude", g.min_altitude_m);
     write_optional(w, "max_altitude", g.max_altitude_m);
+    if (g.upload) w.member("upload", true);
     w.end_object();
   }
   write_optional(w, "max_speed", site.max_speed_mps);

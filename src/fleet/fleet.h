@@ -40,6 +40,9 @@ struct Geofence {
   std::vector<std::pair<double, double>> polygon;  ///< (x east, y north), m; empty = no polygon
   std::optional<double> min_altitude_m;
   std::optional<double> max_altitude_m;
+  /// `upload: true`: the mavlink adapter also gives the fence to the autopilot (its own
+  /// polygon fence, FENCE_* / GF_*), so the vehicle holds it without the companion computer.
+  bool upload = false;
   std::optional<SourceLocation> max_altitude_at;  ///< where the fleet file sets max_altitude
   /// True when (x, y, z) lies inside (a point on the boundary is inside).
   bool contains(double x, double y, double z) const;

@@ -17,7 +17,7 @@ const std::vector<std::string> kSafetyKeys = {"min_separation", "battery_reserve
                                               "max_climb",      "max_descent",     "geofence",
                                               "home_tolerance"};
 const std::vector<std::string> kSeparationKeys = {"horizontal", "vertical"};
-const std::vector<std::string> kGeofenceKeys = {"polygon", "min_altitude", "max_altitude"};
+const std::vector<std::string> kGeofenceKeys = {"polygon", "min_altitude", "max_altitude", "upload"};
 const std::vector<std::string> kTypeKeys = {"adapter", "capabilities", "sensors", "limits", "tolerance"};
 const std::vector<std::string> kToleranceKeys = {"horizontal", "vertical", "speed"};
 const std::vector<std::string> kDroneKeys = {"home",     "battery",  "sensors",
@@ -489,12 +489,18 @@ void FleetParser::geofence(const YAML::Node& node, const std::string& where, std
     std::string key = r_.field(kv.first, kGeofenceKeys, seen, what);
     double value = 0;
     if (key == "polygon") polygon(kv.second, "polygon of " + what, g);
+    if (key == "upload") flag(kv.second, "upload of " + what, g.upload);
     if (key == "min_altitude" && r_.number(kv.second, "min_altitude of " + what, value)) g.min_altitude_m = value;
     if (key == "max_altitude" && r_.number(kv.second, "max_altitude of " + what, value)) {
       g.max_altitude_m = value;
       g.max_altitude_at = location_of(kv.second.Mark());
       max_node = kv.second;
     }
+  }
+  if (g.upload && g.polygon.empty()) {
+    r_.error(node, "upload of " + what + " needs a polygon: an autopilot's fence is a polygon (with an "
+                   "altitude ceiling); add `polygon: [[x, y], ...]` or drop `upload`");
+    return;
   }
   if (g.min_altitude_m && g.max_altitude_m && *g.min_altitude_m >= *g.max_altitude_m) {
     r_.error(*max_node, "max_altitude of " + what + " must be above its min_altitude (" +

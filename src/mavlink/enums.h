@@ -17,6 +17,7 @@ inline constexpr uint16_t COMPONENT_ARM_DISARM = 400;
 inline constexpr uint16_t SET_MESSAGE_INTERVAL = 511;
 inline constexpr uint16_t REQUEST_MESSAGE = 512;
 inline constexpr uint16_t IMAGE_START_CAPTURE = 2000;
+inline constexpr uint16_t NAV_FENCE_POLYGON_VERTEX_INCLUSION = 5001;  ///< param1: the polygon's vertex count
 }  // namespace cmd
 
 namespace result {  // MAV_RESULT

@@ -29,6 +29,7 @@ MessageDef make(uint32_t id, std::string_view name, std::vector<FieldDef> declar
 }
 
 // Fields in common.xml's declaration order.
+// long: one table, a message per entry, read against common.xml line by line
 std::vector<MessageDef> build_table() {
   std::vector<MessageDef> t;
   t.push_back(make(msg::HEARTBEAT, "HEARTBEAT",
@@ -67,6 +68,28 @@ std::vector<MessageDef> build_table() {
                    {{T::u32, "time_boot_ms"}, {T::i32, "lat"}, {T::i32, "lon"},
                     {T::i32, "alt"}, {T::i32, "relative_alt"}, {T::i16, "vx"},
                     {T::i16, "vy"}, {T::i16, "vz"}, {T::u16, "hdg"}}));
+  // The mission protocol, used for the fence (mission_type FENCE): upload (COUNT, REQUEST_INT
+  // or REQUEST, ITEM_INT, ACK) and read back (REQUEST_LIST, COUNT, REQUEST_INT, ITEM_INT, ACK).
+  t.push_back(make(msg::MISSION_REQUEST, "MISSION_REQUEST",
+                   {{T::u8, "target_system"}, {T::u8, "target_component"}, {T::u16, "seq"},
+                    ext(T::u8, "mission_type")}));
+  t.push_back(make(msg::MISSION_REQUEST_LIST, "MISSION_REQUEST_LIST",
+                   {{T::u8, "target_system"}, {T::u8, "target_component"}, ext(T::u8, "mission_type")}));
+  t.push_back(make(msg::MISSION_COUNT, "MISSION_COUNT",
+                   {{T::u8, "target_system"}, {T::u8, "target_component"}, {T::u16, "count"},
+                    ext(T::u8, "mission_type"), ext(T::u32, "opaque_id")}));
+  t.push_back(make(msg::MISSION_ACK, "MISSION_ACK",
+                   {{T::u8, "target_system"}, {T::u8, "target_component"}, {T::u8, "type"},
+                    ext(T::u8, "mission_type"), ext(T::u32, "opaque_id")}));
+  t.push_back(make(msg::MISSION_REQUEST_INT, "MISSION_REQUEST_INT",
+                   {{T::u8, "target_system"}, {T::u8, "target_component"}, {T::u16, "seq"},
+                    ext(T::u8, "mission_type")}));
+  t.push_back(make(msg::MISSION_ITEM_INT, "MISSION_ITEM_INT",
+                   {{T::u8, "target_system"}, {T::u8, "target_component"}, {T::u16, "seq"},
+                    {T::u8, "frame"}, {T::u16, "command"}, {T::u8, "current"},
+                    {T::u8, "autocontinue"}, {T::f32, "param1"}, {T::f32, "param2"},
+                    {T::f32, "param3"}, {T::f32, "param4"}, {T::i32, "x"}, {T::i32, "y"},
+                    {T::f32, "z"}, ext(T::u8, "mission_type")}));
   t.push_back(make(msg::COMMAND_INT, "COMMAND_INT",
                    {{T::u8, "target_system"}, {T::u8, "target_component"}, {T::u8, "frame"},
                     {T::u16, "command"}, {T::u8, "current"}, {T::u8, "autocontinue"},

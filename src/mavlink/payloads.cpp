@@ -264,6 +264,71 @@ struct Layout<CommandInt> {
 };
 
 template <>
+struct Layout<MissionCount> {
+  static constexpr uint32_t id = msg::MISSION_COUNT;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("target_system", m.target_system);
+    v("target_component", m.target_component);
+    v("count", m.count);
+    v("mission_type", m.mission_type);
+    v("opaque_id", m.opaque_id);
+  }
+};
+
+template <>
+struct Layout<MissionRequestList> {
+  static constexpr uint32_t id = msg::MISSION_REQUEST_LIST;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("target_system", m.target_system);
+    v("target_component", m.target_component);
+    v("mission_type", m.mission_type);
+  }
+};
+
+template <>
+struct Layout<MissionAck> {
+  static constexpr uint32_t id = msg::MISSION_ACK;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("target_system", m.target_system);
+    v("target_component", m.target_component);
+    v("type", m.type);
+    v("mission_type", m.mission_type);
+    v("opaque_id", m.opaque_id);
+  }
+};
+
+template <>
+struct Layout<MissionItemInt> {
+  static constexpr uint32_t id = msg::MISSION_ITEM_INT;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("target_system", m.target_system);
+    v("target_component", m.target_component);
+    v("seq", m.seq);
+    v("frame", m.frame);
+    v("command", m.command);
+    v("current", m.current);
+    v("autocontinue", m.autocontinue);
+    v.numbered("param", m.param);
+    v("x", m.x);
+    v("y", m.y);
+    v("z", m.z);
+    v("mission_type", m.mission_type);
+  }
+};
+
+template <typename M, typename V>
+void mission_request_fields(M& m, V& v) {
+  v("target_system", m.target_system);
+  v("target_component", m.target_component);
+  v("seq", m.seq);
+  v("mission_type", m.mission_type);
+}
+
+template <>
 struct Layout<CommandAck> {
   static constexpr uint32_t id = msg::COMMAND_ACK;
   template <typename M, typename V>
@@ -433,6 +498,36 @@ std::optional<CameraCapture> unpack_camera_capture(const Message& m) {
     c.captured = r.get<int8_t>("capture_result") == 1;
   }
   return c;
+}
+
+Message pack(const MissionCount& m) { return pack_fields(m); }
+std::optional<MissionCount> unpack_mission_count(const Message& m) { return unpack_fields<MissionCount>(m); }
+
+Message pack(const MissionRequestList& m) { return pack_fields(m); }
+std::optional<MissionRequestList> unpack_mission_request_list(const Message& m) {
+  return unpack_fields<MissionRequestList>(m);
+}
+
+Message pack(const MissionAck& m) { return pack_fields(m); }
+std::optional<MissionAck> unpack_mission_ack(const Message& m) { return unpack_fields<MissionAck>(m); }
+
+Message pack(const MissionItemInt& m) { return pack_fields(m); }
+std::optional<MissionItemInt> unpack_mission_item_int(const Message& m) { return unpack_fields<MissionItemInt>(m); }
+
+// MISSION_REQUEST and MISSION_REQUEST_INT share their fields; `legacy` says which id.
+Message pack(const MissionRequest& m) {
+  Writer w(m.legacy ? msg::MISSION_REQUEST : msg::MISSION_REQUEST_INT);
+  mission_request_fields(m, w);
+  return w.take();
+}
+
+std::optional<MissionRequest> unpack_mission_request(const Message& m) {
+  if (m.id != msg::MISSION_REQUEST_INT && m.id != msg::MISSION_REQUEST) return std::nullopt;
+  MissionRequest out;
+  Reader r(m);
+  mission_request_fields(out, r);
+  out.legacy = m.id == msg::MISSION_REQUEST;
+  return out;
 }
 
 }  // namespace eamos::mavlink

@@ -185,6 +185,78 @@ struct ParamSet {
   uint8_t param_type = param_type::REAL32;
 };
 
+/// MAV_MISSION_TYPE: which of the vehicle's lists a mission-protocol message is about.
+namespace mission_type {
+inline constexpr uint8_t MISSION = 0, FENCE = 1, RALLY = 2;
+}
+/// MAV_MISSION_RESULT of a MISSION_ACK (the others are refusals of one kind or another).
+namespace mission_result {
+inline constexpr uint8_t ACCEPTED = 0, ERROR = 1, UNSUPPORTED = 3, NO_SPACE = 4, INVALID = 5,
+                         INVALID_SEQUENCE = 13, DENIED = 14, OPERATION_CANCELLED = 15;
+}
+
+/// Starts an upload (from the sender of the list) or answers MISSION_REQUEST_LIST.
+struct MissionCount {
+  uint8_t target_system = 0;
+  uint8_t target_component = 0;
+  uint16_t count = 0;
+  uint8_t mission_type = mission_type::MISSION;
+  uint32_t opaque_id = 0;  ///< the list's version, 0 unknown
+};
+
+/// Asks for item `seq`: MISSION_REQUEST_INT, or the older MISSION_REQUEST (`legacy`), which
+/// an ArduPilot may still send; the answer is MISSION_ITEM_INT either way.
+struct MissionRequest {
+  uint8_t target_system = 0;
+  uint8_t target_component = 0;
+  uint16_t seq = 0;
+  uint8_t mission_type = mission_type::MISSION;
+  bool legacy = false;  ///< packed as MISSION_REQUEST (40) rather than MISSION_REQUEST_INT (51)
+};
+
+/// Asks the vehicle for its list of `mission_type` (a MISSION_COUNT comes back).
+struct MissionRequestList {
+  uint8_t target_system = 0;
+  uint8_t target_component = 0;
+  uint8_t mission_type = mission_type::MISSION;
+};
+
+/// Ends a transfer: the receiver's verdict on the whole list.
+struct MissionAck {
+  uint8_t target_system = 0;
+  uint8_t target_component = 0;
+  uint8_t type = mission_result::ACCEPTED;  ///< MAV_MISSION_RESULT
+  uint8_t mission_type = mission_type::MISSION;
+  uint32_t opaque_id = 0;
+};
+
+/// One item of a list: a MAV_CMD with its parameters, x/y in degE7 for global frames.
+struct MissionItemInt {
+  uint8_t target_system = 0;
+  uint8_t target_component = 0;
+  uint16_t seq = 0;
+  uint8_t frame = 0;  ///< MAV_FRAME
+  uint16_t command = 0;
+  uint8_t current = 0;
+  uint8_t autocontinue = 0;
+  std::array<float, 4> param{};
+  int32_t x = 0, y = 0;
+  float z = 0;
+  uint8_t mission_type = mission_type::MISSION;
+};
+
+Message pack(const MissionCount& m);
+Message pack(const MissionRequest& m);
+Message pack(const MissionRequestList& m);
+Message pack(const MissionAck& m);
+Message pack(const MissionItemInt& m);
+std::optional<MissionCount> unpack_mission_count(const Message& m);
+/// MISSION_REQUEST_INT or MISSION_REQUEST (legacy set); nullopt for any other message.
+std::optional<MissionRequest> unpack_mission_request(const Message& m);
+std::optional<MissionRequestList> unpack_mission_request_list(const Message& m);
+std::optional<MissionAck> unpack_mission_ack(const Message& m);
+std::optional<MissionItemInt> unpack_mission_item_int(const Message& m);
+
 Message pack(const Heartbeat& m);
 Message pack(const ParamRequestRead& m);
 Message pack(const ParamValue& m);

@@ -30,6 +30,7 @@ void register_adapter(mid::AdapterRegistry& registry, MavlinkOptions options) {
         scaled.mode_confirm_s *= options.speed;
         scaled.statustext_wait_s *= options.speed;
         scaled.picture_confirm_s *= options.speed;
+        scaled.fence_reply_s *= options.speed;
         auto drone = std::make_unique<MavlinkDrone>(settings, type, loop, scaled);
         if (std::string error = drone->connect(*url.endpoint); !error.empty()) return failed(error);
         return {mid::CreateStatus::success, std::move(drone), ""};

@@ -78,11 +78,35 @@ Camera::Hooks MavlinkDrone::camera_hooks() {
 std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
   if (std::string error = link_.connect(endpoint); !error.empty()) return error;
   watch_.start();
+  const auto& fence = settings_.site.geofence;
+  fence_wanted_ = fence && fence->upload && !fence->polygon.empty();
   return "";
+}
+
+// Waits for both positions: the corners are placed from the vehicle's local origin, as its
+// setpoints are, so that the autopilot's fence and the companion's are the same area.
+void MavlinkDrone::maybe_upload_fence() {
+  if (!fence_wanted_ || fence_ || !vehicle_.have_position || !vehicle_.have_altitude) return;
+  const Autopilot& ap = *link_.autopilot();
+  auto [lat, lon] = offset_lat_lon(vehicle_.lat_e7, vehicle_.lon_e7, -vehicle_.ned.x, -vehicle_.ned.y);
+  AutopilotFence fence = autopilot_fence(ap, *settings_.site.geofence, settings_.home, settings_.failsafe,
+                                         GlobalOrigin{lat, lon}, link_.sysid());
+  fence_ = std::make_unique<FenceUpload>(
+      loop_, ap,
+      FenceUpload::Hooks{.send = [this](const ml::Message& m) { link_.send(m); },
+                         .note = [this](const std::string& text) { note(text); }},
+      FenceUpload::Options{options_.fence_reply_s, options_.fence_attempts});
+  fence_->start(std::move(fence), link_.sysid(), [this](const std::string& error) {
+    if (!error.empty()) note("fence upload failed: " + error);
+    auto waiting = std::move(after_fence_);
+    after_fence_.clear();
+    for (auto& fn : waiting) fn();
+  });
 }
 
 void MavlinkDrone::on_frame(const ml::Frame& frame) {
   if (frame.sysid != link_.sysid()) return;  // another vehicle (or a GCS) on the same port
+  if (fence_ && frame.compid == ml::comp::AUTOPILOT1) fence_->on_message(frame.message);
   if (auto ack = ml::unpack_command_ack(frame.message)) {
     // MAV_RESULT ends at 9 (UNSUPPORTED_MAV_FRAME): an unknown result answers nothing;
     // the command is sent again and times out as unanswered if it never gets a real one.
@@ -112,6 +136,7 @@ void MavlinkDrone::on_frame(const ml::Frame& frame) {
   }
   if (c.position || c.landed) check_goal();
   if (c.global_position) orbit_.on_global_position();
+  if (c.position || c.global_position) maybe_upload_fence();
   if (c.armed || c.landed) end_motion_on_the_ground();
   if (c.position || c.armed || c.landed) publish();
 }

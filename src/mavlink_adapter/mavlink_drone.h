@@ -28,6 +28,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -37,6 +38,7 @@
 #include "mavlink_adapter/autopilot_texts.h"
 #include "mavlink_adapter/camera.h"
 #include "mavlink_adapter/command_sender.h"
+#include "mavlink_adapter/fence_upload.h"
 #include "mavlink_adapter/link_watch.h"
 #include "mavlink_adapter/mavlink_options.h"
 #include "mavlink_adapter/mode_commands.h"
@@ -79,6 +81,8 @@ class MavlinkDrone final : public mid::AdapterDrone {
   /// The autopilot row chosen from the first HEARTBEAT; nullptr before connect().
   const Autopilot* autopilot() const { return link_.autopilot(); }
   bool link_lost() const { return watch_.lost(); }
+  /// The fence upload (fleet `geofence: {upload: true}`), once started; nullptr otherwise.
+  const FenceUpload* fence_upload() const { return fence_.get(); }
 
  private:
   enum class Until { reached, landed, forever };
@@ -93,6 +97,10 @@ class MavlinkDrone final : public mid::AdapterDrone {
   void on_frame(const mavlink::Frame& frame);
   void on_heartbeat();
   void on_link_lost(const std::string& why);
+  /// Starts the fence upload once the vehicle's global and local positions place its origin.
+  void maybe_upload_fence();
+  /// Arm after the fence is on the autopilot; false when Arm already ended or waits for it.
+  bool arm_needs_fence(mid::ActionId id, const std::function<void()>& armed);
   void note(const std::string& text);  ///< to the trace (message sink)
   /// "; ArduPilot says: …": its warnings and errors since `since` (mission s), or "".
   std::string autopilot_says(double since) const;
@@ -165,6 +173,9 @@ class MavlinkDrone final : public mid::AdapterDrone {
   SetpointStream stream_;
   OrbitFlight orbit_;
   Camera camera_;
+  std::unique_ptr<FenceUpload> fence_;        ///< created at connect when the fence is to be uploaded
+  bool fence_wanted_ = false;                 ///< `upload: true` and a polygon to upload
+  std::vector<std::function<void()>> after_fence_;  ///< Arms waiting for the upload to end
 
   /// The mission armed the vehicle and it has not taken off since: an autopilot's auto-disarm
   /// in this state is survived by arming again before the Takeoff.

@@ -15,7 +15,25 @@ using fleet::Vec3;
 using mid::ActionId;
 using mid::Outcome;
 
+// The autopilot must hold the fence before the vehicle may fly: Arm waits for the upload,
+// and fails with its reason when the vehicle would not take it.
+bool MavlinkDrone::arm_needs_fence(ActionId id, const std::function<void()>& armed) {
+  if (!fence_wanted_) return false;
+  if (!fence_ || !fence_->finished()) {
+    after_fence_.push_back([this, id, armed] {
+      if (tracker_.running(id)) arm(id, armed);
+    });
+    return true;
+  }
+  if (fence_->error().empty()) return false;
+  tracker_.fail(id, mid::FailureReason::refused,
+                "the autopilot does not hold the mission's fence (geofence upload: true): " + fence_->error(),
+                fence_->error());
+  return true;
+}
+
 void MavlinkDrone::arm(ActionId id, std::function<void()> armed) {
+  if (arm_needs_fence(id, armed)) return;
   // Until a HEARTBEAT is folded in, the mode is unknown: switch rather than be refused.
   if (vehicle_.heard && can_arm_in(*link_.autopilot(), vehicle_.custom_mode)) return send_arm(id, std::move(armed));
   auto p = set_mode_params(*link_.autopilot(), link_.autopilot()->arm_mode);

@@ -43,6 +43,11 @@ struct MavlinkOptions {
   /// CAMERA_IMAGE_CAPTURED), not when the command is accepted: an autopilot accepts the
   /// command with no camera behind it. How long after the ACK to wait (seconds; scaled).
   double picture_confirm_s = 2.0;
+  /// The fence upload (fleet `geofence: {upload: true}`): how long to wait for each answer of
+  /// the autopilot before sending again (seconds; scaled like the link's budgets), and how
+  /// many sends before it counts as silent.
+  double fence_reply_s = 1.0;
+  int fence_attempts = 5;
 };
 
 }  // namespace eamos::mavlink_adapter

@@ -80,11 +80,11 @@ std::function<void(ml::Frame)> VehicleLink::receiver(std::shared_ptr<FirstHeartb
   std::weak_ptr<bool> alive = alive_;
   mid::EventLoop* loop = &loop_;
   return [this, first, wanted, alive, loop](ml::Frame frame) {
+    // Read at connect, and posted too: the fence upload confirms its PARAM_SETs on the loop.
     if (auto pv = ml::unpack_param_value(frame.message); pv && frame.compid == ml::comp::AUTOPILOT1) {
       std::lock_guard lock(first->mutex);
       if (first->heard && frame.sysid == first->sysid) first->params[pv->param_id] = pv->param_value;
       first->cv.notify_all();
-      return;
     }
     if (auto hb = ml::unpack_heartbeat(frame.message);
         hb && hb->autopilot != ml::autopilot::INVALID && (wanted == 0 || frame.sysid == wanted)) {

@@ -36,6 +36,13 @@ std::pair<int32_t, int32_t> lat_lon_e7(double x, double y, double east, double n
   return {static_cast<int32_t>(std::lround(lat * 1e7)), static_cast<int32_t>(std::lround(lon * 1e7))};
 }
 
+/// lat_lon_e7's inverse.
+std::pair<double, double> local_xy(int32_t lat_e7, int32_t lon_e7) {
+  double y = (lat_e7 / 1e7 - kHomeLat) * kMetresPerDegree;
+  double x = (lon_e7 / 1e7 - kHomeLon) * kMetresPerDegree * std::cos(kHomeLat * M_PI / 180.0);
+  return {x, y};
+}
+
 const uint32_t kStreamed[] = {ml::msg::LOCAL_POSITION_NED, ml::msg::EXTENDED_SYS_STATE,
                               ml::msg::SYS_STATUS, ml::msg::BATTERY_STATUS,
                               ml::msg::GLOBAL_POSITION_INT};
@@ -136,6 +143,7 @@ void SimVehicle::on_frame(const ml::Frame& frame) {
     return on_command_int(*c);
   }
   if (auto sp = ml::unpack_set_position_target_local_ned(frame.message)) return on_setpoint(*sp);
+  if (on_fence_frame(frame)) return;
   if (auto r = ml::unpack_param_request_read(frame.message)) return on_param_request(*r);
   if (auto s = ml::unpack_setup_signing(frame.message)) return on_setup_signing(*s);
   if (auto hb = ml::unpack_heartbeat(frame.message); hb && hb->autopilot == ml::autopilot::INVALID)
@@ -518,5 +526,7 @@ void SimVehicle::send(const ml::Message& m) {
   if (link_) link_->send(frame);
   if (ground_station_) ground_station_->send(frame);
 }
+
+std::pair<double, double> SimVehicle::local_of(int32_t lat_e7, int32_t lon_e7) const { return local_xy(lat_e7, lon_e7); }
 
 }  // namespace eamos::sim_vehicle

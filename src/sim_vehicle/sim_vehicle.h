@@ -20,7 +20,11 @@
 //    GLOBAL_POSITION_INT) at 1 Hz each, or the rate SET_MESSAGE_INTERVAL asks for;
 //  - disarms 2 s after touching down (PX4's COM_DISARM_LAND);
 //  - PARAM_REQUEST_READ of the autopilot's speed parameters answered with PARAM_VALUE, valued
-//    as the simulator flies.
+//    as the simulator flies; PARAM_SET kept and answered with PARAM_VALUE (integers bytewise
+//    in the PX4 dialect, as floats in ArduPilot's);
+//  - the mission protocol for its fence (mission_type FENCE, sim_vehicle_fence.cpp): an
+//    upload (MISSION_COUNT, its requests, MISSION_ITEM_INT, MISSION_ACK) and a read back
+//    (MISSION_REQUEST_LIST); it keeps the polygon but does not fly by it.
 // Its local NED origin is its home; it runs on its own event loop in real time.
 #include <functional>
 #include <map>
@@ -114,6 +118,16 @@ struct VehicleOptions {
   double reported_velocity_scale = 1.0;
   /// How fast it flies, and the speed parameters it answers with (the simulator's by default).
   fleet::Limits limits;
+  /// Its fence storage: an upload of more corners is refused with MAV_MISSION_NO_SPACE, as
+  /// ArduPilot's is (FENCE_TOTAL, its EEPROM); 0: it keeps no fence and answers nothing.
+  int fence_capacity = 100;
+  /// Ignores the first this many MISSION_COUNTs of a fence upload, as a link losing them would.
+  int fence_counts_ignored = 0;
+  /// Its read back reports each corner this far north of where it was given (degE7): a
+  /// vehicle that stored something else than it acknowledged.
+  int32_t fence_read_back_shift_e7 = 0;
+  /// Parameters a PARAM_SET does not change (the answer keeps the old value).
+  std::set<std::string> read_only_params;
 };
 
 class SimVehicle {
@@ -161,6 +175,15 @@ class SimVehicle {
   OrbitStart orbit_start() const { return orbit_start_; }
   /// Whether a HEARTBEAT of this MAV_TYPE came from a non-autopilot (a GCS, a companion).
   bool heard_heartbeat_of_type(uint8_t type) const { return heartbeat_types_.contains(type); }
+  /// The fence corners it accepted last (MISSION_ACK accepted), in upload order.
+  const std::vector<mavlink::MissionItemInt>& fence() const { return fence_; }
+  /// A parameter set with PARAM_SET, read as the dialect encodes it; nullopt if never set.
+  std::optional<double> param(const std::string& name) const;
+  /// How many fence items it asked for (with MISSION_REQUEST in the ArduPilot dialect).
+  int fence_requests() const { return fence_requests_; }
+  /// Where a point of the earth (degE7) lies in its frame (x east, y north of home), by its own
+  /// earth model: how a test reads the fence it holds.
+  std::pair<double, double> local_of(int32_t lat_e7, int32_t lon_e7) const;
 
  private:
   void on_frame(const mavlink::Frame& frame);
@@ -168,6 +191,12 @@ class SimVehicle {
   void on_command_int(const mavlink::CommandInt& c);
   void on_param_request(const mavlink::ParamRequestRead& r);
   void on_setup_signing(const mavlink::SetupSigning& s);
+  // PARAM_SET and the fence's mission protocol (sim_vehicle_fence.cpp); false: not one of them
+  bool on_fence_frame(const mavlink::Frame& frame);
+  void on_param_set(const mavlink::ParamSet& p);
+  void on_fence_count(const mavlink::Frame& frame, const mavlink::MissionCount& c);
+  void on_fence_item(const mavlink::Frame& frame, const mavlink::MissionItemInt& item);
+  void request_fence_item(const mavlink::Frame& frame, uint16_t seq);
   uint8_t execute(const mavlink::CommandLong& c);  ///< the MAV_RESULT to acknowledge with,
                                                   ///< or kAckLater
   uint8_t set_mode(Mode mode);
@@ -228,6 +257,12 @@ class SimVehicle {
   std::map<uint32_t, int> intervals_asked_;
   std::set<uint8_t> heartbeat_types_;  ///< see heard_heartbeat_of_type
   std::vector<mavlink::CommandLong> orbit_commands_;
+  std::vector<mavlink::MissionItemInt> fence_;     ///< the accepted fence
+  std::vector<mavlink::MissionItemInt> incoming_;  ///< the fence being uploaded
+  uint16_t incoming_next_ = 0;
+  int fence_counts_seen_ = 0;
+  int fence_requests_ = 0;
+  std::map<std::string, mavlink::ParamSet> params_set_;
 
   /// The orbit flown in Mode::orbit: like PX4's orbit task, a point moved around the circle
   /// that the vehicle follows.

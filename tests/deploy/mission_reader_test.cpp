@@ -225,7 +225,7 @@ TEST(MissionSite, TheGeofenceSpeedsAndGustSurviveWriteAndRead) {
                       "safety:\n"
                       "  max_speed: 3.5\n"
                       "  geofence: {polygon: [[-40, -40], [40, -40], [40, 40], [-40, 40]], min_altitude: 1, "
-                      "max_altitude: 25}\n";
+                      "max_altitude: 25, upload: true}\n";
   auto c = test::compile_mission(test::listing2_text(), fleet);
   ASSERT_TRUE(c);
   int d2 = 1;
@@ -239,6 +239,7 @@ TEST(MissionSite, TheGeofenceSpeedsAndGustSurviveWriteAndRead) {
   EXPECT_EQ(site.geofence->polygon[1], std::make_pair(40.0, -40.0));
   EXPECT_EQ(*site.geofence->min_altitude_m, 1.0);
   EXPECT_EQ(*site.geofence->max_altitude_m, 25.0);
+  EXPECT_TRUE(site.geofence->upload);
   EXPECT_EQ(*site.max_speed_mps, 3.5);
   EXPECT_FALSE(site.max_climb_mps);
   ASSERT_TRUE(m.settings.gust);

@@ -247,6 +247,33 @@ TEST(SiteRules, EachDroneGetsItsFenceAndTheSitesSpeeds) {
   EXPECT_EQ(d2.gust->velocity.x, 1.0);
 }
 
+TEST(SiteRules, AFenceIsGivenToTheAutopilotOnlyWhereUploadIsTrue) {
+  test::Parsed p = test::parse(
+      "safety:\n"
+      "  geofence: {polygon: [[0, 0], [10, 0], [10, 10]], upload: true}\n"
+      "drones:\n"
+      "  Drone2:\n"
+      "    geofence: {polygon: [[0, 0], [5, 0], [5, 5]]}\n");
+  ASSERT_TRUE(p.ok) << p.diags.format();
+  EXPECT_TRUE(p.fleet.settings_for("Drone1", "Quad", 0).site.geofence->upload);
+  EXPECT_FALSE(p.fleet.settings_for("Drone2", "Quad", 1).site.geofence->upload);
+}
+
+TEST(SiteRules, AnUploadWithoutAPolygonOrNotABooleanIsAnErrorAtItsLine) {
+  test::Parsed p = test::parse(
+      "safety:\n"
+      "  geofence: {max_altitude: 30, upload: true}\n"
+      "drones:\n"
+      "  Drone1:\n"
+      "    geofence: {polygon: [[0, 0], [5, 0], [5, 5]], upload: maybe}\n");
+  EXPECT_FALSE(p.ok);
+  std::string all = p.diags.format();
+  EXPECT_NE(all.find("fleet.yaml:2:13: error: upload of geofence of safety needs a polygon"), std::string::npos) << all;
+  EXPECT_NE(all.find("fleet.yaml:5:59: error: upload of geofence of drone 'Drone1' must be true or false; got"),
+            std::string::npos)
+      << all;
+}
+
 TEST(SiteRules, ABadGustIsAnErrorAtItsLineWithEveryOtherError) {
   test::Parsed p = test::parse(
       "safety:\n"

@@ -45,6 +45,9 @@ const std::map<uint32_t, uint8_t> kPublished = {
     {msg::CAMERA_TRIGGER, 174},     {msg::CAMERA_FEEDBACK, 52},
     {msg::HIL_STATE_QUATERNION, 4},
     {msg::CAMERA_IMAGE_CAPTURED, 133}, {msg::ORBIT_EXECUTION_STATUS, 11},
+    {msg::MISSION_REQUEST, 230},    {msg::MISSION_REQUEST_LIST, 132},
+    {msg::MISSION_COUNT, 221},      {msg::MISSION_ACK, 153},
+    {msg::MISSION_REQUEST_INT, 196}, {msg::MISSION_ITEM_INT, 38},
 };
 
 TEST(CrcExtra, EveryTableMessageMatchesThePublishedValue) {

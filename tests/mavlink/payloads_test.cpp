@@ -150,6 +150,53 @@ TEST(RoundTrip, CommandInt) {
   EXPECT_EQ(out->z, 25.5f);
 }
 
+TEST(RoundTrip, MissionItemIntKeepsEveryFieldAndTheFenceType) {
+  MissionItemInt in{1, 1, 3, 0, 5001, 0, 1, {4, 0, 0, 0}, -353632620, 1491652370, 0.0f, mission_type::FENCE};
+  auto out = unpack_mission_item_int(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->target_system, 1);
+  EXPECT_EQ(out->seq, 3);
+  EXPECT_EQ(out->frame, 0);
+  EXPECT_EQ(out->command, 5001);
+  EXPECT_EQ(out->autocontinue, 1);
+  EXPECT_EQ(out->param, in.param);
+  EXPECT_EQ(out->x, -353632620);
+  EXPECT_EQ(out->y, 1491652370);
+  EXPECT_EQ(out->mission_type, mission_type::FENCE);
+}
+
+TEST(RoundTrip, MissionCountAckAndRequestListKeepTheMissionType) {
+  auto count = unpack_mission_count(through_the_wire(pack(MissionCount{1, 1, 7, mission_type::FENCE, 42})));
+  ASSERT_TRUE(count);
+  EXPECT_EQ(count->count, 7);
+  EXPECT_EQ(count->mission_type, mission_type::FENCE);
+  EXPECT_EQ(count->opaque_id, 42u);
+  auto ack = unpack_mission_ack(through_the_wire(pack(MissionAck{255, 190, mission_result::NO_SPACE, mission_type::FENCE})));
+  ASSERT_TRUE(ack);
+  EXPECT_EQ(ack->target_system, 255);
+  EXPECT_EQ(ack->target_component, 190);
+  EXPECT_EQ(ack->type, mission_result::NO_SPACE);
+  EXPECT_EQ(ack->mission_type, mission_type::FENCE);
+  auto list = unpack_mission_request_list(through_the_wire(pack(MissionRequestList{1, 1, mission_type::FENCE})));
+  ASSERT_TRUE(list);
+  EXPECT_EQ(list->mission_type, mission_type::FENCE);
+}
+
+TEST(RoundTrip, MissionRequestIsReadFromEitherTheIntOrTheLegacyMessage) {
+  Message modern = pack(MissionRequest{1, 191, 9, mission_type::FENCE, false});
+  Message legacy = pack(MissionRequest{1, 191, 9, mission_type::FENCE, true});
+  EXPECT_EQ(modern.id, msg::MISSION_REQUEST_INT);
+  EXPECT_EQ(legacy.id, msg::MISSION_REQUEST);
+  for (const Message& m : {modern, legacy}) {
+    auto out = unpack_mission_request(through_the_wire(m));
+    ASSERT_TRUE(out);
+    EXPECT_EQ(out->target_component, 191);
+    EXPECT_EQ(out->seq, 9);
+    EXPECT_EQ(out->mission_type, mission_type::FENCE);
+    EXPECT_EQ(out->legacy, m.id == msg::MISSION_REQUEST);
+  }
+}
+
 TEST(RoundTrip, CommandAck) {
   CommandAck in{176, 5, 50, -3, 255, 190};
   auto out = unpack_command_ack(through_the_wire(pack(in)));

@@ -450,6 +450,92 @@ TEST_P(Sitl, TheSitesMaxSpeedPacesAFlightAndATargetOutsideTheFenceIsRefused) {
   EXPECT_LT(x_after - x_at_refusal, 0.5) << f.run.out;  // no step toward x = 40
 }
 
+// The mission's fence given to the autopilot itself (geofence `upload: true`), one instance:
+// eamos uploads it before Arm and flies a short hop inside it; then a ground station of the
+// test reads the autopilot's fence and parameters back, independently of eamos: the polygon
+// lies where the fleet file puts it, and the autopilot's fence is switched on.
+TEST_P(Sitl, TheFenceUploadedBeforeArmIsTheAutopilotsOwnPolygonWithItsSwitchOn) {
+  const std::vector<eamos_test::SitlHome> one = {kHomes[0]};
+  auto sitl = start_fleet(one);
+  if (HasFailure()) return;
+  std::ofstream(dir_ / "fence.eamos") << "var Drone1 Quad\nfunc INIT() { Drone1.Arm(); Drone1.Takeoff(3); "
+                                         "Drone1.FlyByX(4); Drone1.Land(); Drone1.Disarm() }\n";
+  const std::vector<std::pair<double, double>> polygon = {{-15, -12}, {25, -12}, {25, 30}, {-15, 30}};
+  std::string fleet = "safety:\n  geofence: {polygon: [[-15, -12], [25, -12], [25, 30], [-15, 30]], "
+                      "max_altitude: 20, upload: true}\n" + fleet_file(*sitl, one);
+  Flight f = fly((dir_ / "fence.eamos").string(), fleet, dir_);
+  EXPECT_EQ(f.run.status, 0) << f.run.out;
+  EXPECT_NE(f.run.out.find("holds the fence itself"), std::string::npos) << f.run.out;
+  bool px4 = GetParam() == Autopilot::px4;
+  std::vector<std::string> params = px4 ? std::vector<std::string>{"GF_ACTION", "GF_MAX_VER_DIST"}
+                                        : std::vector<std::string>{"FENCE_ENABLE", "FENCE_TYPE", "FENCE_ALT_MAX",
+                                                                   "FENCE_ACTION"};
+  std::vector<eamos::mavlink::MissionItemInt> items;
+  std::map<std::string, double> values;
+  std::string error;
+  ASSERT_TRUE(sitl->read_fence(0, params, {"GF_ACTION"}, 30, items, values, error)) << error;
+  ASSERT_EQ(items.size(), polygon.size());
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    double x = 0, y = 0;
+    eamos_test::mission_xy(items[i].x, items[i].y, x, y);
+    EXPECT_EQ(items[i].command, eamos::mavlink::cmd::NAV_FENCE_POLYGON_VERTEX_INCLUSION);
+    EXPECT_NEAR(x, polygon[i].first, 0.3) << i;
+    EXPECT_NEAR(y, polygon[i].second, 0.3) << i;
+  }
+  if (px4) {
+    EXPECT_EQ(values["GF_ACTION"], 5);  // land, the drone's failsafe
+    EXPECT_NEAR(values["GF_MAX_VER_DIST"], 20, 1e-3);
+  } else {
+    EXPECT_EQ(values["FENCE_ENABLE"], 1);
+    EXPECT_EQ(values["FENCE_TYPE"], 5);  // polygon and maximum altitude
+    EXPECT_NEAR(values["FENCE_ALT_MAX"], 20, 1e-3);
+    EXPECT_EQ(values["FENCE_ACTION"], 2);  // land
+  }
+}
+
+// The fence left on the autopilot by a mission with `upload: true` acts by itself: a second
+// mission, whose fleet file has no geofence (eamos' own guard off), flies toward x = 45 past
+// the fence's east edge (x = 25). ArduCopter's GUIDED ignores a position target outside its
+// fence: the vehicle stays where it is and the FlyTo times out. PX4 flies it (OFFBOARD, about
+// 9 m/s), sees the breach a few metres past the edge and takes the vehicle out of OFFBOARD
+// into its hold; braking from that speed carries it on (docs/adapters.md).
+TEST_P(Sitl, TheAutopilotsOwnFenceActsOnAVehicleFlownOutWithEamosGuardOff) {
+  const std::vector<eamos_test::SitlHome> one = {kHomes[0]};
+  auto sitl = start_fleet(one);
+  if (HasFailure()) return;
+  std::ofstream(dir_ / "arm.eamos") << "var Drone1 Quad\nfunc INIT() { Drone1.Arm(); Drone1.Disarm() }\n";
+  std::string fenced = "safety:\n  geofence: {polygon: [[-15, -12], [25, -12], [25, 30], [-15, 30]], "
+                       "max_altitude: 20, upload: true}\n" + fleet_file(*sitl, one);
+  Flight upload = fly((dir_ / "arm.eamos").string(), fenced, dir_);
+  ASSERT_EQ(upload.run.status, 0) << upload.run.out;
+  std::ofstream(dir_ / "out.eamos") << "var Drone1 Quad\nfunc INIT() { Drone1.Arm(); Drone1.Takeoff(3); "
+                                       "Drone1.FlyTo(45, 0, 3); Drone1.Land(); Drone1.Disarm() }\n";
+  Flight out = fly((dir_ / "out.eamos").string(), fleet_file(*sitl, one), dir_, {.extra = "--telemetry-hz 10"});
+  EXPECT_NE(out.run.status, 0) << out.run.out;
+  const std::vector<std::string>& a = out.actions["Drone1"];
+  EXPECT_NE(std::find(a.begin(), a.end(), "Drone1.FlyTo(45, 0, 3) failed"), a.end()) << out.run.out;
+  double furthest = 0, left_offboard_at = -1;  // x of the first report out of OFFBOARD after it
+  bool offboard = false;
+  std::ifstream in(dir_ / "trace.jsonl");
+  for (std::string line; std::getline(in, line);) {
+    auto e = nlohmann::json::parse(line, nullptr, false);
+    if (e.is_discarded() || e.value("event", "") != "telemetry") continue;
+    furthest = std::max(furthest, e.value("x", 0.0));
+    bool now = e.value("mode", "") == "OFFBOARD";
+    if (offboard && !now && left_offboard_at < 0) left_offboard_at = e.value("x", 0.0);
+    offboard = offboard || now;
+  }
+  std::cout << "[sitl] the autopilot's fence at x = 25: furthest " << furthest << " m, out of OFFBOARD at "
+            << left_offboard_at << " m\n";
+  if (GetParam() == Autopilot::ardupilot) {
+    EXPECT_LT(furthest, 1) << out.run.out;  // GUIDED never took the target beyond its fence
+    return;
+  }
+  EXPECT_NE(out.run.out.find("the vehicle left OFFBOARD for AUTO.LOITER"), std::string::npos) << out.run.out;
+  EXPECT_GT(left_offboard_at, 25) << out.run.out;  // the breach, not eamos, ended the flight out
+  EXPECT_LT(left_offboard_at, 36) << out.run.out;
+}
+
 // The test stops Drone2's autopilot in flight: its link is lost, the mission fails saying
 // so, and the two others run their failsafe. `extra`: --distributed, where the lost vehicle's
 // DEX is a process of its own that must tell the others.

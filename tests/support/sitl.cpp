@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -79,6 +80,17 @@ void geographic_home(const SitlHome& h, double& lat, double& lon) {
   lat = kOriginLat + h.y / per_lat;
   lon = kOriginLon + h.x / per_lon;
 }
+
+}  // namespace
+
+void mission_xy(int32_t lat_e7, int32_t lon_e7, double& x, double& y) {
+  double per_lat, per_lon;
+  metres_per_degree(kOriginLat, per_lat, per_lon);
+  y = (lat_e7 / 1e7 - kOriginLat) * per_lat;
+  x = (lon_e7 / 1e7 - kOriginLon) * per_lon;
+}
+
+namespace {
 
 std::string fixed(double v, int digits) {
   std::ostringstream s;
@@ -532,6 +544,98 @@ bool SitlFleet::set_param(int i, const std::string& name, float value, uint8_t t
   opened.link.reset();
   if (!ok) error = "SITL instance " + std::to_string(i) + ": no PARAM_VALUE " + name + " = " + fixed(value, 2) + "\n" + log_tail(i);
   return ok;
+}
+
+namespace {
+
+// What read_fence collects from the vehicle's link thread.
+struct FenceRead {
+  std::mutex mutex;
+  std::condition_variable changed;
+  int count = -1;  ///< the MISSION_COUNT, -1 before it
+  std::map<uint16_t, ml::MissionItemInt> items;
+  std::map<std::string, float> params;
+};
+
+// Asks for what has not come yet: the count, the items, the parameters.
+void ask_fence(FenceRead& r, uint8_t vehicle, const std::vector<std::string>& params,
+               const std::function<void(const ml::Message&)>& send) {
+  ml::Heartbeat hb;
+  hb.type = 6;       // MAV_TYPE_GCS
+  hb.autopilot = 8;  // MAV_AUTOPILOT_INVALID
+  send(ml::pack(hb));
+  std::unique_lock lock(r.mutex);
+  int count = r.count;
+  std::vector<uint16_t> missing;
+  for (int k = 0; k < count; ++k)
+    if (!r.items.contains(static_cast<uint16_t>(k))) missing.push_back(static_cast<uint16_t>(k));
+  std::vector<std::string> unread;
+  for (const std::string& p : params)
+    if (!r.params.contains(p)) unread.push_back(p);
+  lock.unlock();
+  if (count < 0) send(ml::pack(ml::MissionRequestList{vehicle, 1, ml::mission_type::FENCE}));
+  for (uint16_t k : missing) send(ml::pack(ml::MissionRequest{vehicle, 1, k, ml::mission_type::FENCE}));
+  for (const std::string& p : unread) send(ml::pack(ml::ParamRequestRead{vehicle, 1, p, -1}));
+}
+
+}  // namespace
+
+bool SitlFleet::read_fence(int i, const std::vector<std::string>& params, const std::vector<std::string>& integer,
+                           double timeout_s, std::vector<ml::MissionItemInt>& items,
+                           std::map<std::string, double>& values, std::string& error) {
+  FenceRead r;
+  const uint8_t vehicle = static_cast<uint8_t>(sysid(i));
+  ml::OpenResult opened = ml::Link::open(
+      *ml::parse_url(connection(i)).endpoint,
+      [&r, vehicle](ml::Frame f) {
+        if (f.sysid != vehicle || f.compid != 1) return;
+        std::lock_guard lock(r.mutex);
+        if (auto c = ml::unpack_mission_count(f.message); c && c->mission_type == ml::mission_type::FENCE) r.count = c->count;
+        if (auto it = ml::unpack_mission_item_int(f.message); it && it->mission_type == ml::mission_type::FENCE)
+          r.items[it->seq] = *it;
+        if (auto p = ml::unpack_param_value(f.message)) r.params[p->param_id] = p->param_value;
+        r.changed.notify_all();
+      },
+      0.2);
+  if (!opened.link) {
+    error = "cannot read the fence of SITL instance " + std::to_string(i) + ": " + opened.error;
+    return false;
+  }
+  ml::Encoder encoder{250, 190, 0};
+  auto send = [&](const ml::Message& m) { opened.link->send(encoder.encode(m)); };
+  auto done = [&] {
+    if (r.count < 0 || static_cast<int>(r.items.size()) < r.count) return false;
+    for (const std::string& p : params)
+      if (!r.params.contains(p)) return false;
+    return true;
+  };
+  const double deadline = now_s() + timeout_s;
+  bool ok = false;
+  {
+    std::unique_lock lock(r.mutex);
+    while (!(ok = done()) && now_s() < deadline) {
+      lock.unlock();
+      ask_fence(r, vehicle, params, send);
+      lock.lock();
+      r.changed.wait_for(lock, std::chrono::milliseconds(300), done);
+    }
+  }
+  if (ok) send(ml::pack(ml::MissionAck{vehicle, 1, ml::mission_result::ACCEPTED, ml::mission_type::FENCE}));
+  opened.link.reset();
+  if (!ok) {
+    error = "SITL instance " + std::to_string(i) + ": no complete fence read back (count " + std::to_string(r.count) +
+            ", " + std::to_string(r.items.size()) + " items)\n" + log_tail(i);
+    return false;
+  }
+  items.clear();
+  for (auto& [seq, item] : r.items) items.push_back(item);
+  for (const std::string& p : params) {
+    bool bytewise = options_.autopilot == Autopilot::px4 && std::find(integer.begin(), integer.end(), p) != integer.end();
+    int32_t v = 0;
+    std::memcpy(&v, &r.params[p], sizeof v);
+    values[p] = bytewise ? v : r.params[p];
+  }
+  return true;
 }
 
 // Short-lived links of the test's own, one per instance and all open at once (a STATUSTEXT

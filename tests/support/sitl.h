@@ -7,9 +7,12 @@
 #include <sys/types.h>
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
+
+#include "mavlink/payloads.h"
 
 namespace eamos_test {
 
@@ -47,6 +50,10 @@ struct SitlOptions {
   double battery_drain_s = 0;
 };
 
+/// Where a point of the earth (degE7) lies in the mission frame of the test fleets (x east, y
+/// north of the origin the instances' homes are placed from), on the WGS-84 ellipsoid.
+void mission_xy(int32_t lat_e7, int32_t lon_e7, double& x, double& y);
+
 class SitlFleet {
  public:
   /// The binary from the environment, or "" when the variable is unset or names no file.
@@ -73,6 +80,13 @@ class SitlFleet {
   /// gets must not be helped by it).
   bool set_param(int i, const std::string& name, float value, uint8_t type, double timeout_s, std::string& error,
                  bool as_ground_station = true);
+  /// What the autopilot holds as its fence, read the way a ground station does
+  /// (MISSION_REQUEST_LIST of type FENCE, then each item), and the values of `params` (PX4's
+  /// integers read bytewise when `integer` names them). Call it when eamos has closed the
+  /// port. False with `error` set on timeout.
+  bool read_fence(int i, const std::vector<std::string>& params, const std::vector<std::string>& integer,
+                  double timeout_s, std::vector<eamos::mavlink::MissionItemInt>& items,
+                  std::map<std::string, double>& values, std::string& error);
   /// Kills one instance at once (a vehicle whose link is lost mid-flight).
   void kill_instance(int i);
   /// SIGTERM, then SIGKILL after a grace period, for every instance still running.
