@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <cstdio>
 
 namespace eamos::dex {
@@ -147,6 +149,16 @@ void SeparationGuard::for_neighbours(int d, double reach_m, Fn fn) {
   const long long rings = std::max(1LL, static_cast<long long>(std::ceil(reach_m / cell_m_)));
   const long long ix = static_cast<long long>(std::floor(k.p.x / cell_m_));
   const long long iy = static_cast<long long>(std::floor(k.p.y / cell_m_));
+  // A reach wider than the occupied cells: look through those cells instead of the square.
+  if ((2 * rings + 1) * (2 * rings + 1) > static_cast<long long>(grid_.size())) {
+    for (const auto& [cell, members] : grid_) {
+      const long long x = cell >> 32, y = static_cast<std::int32_t>(cell & 0xffffffffLL);
+      if (std::llabs(x - ix) > rings || std::llabs(y - iy) > rings) continue;
+      for (std::size_t i = 0; i < members.size(); ++i)
+        if (members[i] != d) fn(members[i]);
+    }
+    return;
+  }
   for (long long x = ix - rings; x <= ix + rings; ++x)
     for (long long y = iy - rings; y <= iy + rings; ++y) {
       auto it = grid_.find((x << 32) ^ (y & 0xffffffffLL));
@@ -163,9 +175,17 @@ void SeparationGuard::update(int d, const mid::DroneState& s) {
   if (d < 0 || d >= static_cast<int>(tracks_.size())) return;
   Track& k = tracks_[d];
   const Vec p{s.x, s.y, s.z};
-  if (!k.known) k.v = {};
-  else if (s.t > k.t + 1e-6) k.v = (p - k.p) * (1.0 / (s.t - k.t));
-  else if (s.t < k.t) return;  // an older sample overtaken by a newer one
+  // A velocity from samples closer than kMinVelocityDtS apart is mostly their noise (a MAVLink
+  // vehicle's two position messages a millisecond apart): the position moves on, the
+  // velocity waits for a sample far enough from the one it was measured from.
+  if (s.t < k.t) return;  // an older sample overtaken by a newer one
+  if (!k.known) {
+    k.v = {};
+    k.v_p = p, k.v_t = s.t;
+  } else if (s.t >= k.v_t + kMinVelocityDtS) {
+    k.v = (p - k.v_p) * (1.0 / (s.t - k.v_t));
+    k.v_p = p, k.v_t = s.t;
+  }
   k.known = true;
   k.p = p;
   k.t = s.t;

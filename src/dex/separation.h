@@ -37,6 +37,7 @@ inline constexpr double kSeparationCheckS = 0.2;    ///< a drone's pairs are loo
 inline constexpr double kMaxGiveWayS = 30.0;        ///< a longer hold fails the mission
 inline constexpr double kLastMomentS = 1.5;         ///< this close to a loss, priority no longer counts
 inline constexpr double kMovingMps = 0.3;           ///< slower counts as standing still
+inline constexpr double kMinVelocityDtS = 0.02;     ///< a velocity spans at least this much mission time
 
 struct Vec {
   double x = 0, y = 0, z = 0;
@@ -87,6 +88,8 @@ class SeparationGuard {
     bool airborne = false;
     double t = 0.0;
     Vec p, v;
+    Vec v_p;          ///< the position and time the velocity was last measured from
+    double v_t = 0.0;
     long long cell = 0;
     bool in_grid = false;
     double checked_at = -1e300;
