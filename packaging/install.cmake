@@ -55,7 +55,8 @@ eamos_export(eamos_mavlink mavlink mavlink crc.h enums.h field_def.h fields.h fr
              signing.h url.h)
 eamos_export(eamos_mavlink_adapter mavlink_adapter mavlink_adapter adapter.h autopilot.h autopilot_params.h
              autopilot_texts.h camera.h command_sender.h link_watch.h mavlink_drone.h mavlink_options.h
-             mode_commands.h orbit_flight.h setpoint_pacer.h setpoint_stream.h telemetry.h vehicle_clock.h vehicle_link.h)
+             fence_upload.h mode_commands.h orbit_flight.h setpoint_pacer.h setpoint_stream.h telemetry.h vehicle_clock.h
+             vehicle_link.h)
 # version.h (EAMOS_VERSION) is generated into the build tree.
 set_target_properties(eamos_version PROPERTIES EXPORT_NAME version
                       INTERFACE_INCLUDE_DIRECTORIES "$<BUILD_INTERFACE:${PROJECT_BINARY_DIR}/generated>")

@@ -113,7 +113,7 @@ class DroneArming {
     if (st.kind == StatementKind::async_call) {
       Flow f = block(st.function_index, s, record);
       detached |= f.seen;
-      return {s | f.seen, s | f.seen};
+      return {static_cast<States>(s | f.seen), static_cast<States>(s | f.seen)};
     }
     if (st.control == ControlKind::none) return block(st.function_index, s, record);
     return control(st, s, record, detached);
@@ -123,8 +123,8 @@ class DroneArming {
     if (st.drone_index != drone_) return {s, s};
     const fleet::ActionSpec* spec = type_.find_action(st.callee);
     if (spec && spec->action_class == fleet::ActionClass::system) {
-      if (st.callee == "Arm") return {kArmed, s | kArmed};
-      if (st.callee == "Disarm") return {kDisarmed, s | kDisarmed};
+      if (st.callee == "Arm") return {kArmed, static_cast<States>(s | kArmed)};
+      if (st.callee == "Disarm") return {kDisarmed, static_cast<States>(s | kDisarmed)};
     }
     if (!spec || spec->action_class != fleet::ActionClass::motion) return {s, s};
     if (record) {
