@@ -121,10 +121,17 @@ bool SeparationGuard::holding(int d) {
   return false;
 }
 
+namespace {
+
+/// The grid's key of cell (ix, iy), and back: ix in the high 32 bits, iy in the low.
+long long cell_key(long long ix, long long iy) { return (ix << 32) ^ (iy & 0xffffffffLL); }
+long long cell_x(long long key) { return key >> 32; }
+long long cell_y(long long key) { return static_cast<std::int32_t>(key & 0xffffffffLL); }
+
+}  // namespace
+
 long long SeparationGuard::cell_of(const Vec& p) const {
-  const long long ix = static_cast<long long>(std::floor(p.x / cell_m_));
-  const long long iy = static_cast<long long>(std::floor(p.y / cell_m_));
-  return (ix << 32) ^ (iy & 0xffffffffLL);
+  return cell_key(static_cast<long long>(std::floor(p.x / cell_m_)), static_cast<long long>(std::floor(p.y / cell_m_)));
 }
 
 void SeparationGuard::place(int d) {
@@ -149,26 +156,21 @@ void SeparationGuard::for_neighbours(int d, double reach_m, Fn fn) {
   const long long rings = std::max(1LL, static_cast<long long>(std::ceil(reach_m / cell_m_)));
   const long long ix = static_cast<long long>(std::floor(k.p.x / cell_m_));
   const long long iy = static_cast<long long>(std::floor(k.p.y / cell_m_));
+  // By index, not by copy: giving way and resuming never move a drone between cells (only
+  // update() does), so the list stays as it is while `fn` runs.
+  auto visit = [&](const std::vector<int>& members) {
+    for (std::size_t i = 0; i < members.size(); ++i)
+      if (members[i] != d) fn(members[i]);
+  };
   // A reach wider than the occupied cells: look through those cells instead of the square.
   if ((2 * rings + 1) * (2 * rings + 1) > static_cast<long long>(grid_.size())) {
-    for (const auto& [cell, members] : grid_) {
-      const long long x = cell >> 32, y = static_cast<std::int32_t>(cell & 0xffffffffLL);
-      if (std::llabs(x - ix) > rings || std::llabs(y - iy) > rings) continue;
-      for (std::size_t i = 0; i < members.size(); ++i)
-        if (members[i] != d) fn(members[i]);
-    }
+    for (const auto& [cell, members] : grid_)
+      if (std::llabs(cell_x(cell) - ix) <= rings && std::llabs(cell_y(cell) - iy) <= rings) visit(members);
     return;
   }
   for (long long x = ix - rings; x <= ix + rings; ++x)
-    for (long long y = iy - rings; y <= iy + rings; ++y) {
-      auto it = grid_.find((x << 32) ^ (y & 0xffffffffLL));
-      if (it == grid_.end()) continue;
-      // By index, not by copy: giving way and resuming never move a drone between cells
-      // (only update() does), so the list stays as it is while `fn` runs.
-      const std::vector<int>& members = it->second;
-      for (std::size_t i = 0; i < members.size(); ++i)
-        if (members[i] != d) fn(members[i]);
-    }
+    for (long long y = iy - rings; y <= iy + rings; ++y)
+      if (auto it = grid_.find(cell_key(x, y)); it != grid_.end()) visit(it->second);
 }
 
 void SeparationGuard::update(int d, const mid::DroneState& s) {
