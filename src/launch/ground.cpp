@@ -424,8 +424,11 @@ void Ground::poll_children() {
   for (auto& d : drones_) {
     if (!d.local || d.child.exit_status) continue;
     poll(d.child);
-    if (d.child.exit_status)
-      out_ << "ground: the DEX of " << d.name << " exited with status " << *d.child.exit_status << "\n" << std::flush;
+    if (!d.child.exit_status) continue;
+    char usage[96];
+    std::snprintf(usage, sizeof usage, " (%.2f CPU-s, peak RSS %.1f MB)", d.child.cpu_s, d.child.max_rss_kb / 1024.0);
+    out_ << "ground: the DEX of " << d.name << " exited with status " << *d.child.exit_status << usage << "\n"
+         << std::flush;
   }
 }
 

@@ -132,6 +132,9 @@ class Distributed : public ::testing::Test {
                         (dir_ / "dist.jsonl").string() + " --summary " + (dir_ / "summary.json").string());
     ASSERT_EQ(dist.status, 0) << dist.out;
     EXPECT_NE(dist.out.find("every drone is ready; starting run"), std::string::npos) << dist.out;
+    // Each DEX's CPU time and peak memory as it exits (docs/performance.md reads them).
+    EXPECT_NE(dist.out.find("exited with status 0 ("), std::string::npos) << dist.out;
+    EXPECT_NE(dist.out.find(" CPU-s, peak RSS "), std::string::npos) << dist.out;
     // Both traces keep the schema (docs/trace.md), whichever way the mission ran.
     EXPECT_EQ(schema_errors(dir_ / "local.jsonl"), "");
     EXPECT_EQ(schema_errors(dir_ / "dist.jsonl"), "");
