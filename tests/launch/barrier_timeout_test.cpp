@@ -3,8 +3,11 @@
 // instant Cyclone DDS gives a pending handshake up (where Debian 12's build can crash).
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include "launch/dex_process.h"
 #include "launch/ground.h"
+#include "loopback_config.h"
 #include "transport/dds_node.h"
 
 namespace {
@@ -27,6 +30,20 @@ TEST(BarrierTimeout, ASecureBarrierEndsBeforeCycloneGivesAHandshakeUp) {
   // Every DEX the launch starts waits for the start 5 s longer than the barrier.
   EXPECT_LT(eamos::launch::kMaxSecureBarrierS + 5.0, eamos::transport::kHandshakeGiveUpS);
   EXPECT_LT(eamos::launch::kSecureUnreadyLimitS, eamos::transport::kHandshakeGiveUpS);
+}
+
+}  // namespace
+
+namespace {
+
+// Every DEX and the ground is a participant with an automatic index of its own on one host:
+// with fewer indices than 101, the 100th DEX of a 100-drone launch cannot join DDS.
+TEST(LoopbackConfiguration, AHundredDronesAndTheGroundEachFindAParticipantIndex) {
+  std::string xml = eamos::transport::kLoopbackConfig;
+  const std::string tag = "<MaxAutoParticipantIndex>";
+  auto at = xml.find(tag);
+  ASSERT_NE(at, std::string::npos) << xml;
+  EXPECT_GE(std::stoi(xml.substr(at + tag.size())) + 1, 101) << xml;
 }
 
 }  // namespace
