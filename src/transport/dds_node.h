@@ -1,6 +1,6 @@
 #pragma once
 // One process's place on the DDS domain: a participant with the five eamos topics, a
-// writer and a reader for each, and the QoS the guarantees rest on:
+// writer and a reader for each, and the QoS the delivery guarantees rest on:
 //  - triggers: reliable, transient-local; the writer keeps every sample until each matched
 //    reader has acknowledged it (keep-all history: none is lost), and of the acknowledged
 //    ones the newest `durable_triggers` for a reader matched late (or again after a network
