@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <iostream>
@@ -24,6 +25,14 @@ std::uint64_t process_nonce() {
 }
 
 
+/// What this drone's trigger writer keeps for a reader that matched late (a DEX whose
+/// reader matched only after the start, discovery still going on, or again after a network
+/// cut): twice what one pass through its part of the mission sends, at least the
+/// transport's default. Older triggers were acknowledged by every reader matched then.
+int durable_triggers(const dex::Mission& m) {
+  return static_cast<int>(std::clamp<long long>(2 * m.messages_per_pass(), transport::kDefaultDurableTriggers, 1 << 20));
+}
+
 }  // namespace
 
 volatile std::sig_atomic_t g_dex_signal = 0;
@@ -31,7 +40,7 @@ volatile std::sig_atomic_t g_dex_signal = 0;
 namespace {
 
 // SIGTERM (a service stopped, the ground's clean-up) or Ctrl-C on a DEX run by hand: the
-// loop notices at its next tick and abandons the mission into the failsafe. A second
+// loop notices at its next heartbeat and abandons the mission into the failsafe. A second
 // signal ends the process at once (_exit is async-signal-safe; nothing else is done here).
 void on_dex_signal(int signal) {
   if (g_dex_signal != 0) _exit(128 + signal);
@@ -120,7 +129,9 @@ bool DexProcess::open_dds() {
   dds.mission_hash = mission_.hash;
   dds.self = mission_.self;
   if (!o_.insecure) dds.security_folder = o_.folder + "/security";
+  dds.durable_triggers = durable_triggers(mission_);
   std::string error;
+  joined_at_ = wall_s();
   node_ = transport::DdsNode::open(dds, std::move(h), error);
   if (!node_) {
     err_ << "eamos dex: error: " << error << "\n";
@@ -172,6 +183,7 @@ bool DexProcess::wait_for_start() {
   publish_status(true);
   const double lease = o_.dds.lease_s;
   const double deadline = o_.start_timeout_s > 0 ? wall_s() + o_.start_timeout_s : 1e300;
+  const double unready_deadline = o_.insecure ? 1e300 : joined_at_ + o_.unready_limit_s;
   bool ready_sent = false;
   std::set<std::uint64_t> refused;
   out_ << name() << ": DEX of mission " << mission_.hash.substr(0, 12) << " waiting for its peers\n" << std::flush;
@@ -194,6 +206,7 @@ bool DexProcess::wait_for_start() {
       return false;
     }
     if (!ready_sent) ready_sent = ready_when_all_seen();
+    if (!ready_sent && wall_s() > unready_deadline) return leave_unready();
     for (const LifecycleSample& s : starts)
       if (std::optional<bool> taken = take_start(s, refused)) return *taken;
     if (wall_s() > deadline) {
@@ -202,6 +215,22 @@ bool DexProcess::wait_for_start() {
       return false;
     }
   }
+}
+
+// With DDS Security, a drone not heard from by now has a handshake with this DEX that does
+// not complete; Cyclone would give it up at kHandshakeGiveUpS, where Debian's build can
+// crash. Leaving the domain first ends this DEX cleanly (nothing has flown); a service
+// restarts it and its handshakes begin again.
+bool DexProcess::leave_unready() {
+  std::map<int, TelemetrySample> seen = inbox_.latest();
+  std::string missing;
+  for (int d = 0; d < static_cast<int>(mission_.fleet.size()); ++d)
+    if (d != mission_.self && !seen.count(d)) missing += (missing.empty() ? "" : ", ") + mission_.fleet[d];
+  err_ << "eamos dex: error: " << name() << ": not ready " << o_.unready_limit_s
+       << " s after joining DDS: nothing heard from " << missing
+       << " (their DEX is not running, or its DDS Security handshake with this one did not complete); "
+       << "leaving before Cyclone DDS gives the handshakes up; start this DEX again\n";
+  return false;
 }
 
 // READY once a telemetry sample came from every other drone, not only those whose telemetry
@@ -263,12 +292,16 @@ std::optional<bool> DexProcess::take_start(const LifecycleSample& s, std::set<st
 bool DexProcess::begin() {
   if (!reach_start_instant()) return false;
   transport_ = std::make_unique<transport::DdsTransport>(*node_, start_.run_id);
+  last_trigger_seq_.assign(mission_.fleet.size(), 0);
+  // What the status reports (triggers sent) and a failed write are acted on as they happen.
+  transport_->on_change([this] { schedule_settle(); });
   open_traces();
   make_engine();
   watch_run();
   publish_status(true);
   engine_->start();
-  tick();
+  heartbeat();
+  settle();
   return true;
 }
 
@@ -336,10 +369,14 @@ void DexProcess::make_engine() {
   hooks.on_end = [this] {
     end_reached_ = true;
     publish_status();
+    schedule_settle();
   };
-  // Idle now, not at the next tick: the lead's FINISHED carries the instant the last drone
+  // Idle now, not later: the lead's FINISHED carries the instant the last drone
   // went idle (StatusSample::since), which is the mission's duration.
-  hooks.on_idle = [this] { publish_status(); };
+  hooks.on_idle = [this] {
+    publish_status();
+    schedule_settle();
+  };
   engine_ = std::make_unique<dex::Engine>(mission_, *drone_, *loop_, hooks);
   start_separation();
   phase_ = Phase::running;
