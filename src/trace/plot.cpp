@@ -696,7 +696,7 @@ struct AltitudeFrame {
 
 // ---- large fleets: a summary instead of a row per drone --------------------------------
 
-constexpr std::size_t kManyDrones = 40;  ///< more drones than this: the summary view
+constexpr std::size_t kManyDrones = kPlotSummaryAbove;
 constexpr std::size_t kDetailRows = 10;  ///< rows of their own in the summary view
 constexpr int kColumns = 410;            ///< time columns of the summary's bands (2 px each)
 constexpr double kBandHeight = 150;      ///< the state band's plot area, px

@@ -254,5 +254,23 @@ TEST(Plot, InASummaryTheDroneWhoseActionFailedHasARowAndTheBandCountsTheFailsafe
   EXPECT_EQ(failed.back(), 50) << "every drone ends in its failsafe";
 }
 
+// The run keeps for the picture what it draws: a 1,000-drone show's k² barrier messages
+// held 19 GB, and telemetry is never drawn (the tracks come from the run's result).
+TEST(Plot, TheRunKeepsNoTelemetryForThePictureAndNoMessagesBeyondFortyDrones) {
+  dex::TraceEvent message, telemetry, start;
+  message.event = "message";
+  telemetry.event = "telemetry";
+  start.event = "start";
+  trace::PlotTrace small(40), large(41);
+  for (trace::PlotTrace* p : {&small, &large})
+    for (const dex::TraceEvent* e : {&message, &telemetry, &start}) p->record(*e);
+  EXPECT_TRUE(small.takes_messages());
+  EXPECT_FALSE(large.takes_messages()) << "the runner then builds none";
+  ASSERT_EQ(small.events.size(), 2u);
+  EXPECT_EQ(small.events[0].event, "message");
+  ASSERT_EQ(large.events.size(), 1u);
+  EXPECT_EQ(large.events[0].event, "start");
+}
+
 }  // namespace
 }  // namespace eamos
