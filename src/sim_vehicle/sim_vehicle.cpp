@@ -452,18 +452,9 @@ ml::Message SimVehicle::telemetry(uint32_t id) const {
   mid::DroneState s = drone_.state();
   Vec3 v = drone_.velocity();
   switch (id) {
-    case ml::msg::LOCAL_POSITION_NED: {
-      v = v * options_.reported_velocity_scale;
-      ml::LocalPositionNed p;
-      p.time_boot_ms = static_cast<uint32_t>(s.t * 1000.0);
-      p.x = static_cast<float>(s.y);
-      p.y = static_cast<float>(s.x);
-      p.z = static_cast<float>(-s.z);
-      p.vx = static_cast<float>(v.y);
-      p.vy = static_cast<float>(v.x);
-      p.vz = static_cast<float>(-v.z);
-      return ml::pack(p);
-    }
+    case ml::msg::LOCAL_POSITION_NED: return local_position(s, v);
+    case ml::msg::GLOBAL_POSITION_INT: return global_position(s, v);
+    case ml::msg::ORBIT_EXECUTION_STATUS: return orbit_status(s);
     case ml::msg::EXTENDED_SYS_STATE: {
       ml::ExtendedSysState e;
       e.landed_state = s.landed                ? ml::landed::ON_GROUND
@@ -483,34 +474,53 @@ ml::Message SimVehicle::telemetry(uint32_t id) const {
       b.voltages.fill(UINT16_MAX);
       return ml::pack(b);
     }
-    case ml::msg::GLOBAL_POSITION_INT: {
-      ml::GlobalPositionInt g;
-      g.time_boot_ms = static_cast<uint32_t>(s.t * 1000.0);
-      std::tie(g.lat, g.lon) = lat_lon_e7(s.x, s.y, options_.east_m, options_.north_m);
-      g.vx = static_cast<int16_t>(std::lround(v.y * 100.0));
-      g.vy = static_cast<int16_t>(std::lround(v.x * 100.0));
-      g.vz = static_cast<int16_t>(std::lround(-v.z * 100.0));
-      g.alt = static_cast<int32_t>(std::lround((options_.home_amsl_m + s.z) * 1000.0));
-      g.relative_alt = static_cast<int32_t>(std::lround((s.z - options_.home_above_origin_m) * 1000.0));
-      // As a real autopilot: cdeg from north, UINT16_MAX when the vehicle does not know. Flying
-      // setpoints that name a heading, this vehicle turns to it at once; otherwise the
-      // simulator's nose follows its velocity.
-      const bool yaw_set = mode_ == Mode::setpoint && setpoint_yaw_deg_;
-      const double heading = yaw_set ? *setpoint_yaw_deg_ : s.heading;
-      if (std::isfinite(heading)) g.hdg = static_cast<uint16_t>(std::lround(heading * 100.0) % 36000);
-      return ml::pack(g);
-    }
-    case ml::msg::ORBIT_EXECUTION_STATUS: {
-      // As PX4's FlightTaskOrbit reports it: MAV_FRAME_GLOBAL, the centre in degE7.
-      ml::OrbitExecutionStatus o;
-      o.time_usec = static_cast<uint64_t>(s.t * 1e6);
-      o.radius = static_cast<float>(-orbit_.direction * orbit_.radius);
-      o.frame = 0;
-      std::tie(o.x, o.y) = lat_lon_e7(orbit_.centre.x, orbit_.centre.y, options_.east_m, options_.north_m);
-      o.z = static_cast<float>(options_.home_amsl_m + orbit_.centre.z);
-      return ml::pack(o);
-    }
   }
+  return heartbeat(s);
+}
+
+ml::Message SimVehicle::local_position(const mid::DroneState& s, Vec3 v) const {
+  v = v * options_.reported_velocity_scale;
+  ml::LocalPositionNed p;
+  p.time_boot_ms = static_cast<uint32_t>(s.t * 1000.0);
+  p.x = static_cast<float>(s.y);
+  p.y = static_cast<float>(s.x);
+  p.z = static_cast<float>(-s.z);
+  p.vx = static_cast<float>(v.y);
+  p.vy = static_cast<float>(v.x);
+  p.vz = static_cast<float>(-v.z);
+  return ml::pack(p);
+}
+
+ml::Message SimVehicle::global_position(const mid::DroneState& s, Vec3 v) const {
+  ml::GlobalPositionInt g;
+  g.time_boot_ms = static_cast<uint32_t>(s.t * 1000.0);
+  std::tie(g.lat, g.lon) = lat_lon_e7(s.x, s.y, options_.east_m, options_.north_m);
+  g.vx = static_cast<int16_t>(std::lround(v.y * 100.0));
+  g.vy = static_cast<int16_t>(std::lround(v.x * 100.0));
+  g.vz = static_cast<int16_t>(std::lround(-v.z * 100.0));
+  g.alt = static_cast<int32_t>(std::lround((options_.home_amsl_m + s.z) * 1000.0));
+  g.relative_alt = static_cast<int32_t>(std::lround((s.z - options_.home_above_origin_m) * 1000.0));
+  // As a real autopilot: cdeg from north, UINT16_MAX when the vehicle does not know. Flying
+  // setpoints that name a heading, this vehicle turns to it at once; otherwise the
+  // simulator's nose follows its velocity.
+  const bool yaw_set = mode_ == Mode::setpoint && setpoint_yaw_deg_;
+  const double heading = yaw_set ? *setpoint_yaw_deg_ : s.heading;
+  if (std::isfinite(heading)) g.hdg = static_cast<uint16_t>(std::lround(heading * 100.0) % 36000);
+  return ml::pack(g);
+}
+
+// As PX4's FlightTaskOrbit reports it: MAV_FRAME_GLOBAL, the centre in degE7.
+ml::Message SimVehicle::orbit_status(const mid::DroneState& s) const {
+  ml::OrbitExecutionStatus o;
+  o.time_usec = static_cast<uint64_t>(s.t * 1e6);
+  o.radius = static_cast<float>(-orbit_.direction * orbit_.radius);
+  o.frame = 0;
+  std::tie(o.x, o.y) = lat_lon_e7(orbit_.centre.x, orbit_.centre.y, options_.east_m, options_.north_m);
+  o.z = static_cast<float>(options_.home_amsl_m + orbit_.centre.z);
+  return ml::pack(o);
+}
+
+ml::Message SimVehicle::heartbeat(const mid::DroneState& s) const {
   ml::Heartbeat hb;
   hb.type = ml::mav_type::QUADROTOR;
   hb.autopilot = dialect_.mav_autopilot;

@@ -221,6 +221,11 @@ class SimVehicle {
   void send_stream(uint32_t message_id);
   void check_preflight_disarm();
   mavlink::Message telemetry(uint32_t message_id) const;
+  // telemetry's messages that are more than a field or two
+  mavlink::Message local_position(const mid::DroneState& s, fleet::Vec3 velocity) const;
+  mavlink::Message global_position(const mid::DroneState& s, fleet::Vec3 velocity) const;
+  mavlink::Message orbit_status(const mid::DroneState& s) const;
+  mavlink::Message heartbeat(const mid::DroneState& s) const;
   void send(const mavlink::Message& m);
   mavlink::OpenResult open_link(const mavlink::Endpoint& endpoint);
 

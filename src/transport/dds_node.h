@@ -1,6 +1,6 @@
 #pragma once
 // One process's place on the DDS domain: a participant with the five eamos topics, a
-// writer and a reader for each, and the QoS the guarantees rest on:
+// writer and a reader for each, and the QoS the delivery guarantees rest on:
 //  - triggers: reliable, transient-local, keep-all: a reader matched late (or re-matched
 //    after a network hiccup) still gets every trigger of the run;
 //  - telemetry: reliable, transient-local, keep-last 1 per drone: newest value wins;

@@ -138,9 +138,9 @@ TEST(DdsNode, ReportsWhoseStatusWriterWentAway) {
   observer.reset();
 }
 
-// A handler runs on Cyclone's listener thread, called from C: an exception used to go up
-// through Cyclone itself (this test then hung; a DEX stopped hearing the others, or
-// died). Now the one sample is dropped and the rest of the batch still arrives.
+// A handler runs on Cyclone's listener thread, called from C: an exception going up through
+// Cyclone itself would hang this test (a DEX would stop hearing the others, or die). The one
+// sample is dropped and the rest of the batch still arrives.
 TEST(DdsNode, HandlerThatThrowsLosesOnlyItsSample) {
   std::string error;
   DdsOptions options;

@@ -646,7 +646,7 @@ void Sitl::fly_listing2(const std::string& extra) {
   std::cout << "  radii along the orbit: " << trail << "\n";
   for (const std::string& text : f.vehicle["Drone2"])
     if (text.find("DO_ORBIT radius") != std::string::npos) std::cout << "  " << text << "\n";
-  // Orbit() is 5 m, held within 5 % (issue 12) on average around where the Orbit started, and
+  // Orbit() is 5 m, held within 5 % on average around where the Orbit started, and
   // every sample within kSampleBound, on both autopilots: ArduCopter from setpoints, PX4 in its
   // own ORBIT mode with the radius corrected by the one flown (docs/adapters.md). The radii are
   // printed above.
