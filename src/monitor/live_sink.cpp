@@ -18,7 +18,9 @@ void LiveSink::record(const dex::TraceEvent& e) {
 }
 
 bool LiveSink::skip(const dex::TraceEvent& e) {
-  if (!thin_ || e.event != "telemetry" || !e.state) return false;
+  if (!thin_) return false;
+  if (e.event == "message") return true;
+  if (e.event != "telemetry" || !e.state) return false;
   Sent now{e.t, e.state->armed, e.state->landed};
   auto [at, first] = last_sent_.emplace(e.drone, now);
   if (first) return false;

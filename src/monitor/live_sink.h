@@ -13,11 +13,11 @@
 
 namespace eamos::monitor {
 
-/// Above this many drones the page gets each drone's telemetry at most once per
-/// kThinTelemetryPeriod mission seconds (and whenever it arms, disarms, takes off or lands):
-/// at 1,000 drones and 5 Hz the samples would be nearly all of the page's work. The page
-/// draws those drones as dots on a canvas and interpolates between samples; the trace file
-/// keeps every sample.
+/// Above this many drones (the page's lanes are then a canvas, with no trigger arrows) the
+/// page gets no messages between drones, which in one process are k² per fleet-wide barrier
+/// of k drones (a million at 1,000 drones), and each drone's telemetry at most once per
+/// kThinTelemetryPeriod mission seconds (and whenever it arms, disarms, takes off or lands;
+/// the map interpolates between samples). The trace file keeps every event.
 constexpr std::size_t kThinTelemetryAbove = 60;
 constexpr double kThinTelemetryPeriod = 1.0;
 
@@ -27,13 +27,14 @@ class LiveSink : public dex::TraceSink {
   explicit LiveSink(MonitorServer& server, std::vector<std::string> fleet = {})
       : server_(server), thin_(fleet.size() > kThinTelemetryAbove), writer_(buffer_, std::move(fleet)) {}
   void record(const dex::TraceEvent& e) override;
+  bool takes_messages() const override { return !thin_; }
 
  private:
   struct Sent {
     double t;
     bool armed, landed;
   };
-  bool skip(const dex::TraceEvent& e);  ///< a telemetry sample the page does without
+  bool skip(const dex::TraceEvent& e);  ///< an event a large fleet's page does without
 
   MonitorServer& server_;
   bool thin_;

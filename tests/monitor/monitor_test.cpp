@@ -47,20 +47,29 @@ std::size_t live_events_of(std::size_t fleet_size) {
   };
   for (int k = 0; k <= 15; ++k) sample(k * 0.2, false);
   sample(3.2, true);
-  eamos::dex::TraceEvent start;
-  start.t = 3.2;
+  eamos::dex::TraceEvent start, message;
+  start.t = message.t = 3.2;
   start.event = "start";
   start.drone = "D1";
   sink.record(start);
+  message.event = "message";
+  message.kind = "trigger";
+  message.from = 0;
+  message.to = 1;
+  sink.record(message);
   return server.event_count();
 }
 
-TEST(MonitorLive, AThousandDroneFleetsPageGetsEachDronesTelemetryOnceASecondAndEveryChange) {
-  // 0, 1, 2 and 3 s, the landing and the start; a small fleet's page gets every sample.
+TEST(MonitorLive, AThousandDroneFleetsPageGetsEachDronesTelemetryOnceASecondAndNoMessages) {
+  // 0, 1, 2 and 3 s, the landing and the start; a small fleet's page gets every sample and the message.
   EXPECT_EQ(live_events_of(1000), 6u);
   EXPECT_EQ(live_events_of(61), 6u);
-  EXPECT_EQ(live_events_of(60), 18u);
-  EXPECT_EQ(live_events_of(20), 18u);
+  EXPECT_EQ(live_events_of(60), 19u);
+  EXPECT_EQ(live_events_of(20), 19u);
+  eamos::monitor::MonitorServer server;
+  EXPECT_FALSE(eamos::monitor::LiveSink(server, std::vector<std::string>(61, "D")).takes_messages())
+      << "the runner then builds none";
+  EXPECT_TRUE(eamos::monitor::LiveSink(server, std::vector<std::string>(60, "D")).takes_messages());
 }
 
 TEST(MonitorTrace, EveryBadLineIsReportedWithItsLineNumber) {

@@ -756,7 +756,9 @@ function renderLanes() {
 // Level of detail for large fleets: one pixel row group per drone, bars merged below a pixel.
 function renderLanesCanvas() {
   const canvas = $('lanes-canvas');
-  const rowH = Math.max(2, Math.min(8, Math.floor(4000 / D.drones.length)));
+  // At most 1,200 px tall: the browser paints the whole canvas each frame, and a thousand
+  // rows of 4 px (6 million pixels) made a live page fall seconds behind.
+  const rowH = Math.max(1, Math.min(8, Math.floor(1200 / D.drones.length)));
   const w = Math.max(400, $('lanes-scroll').clientWidth - 4);
   // Resizing a canvas reallocates it (4,000 rows of a thousand drones): only when it changes.
   if (canvas.width !== w) canvas.width = w;
