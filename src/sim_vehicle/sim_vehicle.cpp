@@ -91,7 +91,7 @@ SimVehicle::SimVehicle(mid::EventLoop& loop, VehicleOptions options)
       drone_(vehicle_settings(options.sysid, options.battery_percent), vehicle_type(options.limits), loop),
       encoder_{options.sysid, ml::comp::AUTOPILOT1, 0},
       dialect_(*options.dialect),
-      mode_(dialect_.boot) {}
+      mode_(options.boot_mode.value_or(dialect_.boot)) {}
 
 SimVehicle::~SimVehicle() {
   link_.reset();
@@ -234,6 +234,9 @@ uint8_t SimVehicle::execute(const ml::CommandLong& c) {
       bool arm = c.param[0] > 0.5f;
       if (!arm && !s.landed) return ml::result::DENIED;
       if (arm && s.battery <= 0.0) return ml::result::DENIED;
+      // PX4's arming checks hold each mode's requirements: OFFBOARD's is a fresh setpoint.
+      if (arm && mode_ == Mode::setpoint && dialect_.setpoints_before_switch && !setpoints_fresh())
+        return ml::result::TEMPORARILY_REJECTED;
       loop_.cancel(disarm_timer_);
       start_then_ack(c.command, arm ? "Arm" : "Disarm");
       return kAckLater;
@@ -296,9 +299,7 @@ uint8_t SimVehicle::set_mode(Mode mode) {
   switch (mode) {
     case Mode::setpoint:
       // PX4's rule: no switch to OFFBOARD unless setpoints are already streaming.
-      if (dialect_.setpoints_before_switch &&
-          (!have_setpoint_ || loop_.now() - setpoint_at_ > options_.offboard_loss_s))
-        return ml::result::DENIED;
+      if (dialect_.setpoints_before_switch && !setpoints_fresh()) return ml::result::DENIED;
       mode_ = Mode::setpoint;
       flying_ = false;
       if (!s.landed) start("Hover", {});  // hold until a setpoint says otherwise
@@ -361,6 +362,10 @@ void SimVehicle::fly_to_setpoint() {
   flying_to_ = setpoint_;  // the setpoint, not where the hold stands (a stand-off is no new setpoint)
   flying_ = true;
   start("FlyTo", {setpoint_.x + options_.setpoint_standoff_east_m, setpoint_.y, setpoint_.z});
+}
+
+bool SimVehicle::setpoints_fresh() const {
+  return have_setpoint_ && loop_.now() - setpoint_at_ <= options_.offboard_loss_s;
 }
 
 void SimVehicle::check_offboard() {

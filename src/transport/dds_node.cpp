@@ -29,17 +29,21 @@ bool looks_like_address(const std::string& s) {
 std::string retcode(dds_return_t rc) { return dds_strretcode(rc); }
 
 /// Reliable, transient-local: what a reader needs even when it matched late.
-dds_qos_t* durable_qos(bool keep_all, double lease_s) {
+/// `durable` 0: keep-last 1 (newest value wins, per instance); otherwise keep-all until
+/// acknowledged, then the newest `durable` for late readers.
+dds_qos_t* durable_qos(int durable, double lease_s) {
   dds_qos_t* q = dds_create_qos();
   // A write may block while readers catch up; never as long as the lease, or a busy drone
   // would look lost to the others.
   dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, static_cast<dds_duration_t>(lease_s / 4 * 1e9));
   dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
-  // What a late reader gets is the durability service's history, not the writer's:
-  // its default (keep-last 1) would hand a late DEX only the newest trigger.
-  if (keep_all) {
+  // What a late reader gets is the durability service's history, not the writer's: its
+  // default (keep-last 1) would hand a late DEX only the newest trigger. Cyclone keeps a
+  // sample in the writer until every matched reader acknowledged it (keep-all history),
+  // and after that only as long as it is among the durability service's newest `durable`.
+  if (durable > 0) {
     dds_qset_history(q, DDS_HISTORY_KEEP_ALL, 0);
-    dds_qset_durability_service(q, 0, DDS_HISTORY_KEEP_ALL, 0, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED,
+    dds_qset_durability_service(q, 0, DDS_HISTORY_KEEP_LAST, durable, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED,
                                 DDS_LENGTH_UNLIMITED);
   } else {
     dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
@@ -257,7 +261,7 @@ dds_entity_t grouping(dds_entity_t participant, bool publisher, const std::vecto
 struct TopicSpec {
   const char* name;
   const dds_topic_descriptor_t* type;
-  bool keep_all;  ///< history KEEP_ALL (triggers, traces) rather than the last sample
+  int durable;    ///< acknowledged samples kept for late readers (triggers, traces); 0: the newest value wins
   int* writer;    ///< 0 when this participant does not write the topic
   int* reader;    ///< 0 when it does not read it
   dds_on_data_available_fn on_data;
@@ -273,7 +277,7 @@ struct Endpoints {
 
 /// Creates `spec`'s topic, its writer and its reader; false with `error` set when DDS refuses.
 bool create_topic(const Endpoints& at, const TopicSpec& spec, const DdsOptions& options, std::string& error) {
-  dds_qos_t* qos = durable_qos(spec.keep_all, options.lease_s);
+  dds_qos_t* qos = durable_qos(spec.durable, options.lease_s);
   dds_entity_t topic = dds_create_topic(at.participant, spec.type, spec.name, qos, nullptr);
   if (topic < 0) {
     dds_delete_qos(qos);
@@ -323,14 +327,15 @@ bool DdsNode::create_endpoints(const DdsOptions& options, std::string& error) {
   const bool drone = mission_hash_.empty() || options.self != kGroundParticipant;
   // Only the ground reads traces: a DEX does not take every other drone's events.
   const bool traces = handlers_.trace != nullptr;
+  const int triggers = std::max(1, options.durable_triggers), trace = std::max(1, options.durable_trace);
   const TopicSpec specs[] = {
-      {"eamos_trigger", &eamos_wire_Trigger_desc, true, &w_trigger_, &r_trigger_, on_trigger, drone, true, false},
-      {"eamos_telemetry", &eamos_wire_Telemetry_desc, false, &w_telemetry_, &r_telemetry_, on_telemetry, drone,
+      {"eamos_trigger", &eamos_wire_Trigger_desc, triggers, &w_trigger_, &r_trigger_, on_trigger, drone, true, false},
+      {"eamos_telemetry", &eamos_wire_Telemetry_desc, 0, &w_telemetry_, &r_telemetry_, on_telemetry, drone,
        true, false},
-      {"eamos_lifecycle", &eamos_wire_Lifecycle_desc, false, &w_lifecycle_, &r_lifecycle_, on_lifecycle, true, true,
+      {"eamos_lifecycle", &eamos_wire_Lifecycle_desc, 0, &w_lifecycle_, &r_lifecycle_, on_lifecycle, true, true,
        false},
-      {"eamos_status", &eamos_wire_Status_desc, false, &w_status_, &r_status_, on_status, drone, true, true},
-      {"eamos_trace", &eamos_wire_TraceRecord_desc, true, &w_trace_, &r_trace_, on_trace, drone, traces, false},
+      {"eamos_status", &eamos_wire_Status_desc, 0, &w_status_, &r_status_, on_status, drone, true, true},
+      {"eamos_trace", &eamos_wire_TraceRecord_desc, trace, &w_trace_, &r_trace_, on_trace, drone, traces, false},
   };
   for (const TopicSpec& spec : specs)
     if (!create_topic(at, spec, options, error)) return false;

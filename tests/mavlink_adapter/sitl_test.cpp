@@ -334,11 +334,6 @@ void Sitl::fly_second_mission(const std::string& extra) {
 TEST_P(Sitl, ASecondMissionRightAfterTheFirstWaitsArmedLongerThanTheAutoDisarm) { fly_second_mission(""); }
 
 TEST_P(Sitl, ASecondMissionWithOneDexPerDroneWaitsArmedLongerThanTheAutoDisarm) {
-  // Known regression, not yet understood: on PX4 the second mission's Arm is now refused
-  // ("Arming denied: Resolve system health failures first", 1.5 s in) with one DEX per drone,
-  // while the in-process case above passes. Skipped on PX4, saying so, until it is found.
-  if (GetParam() == Autopilot::px4)
-    GTEST_SKIP() << "known regression on PX4: the second mission's Arm is refused (system health) with one DEX per drone";
   fly_second_mission("--distributed");
 }
 
