@@ -1,5 +1,6 @@
 #include "lang/arming.h"
 
+#include <algorithm>
 #include <map>
 #include <string>
 #include <utility>
@@ -32,47 +33,134 @@ bool is_repeat(ControlKind k) {
 bool is_do_sync(ControlKind k) { return k == ControlKind::DoUntilSync || k == ControlKind::DoWhileSync; }
 bool is_do_async(ControlKind k) { return k == ControlKind::DoUntilAsync || k == ControlKind::DoWhileAsync; }
 
-/// One drone's Armed state through the mission, memoised per (block, entry state): a block
-/// is analysed at most four times per drone however often it is called.
-class DroneArming {
+/// Which drones each function and each statement may arm, disarm or move: a drone's
+/// analysis visits only the statements that mention it, so a show where every drone flies
+/// in every PAR costs each drone its own statements, not the fleet's. Built once for all
+/// drones; its size is the statements times the drones each one reaches.
+class Mentions {
  public:
-  DroneArming(const Mission& m, const fleet::DroneType& type, int drone, std::map<std::pair<int, int>, Finding>& out)
-      : m_(m), type_(type), drone_(drone), out_(out), mentions_(m.functions.size(), 0),
-        memo_(m.functions.size() * 4), recorded_(m.functions.size() * 4, 0) {}
-
-  void run(int init) { block(init, kDisarmed, true); }
-
- private:
-  bool mentioned(int fn) {
-    if (fn < 0) return false;
-    char& known = mentions_[fn];
-    if (known) return known == 2;
-    known = 1;  // the checker has ruled out recursion; this only guards re-entry
-    bool any = false;
-    for (const Statement& s : m_.functions[fn].body) {
-      if (s.kind == StatementKind::action) any = any || s.drone_index == drone_;
-      else if (s.function_index >= 0) any = mentioned(s.function_index) || any;
-      for (int b : s.branch_functions) any = mentioned(b) || any;
-    }
-    known = any ? 2 : 1;
-    return any;
+  explicit Mentions(const Mission& m) : m_(m), of_function_(m.functions.size()), state_(m.functions.size(), 0) {
+    by_function_.resize(m.functions.size());
+    for (std::size_t fn = 0; fn < m.functions.size(); ++fn) index(static_cast<int>(fn));
   }
 
+  /// The statements of `fn` that mention `drone`, in order (indices into its body).
+  std::vector<int> statements(int fn, int drone) const {
+    std::vector<int> out;
+    const auto& pairs = by_function_[fn];
+    auto it = std::lower_bound(pairs.begin(), pairs.end(), std::pair<int, int>{drone, -1});
+    for (; it != pairs.end() && it->first == drone; ++it) out.push_back(it->second);
+    return out;
+  }
+
+  bool mentions(int fn, int drone) const {
+    return fn >= 0 && std::binary_search(of_function_[fn].begin(), of_function_[fn].end(), drone);
+  }
+
+ private:
+  /// Fills of_function_[fn] and by_function_[fn], callees first; iterative, since calls can
+  /// nest as deep as the mission's functions.
+  void index(int root) {
+    std::vector<std::pair<int, std::size_t>> stack;  // (function, next statement to look at)
+    if (state_[root] == 0) stack.push_back({root, 0});
+    while (!stack.empty()) {
+      auto [fn, next] = stack.back();
+      state_[fn] = 1;
+      const std::vector<Statement>& body = m_.functions[fn].body;
+      int pending = -1;  // a callee not indexed yet
+      for (; next < body.size() && pending < 0; next += pending < 0 ? 1 : 0)
+        for (int callee : callees(body[next]))
+          if (callee >= 0 && state_[callee] == 0) {
+            pending = callee;
+            break;
+          }
+      stack.back().second = next;
+      if (pending >= 0) {
+        stack.push_back({pending, 0});
+        continue;
+      }
+      finish(fn);
+      stack.pop_back();
+    }
+  }
+
+  static std::vector<int> callees(const Statement& s) {
+    std::vector<int> out;
+    if (s.kind != StatementKind::action && s.function_index >= 0) out.push_back(s.function_index);
+    out.insert(out.end(), s.branch_functions.begin(), s.branch_functions.end());
+    return out;
+  }
+
+  void finish(int fn) {
+    std::vector<std::pair<int, int>>& pairs = by_function_[fn];
+    const std::vector<Statement>& body = m_.functions[fn].body;
+    for (std::size_t i = 0; i < body.size(); ++i) {
+      const Statement& s = body[i];
+      int at = static_cast<int>(i);
+      if (s.kind == StatementKind::action && s.drone_index >= 0) pairs.push_back({s.drone_index, at});
+      for (int callee : callees(s))
+        if (callee >= 0 && state_[callee] == 2)  // not a recursive call: the checker reports those
+          for (int d : of_function_[callee]) pairs.push_back({d, at});
+    }
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    std::vector<int>& drones = of_function_[fn];
+    for (const auto& [d, at] : pairs)
+      if (drones.empty() || drones.back() != d) drones.push_back(d);
+    state_[fn] = 2;
+  }
+
+  const Mission& m_;
+  std::vector<std::vector<int>> of_function_;                ///< per function: sorted drones
+  std::vector<std::vector<std::pair<int, int>>> by_function_;  ///< per function: (drone, statement)
+  std::vector<char> state_;  ///< per function: 0 not seen, 1 being indexed, 2 done
+};
+
+/// One drone's Armed state through the mission, memoised per (block, entry state): a block
+/// is analysed at most four times per drone however often it is called. The memo is shared
+/// by the drones in turn and reset where the last one wrote, so that a thousand drones do
+/// not each clear a table of every function.
+class DroneArming {
+ public:
+  DroneArming(const Mission& m, const Mentions& mentions, std::map<std::pair<int, int>, Finding>& out)
+      : m_(m), mentions_(mentions), out_(out), memo_(m.functions.size() * 4), recorded_(m.functions.size() * 4, 0) {}
+
+  void run(int init, const fleet::DroneType& type, int drone) {
+    for (std::size_t slot : touched_) {
+      memo_[slot] = Flow{};
+      recorded_[slot] = 0;
+    }
+    touched_.clear();
+    type_ = &type;
+    drone_ = drone;
+    block(init, kDisarmed, true);
+  }
+
+  /// Statements a drone's analysis has visited so far, over every run: the work done.
+  long long visited() const { return visited_; }
+
+ private:
   Flow block(int fn, States entry, bool record) {
-    if (fn < 0 || entry == 0 || !mentioned(fn)) return {entry, entry};
+    if (fn < 0 || entry == 0 || !mentions_.mentions(fn, drone_)) return {entry, entry};
     std::size_t slot = static_cast<std::size_t>(fn) * 4 + entry;
     bool cached = memo_[slot].seen != 0;
     if (cached && (!record || recorded_[slot])) return memo_[slot];
     const Function& f = m_.functions[fn];
-    Flow flow = f.block == BlockKind::par ? par(f, entry, record) : seq(f, entry, record);
+    std::vector<int> mine = mentions_.statements(fn, drone_);
+    Flow flow = f.block == BlockKind::par ? par(f, mine, entry, record) : seq(f, mine, entry, record);
+    if (!cached) touched_.push_back(slot);
     memo_[slot] = flow;
     if (record) recorded_[slot] = 1;
     return flow;
   }
 
-  Flow seq(const Function& f, States entry, bool record) {
+  /// Statements that do not mention the drone leave its state as it is, async ones too:
+  /// only `mine`, the statements that do, are visited.
+  Flow seq(const Function& f, const std::vector<int>& mine, States entry, bool record) {
     States s = entry, seen = entry, detached = 0;  // detached: what async work may set at any time
-    for (const Statement& st : f.body) {
+    for (int i : mine) {
+      const Statement& st = f.body[i];
+      ++visited_;
       Flow step = statement(st, s, record, detached);
       s = step.exit ? step.exit | detached : 0;  // a path that failed stays failed
       seen |= step.seen | s;
@@ -81,23 +169,30 @@ class DroneArming {
   }
 
   /// Siblings run at once: each starts from the entry or from whatever another sibling
-  /// that arms or disarms this drone may have set meanwhile.
-  Flow par(const Function& f, States entry, bool record) {
+  /// that arms or disarms this drone may have set meanwhile. Siblings that do not mention
+  /// the drone neither change it nor see more than the others do.
+  Flow par(const Function& f, const std::vector<int>& mine, States entry, bool record) {
     std::vector<Flow> alone;
-    for (const Statement& st : f.body) {
+    for (int i : mine) {
       States detached = 0;
-      Flow flow = statement(st, entry, false, detached);
+      ++visited_;
+      Flow flow = statement(f.body[i], entry, false, detached);
       alone.push_back({static_cast<States>(flow.exit | detached), static_cast<States>(flow.seen | detached)});
     }
     auto changes = [&](std::size_t i) { return alone[i].seen != entry || alone[i].exit != entry; };
+    // What the changing siblings before and after each one may set: each start leaves out
+    // only its own sibling, in one pass each way rather than one per pair.
+    std::size_t n = mine.size();
+    std::vector<States> before(n + 1, 0), after(n + 1, 0);
+    for (std::size_t j = 0; j < n; ++j) before[j + 1] = before[j] | (changes(j) ? alone[j].seen : 0);
+    for (std::size_t j = n; j-- > 0;) after[j] = after[j + 1] | (changes(j) ? alone[j].seen : 0);
     States exit = 0, seen = entry;
     bool changed = false;
-    for (std::size_t i = 0; i < f.body.size(); ++i) {
-      States start = entry;
-      for (std::size_t j = 0; j < f.body.size(); ++j)
-        if (j != i && changes(j)) start |= alone[j].seen;
+    for (std::size_t i = 0; i < n; ++i) {
+      States start = entry | before[i] | after[i + 1];
       States detached = 0;
-      Flow flow = statement(f.body[i], start, record, detached);
+      ++visited_;
+      Flow flow = statement(f.body[mine[i]], start, record, detached);
       seen |= flow.seen | detached;
       if (changes(i)) {
         exit |= flow.exit | detached;
@@ -121,7 +216,7 @@ class DroneArming {
 
   Flow action(const Statement& st, States s, bool record) {
     if (st.drone_index != drone_) return {s, s};
-    const fleet::ActionSpec* spec = type_.find_action(st.callee);
+    const fleet::ActionSpec* spec = type_->find_action(st.callee);
     if (spec && spec->action_class == fleet::ActionClass::system) {
       if (st.callee == "Arm") return {kArmed, static_cast<States>(s | kArmed)};
       if (st.callee == "Disarm") return {kDisarmed, static_cast<States>(s | kDisarmed)};
@@ -170,22 +265,27 @@ class DroneArming {
   }
 
   const Mission& m_;
-  const fleet::DroneType& type_;
-  int drone_;
+  const Mentions& mentions_;
   std::map<std::pair<int, int>, Finding>& out_;
-  std::vector<char> mentions_;  ///< per function: 0 unknown, 1 no action of this drone, 2 some
+  const fleet::DroneType* type_ = nullptr;
+  int drone_ = -1;
   std::vector<Flow> memo_;
   std::vector<char> recorded_;
+  std::vector<std::size_t> touched_;  ///< memo slots written since the last reset
+  long long visited_ = 0;
 };
 
 }  // namespace
 
 void check_armed_before_motion(const Mission& mission, const std::vector<fleet::DroneType>& types,
-                               Diagnostics& diags) {
+                               Diagnostics& diags, long long* work) {
   if (mission.init_function < 0) return;
   std::map<std::pair<int, int>, Finding> findings;
+  Mentions mentions(mission);
+  DroneArming arming(mission, mentions, findings);
   for (std::size_t d = 0; d < mission.drones.size() && d < types.size(); ++d)
-    DroneArming(mission, types[d], static_cast<int>(d), findings).run(mission.init_function);
+    arming.run(mission.init_function, types[d], static_cast<int>(d));
+  if (work) *work = arming.visited();
   for (const auto& [at, f] : findings) {
     if (!f.some) continue;
     const Statement& st = *f.statement;
