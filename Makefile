@@ -33,8 +33,8 @@ test: build
 	@bash scripts/test.sh $(BUILD) $(BUILD)-fuzz 5
 
 # The suites under AddressSanitizer + UBSan and under ThreadSanitizer, each sanitizer in a
-# build tree of its own ($(BUILD)-asan, $(BUILD)-tsan; scripts/sanitize.sh). Not yet in
-# .ci/run (docs/performance.md, "The sanitizer runs").
+# build tree of its own ($(BUILD)-asan, $(BUILD)-tsan; scripts/sanitize.sh); .ci/run
+# runs it after make test (docs/performance.md, "The sanitizer runs").
 sanitize: deps
 	@bash scripts/sanitize.sh all $(BUILD)
 

@@ -1,4 +1,4 @@
-// `eamos verify` performance (issue 15): Listing 2 with every path its fleet allows (the If
+// `eamos verify` performance: Listing 2 with every path its fleet allows (the If
 // on Drone1's sensor both ways, with and without --jitter) under 100 ms, and one path of the
 // 5,000-node / 20-drone stress mission under 1 s. Each iteration verifies from the compiled
 // mission files, as `eamos verify` does after compiling.

@@ -28,7 +28,7 @@ awk '/"per_drone"/ {in_drones = 1} in_drones && /^        "nodes":/ {
 "$BUILD/bench/bench_dex" --benchmark_out=out/bench/dex.json --benchmark_out_format=json \
   --benchmark_repetitions=${REPS:-5} --benchmark_report_aggregates_only=true
 
-# Distributed execution (issue 4). Cross-drone trigger latency through eamos's DDS
+# Distributed execution. Cross-drone trigger latency through eamos's DDS
 # transport and event loops, then ddsperf ping/pong on the same loopback configuration in
 # the same run (ddsperf prints RTT/2).
 "$BUILD/bench/bench_dds_latency" --benchmark_out=out/bench/dds_latency.json --benchmark_out_format=json

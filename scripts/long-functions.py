@@ -7,7 +7,7 @@ comment starting `// long:` with the reason, on one of the three lines above its
 such a function is not listed. Usage:
 
   scripts/long-functions.py [--max N] [--check] [--all] [--exclude PATH]... PATH...
-                                                  (files or folders, their *.cpp)
+                                                  (files or folders, their *.cpp and *.h)
 
 --check: exit 1 when any function is listed (the ctest case `LongFunctionsHaveAReason`).
 The scan is lexical (comments, strings and characters removed, braces matched), which is
@@ -164,7 +164,7 @@ def sources(paths):
         if os.path.isdir(p):
             for root, _, files in sorted(os.walk(p)):
                 for f in sorted(files):
-                    if f.endswith('.cpp'):
+                    if f.endswith(('.cpp', '.h')):
                         yield os.path.join(root, f)
         else:
             yield p

@@ -98,6 +98,11 @@ struct Mission {
 
   /// Index of the node with MEG id `meg` held by `drone`, or -1.
   int find(int meg, int drone) const;
+  /// The messages one pass through this drone's part of the mission sends (OutBridge): an
+  /// `ended` from each of its nodes to each other drone it links to, an arrival per sync
+  /// point it announces, a cancel to every other drone per Do condition it holds. A loop
+  /// repeats them; it does not add to them.
+  long long messages_per_pass() const;
   /// Key of (meg, drone) in `index`.
   static std::uint64_t key(int meg, int drone) {
     return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(meg)) << 32) | static_cast<std::uint32_t>(drone);

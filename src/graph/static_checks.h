@@ -1,5 +1,5 @@
 #pragma once
-// Static analysis of a mission's logic before anything flies (issue 15, item 3): waits that
+// Static analysis of a mission's logic before anything flies: waits that
 // can never end, loops that never end, branches that can never run, and cross-drone
 // deadlock, found on the MEG. Every finding is a fact that holds on every flight where the
 // statement is reached; what eamos cannot prove is not reported (docs/verify.md, "Static

@@ -18,6 +18,14 @@ std::string DexProcess::who(int drone) const {
 }
 
 void DexProcess::reject(int sender, const std::string& what, const std::string& why) {
+  // What was logged is remembered up to a bound: a peer sending ever new faults (each replay
+  // names its own sequence number) must not grow this process's memory.
+  if (rejected_.size() > kMaxRemembered) return;
+  if (rejected_.size() == kMaxRemembered) {
+    rejected_.insert("");
+    err_ << name() << ": more ignored samples than " << kMaxRemembered << " kinds; no longer logging them\n";
+    return;
+  }
   if (rejected_.insert(std::to_string(sender) + " " + what + " " + why).second)
     err_ << name() << ": ignored a " << what << " sample from " << who(sender) << ": " << why << "\n";
 }
@@ -93,7 +101,7 @@ bool DexProcess::finish_agreed(int lead, std::string& why) const {
 void DexProcess::on_finished(const LifecycleSample& s) {
   // Only the lead may say it, and only when this drone sees what the lead saw: every
   // drone idle and nothing in flight. The statuses that show it may still be on their
-  // way: a FINISHED not agreed with yet is kept and checked again at every tick.
+  // way: a FINISHED not agreed with yet is kept and checked again as statuses come.
   std::string why;
   if (s.drone == transport::kGround) return reject(s.drone, "finished", "only the lead drone ends a mission");
   if (finish_agreed(s.drone, why)) return complete();
@@ -105,7 +113,7 @@ void DexProcess::check_pending_finished() {
   if (!pending_finished_ || phase_ != Phase::running) return;
   std::string why;
   if (finish_agreed(pending_finished_->drone, why)) return complete();
-  // Statuses arrive within a few ticks; one not agreed with after the lease is refused.
+  // Statuses arrive within moments; one not agreed with after the lease is refused.
   if (wall_s() - pending_since_ > o_.dds.lease_s) reject(pending_finished_->drone, "finished", why);
 }
 

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <iostream>
@@ -24,6 +25,14 @@ std::uint64_t process_nonce() {
 }
 
 
+/// What this drone's trigger writer keeps for a reader that matched late (a DEX whose
+/// reader matched only after the start, discovery still going on, or again after a network
+/// cut): twice what one pass through its part of the mission sends, at least the
+/// transport's default. Older triggers were acknowledged by every reader matched then.
+int durable_triggers(const dex::Mission& m) {
+  return static_cast<int>(std::clamp<long long>(2 * m.messages_per_pass(), transport::kDefaultDurableTriggers, 1 << 20));
+}
+
 }  // namespace
 
 volatile std::sig_atomic_t g_dex_signal = 0;
@@ -31,7 +40,7 @@ volatile std::sig_atomic_t g_dex_signal = 0;
 namespace {
 
 // SIGTERM (a service stopped, the ground's clean-up) or Ctrl-C on a DEX run by hand: the
-// loop notices at its next tick and abandons the mission into the failsafe. A second
+// loop notices at its next heartbeat and abandons the mission into the failsafe. A second
 // signal ends the process at once (_exit is async-signal-safe; nothing else is done here).
 void on_dex_signal(int signal) {
   if (g_dex_signal != 0) _exit(128 + signal);
@@ -120,6 +129,7 @@ bool DexProcess::open_dds() {
   dds.mission_hash = mission_.hash;
   dds.self = mission_.self;
   if (!o_.insecure) dds.security_folder = o_.folder + "/security";
+  dds.durable_triggers = durable_triggers(mission_);
   std::string error;
   node_ = transport::DdsNode::open(dds, std::move(h), error);
   if (!node_) {
@@ -263,12 +273,16 @@ std::optional<bool> DexProcess::take_start(const LifecycleSample& s, std::set<st
 bool DexProcess::begin() {
   if (!reach_start_instant()) return false;
   transport_ = std::make_unique<transport::DdsTransport>(*node_, start_.run_id);
+  last_trigger_seq_.assign(mission_.fleet.size(), 0);
+  // What the status reports (triggers sent) and a failed write are acted on as they happen.
+  transport_->on_change([this] { schedule_settle(); });
   open_traces();
   make_engine();
   watch_run();
   publish_status(true);
   engine_->start();
-  tick();
+  heartbeat();
+  settle();
   return true;
 }
 
@@ -336,10 +350,14 @@ void DexProcess::make_engine() {
   hooks.on_end = [this] {
     end_reached_ = true;
     publish_status();
+    schedule_settle();
   };
-  // Idle now, not at the next tick: the lead's FINISHED carries the instant the last drone
+  // Idle now, not later: the lead's FINISHED carries the instant the last drone
   // went idle (StatusSample::since), which is the mission's duration.
-  hooks.on_idle = [this] { publish_status(); };
+  hooks.on_idle = [this] {
+    publish_status();
+    schedule_settle();
+  };
   engine_ = std::make_unique<dex::Engine>(mission_, *drone_, *loop_, hooks);
   start_separation();
   phase_ = Phase::running;

@@ -11,12 +11,30 @@
 
 namespace eamos::launch {
 
-void DexProcess::tick() {
-  // A heartbeat of the loop itself: liveliness is asserted only while the loop runs, so a
-  // hung DEX is lost like a dead one; status changes (busy/idle) are published here.
+void DexProcess::heartbeat() {
+  // The loop's own heartbeat, a few times per lease: liveliness is asserted only while the
+  // loop runs, so a hung DEX is lost like a dead one; a signal and a FINISHED nobody agreed
+  // with are noticed here. Everything else is done when the event that changes it comes
+  // (settle): a drone waiting at a barrier wakes only for this.
   node_->assert_alive();
   if (phase_ == Phase::running && g_dex_signal != 0)
     abandon(name() + "'s DEX was interrupted (" + signal_name(g_dex_signal) + ")", std::nullopt, true);
+  check_pending_finished();
+  loop_->after(heartbeat_s() * o_.speed, [this] { heartbeat(); });
+}
+
+void DexProcess::schedule_settle() {
+  // Once per burst of changes, after the callback that made them (the engine may be in
+  // the middle of a step when it sends).
+  if (settle_scheduled_) return;
+  settle_scheduled_ = true;
+  loop_->after(0.0, [this] {
+    settle_scheduled_ = false;
+    settle();
+  });
+}
+
+void DexProcess::settle() {
   if (phase_ == Phase::running && transport_->write_errors() > 0) {
     // A trigger that did not go out would leave another drone waiting for ever.
     abandon("DDS could not send a trigger or telemetry sample (write failed or blocked too long)", std::nullopt,
@@ -25,8 +43,6 @@ void DexProcess::tick() {
   publish_status();
   check_finished();
   check_pending_finished();
-  double every = tick_s() * o_.speed;
-  loop_->after(every, [this] { tick(); });
 }
 
 bool DexProcess::ours(const std::string& hash, std::uint64_t run) {
@@ -35,7 +51,7 @@ bool DexProcess::ours(const std::string& hash, std::uint64_t run) {
     return false;
   }
   if (run != start_.run_id) {
-    if (stale_runs_.insert(run).second)
+    if (stale_runs_.size() < kMaxRemembered && stale_runs_.insert(run).second)
       err_ << name() << ": ignoring messages of run " << run << " (this drone is in run " << start_.run_id << ")\n";
     return false;
   }
@@ -43,7 +59,7 @@ bool DexProcess::ours(const std::string& hash, std::uint64_t run) {
 }
 
 void DexProcess::note_foreign(const std::string& hash) {
-  if (foreign_.insert(hash).second)
+  if (foreign_.size() < kMaxRemembered && foreign_.insert(hash).second)
     err_ << name() << ": ignoring messages of another mission (hash " << hash.substr(0, 12)
          << "…) on DDS domain " << o_.dds.domain << "\n";
 }
@@ -55,9 +71,12 @@ void DexProcess::on_trigger(const TriggerSample& s) {
   if (s.to == transport::kEveryDrone && !waits_for_arrival(s.message)) return;
   std::string why;
   if (!trigger_allowed(s, why)) return reject(s.message.from, "trigger", why);
-  // Reliable delivery never repeats a sample: a second one with the same number is a replay.
-  if (!seen_triggers_.insert({s.message.from, s.seq}).second)
+  // Reliable delivery never repeats a sample: one numbered at or below the newest accepted
+  // one from its sender is a replay (trigger_allowed checked the sender's range).
+  std::uint64_t& last = last_trigger_seq_[s.message.from];
+  if (s.seq <= last)
     return reject(s.message.from, "trigger", "sequence number " + std::to_string(s.seq) + " was already received");
+  last = s.seq;
   // Only what was accepted is counted: a dropped sample counted as received would leave
   // Σsent ≠ Σreceived and the mission waiting for ever.
   if (s.message.kind != dex::Message::Kind::cancel) ++received_;
@@ -67,7 +86,7 @@ void DexProcess::on_trigger(const TriggerSample& s) {
     tee_.record(event);
     engine_->receive(s.message);
   }
-  publish_status();
+  settle();
 }
 
 bool DexProcess::too_late(const dex::TraceEvent& event) {
@@ -142,6 +161,7 @@ void DexProcess::on_status(const StatusSample& s) {
     publish_status(true);
   }
   if (termination_) termination_->report({s.drone, s.wave, s.busy, s.sent, s.received});
+  settle();  // the lead's next wave, or a FINISHED this drone can now agree with
 }
 
 void DexProcess::on_lost(const std::string& hash, int drone, std::uint64_t nonce) {
@@ -188,7 +208,7 @@ void DexProcess::publish_status(bool force) {
 
 // Only the lead (it ran the end node) decides, by termination waves (launch/termination.h);
 // everyone else follows its FINISHED. Waves start once the newest statuses look over, so an
-// active fleet is not asked at every tick.
+// active fleet is not asked at every change.
 void DexProcess::check_finished() {
   if (phase_ != Phase::running || !end_reached_) return;
   if (!termination_) termination_.emplace(static_cast<int>(mission_.fleet.size()));

@@ -67,6 +67,10 @@ class DdsTraceSink : public dex::TraceSink {
   bool scheduled_ = false;
 };
 
+/// How many distinct ignored inputs (faults, other runs, other missions) a DEX remembers
+/// having logged; beyond that it stops logging them rather than grow.
+inline constexpr std::size_t kMaxRemembered = 1000;
+
 /// Set by the DEX's SIGINT/SIGTERM handler (dex_process.cpp); 0 until a signal came.
 extern volatile std::sig_atomic_t g_dex_signal;
 inline const char* signal_name(int signal) { return signal == SIGINT ? "SIGINT" : "SIGTERM"; }
@@ -125,7 +129,11 @@ class DexProcess {
   /// Logs once per sender and kind of fault that a sample was ignored.
   void reject(int sender, const std::string& what, const std::string& why);
   std::string who(int drone) const;
-  void tick();
+  void heartbeat();
+  /// Publishes what changed (busy/idle, counters), lets the lead look for the mission's
+  /// end and checks a pending FINISHED: after every input and every trigger sent.
+  void settle();
+  void schedule_settle();
   void publish_status(bool force = false);
   void check_finished();
   /// Trigger counters of the whole fleet (this drone's own and every other drone's newest
@@ -150,8 +158,9 @@ class DexProcess {
   void note_foreign(const std::string& hash);
   StatusSample status_now(Phase phase) const;
   std::string name() const { return mission_.fleet[mission_.self]; }
-  /// Wall seconds between ticks: how soon busy/idle changes are published.
-  double tick_s() const { return std::min(0.02, o_.dds.lease_s / 4); }
+  /// Wall seconds between heartbeats: a quarter of the lease, so one late heartbeat does
+  /// not cost the drone its liveliness. Also how soon a signal is noticed.
+  double heartbeat_s() const { return o_.dds.lease_s / 4; }
 
   const DexProcessOptions& o_;
   std::ostream& out_;
@@ -184,13 +193,18 @@ class DexProcess {
   std::uint64_t received_ = 0;
   std::map<int, StatusSample> statuses_;  ///< other drones' newest status of this run
   std::optional<StatusSample> last_status_;
+  bool settle_scheduled_ = false;
   std::optional<TerminationDetector> termination_;  ///< the lead's waves (made at the start)
   std::uint64_t wave_answered_ = 0;                 ///< the newest wave this drone answered
   std::string error_;
   std::set<std::string> foreign_;
   std::set<std::uint64_t> stale_runs_;
   std::unique_ptr<dex::FailsafeWait> failsafe_wait_;  ///< from the abandon on
-  std::set<std::pair<int, std::uint64_t>> seen_triggers_;  ///< (sender, seq) of every accepted trigger
+  /// Per sender, the sequence number of the newest accepted trigger. Reliable DDS hands one
+  /// writer's samples over in order (also what a re-matched writer sends again from its
+  /// durable history), so a number not above it is a repeat: one number per drone, however
+  /// long the mission.
+  std::vector<std::uint64_t> last_trigger_seq_;
   std::set<std::string> rejected_;                        ///< what was logged as ignored
   std::optional<LifecycleSample> pending_finished_;       ///< a FINISHED this DEX does not agree with (yet)
   double pending_since_ = 0.0;                            ///< wall time it came

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "launch/inbox.h"
+#include "launch/process_watch.h"
 #include "launch/spawn.h"
 #include "launch/wall_time.h"
 #include "mid/home_check.h"
@@ -144,7 +145,13 @@ class Ground {
   double mission_now() const { return (unix_ns() - start_at_ns_) / 1e9 * o_.speed; }
   void record_lifecycle(const LifecycleSample& s);
   bool start_processes();
-  void tick();
+  /// Looks at what may have changed: a signal, the barrier, the flight's end. After every
+  /// input that can change them, after a DEX process ended (poll_children first) and at
+  /// each deadline; never on a timer of its own (the ground idles while the drones fly).
+  void check();
+  /// check() at `wall_s` seconds from now (a deadline: the barrier's, a lost drone's...).
+  void check_after(double wall_s);
+  void poll_on_timer();
   void send_start();
   void fail_barrier(const std::string& why);
   void on_lifecycle(const LifecycleSample& s);
@@ -201,13 +208,17 @@ class Ground {
   bool interrupted_ = false;
   Collect collect_;
   dex::TelemetryRecorder telemetry_;
+  std::unique_ptr<ProcessWatch> watch_;  ///< DEX exits and signals wake the loop
 
   // Last, so it goes first: its listener threads post through inbox_ to loop_.
   std::unique_ptr<transport::DdsNode> node_;
 };
 
 volatile std::sig_atomic_t g_signal = 0;
-void on_signal(int signal) { g_signal = signal; }
+void on_signal(int signal) {
+  g_signal = signal;
+  ProcessWatch::signal_arrived();
+}
 
 std::uint64_t random_id() {
   std::random_device rd;
@@ -248,12 +259,25 @@ bool Ground::prepare() {
 // Discovery: the ground's DDS participant, every sample handed to the loop's thread.
 bool Ground::open_dds() {
   transport::DdsHandlers h;
-  h.lifecycle = [this](LifecycleSample s) { inbox_.deliver([this, s] { on_lifecycle(s); }); };
-  h.status = [this](StatusSample s) { inbox_.deliver([this, s] { on_status(s); }); };
+  h.lifecycle = [this](LifecycleSample s) {
+    inbox_.deliver([this, s] {
+      on_lifecycle(s);
+      check();
+    });
+  };
+  h.status = [this](StatusSample s) {
+    inbox_.deliver([this, s] {
+      on_status(s);
+      check();
+    });
+  };
   h.trace = [this](TraceSample s) { inbox_.deliver([this, s] { on_trace(s); }); };
   h.telemetry = [this](TelemetrySample s) { inbox_.deliver([this, s] { on_telemetry(s); }); };
   h.lost = [this](const std::string& hash, int drone, std::uint64_t nonce) {
-    inbox_.deliver([this, hash, drone, nonce] { on_lost(hash, drone, nonce); });
+    inbox_.deliver([this, hash, drone, nonce] {
+      on_lost(hash, drone, nonce);
+      check();
+    });
   };
   // Logged on the ground's own thread: the listener that dropped the sample only posts.
   h.dropped = [this](const std::string& line) { inbox_.deliver([this, line] { err_ << "ground: " << line << "\n"; }); };
@@ -274,7 +298,7 @@ bool Ground::open_dds() {
   return true;
 }
 
-// From the DEX processes' start to their end: the barrier, the run and its end (tick).
+// From the DEX processes' start to their end: the barrier, the run and its end (check).
 bool Ground::fly() {
   // waitpid needs SIGCHLD at its default; Ctrl-C or a TERM aborts the run (every drone
   // runs its failsafe) instead of killing the ground in the middle of it.
@@ -287,8 +311,25 @@ bool Ground::fly() {
     return false;
   }
   barrier_deadline_ = wall_s() + o_.barrier_timeout_s;
-  tick();
+  watch_ = std::make_unique<ProcessWatch>([this] {
+    loop_.post([this] {
+      poll_children();
+      check();
+    });
+  });
+  bool watched = true;
+  for (auto& d : drones_)
+    if (d.local) watched = watch_->watch(d.child.pid) && watched;
+  watch_->start();
+  if (!watched) poll_on_timer();
+  check_after(o_.barrier_timeout_s);
+  // From inside the run: a stop() before it would be forgotten.
+  loop_.post([this] {
+    poll_children();
+    check();
+  });
   loop_.run_until(1e9);
+  watch_.reset();
   node_.reset();
   for (auto& d : drones_)
     if (d.local) reap(d.child, 5.0);
@@ -385,10 +426,7 @@ bool Ground::start_processes() {
   return true;
 }
 
-void Ground::tick() {
-  // The next tick first: should anything below throw, the ground still ticks and ends.
-  loop_.after(0.05, [this] { tick(); });
-  poll_children();
+void Ground::check() {
   if (g_signal != 0 && stage_ != Stage::done) {
     // A second time: stop the DEXes now (a DEX takes SIGTERM as "abandon the mission",
     // which it already does), leaving each drone in the failsafe it was commanded.
@@ -398,6 +436,21 @@ void Ground::tick() {
   if (stage_ == Stage::barrier) watch_barrier();
   else if (stage_ == Stage::running) watch_flight();
   if (stage_ == Stage::done) loop_.stop();
+}
+
+void Ground::check_after(double seconds) {
+  // A hair late rather than early: the checks compare wall times with their deadlines.
+  loop_.after(seconds + 0.01, [this] { check(); });
+}
+
+void Ground::poll_on_timer() {
+  // Only where the kernel has no pidfds (before Linux 5.3): the children are looked at twice
+  // a second instead.
+  loop_.after(0.5, [this] {
+    poll_children();
+    check();
+    if (stage_ != Stage::done) poll_on_timer();
+  });
 }
 
 void Ground::poll_children() {
@@ -441,7 +494,10 @@ void Ground::watch_flight() {
     stop_all(SIGKILL);
     stage_ = Stage::done;
   } else if (all_done()) {
-    if (!finish_at_) finish_at_ = wall_s() + 0.3;  // the last trace samples may still be on the way
+    if (!finish_at_) {
+      finish_at_ = wall_s() + 0.3;  // the last trace samples may still be on the way
+      check_after(0.3);
+    }
     if (wall_s() > *finish_at_) stage_ = Stage::done;
   }
 }
@@ -464,6 +520,7 @@ void Ground::on_lost(const std::string& hash, int drone, std::uint64_t nonce) {
   if (d.lost) return;
   d.lost = true;  // wait for its final status only so long (all_done)
   d.lost_at = wall_s();
+  check_after(o_.final_state_timeout_s);
   err_ << "ground: " << d.name << " lost its liveliness\n";
 }
 
@@ -505,6 +562,7 @@ void Ground::send_start() {
   r_.run_id = start.run_id;
   stage_ = Stage::running;
   wall_guard_ = wall_s() + o_.start_delay_s + o_.time_limit_s / o_.speed + 700.0 / o_.speed + 30.0;
+  check_after(wall_guard_ - wall_s());
   out_ << "ground: every drone is ready; starting run " << start.run_id << "\n" << std::flush;
 }
 

@@ -418,6 +418,57 @@ struct Layout<SetupSigning> {
     v("initial_timestamp", m.initial_timestamp);
   }
 };
+
+template <>
+struct Layout<CameraTrigger> {
+  static constexpr uint32_t id = msg::CAMERA_TRIGGER;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("time_usec", m.time_usec);
+    v("seq", m.seq);
+  }
+};
+
+template <>
+struct Layout<CameraFeedback> {
+  static constexpr uint32_t id = msg::CAMERA_FEEDBACK;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("time_usec", m.time_usec);
+    v("target_system", m.target_system);
+    v("cam_idx", m.cam_idx);
+    v("img_idx", m.img_idx);
+    v("lat", m.lat);
+    v("lng", m.lng);
+    v("alt_msl", m.alt_msl);
+    v("alt_rel", m.alt_rel);
+    v("roll", m.roll);
+    v("pitch", m.pitch);
+    v("yaw", m.yaw);
+    v("foc_len", m.foc_len);
+    v("flags", m.flags);
+    v("completed_captures", m.completed_captures);
+  }
+};
+
+template <>
+struct Layout<CameraImageCaptured> {
+  static constexpr uint32_t id = msg::CAMERA_IMAGE_CAPTURED;
+  template <typename M, typename V>
+  static void fields(M& m, V& v) {
+    v("time_boot_ms", m.time_boot_ms);
+    v("time_utc", m.time_utc);
+    v("camera_id", m.camera_id);
+    v("lat", m.lat);
+    v("lon", m.lon);
+    v("alt", m.alt);
+    v("relative_alt", m.relative_alt);
+    v("q", m.q);
+    v("image_index", m.image_index);
+    v("capture_result", m.capture_result);
+    v("file_url", m.file_url);
+  }
+};
 }  // namespace
 
 Message pack(const Heartbeat& m) { return pack_fields(m); }
@@ -474,30 +525,36 @@ std::optional<Statustext> unpack_statustext(const Message& m) { return unpack_fi
 Message pack(const SetupSigning& m) { return pack_fields(m); }
 std::optional<SetupSigning> unpack_setup_signing(const Message& m) { return unpack_fields<SetupSigning>(m); }
 
+Message pack(const CameraTrigger& m) { return pack_fields(m); }
+std::optional<CameraTrigger> unpack_camera_trigger(const Message& m) { return unpack_fields<CameraTrigger>(m); }
+
+Message pack(const CameraFeedback& m) { return pack_fields(m); }
+std::optional<CameraFeedback> unpack_camera_feedback(const Message& m) { return unpack_fields<CameraFeedback>(m); }
+
+Message pack(const CameraImageCaptured& m) { return pack_fields(m); }
+std::optional<CameraImageCaptured> unpack_camera_image_captured(const Message& m) {
+  return unpack_fields<CameraImageCaptured>(m);
+}
+
+// The image numbers are cast to each message's field type: a sequence past it wraps as the
+// vehicle's own counter does.
 Message pack(const CameraCapture& m) {
-  FieldWriter w(def_of(m.message_id));
-  if (m.message_id == msg::CAMERA_TRIGGER) w.set("seq", static_cast<uint32_t>(m.image_index));
-  if (m.message_id == msg::CAMERA_FEEDBACK) w.set("img_idx", static_cast<uint16_t>(m.image_index));
-  if (m.message_id == msg::CAMERA_IMAGE_CAPTURED) {
-    w.set("image_index", static_cast<int32_t>(m.image_index));
-    w.set("capture_result", static_cast<int8_t>(m.captured ? 1 : 0));
-  }
-  return w.take();
+  if (m.message_id == msg::CAMERA_TRIGGER)
+    return pack(CameraTrigger{.seq = static_cast<uint32_t>(m.image_index)});
+  if (m.message_id == msg::CAMERA_FEEDBACK)
+    return pack(CameraFeedback{.img_idx = static_cast<uint16_t>(m.image_index)});
+  CameraImageCaptured c;
+  c.image_index = static_cast<int32_t>(m.image_index);
+  c.capture_result = m.captured ? 1 : 0;
+  return pack(c);
 }
 
 std::optional<CameraCapture> unpack_camera_capture(const Message& m) {
-  if (m.id != msg::CAMERA_TRIGGER && m.id != msg::CAMERA_FEEDBACK && m.id != msg::CAMERA_IMAGE_CAPTURED)
-    return std::nullopt;
-  FieldReader r(def_of(m.id), m);
-  CameraCapture c;
-  c.message_id = m.id;
-  if (m.id == msg::CAMERA_TRIGGER) c.image_index = r.get<uint32_t>("seq");
-  if (m.id == msg::CAMERA_FEEDBACK) c.image_index = r.get<uint16_t>("img_idx");
-  if (m.id == msg::CAMERA_IMAGE_CAPTURED) {
-    c.image_index = r.get<int32_t>("image_index");
-    c.captured = r.get<int8_t>("capture_result") == 1;
-  }
-  return c;
+  if (auto t = unpack_camera_trigger(m)) return CameraCapture{m.id, t->seq, true};
+  if (auto f = unpack_camera_feedback(m)) return CameraCapture{m.id, f->img_idx, true};
+  if (auto c = unpack_camera_image_captured(m))
+    return CameraCapture{m.id, c->image_index, c->capture_result == 1};
+  return std::nullopt;
 }
 
 Message pack(const MissionCount& m) { return pack_fields(m); }

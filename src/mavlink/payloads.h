@@ -143,6 +143,40 @@ struct Statustext {
   uint8_t chunk_seq = 0;
 };
 
+/// PX4's camera_trigger module: a picture was triggered (CAMERA_TRIGGER).
+struct CameraTrigger {
+  uint64_t time_usec = 0;
+  uint32_t seq = 0;  ///< image sequence number
+};
+
+/// ArduPilot's AP_Camera: a picture was taken, where and how (CAMERA_FEEDBACK).
+struct CameraFeedback {
+  uint64_t time_usec = 0;
+  uint8_t target_system = 0;
+  uint8_t cam_idx = 0;
+  uint16_t img_idx = 0;
+  int32_t lat = 0, lng = 0;             ///< degE7
+  float alt_msl = 0, alt_rel = 0;       ///< m
+  float roll = 0, pitch = 0, yaw = 0;   ///< deg
+  float foc_len = 0;                    ///< mm
+  uint8_t flags = 0;                    ///< CAMERA_FEEDBACK_FLAGS
+  uint16_t completed_captures = 0;
+};
+
+/// The camera protocol's report of one capture, which may have failed (CAMERA_IMAGE_CAPTURED).
+struct CameraImageCaptured {
+  uint32_t time_boot_ms = 0;
+  uint64_t time_utc = 0;  ///< us since the Unix epoch, 0 unknown
+  uint8_t camera_id = 0;
+  int32_t lat = 0, lon = 0;  ///< degE7
+  int32_t alt = 0;           ///< mm above mean sea level
+  int32_t relative_alt = 0;  ///< mm above ground
+  std::array<float, 4> q{1, 0, 0, 0};  ///< the camera's attitude, w, x, y, z
+  int32_t image_index = 0;
+  int8_t capture_result = 0;  ///< 1 success, 0 failure
+  std::string file_url;       ///< up to 205 characters; read: printable ASCII only
+};
+
 /// A vehicle's word that it took a picture, from whichever message its camera sends:
 /// CAMERA_TRIGGER (PX4's camera_trigger), CAMERA_FEEDBACK (ArduPilot's AP_Camera) or
 /// CAMERA_IMAGE_CAPTURED (the camera protocol; it may report a failed capture).
@@ -274,7 +308,11 @@ Message pack(const SetPositionTargetLocalNed& m);
 Message pack(const ExtendedSysState& m);
 Message pack(const BatteryStatus& m);
 Message pack(const Statustext& m);
-/// As the CameraCapture's message_id says (the other fields of that message zero).
+Message pack(const CameraTrigger& m);
+Message pack(const CameraFeedback& m);
+Message pack(const CameraImageCaptured& m);
+/// As the CameraCapture's message_id says, CAMERA_IMAGE_CAPTURED for an id of none of the
+/// three; the message's other fields at their defaults.
 Message pack(const CameraCapture& m);
 
 /// Gives the vehicle the link's signing key (an all-zero key and timestamp turn signing off).
@@ -305,6 +343,9 @@ std::optional<SetPositionTargetLocalNed> unpack_set_position_target_local_ned(co
 std::optional<ExtendedSysState> unpack_extended_sys_state(const Message& m);
 std::optional<BatteryStatus> unpack_battery_status(const Message& m);
 std::optional<Statustext> unpack_statustext(const Message& m);
+std::optional<CameraTrigger> unpack_camera_trigger(const Message& m);
+std::optional<CameraFeedback> unpack_camera_feedback(const Message& m);
+std::optional<CameraImageCaptured> unpack_camera_image_captured(const Message& m);
 /// CAMERA_TRIGGER, CAMERA_FEEDBACK or CAMERA_IMAGE_CAPTURED; nullopt for any other message.
 std::optional<CameraCapture> unpack_camera_capture(const Message& m);
 

@@ -33,6 +33,7 @@ const Autopilot* autopilot_for(uint8_t mav_autopilot) {
 }
 
 bool can_arm_in(const Autopilot& a, uint32_t custom_mode) {
+  if (a.stream_before_switch && custom_mode == a.setpoint_mode) return false;
   return custom_mode != a.land_mode && custom_mode != a.rtl_mode;
 }
 

@@ -43,7 +43,9 @@ struct Autopilot {
   uint16_t picture_command;
 };
 
-/// False for the modes the autopilot refuses to arm in.
+/// False for the modes the autopilot refuses to arm in, or may refuse: PX4's OFFBOARD, where
+/// it stands after a mission that ended with NAV_LAND, arms only while setpoints stream, and an
+/// Arm comes before them.
 bool can_arm_in(const Autopilot& a, uint32_t custom_mode);
 
 /// The row for a HEARTBEAT.autopilot value; nullptr for autopilots we do not fly.

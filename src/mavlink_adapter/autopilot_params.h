@@ -36,7 +36,7 @@ std::vector<LimitParam> limit_params(const Autopilot& a);
 
 /// How the autopilot's return-to-launch flies, which ReturnHome hands to it: it climbs to
 /// its return altitude first, flies home, waits, then lands. A deadline for the straight way
-/// home and down expired on both autopilots (issue 12): ArduCopter climbs to RTL_ALT 15 m
+/// home and down would expire on both autopilots: ArduCopter climbs to RTL_ALT 15 m
 /// and loiters RTL_LOIT_TIME 5 s, PX4 climbs to RTL_RETURN_ALT 60 m.
 struct ReturnProfile {
   /// ArduPilot RTL_ALT, PX4 RTL_RETURN_ALT: it climbs to at least this height above home

@@ -91,7 +91,7 @@ SimVehicle::SimVehicle(mid::EventLoop& loop, VehicleOptions options)
       drone_(vehicle_settings(options.sysid, options.battery_percent), vehicle_type(options.limits), loop),
       encoder_{options.sysid, ml::comp::AUTOPILOT1, 0},
       dialect_(*options.dialect),
-      mode_(dialect_.boot) {}
+      mode_(options.boot_mode.value_or(dialect_.boot)) {}
 
 SimVehicle::~SimVehicle() {
   link_.reset();
@@ -234,6 +234,9 @@ uint8_t SimVehicle::execute(const ml::CommandLong& c) {
       bool arm = c.param[0] > 0.5f;
       if (!arm && !s.landed) return ml::result::DENIED;
       if (arm && s.battery <= 0.0) return ml::result::DENIED;
+      // PX4's arming checks hold each mode's requirements: OFFBOARD's is a fresh setpoint.
+      if (arm && mode_ == Mode::setpoint && dialect_.setpoints_before_switch && !setpoints_fresh())
+        return ml::result::TEMPORARILY_REJECTED;
       loop_.cancel(disarm_timer_);
       start_then_ack(c.command, arm ? "Arm" : "Disarm");
       return kAckLater;
@@ -296,9 +299,7 @@ uint8_t SimVehicle::set_mode(Mode mode) {
   switch (mode) {
     case Mode::setpoint:
       // PX4's rule: no switch to OFFBOARD unless setpoints are already streaming.
-      if (dialect_.setpoints_before_switch &&
-          (!have_setpoint_ || loop_.now() - setpoint_at_ > options_.offboard_loss_s))
-        return ml::result::DENIED;
+      if (dialect_.setpoints_before_switch && !setpoints_fresh()) return ml::result::DENIED;
       mode_ = Mode::setpoint;
       flying_ = false;
       if (!s.landed) start("Hover", {});  // hold until a setpoint says otherwise
@@ -361,6 +362,10 @@ void SimVehicle::fly_to_setpoint() {
   flying_to_ = setpoint_;  // the setpoint, not where the hold stands (a stand-off is no new setpoint)
   flying_ = true;
   start("FlyTo", {setpoint_.x + options_.setpoint_standoff_east_m, setpoint_.y, setpoint_.z});
+}
+
+bool SimVehicle::setpoints_fresh() const {
+  return have_setpoint_ && loop_.now() - setpoint_at_ <= options_.offboard_loss_s;
 }
 
 void SimVehicle::check_offboard() {
@@ -452,18 +457,9 @@ ml::Message SimVehicle::telemetry(uint32_t id) const {
   mid::DroneState s = drone_.state();
   Vec3 v = drone_.velocity();
   switch (id) {
-    case ml::msg::LOCAL_POSITION_NED: {
-      v = v * options_.reported_velocity_scale;
-      ml::LocalPositionNed p;
-      p.time_boot_ms = static_cast<uint32_t>(s.t * 1000.0);
-      p.x = static_cast<float>(s.y);
-      p.y = static_cast<float>(s.x);
-      p.z = static_cast<float>(-s.z);
-      p.vx = static_cast<float>(v.y);
-      p.vy = static_cast<float>(v.x);
-      p.vz = static_cast<float>(-v.z);
-      return ml::pack(p);
-    }
+    case ml::msg::LOCAL_POSITION_NED: return local_position(s, v);
+    case ml::msg::GLOBAL_POSITION_INT: return global_position(s, v);
+    case ml::msg::ORBIT_EXECUTION_STATUS: return orbit_status(s);
     case ml::msg::EXTENDED_SYS_STATE: {
       ml::ExtendedSysState e;
       e.landed_state = s.landed                ? ml::landed::ON_GROUND
@@ -483,34 +479,53 @@ ml::Message SimVehicle::telemetry(uint32_t id) const {
       b.voltages.fill(UINT16_MAX);
       return ml::pack(b);
     }
-    case ml::msg::GLOBAL_POSITION_INT: {
-      ml::GlobalPositionInt g;
-      g.time_boot_ms = static_cast<uint32_t>(s.t * 1000.0);
-      std::tie(g.lat, g.lon) = lat_lon_e7(s.x, s.y, options_.east_m, options_.north_m);
-      g.vx = static_cast<int16_t>(std::lround(v.y * 100.0));
-      g.vy = static_cast<int16_t>(std::lround(v.x * 100.0));
-      g.vz = static_cast<int16_t>(std::lround(-v.z * 100.0));
-      g.alt = static_cast<int32_t>(std::lround((options_.home_amsl_m + s.z) * 1000.0));
-      g.relative_alt = static_cast<int32_t>(std::lround((s.z - options_.home_above_origin_m) * 1000.0));
-      // As a real autopilot: cdeg from north, UINT16_MAX when the vehicle does not know. Flying
-      // setpoints that name a heading, this vehicle turns to it at once; otherwise the
-      // simulator's nose follows its velocity.
-      const bool yaw_set = mode_ == Mode::setpoint && setpoint_yaw_deg_;
-      const double heading = yaw_set ? *setpoint_yaw_deg_ : s.heading;
-      if (std::isfinite(heading)) g.hdg = static_cast<uint16_t>(std::lround(heading * 100.0) % 36000);
-      return ml::pack(g);
-    }
-    case ml::msg::ORBIT_EXECUTION_STATUS: {
-      // As PX4's FlightTaskOrbit reports it: MAV_FRAME_GLOBAL, the centre in degE7.
-      ml::OrbitExecutionStatus o;
-      o.time_usec = static_cast<uint64_t>(s.t * 1e6);
-      o.radius = static_cast<float>(-orbit_.direction * orbit_.radius);
-      o.frame = 0;
-      std::tie(o.x, o.y) = lat_lon_e7(orbit_.centre.x, orbit_.centre.y, options_.east_m, options_.north_m);
-      o.z = static_cast<float>(options_.home_amsl_m + orbit_.centre.z);
-      return ml::pack(o);
-    }
   }
+  return heartbeat(s);
+}
+
+ml::Message SimVehicle::local_position(const mid::DroneState& s, Vec3 v) const {
+  v = v * options_.reported_velocity_scale;
+  ml::LocalPositionNed p;
+  p.time_boot_ms = static_cast<uint32_t>(s.t * 1000.0);
+  p.x = static_cast<float>(s.y);
+  p.y = static_cast<float>(s.x);
+  p.z = static_cast<float>(-s.z);
+  p.vx = static_cast<float>(v.y);
+  p.vy = static_cast<float>(v.x);
+  p.vz = static_cast<float>(-v.z);
+  return ml::pack(p);
+}
+
+ml::Message SimVehicle::global_position(const mid::DroneState& s, Vec3 v) const {
+  ml::GlobalPositionInt g;
+  g.time_boot_ms = static_cast<uint32_t>(s.t * 1000.0);
+  std::tie(g.lat, g.lon) = lat_lon_e7(s.x, s.y, options_.east_m, options_.north_m);
+  g.vx = static_cast<int16_t>(std::lround(v.y * 100.0));
+  g.vy = static_cast<int16_t>(std::lround(v.x * 100.0));
+  g.vz = static_cast<int16_t>(std::lround(-v.z * 100.0));
+  g.alt = static_cast<int32_t>(std::lround((options_.home_amsl_m + s.z) * 1000.0));
+  g.relative_alt = static_cast<int32_t>(std::lround((s.z - options_.home_above_origin_m) * 1000.0));
+  // As a real autopilot: cdeg from north, UINT16_MAX when the vehicle does not know. Flying
+  // setpoints that name a heading, this vehicle turns to it at once; otherwise the
+  // simulator's nose follows its velocity.
+  const bool yaw_set = mode_ == Mode::setpoint && setpoint_yaw_deg_;
+  const double heading = yaw_set ? *setpoint_yaw_deg_ : s.heading;
+  if (std::isfinite(heading)) g.hdg = static_cast<uint16_t>(std::lround(heading * 100.0) % 36000);
+  return ml::pack(g);
+}
+
+// As PX4's FlightTaskOrbit reports it: MAV_FRAME_GLOBAL, the centre in degE7.
+ml::Message SimVehicle::orbit_status(const mid::DroneState& s) const {
+  ml::OrbitExecutionStatus o;
+  o.time_usec = static_cast<uint64_t>(s.t * 1e6);
+  o.radius = static_cast<float>(-orbit_.direction * orbit_.radius);
+  o.frame = 0;
+  std::tie(o.x, o.y) = lat_lon_e7(orbit_.centre.x, orbit_.centre.y, options_.east_m, options_.north_m);
+  o.z = static_cast<float>(options_.home_amsl_m + orbit_.centre.z);
+  return ml::pack(o);
+}
+
+ml::Message SimVehicle::heartbeat(const mid::DroneState& s) const {
   ml::Heartbeat hb;
   hb.type = ml::mav_type::QUADROTOR;
   hb.autopilot = dialect_.mav_autopilot;

@@ -15,7 +15,9 @@
 //    MAV_RESULT_UNSUPPORTED. A resend (confirmation > 0) of the last command is
 //    acknowledged again, not executed twice;
 //  - SET_POSITION_TARGET_LOCAL_NED flown in OFFBOARD; setpoints older than 1 s there fall
-//    back to AUTO.LOITER (PX4's offboard loss failsafe, COM_OF_LOSS_T);
+//    back to AUTO.LOITER (PX4's offboard loss failsafe, COM_OF_LOSS_T); no arming in
+//    OFFBOARD without them (PX4: MAV_RESULT_TEMPORARILY_REJECTED, "Arming denied: Resolve
+//    system health failures first");
 //  - telemetry (LOCAL_POSITION_NED, EXTENDED_SYS_STATE, SYS_STATUS, BATTERY_STATUS,
 //    GLOBAL_POSITION_INT) at 1 Hz each, or the rate SET_MESSAGE_INTERVAL asks for;
 //  - disarms 2 s after touching down (PX4's COM_DISARM_LAND);
@@ -86,6 +88,10 @@ struct VehicleOptions {
   /// altitude drifts on the ground meanwhile: on SITL 0.2 m lower than the ground 15 s later.
   double home_above_origin_m = 0.0;
   double offboard_loss_s = 1.0;    ///< OFFBOARD without a fresh setpoint this long: hold
+  /// The mode it starts in instead of its dialect's boot mode: where a previous mission left
+  /// it. PX4 SITL stood disarmed in OFFBOARD (vehicle_status nav_state 14) after a mission
+  /// that flew setpoints and ended with NAV_LAND and a disarm.
+  std::optional<Mode> boot_mode;
   double disarm_after_land_s = 2.0;
   double default_rate_hz = 1.0;    ///< telemetry rate until SET_MESSAGE_INTERVAL says otherwise
   /// false: the picture command is accepted but no camera confirms it, as an autopilot whose
@@ -211,6 +217,7 @@ class SimVehicle {
   void ack(uint16_t command, uint8_t result);
   void after_touchdown();
   void check_offboard();
+  bool setpoints_fresh() const;  ///< a setpoint came within offboard_loss_s
   // DO_ORBIT (sim_vehicle_orbit.cpp)
   /// `centre` (x, y of its frame) when the command names one (COMMAND_INT), else where it is.
   uint8_t start_orbit(const mavlink::CommandLong& c, std::optional<fleet::Vec3> centre);
@@ -221,6 +228,11 @@ class SimVehicle {
   void send_stream(uint32_t message_id);
   void check_preflight_disarm();
   mavlink::Message telemetry(uint32_t message_id) const;
+  // telemetry's messages that are more than a field or two
+  mavlink::Message local_position(const mid::DroneState& s, fleet::Vec3 velocity) const;
+  mavlink::Message global_position(const mid::DroneState& s, fleet::Vec3 velocity) const;
+  mavlink::Message orbit_status(const mid::DroneState& s) const;
+  mavlink::Message heartbeat(const mid::DroneState& s) const;
   void send(const mavlink::Message& m);
   mavlink::OpenResult open_link(const mavlink::Endpoint& endpoint);
 

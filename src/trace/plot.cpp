@@ -491,6 +491,20 @@ void draw_waits(std::ostream& out, const RunResult& run, const std::vector<Wait>
   }
 }
 
+/// The timeline's time axis: a grid line from `top` to `bottom` at each step, labelled below.
+void draw_time_axis(std::ostream& out, double top, double bottom, double until) {
+  double step = nice_step(until, 12);
+  out << "<g class=\"time-axis\" font-size=\"11\" fill=\"#444444\">\n";
+  for (double t = 0; t <= until + 1e-9; t += step) {
+    double px = time_x(t, until);
+    out << "<line x1=\"" << num(px) << "\" y1=\"" << num(top) << "\" x2=\"" << num(px) << "\" y2=\""
+        << num(bottom + 4) << "\" stroke=\"#eeeeee\"/>\n";
+    out << text(px, bottom + 16, num(t), "text-anchor=\"middle\"");
+  }
+  out << text((kLeft + kRight) / 2, bottom + 32, "mission time (s)", "text-anchor=\"middle\"");
+  out << "</g>\n";
+}
+
 /// Returns the y below the panel.
 double timeline(std::ostream& out, const RunResult& run, const std::vector<TraceEvent>& events, double top,
                 double until) {
@@ -510,16 +524,7 @@ double timeline(std::ostream& out, const RunResult& run, const std::vector<Trace
     y = rows.bottom(d);
   }
   double bottom = y;
-  double step = nice_step(until, 12);
-  out << "<g class=\"time-axis\" font-size=\"11\" fill=\"#444444\">\n";
-  for (double t = 0; t <= until + 1e-9; t += step) {
-    double px = time_x(t, until);
-    out << "<line x1=\"" << num(px) << "\" y1=\"" << num(top) << "\" x2=\"" << num(px) << "\" y2=\""
-        << num(bottom + 4) << "\" stroke=\"#eeeeee\"/>\n";
-    out << text(px, bottom + 16, num(t), "text-anchor=\"middle\"");
-  }
-  out << text((kLeft + kRight) / 2, bottom + 32, "mission time (s)", "text-anchor=\"middle\"");
-  out << "</g>\n";
+  draw_time_axis(out, top, bottom, until);
   for (std::size_t d = 0; d < run.drones.size(); ++d) {
     const std::string& name = run.drones[d].name;
     double rt = rows.top[d];

@@ -29,17 +29,21 @@ bool looks_like_address(const std::string& s) {
 std::string retcode(dds_return_t rc) { return dds_strretcode(rc); }
 
 /// Reliable, transient-local: what a reader needs even when it matched late.
-dds_qos_t* durable_qos(bool keep_all, double lease_s) {
+/// `durable` 0: keep-last 1 (newest value wins, per instance); otherwise keep-all until
+/// acknowledged, then the newest `durable` for late readers.
+dds_qos_t* durable_qos(int durable, double lease_s) {
   dds_qos_t* q = dds_create_qos();
   // A write may block while readers catch up; never as long as the lease, or a busy drone
   // would look lost to the others.
   dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, static_cast<dds_duration_t>(lease_s / 4 * 1e9));
   dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
-  // What a late reader gets is the durability service's history, not the writer's:
-  // its default (keep-last 1) would hand a late DEX only the newest trigger.
-  if (keep_all) {
+  // What a late reader gets is the durability service's history, not the writer's: its
+  // default (keep-last 1) would hand a late DEX only the newest trigger. Cyclone keeps a
+  // sample in the writer until every matched reader acknowledged it (keep-all history),
+  // and after that only as long as it is among the durability service's newest `durable`.
+  if (durable > 0) {
     dds_qset_history(q, DDS_HISTORY_KEEP_ALL, 0);
-    dds_qset_durability_service(q, 0, DDS_HISTORY_KEEP_ALL, 0, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED,
+    dds_qset_durability_service(q, 0, DDS_HISTORY_KEEP_LAST, durable, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED,
                                 DDS_LENGTH_UNLIMITED);
   } else {
     dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
@@ -253,6 +257,55 @@ dds_entity_t grouping(dds_entity_t participant, bool publisher, const std::vecto
   return e;
 }
 
+/// One topic of the wire and where its endpoints' handles go.
+struct TopicSpec {
+  const char* name;
+  const dds_topic_descriptor_t* type;
+  int durable;    ///< acknowledged samples kept for late readers (triggers, traces); 0: the newest value wins
+  int* writer;    ///< 0 when this participant does not write the topic
+  int* reader;    ///< 0 when it does not read it
+  dds_on_data_available_fn on_data;
+  bool write, read;
+  bool liveliness;  ///< the status topic: manual liveliness, whose changes the reader hears
+};
+
+/// Where a topic's writer and reader go, and who hears the reader.
+struct Endpoints {
+  dds_entity_t participant, publisher, subscriber;
+  void* node;  ///< the listeners' argument
+};
+
+/// Creates `spec`'s topic, its writer and its reader; false with `error` set when DDS refuses.
+bool create_topic(const Endpoints& at, const TopicSpec& spec, const DdsOptions& options, std::string& error) {
+  dds_qos_t* qos = durable_qos(spec.durable, options.lease_s);
+  dds_entity_t topic = dds_create_topic(at.participant, spec.type, spec.name, qos, nullptr);
+  if (topic < 0) {
+    dds_delete_qos(qos);
+    error = std::string("cannot create DDS topic ") + spec.name + ": " + retcode(topic);
+    return false;
+  }
+  dds_qos_t* wqos = dds_create_qos();
+  dds_copy_qos(wqos, qos);
+  if (spec.liveliness) dds_qset_liveliness(wqos, DDS_LIVELINESS_MANUAL_BY_TOPIC, DDS_SECS(1) * options.lease_s);
+  *spec.writer = spec.write ? dds_create_writer(at.publisher, topic, wqos, nullptr) : 0;
+  dds_delete_qos(wqos);
+  dds_listener_t* listener = dds_create_listener(at.node);
+  dds_lset_data_available(listener, spec.on_data);
+  if (spec.liveliness) dds_lset_liveliness_changed(listener, on_liveliness);
+  dds_qset_ignorelocal(qos, DDS_IGNORELOCAL_PARTICIPANT);
+  *spec.reader = spec.read ? dds_create_reader(at.subscriber, topic, qos, listener) : 0;
+  dds_delete_listener(listener);
+  dds_delete_qos(qos);
+  if (*spec.writer < 0 || *spec.reader < 0) {
+    error = std::string("cannot create DDS endpoints of ") + spec.name + ": " +
+            retcode(*spec.writer < 0 ? *spec.writer : *spec.reader) +
+            (options.security_folder.empty() ? "" : " (do the permissions in " + options.security_folder +
+                                                        " belong to this drone and mission?)");
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 bool DdsNode::create_endpoints(const DdsOptions& options, std::string& error) {
@@ -264,62 +317,28 @@ bool DdsNode::create_endpoints(const DdsOptions& options, std::string& error) {
     read_in.push_back(partition_of(mission_hash_, kGroundParticipant));
     for (int d = 0; d < handlers_.limits.drones; ++d) read_in.push_back(partition_of(mission_hash_, d));
   }
-  dds_entity_t publisher = grouping(participant_, true, write_in);
-  dds_entity_t subscriber = grouping(participant_, false, read_in);
-  if (publisher < 0 || subscriber < 0) {
-    error = "cannot create the DDS publisher and subscriber: " + retcode(publisher < 0 ? publisher : subscriber);
+  Endpoints at{participant_, grouping(participant_, true, write_in), grouping(participant_, false, read_in), this};
+  if (at.publisher < 0 || at.subscriber < 0) {
+    error = "cannot create the DDS publisher and subscriber: " +
+            retcode(at.publisher < 0 ? at.publisher : at.subscriber);
     return false;
   }
   // The ground writes only lifecycle samples (its permissions allow nothing else).
-  const bool ground = !mission_hash_.empty() && options.self == kGroundParticipant;
-
-  struct TopicSpec {
-    const char* name;
-    const dds_topic_descriptor_t* type;
-    bool keep_all;
-    int* writer;
-    int* reader;
-    dds_on_data_available_fn on_data;
+  const bool drone = mission_hash_.empty() || options.self != kGroundParticipant;
+  // Only the ground reads traces: a DEX does not take every other drone's events.
+  const bool traces = handlers_.trace != nullptr;
+  const int triggers = std::max(1, options.durable_triggers), trace = std::max(1, options.durable_trace);
+  const TopicSpec specs[] = {
+      {"eamos_trigger", &eamos_wire_Trigger_desc, triggers, &w_trigger_, &r_trigger_, on_trigger, drone, true, false},
+      {"eamos_telemetry", &eamos_wire_Telemetry_desc, 0, &w_telemetry_, &r_telemetry_, on_telemetry, drone,
+       true, false},
+      {"eamos_lifecycle", &eamos_wire_Lifecycle_desc, 0, &w_lifecycle_, &r_lifecycle_, on_lifecycle, true, true,
+       false},
+      {"eamos_status", &eamos_wire_Status_desc, 0, &w_status_, &r_status_, on_status, drone, true, true},
+      {"eamos_trace", &eamos_wire_TraceRecord_desc, trace, &w_trace_, &r_trace_, on_trace, drone, traces, false},
   };
-  TopicSpec specs[] = {
-      {"eamos_trigger", &eamos_wire_Trigger_desc, true, &w_trigger_, &r_trigger_, on_trigger},
-      {"eamos_telemetry", &eamos_wire_Telemetry_desc, false, &w_telemetry_, &r_telemetry_, on_telemetry},
-      {"eamos_lifecycle", &eamos_wire_Lifecycle_desc, false, &w_lifecycle_, &r_lifecycle_, on_lifecycle},
-      {"eamos_status", &eamos_wire_Status_desc, false, &w_status_, &r_status_, on_status},
-      {"eamos_trace", &eamos_wire_TraceRecord_desc, true, &w_trace_, &r_trace_, on_trace},
-  };
-  for (TopicSpec& spec : specs) {
-    dds_qos_t* qos = durable_qos(spec.keep_all, options.lease_s);
-    dds_entity_t topic = dds_create_topic(participant_, spec.type, spec.name, qos, nullptr);
-    if (topic < 0) {
-      dds_delete_qos(qos);
-      error = std::string("cannot create DDS topic ") + spec.name + ": " + retcode(topic);
-      return false;
-    }
-    dds_qos_t* wqos = dds_create_qos();
-    dds_copy_qos(wqos, qos);
-    if (spec.writer == &w_status_)
-      dds_qset_liveliness(wqos, DDS_LIVELINESS_MANUAL_BY_TOPIC, DDS_SECS(1) * options.lease_s);
-    bool write = !ground || spec.writer == &w_lifecycle_;
-    *spec.writer = write ? dds_create_writer(publisher, topic, wqos, nullptr) : 0;
-    dds_delete_qos(wqos);
-    dds_listener_t* listener = dds_create_listener(this);
-    dds_lset_data_available(listener, spec.on_data);
-    if (spec.reader == &r_status_) dds_lset_liveliness_changed(listener, on_liveliness);
-    dds_qset_ignorelocal(qos, DDS_IGNORELOCAL_PARTICIPANT);
-    // Only the ground reads traces: a DEX does not take every other drone's events.
-    bool wanted = spec.reader != &r_trace_ || handlers_.trace != nullptr;
-    *spec.reader = wanted ? dds_create_reader(subscriber, topic, qos, listener) : 0;
-    dds_delete_listener(listener);
-    dds_delete_qos(qos);
-    if (*spec.writer < 0 || *spec.reader < 0) {
-      error = std::string("cannot create DDS endpoints of ") + spec.name + ": " +
-              retcode(*spec.writer < 0 ? *spec.writer : *spec.reader) +
-              (options.security_folder.empty() ? "" : " (do the permissions in " + options.security_folder +
-                                                          " belong to this drone and mission?)");
-      return false;
-    }
-  }
+  for (const TopicSpec& spec : specs)
+    if (!create_topic(at, spec, options, error)) return false;
   return true;
 }
 

@@ -1,13 +1,15 @@
 #pragma once
 // One process's place on the DDS domain: a participant with the five eamos topics, a
-// writer and a reader for each, and the QoS the guarantees rest on:
-//  - triggers: reliable, transient-local, keep-all: a reader matched late (or re-matched
-//    after a network hiccup) still gets every trigger of the run;
+// writer and a reader for each, and the QoS the delivery guarantees rest on:
+//  - triggers: reliable, transient-local; the writer keeps every sample until each matched
+//    reader has acknowledged it (keep-all history: none is lost), and of the acknowledged
+//    ones the newest `durable_triggers` for a reader matched late (or again after a network
+//    hiccup): memory bounded by the mission, not by its length;
 //  - telemetry: reliable, transient-local, keep-last 1 per drone: newest value wins;
 //  - lifecycle and status: reliable, transient-local, keep-last 1 per (mission, drone[,
 //    kind]); the status writer offers MANUAL_BY_TOPIC liveliness with the lease, asserted
 //    by its owner's event loop, so a hung DEX is as lost as a killed one;
-//  - trace: reliable, transient-local, keep-all, for the ground's merged trace.
+//  - trace: as triggers, for the ground's merged trace, with `durable_trace` kept.
 // Received samples are converted and handed to the handlers on a DDS thread: handlers
 // must only post() to their event loop.
 #include <atomic>
@@ -22,6 +24,11 @@
 #include "transport/samples.h"
 
 namespace eamos::transport {
+
+inline constexpr int kDefaultDurableTriggers = 256;
+/// About two seconds of a busy drone's trace events: what a ground that matched a DEX's
+/// trace writer late still gets.
+inline constexpr int kDefaultDurableTrace = 1024;
 
 struct DdsOptions {
   int domain = 0;
@@ -40,6 +47,11 @@ struct DdsOptions {
   /// docs/security.md): identity_ca.pem, permissions_ca.pem, governance.p7s, identity.pem,
   /// identity_key.pem and permissions.p7s. "": no DDS Security (`--insecure`).
   std::string security_folder;
+  /// Acknowledged samples the trigger and trace writers keep for readers that match late
+  /// (durability service history depth). The DEX sizes the first from its mission
+  /// (launch/dex_process.cpp).
+  int durable_triggers = kDefaultDurableTriggers;
+  int durable_trace = kDefaultDurableTrace;
 };
 
 /// The files of a security folder, in the order the Cyclone DDS configuration names them.

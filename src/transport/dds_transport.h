@@ -7,6 +7,7 @@
 // receiver cannot tell a real one it has no use for from a forged one, and a cancel only
 // ever stops work, never starts any, so the lead need not wait for one in flight.
 #include <cstdint>
+#include <functional>
 
 #include "dex/bridge.h"
 #include "transport/dds_node.h"
@@ -20,6 +21,7 @@ class DdsTransport : public dex::Transport {
     TriggerSample s{run_id_, to, ++seq_, m};
     if (m.kind == dex::Message::Kind::ended) ++sent_;
     if (!node_.write(s)) ++write_errors_;
+    changed();
   }
   /// One sample for the whole set: DDS hands it to every reader (one multicast packet on a
   /// network that has multicast). Counted once per drone that will take it.
@@ -27,10 +29,16 @@ class DdsTransport : public dex::Transport {
     TriggerSample s{run_id_, kEveryDrone, ++seq_, m};
     for (int d : to) sent_ += d != m.from ? 1 : 0;
     if (!node_.write(s)) ++write_errors_;
+    changed();
   }
   void publish(std::shared_ptr<const dex::Telemetry> t) override {
-    if (!node_.write(TelemetrySample{run_id_, *t})) ++write_errors_;
+    if (node_.write(TelemetrySample{run_id_, *t})) return;
+    ++write_errors_;
+    changed();
   }
+  /// Called after every trigger sent and every failed write: the DEX publishes its counters
+  /// and acts on a failure then, instead of looking for changes on a timer.
+  void on_change(std::function<void()> fn) { on_change_ = std::move(fn); }
   std::uint64_t sent() const { return sent_; }
   std::uint64_t write_errors() const { return write_errors_; }
 
@@ -40,6 +48,10 @@ class DdsTransport : public dex::Transport {
   std::uint64_t seq_ = 0;
   std::uint64_t sent_ = 0;
   std::uint64_t write_errors_ = 0;
+  std::function<void()> on_change_;
+  void changed() {
+    if (on_change_) on_change_();
+  }
 };
 
 }  // namespace eamos::transport

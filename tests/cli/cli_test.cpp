@@ -242,7 +242,7 @@ TEST_F(Cli, AsyncWorkInALoopIsNotWarnedAboutAndEveryPictureEndsOnce) {
 
 // A Do* whose condition is false when reached runs neither branch: with the lead's pack
 // already below patrol's 98 % it must skip its orbit and still go home, not hover at 10 m
-// until the simulator's battery failsafe lands it (955 s, mission failed, before the fix).
+// until the simulator's battery failsafe lands it (955 s, mission failed).
 TEST_F(Cli, PatrolWithTheLeadsBatteryAlreadyLowSkipsTheOrbitAndBringsTheLeadHome) {
   Output r = eamos("run -q " + std::string(EAMOS_SOURCE_DIR) + "/examples/patrol.eamos --fleet " + EAMOS_SOURCE_DIR +
                    "/tests/cli/data/patrol-low-battery.yaml --trace " + (dir_ / "t.jsonl").string() +

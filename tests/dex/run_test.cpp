@@ -1,5 +1,5 @@
 // Missions flown in the simulator on virtual time, asserting on the trace: the first
-// semantic rules of docs/language.md as executed by the DEX (more follow with issue 3).
+// semantic rules of docs/language.md as executed by the DEX (semantics_test.cpp has the rest).
 #include <gtest/gtest.h>
 
 #include <algorithm>

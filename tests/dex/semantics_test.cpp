@@ -249,7 +249,7 @@ TEST(Semantics, ActionExceedingItsFleetTimeoutFails) {
   EXPECT_NE(f.result.failure->reason.find("timed out"), std::string::npos) << f.result.failure->reason;
 }
 
-// --- Loops that take no time (issue 11.2). `eamos check` refuses such loops; the DEX must
+// --- Loops that take no time. `eamos check` refuses such loops; the DEX must
 // still never hang on one, since a mission file is input like any other. The missions are
 // compiled with a picture in the loop, which the test then turns into a fork (no time).
 
@@ -357,7 +357,7 @@ TEST(Semantics, LoopThatTakesNoTimeRunsOneIterationPerEventLoopCallback) {
   EXPECT_EQ(trace.evaluations, static_cast<std::size_t>(dex::kMaxInstantIterations));
 }
 
-// --- async work started again by a loop while it still runs (issue 11.3): each start is an
+// --- async work started again by a loop while it still runs: each start is an
 // instance of its own that ends, and is traced, exactly once.
 
 TEST(Semantics, AsyncWorkStartedAgainByALoopBeforeItEndedEndsOnceForEveryStart) {
@@ -417,7 +417,7 @@ TEST(Semantics, DoAsyncStartedAgainWhileItsDoBranchRunsCancelsThatRunFirst) {
   EXPECT_FALSE(f.result.drones[1].state.armed);
 }
 
-// --- Completion (issue 11.4): the mission completes at the instant its last work ends, and
+// --- Completion: the mission completes at the instant its last work ends, and
 // the trace says so last.
 
 TEST(Semantics, MissionWhoseLastWorkIsAsyncCompletesWhenThatWorkEnds) {
@@ -448,9 +448,9 @@ TEST(Semantics, DoAsyncDoneBranchThatEndsLastCompletesTheMissionWhenItEnds) {
 // B at 1 and 2 s. The If is A's and reads B, so B's samples go to A. A's pause ends at 2 s,
 // but was scheduled (at 1.5 s) after B's timer for 2 s (at 1 s): B's sample of 2 s is still
 // on its way to A when A reaches the end node.
-// Telemetry cannot start anything in a fleet whose engines are all idle; it used to count as
-// a message in flight, and its delivery never checked again: the run waited for the time
-// limit although every drone had reached the end (seen once on PX4 SITL, issue 12).
+// Telemetry cannot start anything in a fleet whose engines are all idle: counted as a message
+// in flight, it would keep the run waiting for the time limit although every drone had
+// reached the end.
 TEST(Semantics, MissionCompletesWhenItsLastWorkEndsWithTelemetryStillOnItsWay) {
   Flight f = fly(kTwo + "func INIT() { PAR_x() }\nfunc PAR_x() { A.Arm(); SEQ_b() }\n"
                         "func SEQ_b() { B.Arm(); PauseFor(1.5); If(A.Armed() && B.Armed(), SEQ_p, SEQ_p) }\n"

@@ -263,5 +263,99 @@ TEST(SeparationPrediction, CoursesThatMeetWithinTheHorizonAreAConflict) {
   EXPECT_FALSE(dex::predict({0, 0, 5}, {-1, 0, 0}, {1, 0, 5}, {1, 0, 0}, min, 3.0).conflict);
 }
 
+// A guard over drones named A, B, C…: A flown here (a simulator drone standing by, so a
+// conflict of its own is recorded as one it cannot hold for), the others flown elsewhere, all
+// fed telemetry samples by hand on virtual time: what the guard makes of the samples alone.
+struct Guarded {
+  mid::EventLoop loop;
+  mid::AdapterRegistry adapters;
+  std::unique_ptr<mid::Drone> a;
+  dex::Mission mission;
+  dex::MemoryTrace trace;
+  std::unique_ptr<dex::SeparationGuard> guard;
+
+  explicit Guarded(int drones) {
+    sim::register_adapter(adapters);
+    for (int i = 0; i < drones; ++i) mission.fleet.push_back(i < 26 ? std::string(1, char('A' + i)) : "D" + std::to_string(i));
+    fleet::DroneSettings s;
+    s.name = "A";
+    s.adapter = "sim";
+    a = adapters.create("sim", s, fleet::generic_multirotor("Quad"), loop).drone;
+    guard = std::make_unique<dex::SeparationGuard>(mission, loop, dex::SeparationHooks{&trace, {}});
+    guard->fly(0, *a, fleet::Limits{});
+  }
+  /// Mission time moves on to `t` (the guard looks at a drone's pairs at most every 0.2 s).
+  void at(double t) {
+    loop.at(t, [] {});
+    loop.run_until(t);
+  }
+  void sample(int d, double t, double x, double y = 0.0) {
+    mid::DroneState s;
+    s.t = t;
+    s.x = x;
+    s.y = y;
+    s.z = 5.0;
+    s.landed = false;
+    guard->update(d, s);
+  }
+  int conflicts() const {
+    int n = 0;
+    for (const dex::TraceEvent& e : trace.events) n += e.event == "conflict";
+    return n;
+  }
+};
+
+// A MAVLink vehicle sends its position in two messages (LOCAL_POSITION_NED, GLOBAL_POSITION_INT)
+// a millisecond apart, each a little off the other: 5 cm in 1 ms read as 50 m/s would see B,
+// 60 m ahead, met within a second. A velocity spans at least kMinVelocityDtS (20 ms).
+TEST(SeparationGuard, TwoPositionsAMillisecondApartDoNotMakeASpeed) {
+  Guarded g(2);
+  g.sample(1, 0.0, 60.0);
+  g.sample(0, 0.0, 0.0);
+  g.at(0.1);
+  g.sample(0, 0.1, 0.0);
+  g.at(0.2);
+  g.sample(0, 0.101, 0.05);  // checked now: 0.2 s since the first look
+  EXPECT_EQ(g.conflicts(), 0);
+  EXPECT_EQ(g.guard->pairs_predicted(), 0u) << "A counts as standing still";
+  // 21 ms after the sample it is measured from, 10 cm is a speed (4.8 m/s), and B, 60 m
+  // away, is no conflict.
+  g.at(0.4);
+  g.sample(0, 0.121, 0.1);
+  EXPECT_EQ(g.guard->pairs_predicted(), 1u);
+  EXPECT_EQ(g.conflicts(), 0);
+}
+
+// The neighbours a drone's pairs are looked for in: the cells its reach spans. Walked as a
+// square of cells, or, when that square holds more cells than are occupied, through the
+// occupied cells: both find B, two cells (62 m each) east of A within a reach of two cells,
+// and neither finds C, six cells east.
+TEST(SeparationGuard, BothNeighbourWalksFindTheDronesInReachAndOnlyThem) {
+  for (int far_away : {0, 40}) {  // 3 occupied cells (fewer than the 25 in reach), or 43
+    Guarded g(3 + far_away);
+    g.sample(1, 0.0, 130.0);
+    g.sample(2, 0.0, 400.0);
+    for (int i = 0; i < far_away; ++i) g.sample(3 + i, 0.0, -1000.0 - 100.0 * i, 5000.0);
+    g.sample(0, 0.0, 0.0);
+    g.at(0.3);
+    g.sample(0, 0.3, 6.0);  // 20 m/s east: reach 2 + 3 × (20 + 20) = 122 m, two cells
+    EXPECT_EQ(g.guard->pairs_predicted(), 1u) << far_away << " far away drones";
+  }
+}
+
+// A velocity of hundreds of millions of m/s (a position that jumped 10,000 km, as a corrupted
+// or forged sample may) spans tens of millions of cells each way: walked as a square, 10^15
+// cells and the DEX stuck at 100 % CPU with its drone in the air. The walk goes through the
+// occupied cells instead, and still finds every drone within that reach.
+TEST(SeparationGuard, AnAbsurdSpeedLooksThroughTheOccupiedCellsOnly) {
+  Guarded g(3);
+  g.sample(1, 0.0, 130.0);
+  g.sample(2, 0.0, 400.0);
+  g.sample(0, 0.0, 0.0);
+  g.at(0.3);
+  g.sample(0, 0.05, 1.0e7);
+  EXPECT_EQ(g.guard->pairs_predicted(), 2u);
+}
+
 }  // namespace
 }  // namespace eamos::test

@@ -1,5 +1,5 @@
 // Drone colours: every picture (graphs, plot, monitor) tells drones apart by colour, so a
-// fleet of more than eight must not reuse one (the palette used to cycle after eight).
+// fleet of more than eight must not reuse one (a palette cycling after eight would).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -57,10 +57,14 @@ DdsHandlers record_into(Received& r) {
   return h;
 }
 
-TEST(DdsNode, LateReaderGetsEveryTriggerWrittenBeforeItJoined) {
+TEST(DdsNode, LateReaderGetsTheNewestTriggersTheWriterKeepsInOrder) {
+  // A reader matched after the writes gets what the writer's durable history holds: the
+  // newest `durable_triggers` (the older ones were acknowledged by every reader matched
+  // then), in the order written. A writer that kept them all grew with the mission.
   std::string error;
   DdsOptions options;
   options.domain = 41;
+  options.durable_triggers = 100;
   Received ignored;
   auto writer = DdsNode::open(options, record_into(ignored), error);
   ASSERT_TRUE(writer) << error;
@@ -76,10 +80,19 @@ TEST(DdsNode, LateReaderGetsEveryTriggerWrittenBeforeItJoined) {
   Received got;
   auto reader = DdsNode::open(options, record_into(got), error);
   ASSERT_TRUE(reader) << error;
-  ASSERT_TRUE(got.wait([&] { return got.triggers.size() >= 500; })) << got.triggers.size();
+  ASSERT_TRUE(got.wait([&] { return got.triggers.size() >= 100; })) << got.triggers.size();
+  // One more, written now: it comes after the history, and nothing older than it came.
+  TriggerSample last;
+  last.run_id = 1;
+  last.to = 1;
+  last.seq = 501;
+  last.message.mission_hash = "h";
+  ASSERT_TRUE(writer->write(last));
+  ASSERT_TRUE(got.wait([&] { return got.triggers.size() >= 101; })) << got.triggers.size();
   {
     std::lock_guard<std::mutex> lock(got.mutex);
-    for (int i = 0; i < 500; ++i) EXPECT_EQ(got.triggers[i].seq, static_cast<std::uint64_t>(i + 1));
+    ASSERT_EQ(got.triggers.size(), 101u);
+    for (int i = 0; i < 101; ++i) EXPECT_EQ(got.triggers[i].seq, static_cast<std::uint64_t>(401 + i));
   }
   reader.reset();
   writer.reset();
@@ -138,9 +151,9 @@ TEST(DdsNode, ReportsWhoseStatusWriterWentAway) {
   observer.reset();
 }
 
-// A handler runs on Cyclone's listener thread, called from C: an exception used to go up
-// through Cyclone itself (this test then hung; a DEX stopped hearing the others, or
-// died). Now the one sample is dropped and the rest of the batch still arrives.
+// A handler runs on Cyclone's listener thread, called from C: an exception going up through
+// Cyclone itself would hang this test (a DEX would stop hearing the others, or die). The one
+// sample is dropped and the rest of the batch still arrives.
 TEST(DdsNode, HandlerThatThrowsLosesOnlyItsSample) {
   std::string error;
   DdsOptions options;

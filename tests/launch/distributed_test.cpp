@@ -525,11 +525,10 @@ void expect_every_drone_in_failsafe(const fs::path& dir, const Output& r) {
   }
 }
 
-// Bytes that are not UTF-8 in an ABORT's reason used to reach nlohmann::json::dump in the
-// ground's trace and summary, whose exception lost the whole report.
-// Text from outside that is not UTF-8 (here an ABORT's reason) used to make the ground's
-// JSON trace writer throw and die without a summary. Such a sample is now dropped where it
-// arrives (from_wire) and logged; the DEXes go on and obey the valid ABORT that follows.
+// Text from outside that is not UTF-8 (here an ABORT's reason) would make the ground's JSON
+// trace writer (nlohmann::json::dump) throw and lose the whole report. Such a sample is
+// dropped where it arrives (from_wire) and logged; the DEXes go on and obey the valid ABORT
+// that follows.
 TEST_F(Distributed, AbortWithAReasonThatIsNotUtf8IsDroppedAndTheNextAbortIsObeyed) {
   Output r = launch_and_abort_from_outside(dir_, 36, eamos::transport::kGround, "stop \xff\xfe now", true);
   ASSERT_NO_FATAL_FAILURE(expect_every_drone_in_failsafe(dir_, r));
@@ -539,9 +538,9 @@ TEST_F(Distributed, AbortWithAReasonThatIsNotUtf8IsDroppedAndTheNextAbortIsObeye
   EXPECT_NE(log.find("dropped a lifecycle sample"), std::string::npos) << log;
 }
 
-// A sender number no drone of the mission has used to make each DEX throw (fleet.at) out
-// of its event loop and exit with its drone in the air. Now the sample is dropped and
-// logged where it arrives, and the DEXes still obey the valid ABORT after it.
+// A sender number no drone of the mission has must not make a DEX throw (fleet.at) out of
+// its event loop and exit with its drone in the air: the sample is dropped and logged where
+// it arrives, and the DEXes still obey the valid ABORT after it.
 TEST_F(Distributed, AbortFromAnUnknownDroneNumberIsDroppedAndTheNextAbortIsObeyed) {
   Output r = launch_and_abort_from_outside(dir_, 37, 7, "from nowhere", true);
   ASSERT_NO_FATAL_FAILURE(expect_every_drone_in_failsafe(dir_, r));
@@ -551,8 +550,8 @@ TEST_F(Distributed, AbortFromAnUnknownDroneNumberIsDroppedAndTheNextAbortIsObeye
   EXPECT_NE(log.find("valid abort after the bad one"), std::string::npos) << log;
 }
 
-// A DEX stopped with SIGTERM (its service stopped, a shutdown) used to die at once: the
-// others failed on its lost liveliness, its own drone stayed in the air.
+// A DEX stopped with SIGTERM (its service stopped, a shutdown) must not die at once: the
+// others would fail on its lost liveliness, its own drone would stay in the air.
 TEST_F(Distributed, SigtermOnADexLandsItsDroneAndEveryOther) {
   std::string mission = std::string(EAMOS_SOURCE_DIR) + "/tests/launch/missions/long_hover.eamos";
   Output c = eamos("compile -q " + mission + " -o " + (dir_ / "deploy").string());

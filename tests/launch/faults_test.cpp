@@ -1,6 +1,6 @@
-// Faults of the distributed run that must end safely and be reported truly (issue 13,
-// item 4): a DEX frozen longer than the liveliness lease, a ground stopped mid-run, a
-// second launch of a running deployment. Real `eamos launch` / `eamos dex` processes on
+// Faults of the distributed run that must end safely and be reported truly: a DEX frozen
+// longer than the liveliness lease, a ground stopped mid-run, a second launch of a running
+// deployment. Real `eamos launch` / `eamos dex` processes on
 // loopback, DDS domains 160-169; nothing here sleeps: the tests block on the processes'
 // output (a frozen DEX is resumed when the ground reports it lost, not after a timer).
 #include <gtest/gtest.h>
@@ -67,10 +67,10 @@ class Faults : public ::testing::Test {
 };
 
 // Frozen (SIGSTOP) after its takeoff until the others have given it up and landed (their
-// DEXes exited: over two wall seconds, twice the lease), then resumed: the DEX used to
+// DEXes exited: over two wall seconds, twice the lease), then resumed: the DEX must not
 // replay every timer that fell due meanwhile in milliseconds, starting its next actions
-// with back-dated trace times before it heard of the ABORT. Now its loop sees the stall,
-// and the failsafe comes first, at the mission time of the resume.
+// with back-dated trace times before it hears of the ABORT. Its loop sees the stall, and
+// the failsafe comes first, at the mission time of the resume.
 TEST_F(Faults, DexStalledLongerThanTheLeaseAbandonsIntoItsFailsafeWithoutRunningOverdueActions) {
   fs::path deploy = compile(example("listing2.eamos"));
   const double speed = 5.0, lease = 1.0;
@@ -140,10 +140,9 @@ pid_t parent_of(pid_t pid) {
 }
 
 // The ground stopped (SIGTERM) while both drones hover, one of them run by a DEX started
-// elsewhere: the summary used to take each drone's first "failed" status, sent as the
-// failsafe began ("armed, z = 5" for a drone that landed seconds later), and gave the
-// duration as 0.0. Now it waits for each drone's state after its failsafe, and the
-// duration is the mission time of the abort.
+// elsewhere: each drone's first "failed" status, sent as the failsafe began ("armed, z = 5"
+// for a drone that lands seconds later), is not its final state, so the summary waits for
+// each drone's state after its failsafe, and the duration is the mission time of the abort.
 TEST_F(Faults, InterruptedGroundReportsEachDronesStateAfterItsFailsafeAndTheAbortTime) {
   fs::path deploy = compile(test_mission("long_hover.eamos"));
   eamos_test::EamosProcess wing =
@@ -182,8 +181,8 @@ TEST_F(Faults, InterruptedGroundReportsEachDronesStateAfterItsFailsafeAndTheAbor
   }
 }
 
-// A drone whose DEX is lost and never comes back has no known final state: it used to be
-// reported as its last telemetry ("armed, z = 10"), as if that were how it ended.
+// A drone whose DEX is lost and never comes back has no known final state: its last
+// telemetry ("armed, z = 10") is not how it ended.
 TEST_F(Faults, DroneLostForGoodIsReportedWithAnUnknownFinalState) {
   fs::path deploy = compile(test_mission("long_hover.eamos"));
   eamos_test::EamosProcess wing = eamos_test::start_eamos(

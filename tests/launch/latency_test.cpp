@@ -1,4 +1,4 @@
-// How late each message between drones arrived (issue 13, item 4): every trigger's latency
+// How late each message between drones arrived: every trigger's latency
 // is in the merged trace, the ground warns for each one later than --trigger-latency-warn
 // and reports the maximum and p99 in its summary, and --max-trigger-latency makes such a
 // message a fault. Real `eamos launch` processes on loopback, DDS domains 190-192. A late

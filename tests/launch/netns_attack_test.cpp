@@ -1,5 +1,5 @@
-// Attacks and a frozen DEX on the namespace network of netns_test.cpp (issue 13, item 5;
-// docs/security.md "Attacks tried", docs/faults.md "A bad network"). The attacker is a
+// Attacks and a frozen DEX on the namespace network of netns_test.cpp
+// (docs/security.md "Attacks tried", docs/faults.md "A bad network"). The attacker is a
 // process of its own, eamos-dds-attacker (tests/support/dds_attacker.cpp, the project's
 // transport), in a fifth namespace joined to the mission's network only through the relay,
 // as a machine on the drones' network would be. The mission (missions/hops_watch.eamos) is

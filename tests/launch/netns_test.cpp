@@ -1,4 +1,4 @@
-// A bad network between the drones (issue 13, item 5): each DEX and the ground in a
+// A bad network between the drones: each DEX and the ground in a
 // network namespace of its own, created here, connected to the others only through
 // eamos-udp-relay (tests/support/udp_relay.cpp), which loses, delays, jitters and cuts
 // Cyclone DDS's unicast traffic (the kernel here has no netem). Each participant's Cyclone

@@ -153,9 +153,9 @@ TEST(UdpLink, ListenerBeforeTheVehicleIsKnownFollowsTheLastValidFrameOfAnySystem
   EXPECT_EQ(unpack_command_ack(b_side.frames[0].message)->command, 176);
 }
 
-// The frame handler runs on the link's own thread: an exception there used to end the
-// process (std::terminate) with the vehicle in flight. Now that datagram is dropped and
-// the link goes on.
+// The frame handler runs on the link's own thread: an exception escaping it would end the
+// process (std::terminate) with the vehicle in flight. That datagram is dropped and the link
+// goes on.
 TEST(UdpLink, HandlerThatThrowsLosesOnlyThatDatagram) {
   Mailbox got;
   int calls = 0;

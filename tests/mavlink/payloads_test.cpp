@@ -354,3 +354,88 @@ TEST(RoundTrip, ParamSetKeepsTargetNameValueAndType) {
 
 }  // namespace
 }  // namespace eamos::mavlink
+
+namespace eamos::mavlink {
+namespace {
+
+TEST(RoundTrip, CameraTriggerKeepsTimeAndSequence) {
+  auto out = unpack_camera_trigger(through_the_wire(pack(CameraTrigger{123456789012ULL, 70000})));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->time_usec, 123456789012ULL);
+  EXPECT_EQ(out->seq, 70000u);
+}
+
+TEST(RoundTrip, CameraFeedbackKeepsEveryField) {
+  CameraFeedback in{987654321, 1, 2, 513, 473977420, 85455940, 488.5f, 20.25f, 1.5f, -2.5f, 270.0f, 35.0f, 1, 9};
+  auto out = unpack_camera_feedback(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->time_usec, 987654321u);
+  EXPECT_EQ(out->target_system, 1);
+  EXPECT_EQ(out->cam_idx, 2);
+  EXPECT_EQ(out->img_idx, 513);
+  EXPECT_EQ(out->lat, 473977420);
+  EXPECT_EQ(out->lng, 85455940);
+  EXPECT_EQ(out->alt_msl, 488.5f);
+  EXPECT_EQ(out->alt_rel, 20.25f);
+  EXPECT_EQ(out->roll, 1.5f);
+  EXPECT_EQ(out->pitch, -2.5f);
+  EXPECT_EQ(out->yaw, 270.0f);
+  EXPECT_EQ(out->foc_len, 35.0f);
+  EXPECT_EQ(out->flags, 1);
+  EXPECT_EQ(out->completed_captures, 9);
+}
+
+TEST(RoundTrip, CameraImageCapturedKeepsEveryFieldAndAFailedCapture) {
+  CameraImageCaptured in;
+  in.time_boot_ms = 61000;
+  in.time_utc = 1700000000000000ULL;
+  in.camera_id = 1;
+  in.lat = -338688197;
+  in.lon = 1512092955;
+  in.alt = 58000;
+  in.relative_alt = 12000;
+  in.q = {0.5f, 0.5f, -0.5f, 0.5f};
+  in.image_index = -1;
+  in.capture_result = 0;
+  in.file_url = "file:///images/IMG_0001.jpg";
+  auto out = unpack_camera_image_captured(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->time_boot_ms, 61000u);
+  EXPECT_EQ(out->time_utc, 1700000000000000ULL);
+  EXPECT_EQ(out->camera_id, 1);
+  EXPECT_EQ(out->lat, -338688197);
+  EXPECT_EQ(out->lon, 1512092955);
+  EXPECT_EQ(out->alt, 58000);
+  EXPECT_EQ(out->relative_alt, 12000);
+  EXPECT_EQ(out->q, in.q);
+  EXPECT_EQ(out->image_index, -1);
+  EXPECT_EQ(out->capture_result, 0);
+  EXPECT_EQ(out->file_url, in.file_url);
+}
+
+TEST(RoundTrip, CameraImageCapturedFileUrlWithForeignBytesArrivesAsQuestionMarks) {
+  CameraImageCaptured in;
+  in.file_url = std::string("a\n\xff") + "b";
+  auto out = unpack_camera_image_captured(through_the_wire(pack(in)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->file_url, "a??b");
+}
+
+TEST(RoundTrip, CameraCaptureIsReadFromEachOfTheThreeConfirmations) {
+  for (uint32_t id : {msg::CAMERA_TRIGGER, msg::CAMERA_FEEDBACK, msg::CAMERA_IMAGE_CAPTURED}) {
+    auto out = unpack_camera_capture(through_the_wire(pack(CameraCapture{id, 42, true})));
+    ASSERT_TRUE(out) << id;
+    EXPECT_EQ(out->message_id, id);
+    EXPECT_EQ(out->image_index, 42);
+    EXPECT_TRUE(out->captured);
+  }
+  auto failed = unpack_camera_capture(through_the_wire(pack(CameraCapture{msg::CAMERA_IMAGE_CAPTURED, 7, false})));
+  ASSERT_TRUE(failed);
+  EXPECT_FALSE(failed->captured);
+  EXPECT_EQ(failed->image_index, 7);
+  EXPECT_FALSE(unpack_camera_capture(pack(Heartbeat{})));
+  EXPECT_FALSE(unpack_camera_trigger(pack(CameraFeedback{})));
+}
+
+}  // namespace
+}  // namespace eamos::mavlink

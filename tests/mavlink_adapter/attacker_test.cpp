@@ -1,10 +1,10 @@
-// A MAVLink attacker on the adapter's port (issue 13, items 3 and 5; docs/security.md):
+// A MAVLink attacker on the adapter's port (docs/security.md):
 // while `eamos run` flies a real `eamos sim-vehicle` process over loopback UDP, another
 // sender (this test's own socket, another address than the vehicle's) floods the adapter's
 // listening port with garbage and with forged frames carrying the vehicle's system id:
-// HEARTBEATs and COMMAND_ACK DENIED for every command the flight sends. Before the fix the
-// listening link followed any datagram's sender, so the attacker received our commands and
-// its DENIED failed the mission. Expected: not one datagram reaches the attacker, the flight
+// HEARTBEATs and COMMAND_ACK DENIED for every command the flight sends. A listening link that
+// followed any datagram's sender would send our commands to the attacker and its DENIED
+// would fail the mission. Expected: not one datagram reaches the attacker, the flight
 // completes, and the foreign datagrams are counted and logged. Port 25366.
 #include <gtest/gtest.h>
 

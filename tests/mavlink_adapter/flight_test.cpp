@@ -209,6 +209,24 @@ TEST(MavlinkFlight, ArmRefusedByTheAutopilotFailsWithItsResultInWords) {
   EXPECT_FALSE(f.drone->state().armed);
 }
 
+// PX4 SITL stood disarmed in OFFBOARD after a mission that ended with its NAV_LAND, and
+// refuses to arm there without setpoints ("Arming denied: Resolve system health failures
+// first"). A DEX arms only after its wait for the vehicle's fix, when the vehicle's mode is
+// known: the Arm must switch to AUTO.LOITER first, as it does when the mode is unknown.
+TEST(MavlinkFlight, APx4LeftInOffboardByTheLastMissionSwitchesToHoldBeforeItArms) {
+  sim_vehicle::VehicleOptions o;
+  o.boot_mode = sim_vehicle::Mode::setpoint;
+  test::VehicleThread vehicle(25387, kSpeed, o);
+  Flight f(25387);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  for (double until = f.loop.now() + 5.0; f.drone->state().mode.empty() && f.loop.now() < until;)
+    f.loop.run_until(f.loop.now() + 0.05);
+  ASSERT_EQ(f.drone->state().mode, "OFFBOARD");
+  mid::ActionEnd e = f.fly("Arm");
+  ASSERT_EQ(e.outcome, mid::Outcome::succeeded) << e.reason;
+  EXPECT_EQ(vehicle.inspect([](const sim_vehicle::SimVehicle& v) { return v.mode(); }), sim_vehicle::Mode::hold);
+}
+
 // The adapter is an onboard controller; only a fleet file's `announce_as_gcs: true` makes
 // it a ground station too (PX4 then sends it STATUSTEXT, and no longer sees its real ground
 // station's link go: docs/fleet.md). Once the ARM is acknowledged the vehicle has had the

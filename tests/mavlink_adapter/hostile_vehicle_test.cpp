@@ -167,8 +167,8 @@ class DownedVehicle {
 };
 
 // An endless motion (Hover(), Orbit) has no deadline: on a vehicle that is down and disarmed
-// without the mission landing it, it used to run for ever, and a mission that waited for it
-// (a DoUntil watching something else, an async branch) with it, to its time limit.
+// without the mission landing it, it must fail, or it would run for ever, and a mission that
+// waited for it (a DoUntil watching something else, an async branch) with it, to its time limit.
 TEST(HostileVehicle, EndlessMotionFailsWhenTheVehicleIsDownAndDisarmedByItself) {
   DownedVehicle vehicle(25333);
   MavlinkOptions quick;

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <string>
 
@@ -78,6 +79,8 @@ TEST(SitlSeparation, DISABLED_TwoArduCoptersCrossingOneGivesWayAndBothComplete) 
                                                (dir / "trace.jsonl").string());
   EXPECT_EQ(r.status, 0) << r.out;
   Seen s = read_trace(dir / "trace.jsonl");
+  // Each run's closest approach, pass or fail: how far from the minimum the runs stay.
+  std::cout << "[sitl] closest " << s.closest_m << " m, " << s.give_ways << " give-way(s)\n";
   EXPECT_EQ(s.gave_way, "B") << r.out;
   EXPECT_GE(s.resumes, 1) << r.out;
   EXPECT_EQ(s.give_ways, s.resumes);

@@ -1,4 +1,4 @@
-// MAVLink 2 signing against real ArduCopter firmware (issue 13, item 3): `eamos run` gives
+// MAVLink 2 signing against real ArduCopter firmware: `eamos run` gives
 // the SITL vehicle its key (SETUP_SIGNING) and flies a short mission signed; then a ground
 // station of the test on another of the vehicle's ports sends commands unsigned, signed
 // with a wrong key and replayed, and the vehicle ignores them: no COMMAND_ACK, no change of

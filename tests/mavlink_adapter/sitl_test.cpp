@@ -334,11 +334,6 @@ void Sitl::fly_second_mission(const std::string& extra) {
 TEST_P(Sitl, ASecondMissionRightAfterTheFirstWaitsArmedLongerThanTheAutoDisarm) { fly_second_mission(""); }
 
 TEST_P(Sitl, ASecondMissionWithOneDexPerDroneWaitsArmedLongerThanTheAutoDisarm) {
-  // Known regression, not yet understood: on PX4 the second mission's Arm is now refused
-  // ("Arming denied: Resolve system health failures first", 1.5 s in) with one DEX per drone,
-  // while the in-process case above passes. Skipped on PX4, saying so, until it is found.
-  if (GetParam() == Autopilot::px4)
-    GTEST_SKIP() << "known regression on PX4: the second mission's Arm is refused (system health) with one DEX per drone";
   fly_second_mission("--distributed");
 }
 
@@ -646,7 +641,7 @@ void Sitl::fly_listing2(const std::string& extra) {
   std::cout << "  radii along the orbit: " << trail << "\n";
   for (const std::string& text : f.vehicle["Drone2"])
     if (text.find("DO_ORBIT radius") != std::string::npos) std::cout << "  " << text << "\n";
-  // Orbit() is 5 m, held within 5 % (issue 12) on average around where the Orbit started, and
+  // Orbit() is 5 m, held within 5 % on average around where the Orbit started, and
   // every sample within kSampleBound, on both autopilots: ArduCopter from setpoints, PX4 in its
   // own ORBIT mode with the radius corrected by the one flown (docs/adapters.md). The radii are
   // printed above.

@@ -22,7 +22,8 @@ fleet::DroneSettings fenced() {
 
 std::string refusal(const ActionRequest& r, fleet::Vec3 at, bool landed = false) {
   fleet::DroneSettings s = fenced();
-  const fleet::ActionSpec* spec = fleet::generic_multirotor("Quad").find_action(r.name);
+  const fleet::DroneType quad = fleet::generic_multirotor("Quad");  // owns the spec below
+  const fleet::ActionSpec* spec = quad.find_action(r.name);
   return uniform_refusal(r, *spec, {true, landed, at, ""}, s);
 }
 

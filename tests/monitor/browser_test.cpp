@@ -258,7 +258,7 @@ TEST(MonitorBrowser, LiveRunProgressesAndSurvivesReloadAndSecondPage) {
   EXPECT_TRUE(held) << run.seen;
   EXPECT_EQ(status, 0) << run.seen;
   EXPECT_NE(run.seen.find("mission completed in 16.7 s"), std::string::npos) << run.seen;
-  // The signal that stops the page says so; it used to announce every drone's failsafe.
+  // The signal that stops the page says so, rather than announcing every drone's failsafe.
   EXPECT_NE(run.seen.find("interrupted (SIGTERM): the mission has ended; the monitor stops"), std::string::npos)
       << run.seen;
   EXPECT_EQ(run.seen.find("failsafe"), std::string::npos) << run.seen;
@@ -268,7 +268,7 @@ TEST(MonitorBrowser, LiveRunProgressesAndSurvivesReloadAndSecondPage) {
 
 namespace {
 
-// Issue 14's bound: at 20 drones a live page draws each event within 100 ms of eamos emitting
+// The monitor's latency bound: at 20 drones a live page draws each event within 100 ms of eamos emitting
 // it (p95; the page measures it from the wall-clock stamps eamos sends beside live events). In
 // real time; the browser measures 800 live events and the run is then stopped.
 TEST(MonitorBrowser, LiveTwentyDronesAreDrawnWithin100msOfEachEvent) {
@@ -331,8 +331,7 @@ TEST(MonitorBrowser, LaunchOfADeploymentIsServedLiveToItsEnd) {
 
 namespace {
 
-// Issue 37: a failed live run went on saying "● live", with no banner and the reason nowhere on
-// the page. tests/monitor/missions/timeout.eamos fails at 3.65 s; its drones land until 8.2 s.
+// A failed live run must stop saying "● live" and show a banner with the reason. tests/monitor/missions/timeout.eamos fails at 3.65 s; its drones land until 8.2 s.
 TEST(MonitorBrowser, AFailedLiveRunShowsItsFailureAndNoLongerSaysLive) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
   auto run = eamos_test::start_eamos({"run", "tests/monitor/missions/timeout.eamos", "--fleet",

@@ -1,5 +1,5 @@
 // eamos-dds-attacker: a process on a mission's DDS domain that is not one of its drones,
-// for the attack tests of tests/launch/netns_attack_test.cpp (issue 13, item 5). It uses
+// for the attack tests of tests/launch/netns_attack_test.cpp. It uses
 // the project's own transport (DdsNode, the mission's IDL and partitions), so what it
 // writes is exactly what a DEX would write: only who writes it is wrong.
 //
