@@ -81,6 +81,7 @@ install(FILES ${PROJECT_BINARY_DIR}/packaging/eamosConfig.cmake ${PROJECT_BINARY
 install(FILES ${PROJECT_SOURCE_DIR}/config/eamos-dex@.service
         DESTINATION lib/systemd/system COMPONENT runtime)
 install(FILES ${PROJECT_SOURCE_DIR}/config/cyclonedds-network.xml ${PROJECT_SOURCE_DIR}/config/cyclonedds-loopback.xml
+              ${PROJECT_SOURCE_DIR}/config/cyclonedds-hosts.xml
         DESTINATION ${CMAKE_INSTALL_DATADIR}/eamos/config COMPONENT runtime)
 
 # Completions: bash-completion loads completions/eamos on demand; zsh finds _eamos on its

@@ -216,7 +216,9 @@ CLI::App* add_launch(CLI::App& app, Options& o) {
       ->check(eamos::cli::positive());
   launch->add_option("--time-limit", l.time_limit_s, "Fail a mission still running after this many mission seconds")
       ->check(eamos::cli::positive());
-  launch->add_option("--barrier-timeout", l.barrier_timeout_s, "Seconds to wait for every DEX to be ready")
+  launch->add_option("--barrier-timeout", l.barrier_timeout_s,
+                     "Seconds to wait for every DEX to be ready (default: 30, plus 0.5 per drone beyond 20; with DDS "
+                     "Security at most 85)")
       ->check(eamos::cli::positive());
   launch->add_option("--drones", l.local, "Start only these drones here; the others run their DEX elsewhere")
       ->delimiter(',');
@@ -244,6 +246,10 @@ CLI::App* add_dex(CLI::App& app, Options& o) {
       ->check(eamos::cli::positive());
   dexcmd->add_option("--start-timeout", d.start_timeout_s, "Give up when no start came within this many seconds (default: wait)")
       ->check(eamos::cli::non_negative());
+  dexcmd->add_option("--ready-timeout", d.unready_limit_s,
+                     "With DDS Security: leave (exit 1) when not every other drone was heard from within this many "
+                     "seconds of joining DDS, before Cyclone DDS gives its handshakes up (default and most: 90)")
+      ->check(eamos::cli::number_between(0.1, eamos::launch::kSecureUnreadyLimitS));
   dexcmd->add_option("--trace", d.trace_file, "Also write this drone's trace as JSON Lines to this file");
   dexcmd->add_option("--launch-id", d.launch_id,
                      "Take a start only from the `eamos launch` with this id (set by the launch that starts the DEX)");

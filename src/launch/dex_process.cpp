@@ -131,6 +131,7 @@ bool DexProcess::open_dds() {
   if (!o_.insecure) dds.security_folder = o_.folder + "/security";
   dds.durable_triggers = durable_triggers(mission_);
   std::string error;
+  joined_at_ = wall_s();
   node_ = transport::DdsNode::open(dds, std::move(h), error);
   if (!node_) {
     err_ << "eamos dex: error: " << error << "\n";
@@ -182,6 +183,7 @@ bool DexProcess::wait_for_start() {
   publish_status(true);
   const double lease = o_.dds.lease_s;
   const double deadline = o_.start_timeout_s > 0 ? wall_s() + o_.start_timeout_s : 1e300;
+  const double unready_deadline = o_.insecure ? 1e300 : joined_at_ + o_.unready_limit_s;
   bool ready_sent = false;
   std::set<std::uint64_t> refused;
   out_ << name() << ": DEX of mission " << mission_.hash.substr(0, 12) << " waiting for its peers\n" << std::flush;
@@ -204,6 +206,7 @@ bool DexProcess::wait_for_start() {
       return false;
     }
     if (!ready_sent) ready_sent = ready_when_all_seen();
+    if (!ready_sent && wall_s() > unready_deadline) return leave_unready();
     for (const LifecycleSample& s : starts)
       if (std::optional<bool> taken = take_start(s, refused)) return *taken;
     if (wall_s() > deadline) {
@@ -212,6 +215,22 @@ bool DexProcess::wait_for_start() {
       return false;
     }
   }
+}
+
+// With DDS Security, a drone not heard from by now has a handshake with this DEX that does
+// not complete; Cyclone would give it up at kHandshakeGiveUpS, where Debian's build can
+// crash. Leaving the domain first ends this DEX cleanly (nothing has flown); a service
+// restarts it and its handshakes begin again.
+bool DexProcess::leave_unready() {
+  std::map<int, TelemetrySample> seen = inbox_.latest();
+  std::string missing;
+  for (int d = 0; d < static_cast<int>(mission_.fleet.size()); ++d)
+    if (d != mission_.self && !seen.count(d)) missing += (missing.empty() ? "" : ", ") + mission_.fleet[d];
+  err_ << "eamos dex: error: " << name() << ": not ready " << o_.unready_limit_s
+       << " s after joining DDS: nothing heard from " << missing
+       << " (their DEX is not running, or its DDS Security handshake with this one did not complete); "
+       << "leaving before Cyclone DDS gives the handshakes up; start this DEX again\n";
+  return false;
 }
 
 // READY once a telemetry sample came from every other drone, not only those whose telemetry

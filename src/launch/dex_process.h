@@ -15,6 +15,10 @@
 
 namespace eamos::launch {
 
+/// The default of DexProcessOptions::unready_limit_s: ten seconds short of Cyclone's
+/// handshake timeout, for a DEX that started its handshakes a little after joining.
+inline constexpr double kSecureUnreadyLimitS = transport::kHandshakeGiveUpS - 10.0;
+
 struct DexProcessOptions {
   std::string folder;             ///< the drone's deployment folder (holds mission.json)
   transport::DdsOptions dds;
@@ -31,6 +35,10 @@ struct DexProcessOptions {
   /// Mission seconds: a trigger or cancel received later than this after it was sent fails
   /// the mission (this drone's failsafe, ABORT naming the message). 0 = no bound.
   double max_trigger_latency_s = 0.0;
+  /// With DDS Security: wall seconds after joining the domain by which every other drone
+  /// must have been heard from (all its handshakes done); otherwise the DEX leaves with an
+  /// error before Cyclone's handshake timeout (transport::kHandshakeGiveUpS).
+  double unready_limit_s = kSecureUnreadyLimitS;
 };
 
 /// Runs the process; returns its exit status: 0 when the mission completed, 1 otherwise

@@ -87,6 +87,8 @@ class DexProcess {
   bool wait_for_start();
   /// Writes READY when every other drone has been heard from; whether it did.
   bool ready_when_all_seen();
+  /// Gives up waiting for the other drones (DexProcessOptions::unready_limit_s); false.
+  bool leave_unready();
   /// A START seen while waiting: true when it starts this process's run, false when this
   /// process must give up, nothing when it is not this process's (noted in `refused`).
   std::optional<bool> take_start(const LifecycleSample& s, std::set<std::uint64_t>& refused);
@@ -207,6 +209,7 @@ class DexProcess {
   std::vector<std::uint64_t> last_trigger_seq_;
   std::set<std::string> rejected_;                        ///< what was logged as ignored
   std::optional<LifecycleSample> pending_finished_;       ///< a FINISHED this DEX does not agree with (yet)
+  double joined_at_ = 0.0;  ///< wall time the DDS participant was created
   double pending_since_ = 0.0;                            ///< wall time it came
 
   // Last, so it goes first: its listener threads use everything above.

@@ -134,6 +134,7 @@ class Ground {
 
  private:
   bool prepare();
+  bool choose_barrier_timeout();
   bool open_dds();
   bool fly();
   void report_outcome();
@@ -181,7 +182,7 @@ class Ground {
   void interrupt();
   void stop_all(int signal);
 
-  const LaunchOptions& o_;
+  LaunchOptions o_;  // a copy: prepare() settles the barrier timeout
   dex::TraceSink* live_;
   LaunchResult& r_;
   std::ostream& out_;
@@ -248,12 +249,31 @@ bool Ground::prepare() {
       err_ << "eamos launch: error: --drones names '" << n << "', which is not a drone of this mission\n";
       return false;
     }
+  if (!choose_barrier_timeout()) return false;
   r_.header = load_header(o_.dir, hash_, drones_, o_.telemetry_hz, err_);
   for (auto& d : drones_) r_.fleet.push_back(d.name);
   for (auto& d : drones_)
     d.local = !o_.remote_only &&
               (o_.local.empty() || std::find(o_.local.begin(), o_.local.end(), d.name) != o_.local.end());
   return true;
+}
+
+// Past Cyclone's handshake timeout a DEX of Debian's Cyclone DDS can crash (dds_node.h):
+// with DDS Security a longer barrier is refused, and the default grows with the fleet.
+bool Ground::choose_barrier_timeout() {
+  const bool secure = !o_.insecure;
+  if (o_.barrier_timeout_s <= 0) {
+    o_.barrier_timeout_s = barrier_timeout_for(static_cast<int>(drones_.size()), secure);
+    return true;
+  }
+  if (!secure || o_.barrier_timeout_s <= kMaxSecureBarrierS) return true;
+  char secs[32];
+  std::snprintf(secs, sizeof secs, "%g", o_.barrier_timeout_s);
+  err_ << "eamos launch: error: --barrier-timeout " << secs << " is longer than DDS Security allows: "
+       << "Cyclone DDS gives up a handshake after " << transport::kHandshakeGiveUpS
+       << " s, and Debian 12's build can crash then; use --barrier-timeout " << kMaxSecureBarrierS
+       << " or less (a fleet whose handshakes need longer is too large for this host: docs/performance.md)\n";
+  return false;
 }
 
 // Discovery: the ground's DDS participant, every sample handed to the loop's thread.
@@ -457,8 +477,11 @@ void Ground::poll_children() {
   for (auto& d : drones_) {
     if (!d.local || d.child.exit_status) continue;
     poll(d.child);
-    if (d.child.exit_status)
-      out_ << "ground: the DEX of " << d.name << " exited with status " << *d.child.exit_status << "\n" << std::flush;
+    if (!d.child.exit_status) continue;
+    char usage[96];
+    std::snprintf(usage, sizeof usage, " (%.2f CPU-s, peak RSS %.1f MB)", d.child.cpu_s, d.child.max_rss_kb / 1024.0);
+    out_ << "ground: the DEX of " << d.name << " exited with status " << *d.child.exit_status << usage << "\n"
+         << std::flush;
   }
 }
 
@@ -773,6 +796,11 @@ void Ground::record_lifecycle(const LifecycleSample& s) {
 }
 
 }  // namespace
+
+double barrier_timeout_for(int drones, bool secure) {
+  double s = 30.0 + 0.5 * std::max(0, drones - 20);
+  return secure ? std::min(s, kMaxSecureBarrierS) : s;
+}
 
 int launch(const LaunchOptions& options, dex::TraceSink* live, LaunchResult& result, std::ostream& out,
            std::ostream& err) {

@@ -20,7 +20,8 @@ struct LaunchOptions {
   std::string dir;                  ///< deployment folder (manifest.json, one folder per drone)
   transport::DdsOptions dds;
   double speed = 1.0;               ///< mission seconds per wall second, for every DEX
-  double barrier_timeout_s = 30.0;  ///< wall seconds to wait for every READY
+  /// Wall seconds to wait for every READY; 0: barrier_timeout_for(drones, secure).
+  double barrier_timeout_s = 0.0;
   double time_limit_s = 3600.0;     ///< mission seconds, passed to every DEX
   double start_delay_s = 0.5;       ///< wall seconds between START and mission time 0
   std::vector<std::string> local;   ///< drones to start here; empty = all of them (unless remote_only)
@@ -40,6 +41,16 @@ struct LaunchOptions {
   /// elsewhere the ground writes the ABORT when it hears of the message. 0 = no bound.
   double max_trigger_latency_s = 0.0;
 };
+
+/// With DDS Security, the longest start barrier: every DEX it started (whose start timeout
+/// is the barrier's plus 5 s) and the ground itself leave the domain before Cyclone gives
+/// up a pending handshake (transport::kHandshakeGiveUpS), which can crash Debian's build.
+inline constexpr double kMaxSecureBarrierS = 85.0;
+
+/// The start barrier's default: 30 s, and half a second more per drone beyond 20 (each
+/// participant discovers and, with DDS Security, authenticates every other one); with DDS
+/// Security at most kMaxSecureBarrierS.
+double barrier_timeout_for(int drones, bool secure);
 
 struct LaunchResult {
   dex::RunResult run;                   ///< as `eamos run` reports it

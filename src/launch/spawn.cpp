@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -51,12 +52,16 @@ Child spawn(const std::vector<std::string>& argv, const std::string& log, std::s
 void poll(Child& c) {
   if (c.pid <= 0 || c.exit_status) return;
   int status = 0;
-  pid_t r = waitpid(c.pid, &status, WNOHANG);
+  struct rusage usage {};
+  pid_t r = wait4(c.pid, &status, WNOHANG, &usage);
   if (r < 0 && errno == ECHILD) {  // reaped elsewhere: it is gone, its status unknown
     c.exit_status = 255;
     return;
   }
   if (r != c.pid) return;
+  c.cpu_s = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+            static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) / 1e6;
+  c.max_rss_kb = usage.ru_maxrss;
   c.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 

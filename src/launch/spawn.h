@@ -11,6 +11,8 @@ namespace eamos::launch {
 struct Child {
   pid_t pid = -1;
   std::optional<int> exit_status;  ///< set once it ended: its exit code, or 128 + signal
+  double cpu_s = 0.0;              ///< once ended: user + system CPU seconds it used
+  long max_rss_kb = 0;             ///< once ended: its peak resident memory
 };
 
 /// Starts `argv` (argv[0] is the program path) with stdout and stderr appended to `log`;

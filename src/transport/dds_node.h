@@ -54,6 +54,14 @@ struct DdsOptions {
   int durable_trace = kDefaultDurableTrace;
 };
 
+/// Wall seconds after which Cyclone DDS 0.10 gives up a DDS Security handshake that has not
+/// completed (AUTHENTICATION_TIMEOUT in its ddsi_handshake.c). Debian 12's build (0.10.2)
+/// can crash at that moment: the handler of this timeout races with the handshake's other
+/// timers on one heap (eclipse-cyclonedds/cyclonedds#1548, fixed in 11.0). No eamos process
+/// keeps a handshake pending that long: a DEX not ready by kSecureUnreadyLimitS leaves the
+/// domain (launch/dex_process.h), and the ground's start barrier ends before it.
+inline constexpr double kHandshakeGiveUpS = 100.0;
+
 /// The files of a security folder, in the order the Cyclone DDS configuration names them.
 inline constexpr const char* kSecurityFiles[] = {"identity_ca.pem",   "identity.pem",   "identity_key.pem",
                                                  "permissions_ca.pem", "governance.p7s", "permissions.p7s"};
