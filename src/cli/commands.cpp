@@ -138,14 +138,15 @@ void warn_insecure(const char* command) {
                "experiments, never with aircraft that can hurt anyone.\n";
 }
 
-bool write_security(const graph::Compilation& c, const std::string& dir, const SecurityOptions& security) {
+bool write_security(const graph::Compilation& c, const std::string& dir, const std::string& hash,
+                    const SecurityOptions& security) {
   std::vector<std::string> drones;
   for (int d = 0; d < c.drone_count(); ++d) drones.push_back(c.drone_name(d));
   if (security.insecure) {
     security::remove_mission_keys(dir, drones);
     return true;
   }
-  security::MissionKeysRequest r{dir, deploy::mission_hash(c), drones, security.keys_dir, security.valid_days};
+  security::MissionKeysRequest r{dir, hash, drones, security.keys_dir, security.valid_days};
   std::vector<std::string> notes;
   std::string error;
   if (!security::write_mission_keys(r, notes, error)) {
@@ -169,11 +170,12 @@ int cmd_compile(const CommonOptions& o, const std::string& out_dir, const Securi
   graph::Compilation c;
   if (!compile_and_report(o, c, graph::Keep::deployment_graphs)) return 1;
   Diagnostics diags;
-  if (!deploy::write_deployment(c, out_dir, diags)) {
+  std::string hash = deploy::mission_hash(c);
+  if (!deploy::write_deployment(c, out_dir, hash, diags)) {
     std::cerr << diags.format();
     return 1;
   }
-  if (!write_security(c, out_dir, security)) return 1;
+  if (!write_security(c, out_dir, hash, security)) return 1;
   if (package) {
     deploy::PackageOptions p = *package;
     p.insecure = security.insecure;

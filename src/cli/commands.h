@@ -42,7 +42,8 @@ int cmd_compile(const CommonOptions& o, const std::string& out_dir, const Securi
                 const deploy::PackageOptions* package = nullptr);
 /// Writes (or, insecure, removes) the credentials of the deployment in `dir`; false with
 /// the error printed.
-bool write_security(const graph::Compilation& c, const std::string& dir, const SecurityOptions& security);
+bool write_security(const graph::Compilation& c, const std::string& dir, const std::string& hash,
+                    const SecurityOptions& security);
 /// The warning every insecure command prints first.
 void warn_insecure(const char* command);
 int cmd_graph(const CommonOptions& o, const std::string& kind, const std::string& drone,

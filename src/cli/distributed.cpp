@@ -155,11 +155,12 @@ int cmd_run_distributed(const CommonOptions& o, const RunCommandOptions& r, laun
     dir = pattern;
   }
   Diagnostics diags;
-  if (!deploy::write_deployment(c, dir, diags)) {
+  std::string hash = deploy::mission_hash(c);
+  if (!deploy::write_deployment(c, dir, hash, diags)) {
     std::cerr << diags.format();
     return 1;
   }
-  if (!write_security(c, dir, security)) return 1;
+  if (!write_security(c, dir, hash, security)) return 1;
   std::cout << "deployment in " << dir << "\n";
   options.dir = dir;
   options.insecure = security.insecure;

@@ -73,6 +73,11 @@ bool write_text(const std::filesystem::path& path, const std::string& text, Diag
 }  // namespace
 
 bool write_deployment(const graph::Compilation& c, const std::string& dir, Diagnostics& diags) {
+  return write_deployment(c, dir, mission_hash(c), diags);
+}
+
+bool write_deployment(const graph::Compilation& c, const std::string& dir, const std::string& hash,
+                      Diagnostics& diags) {
   namespace fs = std::filesystem;
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -80,7 +85,6 @@ bool write_deployment(const graph::Compilation& c, const std::string& dir, Diagn
     diags.error(nullptr, {}, "cannot create output folder '" + dir + "': " + ec.message());
     return false;
   }
-  std::string hash = mission_hash(c);
   if (!write_text(fs::path(dir) / "manifest.json", manifest(c, hash).dump(2) + "\n", diags)) return false;
   // Mission and fleet text may hold any byte: replaced, not thrown, as in the trace itself.
   std::string header = trace_header(c, hash, 0).dump(2, ' ', false, json::error_handler_t::replace);

@@ -27,5 +27,10 @@ nlohmann::ordered_json trace_header(const graph::Compilation& c, const std::stri
 /// trace with) and DIR/<drone>/mission.json for every drone. Returns false
 /// and reports to `diags` when a file cannot be written.
 bool write_deployment(const graph::Compilation& c, const std::string& dir, Diagnostics& diags);
+/// The same with the mission hash already taken (mission_hash(c)): a caller that needs it
+/// again, for the credentials, takes it once, since at 500,000 statements it is a tenth of
+/// the compile.
+bool write_deployment(const graph::Compilation& c, const std::string& dir, const std::string& hash,
+                      Diagnostics& diags);
 
 }  // namespace eamos::deploy

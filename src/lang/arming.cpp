@@ -2,10 +2,8 @@
 
 #include <algorithm>
 #include <map>
-#include <unordered_map>
 #include <string>
 #include <utility>
-#include <vector>
 
 namespace eamos::lang {
 namespace {
@@ -35,128 +33,134 @@ bool is_repeat(ControlKind k) {
 bool is_do_sync(ControlKind k) { return k == ControlKind::DoUntilSync || k == ControlKind::DoWhileSync; }
 bool is_do_async(ControlKind k) { return k == ControlKind::DoUntilAsync || k == ControlKind::DoWhileAsync; }
 
-/// One drone's Armed state through the mission, memoised per (block, entry state): a block
-/// is analysed at most four times per drone however often it is called.
-/// Which drones each function may run an action of (through what it calls), found once for
-/// the whole fleet, and for each PAR, which of its siblings do for each drone: a drone's
-/// analysis then visits only what concerns it. Walking the mission once per drone costs
-/// drones × statements (at a thousand drones, most of `eamos run`'s CPU in a show).
+/// Which drones each function and each statement may arm, disarm or move: a drone's
+/// analysis visits only the statements that mention it, so a show where every drone flies
+/// in every PAR costs each drone its own statements, not the fleet's. Built once for all
+/// drones; its size is the statements times the drones each one reaches.
 class Mentions {
  public:
-  explicit Mentions(const Mission& m) : m_(m), drones_(m.functions.size()), state_(m.functions.size(), 0) {}
+  explicit Mentions(const Mission& m) : m_(m), of_function_(m.functions.size()), state_(m.functions.size(), 0) {
+    by_function_.resize(m.functions.size());
+    for (std::size_t fn = 0; fn < m.functions.size(); ++fn) index(static_cast<int>(fn));
+  }
 
-  bool mentions(int fn, int drone) {
-    if (fn < 0) return false;
-    const std::vector<int>& list = of(fn);
-    return std::binary_search(list.begin(), list.end(), drone);
-  }
-  bool touches(const Statement& st, int drone) {
-    if (st.kind == StatementKind::action) return st.drone_index == drone;
-    bool any = mentions(st.function_index, drone);
-    for (int b : st.branch_functions) any = mentions(b, drone) || any;
-    return any;
-  }
-  /// The siblings of PAR `fn` that may run an action of `drone`, in body order.
-  std::vector<std::size_t> touching(int fn, int drone) {
-    auto [it, added] = siblings_.try_emplace(fn);
-    if (added) index_siblings(fn, it->second);
-    auto range = std::equal_range(it->second.begin(), it->second.end(), std::pair<int, std::size_t>{drone, 0},
-                                  [](const auto& a, const auto& b) { return a.first < b.first; });
-    std::vector<std::size_t> out;
-    for (auto i = range.first; i != range.second; ++i) out.push_back(i->second);
+  /// The statements of `fn` that mention `drone`, in order (indices into its body).
+  std::vector<int> statements(int fn, int drone) const {
+    std::vector<int> out;
+    const auto& pairs = by_function_[fn];
+    auto it = std::lower_bound(pairs.begin(), pairs.end(), std::pair<int, int>{drone, -1});
+    for (; it != pairs.end() && it->first == drone; ++it) out.push_back(it->second);
     return out;
   }
 
+  bool mentions(int fn, int drone) const {
+    return fn >= 0 && std::binary_search(of_function_[fn].begin(), of_function_[fn].end(), drone);
+  }
+
  private:
-  const std::vector<int>& of(int fn) {
-    if (state_[fn] != 0) return drones_[fn];  // known, or being found (the checker ruled out recursion)
-    state_[fn] = 1;
-    std::vector<int> list;
-    for (const Statement& st : m_.functions[fn].body) add_statement(st, list);
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
-    drones_[fn] = std::move(list);
-    state_[fn] = 2;
-    return drones_[fn];
-  }
-  void add_statement(const Statement& st, std::vector<int>& list) {
-    if (st.kind == StatementKind::action) {
-      if (st.drone_index >= 0) list.push_back(st.drone_index);
-      return;
+  /// Fills of_function_[fn] and by_function_[fn], callees first; iterative, since calls can
+  /// nest as deep as the mission's functions.
+  void index(int root) {
+    std::vector<std::pair<int, std::size_t>> stack;  // (function, next statement to look at)
+    if (state_[root] == 0) stack.push_back({root, 0});
+    while (!stack.empty()) {
+      auto [fn, next] = stack.back();
+      state_[fn] = 1;
+      const std::vector<Statement>& body = m_.functions[fn].body;
+      int pending = -1;  // a callee not indexed yet
+      for (; next < body.size() && pending < 0; next += pending < 0 ? 1 : 0)
+        for (int callee : callees(body[next]))
+          if (callee >= 0 && state_[callee] == 0) {
+            pending = callee;
+            break;
+          }
+      stack.back().second = next;
+      if (pending >= 0) {
+        stack.push_back({pending, 0});
+        continue;
+      }
+      finish(fn);
+      stack.pop_back();
     }
-    auto add = [&](int fn) {
-      if (fn < 0) return;
-      const std::vector<int>& more = of(fn);
-      list.insert(list.end(), more.begin(), more.end());
-    };
-    add(st.function_index);
-    for (int b : st.branch_functions) add(b);
   }
-  void index_siblings(int fn, std::vector<std::pair<int, std::size_t>>& index) {
+
+  static std::vector<int> callees(const Statement& s) {
+    std::vector<int> out;
+    if (s.kind != StatementKind::action && s.function_index >= 0) out.push_back(s.function_index);
+    out.insert(out.end(), s.branch_functions.begin(), s.branch_functions.end());
+    return out;
+  }
+
+  void finish(int fn) {
+    std::vector<std::pair<int, int>>& pairs = by_function_[fn];
     const std::vector<Statement>& body = m_.functions[fn].body;
     for (std::size_t i = 0; i < body.size(); ++i) {
-      std::vector<int> list;
-      add_statement(body[i], list);
-      std::sort(list.begin(), list.end());
-      list.erase(std::unique(list.begin(), list.end()), list.end());
-      for (int d : list) index.push_back({d, i});
+      const Statement& s = body[i];
+      int at = static_cast<int>(i);
+      if (s.kind == StatementKind::action && s.drone_index >= 0) pairs.push_back({s.drone_index, at});
+      for (int callee : callees(s))
+        if (callee >= 0 && state_[callee] == 2)  // not a recursive call: the checker reports those
+          for (int d : of_function_[callee]) pairs.push_back({d, at});
     }
-    std::stable_sort(index.begin(), index.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    std::vector<int>& drones = of_function_[fn];
+    for (const auto& [d, at] : pairs)
+      if (drones.empty() || drones.back() != d) drones.push_back(d);
+    state_[fn] = 2;
   }
 
   const Mission& m_;
-  std::vector<std::vector<int>> drones_;  ///< per function: sorted drone indices
-  std::vector<char> state_;               ///< per function: 0 unknown, 1 being found, 2 known
-  std::unordered_map<int, std::vector<std::pair<int, std::size_t>>> siblings_;  ///< PAR → (drone, sibling)
+  std::vector<std::vector<int>> of_function_;                ///< per function: sorted drones
+  std::vector<std::vector<std::pair<int, int>>> by_function_;  ///< per function: (drone, statement)
+  std::vector<char> state_;  ///< per function: 0 not seen, 1 being indexed, 2 done
 };
 
-/// Per-function tables of one drone's analysis, kept for the next drone: allocating and
-/// clearing them whole for each drone would cost drones × functions. Only the entries a
-/// drone touched are cleared.
-struct ArmingTables {
-  Mentions mentions;
-  std::vector<Flow> memo;  ///< per function and entry state
-  std::vector<char> recorded;
-  std::vector<char> listed;  ///< per function: in `touched`
-  std::vector<int> touched;  ///< functions with an entry set
-  explicit ArmingTables(const Mission& m)
-      : mentions(m), memo(m.functions.size() * 4), recorded(m.functions.size() * 4, 0), listed(m.functions.size(), 0) {}
-  void clear() {
-    for (int fn : touched) {
-      listed[fn] = 0;
-      for (std::size_t e = 0; e < 4; ++e) memo[fn * 4 + e] = {}, recorded[fn * 4 + e] = 0;
-    }
-    touched.clear();
-  }
-};
-
+/// One drone's Armed state through the mission, memoised per (block, entry state): a block
+/// is analysed at most four times per drone however often it is called. The memo is shared
+/// by the drones in turn and reset where the last one wrote, so that a thousand drones do
+/// not each clear a table of every function.
 class DroneArming {
  public:
-  DroneArming(const Mission& m, const fleet::DroneType& type, int drone, std::map<std::pair<int, int>, Finding>& out,
-              ArmingTables& tables)
-      : m_(m), type_(type), drone_(drone), out_(out), tables_(tables) {}
+  DroneArming(const Mission& m, const Mentions& mentions, std::map<std::pair<int, int>, Finding>& out)
+      : m_(m), mentions_(mentions), out_(out), memo_(m.functions.size() * 4), recorded_(m.functions.size() * 4, 0) {}
 
-  void run(int init) { block(init, kDisarmed, true); }
+  void run(int init, const fleet::DroneType& type, int drone) {
+    for (std::size_t slot : touched_) {
+      memo_[slot] = Flow{};
+      recorded_[slot] = 0;
+    }
+    touched_.clear();
+    type_ = &type;
+    drone_ = drone;
+    block(init, kDisarmed, true);
+  }
+
+  /// Statements a drone's analysis has visited so far, over every run: the work done.
+  long long visited() const { return visited_; }
 
  private:
-  bool mentioned(int fn) { return tables_.mentions.mentions(fn, drone_); }
-
   Flow block(int fn, States entry, bool record) {
-    if (fn < 0 || entry == 0 || !mentioned(fn)) return {entry, entry};
+    if (fn < 0 || entry == 0 || !mentions_.mentions(fn, drone_)) return {entry, entry};
     std::size_t slot = static_cast<std::size_t>(fn) * 4 + entry;
-    bool cached = tables_.memo[slot].seen != 0;
-    if (cached && (!record || tables_.recorded[slot])) return tables_.memo[slot];
+    bool cached = memo_[slot].seen != 0;
+    if (cached && (!record || recorded_[slot])) return memo_[slot];
     const Function& f = m_.functions[fn];
-    Flow flow = f.block == BlockKind::par ? par(fn, entry, record) : seq(f, entry, record);
-    tables_.memo[slot] = flow;
-    if (record) tables_.recorded[slot] = 1;
-    if (!tables_.listed[fn]) tables_.listed[fn] = 1, tables_.touched.push_back(fn);
+    std::vector<int> mine = mentions_.statements(fn, drone_);
+    Flow flow = f.block == BlockKind::par ? par(f, mine, entry, record) : seq(f, mine, entry, record);
+    if (!cached) touched_.push_back(slot);
+    memo_[slot] = flow;
+    if (record) recorded_[slot] = 1;
     return flow;
   }
 
-  Flow seq(const Function& f, States entry, bool record) {
+  /// Statements that do not mention the drone leave its state as it is, async ones too:
+  /// only `mine`, the statements that do, are visited.
+  Flow seq(const Function& f, const std::vector<int>& mine, States entry, bool record) {
     States s = entry, seen = entry, detached = 0;  // detached: what async work may set at any time
-    for (const Statement& st : f.body) {
+    for (int i : mine) {
+      const Statement& st = f.body[i];
+      ++visited_;
       Flow step = statement(st, s, record, detached);
       s = step.exit ? step.exit | detached : 0;  // a path that failed stays failed
       seen |= step.seen | s;
@@ -165,37 +169,32 @@ class DroneArming {
   }
 
   /// Siblings run at once: each starts from the entry or from whatever another sibling
-  /// that arms or disarms this drone may have set meanwhile. A sibling without an action of
-  /// this drone changes nothing and starts from the entry and every changing sibling's
-  /// states; the changing siblings' states are counted per state, so that a PAR of a
-  /// thousand drones costs each drone one pass over it, not a thousand.
-  Flow par(int fn, States entry, bool record) {
-    const Function& f = m_.functions[fn];
-    std::vector<std::size_t> touching = tables_.mentions.touching(fn, drone_);
+  /// that arms or disarms this drone may have set meanwhile. Siblings that do not mention
+  /// the drone neither change it nor see more than the others do.
+  Flow par(const Function& f, const std::vector<int>& mine, States entry, bool record) {
     std::vector<Flow> alone;
-    for (std::size_t i : touching) {
+    for (int i : mine) {
       States detached = 0;
+      ++visited_;
       Flow flow = statement(f.body[i], entry, false, detached);
       alone.push_back({static_cast<States>(flow.exit | detached), static_cast<States>(flow.seen | detached)});
     }
-    auto changes = [&](std::size_t k) { return alone[k].seen != entry || alone[k].exit != entry; };
-    int with[4] = {0, 0, 0, 0};  // changing siblings that may pass through each state bit
-    States all = 0;               // the states of every changing sibling
-    for (std::size_t k = 0; k < alone.size(); ++k)
-      if (changes(k))
-        for (States bit : {kArmed, kDisarmed})
-          if (alone[k].seen & bit) ++with[bit], all |= bit;
+    auto changes = [&](std::size_t i) { return alone[i].seen != entry || alone[i].exit != entry; };
+    // What the changing siblings before and after each one may set: each start leaves out
+    // only its own sibling, in one pass each way rather than one per pair.
+    std::size_t n = mine.size();
+    std::vector<States> before(n + 1, 0), after(n + 1, 0);
+    for (std::size_t j = 0; j < n; ++j) before[j + 1] = before[j] | (changes(j) ? alone[j].seen : 0);
+    for (std::size_t j = n; j-- > 0;) after[j] = after[j + 1] | (changes(j) ? alone[j].seen : 0);
     States exit = 0, seen = entry;
-    if (touching.size() < f.body.size()) seen |= all;  // what a sibling that changes nothing starts from
     bool changed = false;
-    for (std::size_t k = 0; k < touching.size(); ++k) {
-      States start = entry;
-      for (States bit : {kArmed, kDisarmed})
-        if (with[bit] - (changes(k) && (alone[k].seen & bit) ? 1 : 0) > 0) start |= bit;
+    for (std::size_t i = 0; i < n; ++i) {
+      States start = entry | before[i] | after[i + 1];
       States detached = 0;
-      Flow flow = statement(f.body[touching[k]], start, record, detached);
+      ++visited_;
+      Flow flow = statement(f.body[mine[i]], start, record, detached);
       seen |= flow.seen | detached;
-      if (changes(k)) {
+      if (changes(i)) {
         exit |= flow.exit | detached;
         changed = true;
       }
@@ -217,7 +216,7 @@ class DroneArming {
 
   Flow action(const Statement& st, States s, bool record) {
     if (st.drone_index != drone_) return {s, s};
-    const fleet::ActionSpec* spec = type_.find_action(st.callee);
+    const fleet::ActionSpec* spec = type_->find_action(st.callee);
     if (spec && spec->action_class == fleet::ActionClass::system) {
       if (st.callee == "Arm") return {kArmed, static_cast<States>(s | kArmed)};
       if (st.callee == "Disarm") return {kDisarmed, static_cast<States>(s | kDisarmed)};
@@ -266,23 +265,27 @@ class DroneArming {
   }
 
   const Mission& m_;
-  const fleet::DroneType& type_;
-  int drone_;
+  const Mentions& mentions_;
   std::map<std::pair<int, int>, Finding>& out_;
-  ArmingTables& tables_;
+  const fleet::DroneType* type_ = nullptr;
+  int drone_ = -1;
+  std::vector<Flow> memo_;
+  std::vector<char> recorded_;
+  std::vector<std::size_t> touched_;  ///< memo slots written since the last reset
+  long long visited_ = 0;
 };
 
 }  // namespace
 
 void check_armed_before_motion(const Mission& mission, const std::vector<fleet::DroneType>& types,
-                               Diagnostics& diags) {
+                               Diagnostics& diags, long long* work) {
   if (mission.init_function < 0) return;
   std::map<std::pair<int, int>, Finding> findings;
-  ArmingTables tables(mission);
-  for (std::size_t d = 0; d < mission.drones.size() && d < types.size(); ++d) {
-    DroneArming(mission, types[d], static_cast<int>(d), findings, tables).run(mission.init_function);
-    tables.clear();
-  }
+  Mentions mentions(mission);
+  DroneArming arming(mission, mentions, findings);
+  for (std::size_t d = 0; d < mission.drones.size() && d < types.size(); ++d)
+    arming.run(mission.init_function, types[d], static_cast<int>(d));
+  if (work) *work = arming.visited();
   for (const auto& [at, f] : findings) {
     if (!f.some) continue;
     const Statement& st = *f.statement;

@@ -1,7 +1,11 @@
+// EC_KEY is deprecated in OpenSSL 3 but kept there; see new_key() for why it is used. Before
+// the first OpenSSL header, pki.h's included.
+#define OPENSSL_SUPPRESS_DEPRECATED
 #include "security/pki.h"
 
 #include <openssl/bio.h>
 #include <openssl/bn.h>
+#include <openssl/ec.h>
 #include <openssl/err.h>
 #include <openssl/pem.h>
 #include <openssl/pkcs7.h>
@@ -43,8 +47,22 @@ std::string bio_text(BIO* b) {
 }
 
 Key new_key() {
-  // P-256: one of the two curves/key types Cyclone's authentication plugin accepts.
-  return Key(EVP_EC_gen("P-256"));
+  // P-256: one of the two curves/key types Cyclone's authentication plugin accepts. Made as
+  // an EC_KEY rather than with EVP_EC_gen: OpenSSL 3 encodes a provider key through its
+  // encoder look-up on every certificate and PEM (about 0.3 ms per drone, most of a
+  // 1,000-drone mission's credentials), a legacy key directly; the key and its PEM
+  // (PKCS#8 "PRIVATE KEY") are the same either way.
+  EC_KEY* ec = EC_KEY_new_by_curve_name(NID_X9_62_prime256v1);
+  if (!ec || EC_KEY_generate_key(ec) != 1) {
+    EC_KEY_free(ec);
+    return nullptr;
+  }
+  Key key(EVP_PKEY_new());
+  if (!key || EVP_PKEY_assign_EC_KEY(key.get(), ec) != 1) {
+    EC_KEY_free(ec);
+    return nullptr;
+  }
+  return key;
 }
 
 /// "CN=Drone1,O=eamos" into an X509_NAME, attribute by attribute in the given order.

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "graph/pipeline.h"
+#include "lang/arming.h"
 
 namespace eamos {
 namespace {
@@ -96,7 +97,6 @@ TEST(Checker, ErrorCarriesFileLineColumnSourceLineAndAnUnderlinedToken) {
             " \tA.Tkeoff(3)\n"
             " \t  ^~~~~~\n");
 }
-
 }  // namespace
 }  // namespace eamos
 
@@ -145,6 +145,48 @@ TEST(Checker, LoopRuleToleratesRecursiveBlocks) {
                    "func SEQ_a() {SEQ_b()}\nfunc SEQ_b() {SEQ_a()}\nfunc SEQ_n() {Drone1.Land()}\n");
   EXPECT_NE(r.text.find("recursion"), std::string::npos) << r.text;
   EXPECT_EQ(r.text.find("without mission time passing"), std::string::npos) << r.text;
+}
+
+/// A show: every drone in every step's PAR, arming first and flying once per step.
+std::string show_mission(int drones, int steps) {
+  std::string text, seq = "func INIT() { SEQ_show() }\nfunc SEQ_show() {\n";
+  for (int d = 0; d < drones; ++d) text += "var D" + std::to_string(d) + " Quad\n";
+  for (int s = 0; s < steps; ++s) {
+    std::string par = "PAR_s" + std::to_string(s);
+    seq += "  " + par + "()\n";
+    text += "func " + par + "() {\n";
+    for (int d = 0; d < drones; ++d) text += "  SEQ_" + std::to_string(d) + "_" + std::to_string(s) + "()\n";
+    text += "}\n";
+    for (int d = 0; d < drones; ++d) {
+      std::string me = "D" + std::to_string(d);
+      text += "func SEQ_" + std::to_string(d) + "_" + std::to_string(s) + "() { " +
+              (s == 0 ? me + ".Arm(); " + me + ".Takeoff(3)" : me + ".FlyTo(1, 2, 3)") + " }\n";
+    }
+  }
+  return text + seq + "}\n";
+}
+
+long long arming_work(int drones, int steps) {
+  graph::Compilation c;
+  Diagnostics d;
+  EXPECT_TRUE(graph::compile(std::make_shared<SourceFile>("show.eamos", show_mission(drones, steps)), fleet::Fleet{},
+                             d, c)) << d.format();
+  Diagnostics again;
+  long long work = 0;
+  lang::check_armed_before_motion(c.mission, c.checked.drone_types, again, &work);
+  EXPECT_EQ(again.warning_count() + again.error_count(), 0u) << again.format();
+  return work;
+}
+
+// Each drone follows its own statements through every PAR, not its siblings': doubling the
+// fleet of a show doubles the work. Following every sibling made a 1,000-drone show's check
+// take minutes.
+TEST(Checker, TheArmedStateRuleGrowsWithTheFleetNotWithItsSquare) {
+  long long small = arming_work(20, 5), large = arming_work(40, 5);
+  EXPECT_GT(small, 0);
+  EXPECT_LE(large, 2 * small + 10) << "20 drones: " << small << " visits; 40 drones: " << large;
+  // A PAR visits its drone's sibling twice (alone, then from what the others set).
+  EXPECT_LE(large, 8 * 40 * 5) << "each drone visits a few times its own statements and the blocks leading to them";
 }
 
 }  // namespace
