@@ -90,7 +90,7 @@ struct RunSinks {
   std::unique_ptr<ProgressDisplay> progress;
   std::ofstream trace_file;
   std::unique_ptr<dex::JsonlTrace> jsonl;
-  dex::MemoryTrace memory;  ///< the plot is drawn from the whole trace after the run
+  std::unique_ptr<trace::PlotTrace> plot;  ///< the plot is drawn from the whole trace after the run
   std::unique_ptr<monitor::MonitorServer> server;
   std::unique_ptr<monitor::LiveSink> live_monitor;
 };
@@ -124,7 +124,10 @@ bool open_sinks(const RunCommandOptions& r, const graph::Compilation& c, const s
     sinks.jsonl->write_header(deploy::trace_header(c, missions[0].hash, r.telemetry_hz));
     sinks.tee.add(sinks.jsonl.get());
   }
-  if (!r.plot.empty()) sinks.tee.add(&sinks.memory);
+  if (!r.plot.empty()) {
+    sinks.plot = std::make_unique<trace::PlotTrace>(missions[0].fleet.size());
+    sinks.tee.add(sinks.plot.get());
+  }
   if (sinks.live_monitor) sinks.tee.add(sinks.live_monitor.get());
   return true;
 }
@@ -182,7 +185,7 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
   if (!open_sinks(r, c, missions, sinks)) return 1;
   dex::RunResult result = dex::run_in_process(missions, adapters, &sinks.tee, run_options(r, interrupt, sinks));
   if (sinks.progress) sinks.progress->finish();
-  if (!report_run(r, result, sinks.memory.events)) return 1;
+  if (!report_run(r, result, sinks.plot ? sinks.plot->events : std::vector<dex::TraceEvent>{})) return 1;
   // A completed mission whose trace was cut is not a run to take as recorded.
   bool trace_cut = sinks.jsonl && !sinks.jsonl->write_error().empty();
   if (trace_cut)

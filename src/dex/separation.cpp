@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstdio>
+#include <limits>
 
 namespace eamos::dex {
 
@@ -69,6 +70,46 @@ Prediction predict_to_goal(Vec pa, Vec va, double left_m, Vec pb, Vec vb, const 
   return still;
 }
 
+Vec Course::at(double t) const {
+  if (!to_goal) return p + v * t;
+  double s = 0.0;
+  const double ramp = accel > 0 && cruise > v0 ? (cruise - v0) / accel : 0.0;
+  if (t <= ramp)
+    s = v0 * t + 0.5 * accel * t * t;
+  else
+    s = v0 * ramp + 0.5 * accel * ramp * ramp + cruise * (t - ramp);
+  return p + u * std::min(s, left);
+}
+
+Course goal_course(Vec p, Vec v, Vec goal, const fleet::Limits& limits) {
+  Course c{.p = p, .v = v, .to_goal = true};
+  const Vec d = goal - p;
+  c.left = speed(d);
+  if (c.left < 1e-6) return c;  // there already: it stays
+  c.u = d * (1.0 / c.left);
+  const double across = std::hypot(c.u.x, c.u.y);
+  c.cruise = std::numeric_limits<double>::infinity();
+  if (across > 1e-9) c.cruise = std::min(c.cruise, limits.max_speed_mps / across);
+  if (c.u.z > 1e-9) c.cruise = std::min(c.cruise, limits.max_climb_mps / c.u.z);
+  if (c.u.z < -1e-9) c.cruise = std::min(c.cruise, limits.max_descent_mps / -c.u.z);
+  c.v0 = std::clamp(v.x * c.u.x + v.y * c.u.y + v.z * c.u.z, 0.0, c.cruise);
+  c.accel = limits.max_accel_mps2;
+  if (c.accel <= 0) c.v0 = c.cruise;  // no limit given: at full speed at once
+  return c;
+}
+
+Prediction predict_courses(const Course& a, const Course& b, const fleet::Separation& min, double horizon_s) {
+  if (!a.to_goal && !b.to_goal) return predict(a.p, a.v, b.p, b.v, min, horizon_s);
+  for (double t0 = 0.0; t0 < horizon_s; t0 += kCourseStepS) {
+    const double t1 = std::min(t0 + kCourseStepS, horizon_s), dt = t1 - t0;
+    if (dt <= 1e-9) break;
+    const Vec pa = a.at(t0), pb = b.at(t0);
+    const Vec va = (a.at(t1) - pa) * (1.0 / dt), vb = (b.at(t1) - pb) * (1.0 / dt);
+    if (Prediction p = predict(pa, va, pb, vb, min, dt); p.conflict) return {true, t0 + p.in_s};
+  }
+  return {};
+}
+
 SeparationGuard::SeparationGuard(const Mission& mission, mid::EventLoop& loop, SeparationHooks hooks)
     : m_(mission),
       loop_(loop),
@@ -85,6 +126,7 @@ SeparationGuard::~SeparationGuard() { halt(); }
 void SeparationGuard::fly(int d, mid::Drone& drone, const fleet::Limits& limits) {
   tracks_[d].drone = &drone;
   tracks_[d].max_speed = limits.max_speed_mps;
+  tracks_[d].limits = limits;
   fastest_seen_ = std::max(fastest_seen_, limits.max_speed_mps);
 }
 
@@ -108,6 +150,38 @@ bool SeparationGuard::outranks(int a, int b) const {
     return p > 0 ? p : d + 1;
   };
   return rank(a) != rank(b) ? rank(a) < rank(b) : a < b;
+}
+
+Course SeparationGuard::course_of(int d) const {
+  const Track& k = tracks_[d];
+  const Vec here = now_at(k);
+  if (k.drone && !k.drone->motion_held())
+    if (std::optional<fleet::Vec3> goal = k.drone->motion_goal())
+      return goal_course(here, k.v, Vec{goal->x, goal->y, goal->z}, k.limits);
+  return Course{.p = here, .v = k.v};
+}
+
+bool SeparationGuard::moving(int d) const {
+  const Track& k = tracks_[d];
+  if (speed(k.v) >= kMovingMps) return true;
+  if (!k.drone || k.drone->motion_held()) return false;
+  const std::optional<fleet::Vec3> goal = k.drone->motion_goal();
+  return goal && speed(Vec{goal->x, goal->y, goal->z} - now_at(k)) > 1e-6;
+}
+
+bool SeparationGuard::too_close_to_resume(int h) const {
+  const Track& H = tracks_[h];
+  if (H.waits_for < 0) return false;
+  const Track& W = tracks_[H.waits_for];
+  if (!W.airborne) return false;  // landed, or its link lost: no longer kept apart
+  const Vec here = now_at(H), there = now_at(W), apart = here - there;
+  if (std::hypot(apart.x, apart.y) >= min_.horizontal_m || std::fabs(apart.z) >= min_.vertical_m) return false;
+  if (speed(W.v) >= kMovingMps) return true;
+  // The other stands: the held drone may leave, but only away from it.
+  const std::optional<fleet::Vec3> goal = H.drone->motion_goal();
+  if (!goal) return true;
+  const Vec way = Vec{goal->x, goal->y, goal->z} - here;
+  return way.x * apart.x + way.y * apart.y + way.z * apart.z <= 0.0;
 }
 
 bool SeparationGuard::holding(int d) {
@@ -215,21 +289,41 @@ void SeparationGuard::check(int d) {
   });
 }
 
+// Towards its goal as fast as it may fly (a drone still speeding up is where it will be), and
+// as its samples go, ending at its goal (a vehicle slower than its limits is where it is
+// going now): the earlier conflict of the two.
+Prediction SeparationGuard::foresee(int a, const Course& mine, int b, double horizon_s) const {
+  const Track& A = tracks_[a];
+  const Track& B = tracks_[b];
+  const Course other = course_of(b);
+  Prediction p = predict_courses(mine, other, min_, horizon_s);
+  const double left = A.drone->motion_distance_left();
+  Prediction sampled;
+  if (!other.to_goal) {
+    sampled = predict_to_goal(now_at(A), A.v, left, now_at(B), B.v, min_, horizon_s);
+  } else {
+    const double v = speed(A.v);
+    Course straight{.p = now_at(A), .v = A.v, .to_goal = v > 1e-9 && std::isfinite(left)};
+    if (straight.to_goal) straight.u = A.v * (1.0 / v), straight.v0 = straight.cruise = v, straight.left = left;
+    sampled = predict_courses(straight, other, min_, horizon_s);
+  }
+  if (sampled.conflict && (!p.conflict || sampled.in_s < p.in_s)) p = sampled;
+  return p;
+}
+
 // From drone a's side (this process flies it): does it give way to b?
 void SeparationGuard::consider(int a, int b) {
   if (halted_ || holding(a)) return;
   Track& A = tracks_[a];
   const Track& B = tracks_[b];
-  if (!A.airborne || !B.airborne || speed(A.v) < kMovingMps) return;
+  if (!A.airborne || !B.airborne || !moving(a)) return;
   ++pairs_;
-  const Prediction p =
-      predict_to_goal(now_at(A), A.v, A.drone->motion_distance_left(), now_at(B), B.v, min_, kSeparationHorizonS);
+  const Prediction p = foresee(a, course_of(a), b, kSeparationHorizonS);
   if (!p.conflict) {
     if (A.unheld_with == b) A.unheld_with = -1;
     return;
   }
-  const bool b_moving = speed(B.v) >= kMovingMps;
-  if (b_moving && outranks(a, b) && p.in_s > kLastMomentS) return;
+  if (moving(b) && outranks(a, b) && p.in_s > kLastMomentS) return;
   give_way(a, b, p);
 }
 
@@ -261,7 +355,9 @@ void SeparationGuard::try_resume(int h) {
   Track& H = tracks_[h];
   const Vec here = now_at(H);
   const double left = H.drone->motion_distance_left();  // its course ends at its goal
-  int blocker = -1;
+  const std::optional<fleet::Vec3> goal = H.drone->motion_goal();
+  // Held within the minimum of the drone it gave way to: flying on could only keep it there.
+  int blocker = too_close_to_resume(h) ? H.waits_for : -1;
   const double reach = min_.horizontal_m + kResumeHorizonS * (std::hypot(H.resume_v.x, H.resume_v.y) + fastest_seen_);
   for_neighbours(h, reach, [&](int n) {
     if (blocker >= 0 || !tracks_[n].airborne) return;
@@ -275,6 +371,20 @@ void SeparationGuard::try_resume(int h) {
     if (predict_to_goal(here, H.hold_v, left, now_at(N), N.v, min_, horizon).conflict) blocker = n;
     for (double share : {0.25, 0.5, 0.75, 1.0})
       if (predict_to_goal(here, H.resume_v * share, left, now_at(N), N.v, min_, horizon).conflict) blocker = n;
+    if (blocker >= 0 || !goal) return;
+    // Towards its goal, from the speed it has (it may still be braking) speeding up as its
+    // limits let it, and at steady shares of its full speed along the line to it (the way it
+    // was going may not be the way to its goal).
+    const Course theirs = course_of(n);
+    Course mine = goal_course(here, H.v, Vec{goal->x, goal->y, goal->z}, H.limits);
+    // What consider() will see once it flies on, so that it does not give way again at once.
+    if (foresee(h, mine, n, horizon).conflict) blocker = n;
+    mine.accel = 0.0;
+    for (double share : {0.25, 0.5, 0.75, 1.0}) {
+      Course steady = mine;
+      steady.v0 = steady.cruise = mine.cruise * share;
+      if (predict_courses(steady, theirs, min_, horizon).conflict) blocker = n;
+    }
   });
   H.blocked_by = blocker;
   if (blocker >= 0) {

@@ -20,6 +20,7 @@
 // drone the few drones around it, not the whole fleet.
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -57,6 +58,25 @@ Prediction predict(Vec pa, Vec va, Vec pb, Vec vb, const fleet::Separation& min,
 /// is no conflict.
 Prediction predict_to_goal(Vec pa, Vec va, double left_m, Vec pb, Vec vb, const fleet::Separation& min,
                            double horizon_s);
+
+/// A drone's course over the horizon. Towards a goal (`to_goal`): from `p` along the unit
+/// line `u`, speeding up at `accel` from `v0` to `cruise` and stopping `left` ahead, at the
+/// goal; a drone still standing with a goal ahead is predicted to move. Without one: straight
+/// on from `p` at `v`, the velocity of its last two positions.
+struct Course {
+  Vec p, v;
+  bool to_goal = false;
+  Vec u;
+  double v0 = 0.0, cruise = 0.0, accel = 0.0, left = 0.0;
+  Vec at(double t) const;
+};
+/// The course of a drone at `p` (velocity `v`) flying to `goal` as fast as `limits` let it:
+/// its horizontal, climb and descent speeds, reached at max_accel.
+Course goal_course(Vec p, Vec v, Vec goal, const fleet::Limits& limits);
+/// As predict(), for courses that need not be straight: each kCourseStepS of the horizon is
+/// taken as a straight piece.
+Prediction predict_courses(const Course& a, const Course& b, const fleet::Separation& min, double horizon_s);
+inline constexpr double kCourseStepS = 0.25;
 
 struct SeparationHooks {
   TraceSink* trace = nullptr;
@@ -96,6 +116,7 @@ class SeparationGuard {
     // drones this process flies
     mid::Drone* drone = nullptr;
     double max_speed = 0.0;  ///< m/s, horizontally: its limits
+    fleet::Limits limits;
     int waits_for = -1;      ///< giving way to this drone; -1 none
     int unheld_with = -1;    ///< a conflict it could not hold for, recorded once
     int blocked_by = -1;     ///< held: the drone its course was last found blocked by
@@ -107,12 +128,21 @@ class SeparationGuard {
 
   Vec now_at(const Track& k) const;
   bool outranks(int a, int b) const;
+  /// Where drone `d` flies now: towards its goal when this process flies it and it has one
+  /// (and is not held), else straight on from its samples.
+  Course course_of(int d) const;
+  /// Whether drone `d` moves or is about to (a goal it is not held from).
+  bool moving(int d) const;
+  /// A held drone inside the minimum of the drone it gave way to stays held, unless that one
+  /// stands still and its own course leads away from it.
+  bool too_close_to_resume(int h) const;
   bool holding(int d);
   long long cell_of(const Vec& p) const;
   void place(int d);
   template <typename Fn>
   void for_neighbours(int d, double reach_m, Fn fn);
   void check(int d);
+  Prediction foresee(int a, const Course& mine, int b, double horizon_s) const;
   void consider(int a, int b);
   void give_way(int a, int b, const Prediction& p);
   void try_resume(int h);

@@ -121,6 +121,7 @@ class MavlinkDrone final : public mid::AdapterDrone {
   void stop_action(mid::ActionId id) override;
   std::string timeout_detail(mid::ActionId id) const override;
   double distance_left(mid::ActionId id) const override;
+  std::optional<fleet::Vec3> goal_of(mid::ActionId id) const override;
   double closing_window_s(const mid::ActionRequest& r) const override;
   /// The vehicle clock's rate as deadlines allow for it: within 0.2 … 1.
   double deadline_clock_rate() const override { return clock_.deadline_rate(); }

@@ -215,6 +215,18 @@ double MavlinkDrone::distance_left(ActionId id) const {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
+// The same goals as distance_left(): a Takeoff the autopilot flies in its own mode has none
+// until it hands over (the vehicle climbs straight up, which separation sees from its samples).
+std::optional<Vec3> MavlinkDrone::goal_of(ActionId id) const {
+  const mid::ActionRequest* r = tracker_.request(id);
+  if (id != motion_owner_ || !r || !vehicle_.have_position) return std::nullopt;
+  if (goal_) return goal_->target();
+  const Vec3 here = position();
+  if (r->name == "Land") return Vec3{here.x, here.y, ground_z()};
+  if (r->name == "ReturnHome") return Vec3{settings_.home.x, settings_.home.y, ground_z()};
+  return std::nullopt;
+}
+
 // In the vehicle's time, like the deadline itself (timeout_for); a deadline the fleet file
 // sets never moves on.
 double MavlinkDrone::closing_window_s(const mid::ActionRequest& r) const {

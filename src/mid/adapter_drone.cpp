@@ -69,6 +69,11 @@ double AdapterDrone::motion_distance_left() const {
   return id == kNoAction ? std::numeric_limits<double>::quiet_NaN() : distance_left(id);
 }
 
+std::optional<fleet::Vec3> AdapterDrone::motion_goal() const {
+  const ActionId id = tracker_.motion();
+  return id == kNoAction ? std::nullopt : goal_of(id);
+}
+
 bool AdapterDrone::resume_motion() {
   const ActionId id = held_;
   held_ = kNoAction;

@@ -33,6 +33,7 @@ class AdapterDrone : public Drone {
   bool hold_motion(double climb_m) final;
   bool resume_motion() final;
   double motion_distance_left() const final;
+  std::optional<fleet::Vec3> motion_goal() const final;
   bool motion_held() const final { return held_ != kNoAction && tracker_.running(held_); }
   void set_fault_sink(std::function<void(const ActionEnd&)> sink) final { fault_sink_ = std::move(sink); }
 
@@ -65,6 +66,8 @@ class AdapterDrone : public Drone {
   /// cannot tell; with closing_window_s(), a deadline that comes while it shrinks moves on
   /// (mid/timeouts.h).
   virtual double distance_left(ActionId) const { return std::numeric_limits<double>::quiet_NaN(); }
+  /// Where the vehicle goes for running motion `id` (motion_goal()); empty when it cannot tell.
+  virtual std::optional<fleet::Vec3> goal_of(ActionId) const { return std::nullopt; }
   /// The closing window of `r`'s deadline in mission seconds; 0 (the default) keeps every
   /// deadline where timeout_for() put it.
   virtual double closing_window_s(const ActionRequest&) const { return 0.0; }

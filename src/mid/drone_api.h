@@ -147,6 +147,11 @@ class Drone {
   /// How far (m) the running goal-directed motion still has to go, held or not; NaN when
   /// none runs or the adapter cannot tell. Separation ends a drone's predicted course there.
   virtual double motion_distance_left() const { return std::numeric_limits<double>::quiet_NaN(); }
+  /// Where the running goal-directed motion goes (held or not), in the mission frame: its
+  /// target (Land: the ground below; ReturnHome: home on the ground); empty when none runs
+  /// or the adapter cannot tell. Separation predicts a drone that has one along the line to
+  /// it, also while it still stands, rather than from its last two positions.
+  virtual std::optional<fleet::Vec3> motion_goal() const { return std::nullopt; }
 
   /// Where the vehicle's own messages go (an autopilot's STATUSTEXT, what the adapter did
   /// about the vehicle on its own, such as re-arming after an auto-disarm): the DEX puts each

@@ -182,6 +182,12 @@ double SimDrone::distance_left(ActionId id) const {
   return std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
 }
 
+std::optional<Vec3> SimDrone::goal_of(mid::ActionId id) const {
+  const Motion& m = held_motion_ ? *held_motion_ : motion_;
+  if (id != motion_owner_ || (m.kind != MotionKind::go && m.kind != MotionKind::land)) return std::nullopt;
+  return m.target;
+}
+
 void SimDrone::stop_motion() {
   bool still = kin_.velocity == Vec3{};
   motion_ = Motion{};

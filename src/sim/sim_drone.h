@@ -61,6 +61,7 @@ class SimDrone final : public mid::AdapterDrone {
   bool hold_vehicle(mid::ActionId id, double climb_m) override;
   void resume_vehicle(mid::ActionId id) override;
   double distance_left(mid::ActionId id) const override;
+  std::optional<fleet::Vec3> goal_of(mid::ActionId id) const override;
   void stop_motion();                           ///< brake and hold where it is
   /// Ends every running action as `end` says and flies the failsafe `what`.
   void enter_failsafe(fleet::Failsafe what, const mid::ActionEnd& end);

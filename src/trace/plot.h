@@ -26,6 +26,29 @@ struct PlotMark {
   std::string label;        ///< "separation", ...
 };
 
+/// Above this many drones the picture is a summary: thin tracks, the fleet's altitude range,
+/// a band of how many drones are in each state over time, and rows only for the drones whose
+/// action failed or that finished last (docs/trace.md, "The picture of a run").
+constexpr std::size_t kPlotSummaryAbove = 40;
+
+/// What plot_svg draws from, kept while a run flies: every event but telemetry (the tracks
+/// come from the RunResult), and the messages between drones only up to kPlotSummaryAbove
+/// drones: in one process a fleet-wide barrier of k drones is k² of them (52 million for a
+/// 1,000-drone show, which held 19 GB), so the summary's rows show no waits.
+class PlotTrace : public dex::TraceSink {
+ public:
+  explicit PlotTrace(std::size_t drones) : messages_(drones <= kPlotSummaryAbove) {}
+  void record(const dex::TraceEvent& e) override {
+    if (e.event == "telemetry" || (!messages_ && e.event == "message")) return;
+    events.push_back(e);
+  }
+  bool takes_messages() const override { return messages_; }
+  std::vector<dex::TraceEvent> events;
+
+ private:
+  bool messages_;
+};
+
 /// `caption`, when given, is a line under the title (which run of several this is).
 std::string plot_svg(const dex::RunResult& run, const std::vector<dex::TraceEvent>& events,
                      const std::vector<PlotMark>& marks = {}, const std::string& caption = "");

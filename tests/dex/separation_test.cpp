@@ -90,6 +90,17 @@ const dex::TraceEvent* first(const Flight& f, const std::string& event) {
   return nullptr;
 }
 
+/// How far `drone` was from `from` at its first `event`, from the trace's telemetry.
+double flown_before(const Flight& f, const std::string& event, const std::string& drone, fleet::Vec3 from) {
+  std::optional<mid::DroneState> last;
+  for (const dex::TraceEvent& e : f.events) {
+    if (e.drone != drone) continue;
+    if (e.event == "telemetry" && e.state) last = *e.state;
+    if (e.event == event && last) return std::hypot(last->x - from.x, last->y - from.y, last->z - from.z);
+  }
+  return 1e9;
+}
+
 void expect_valid_trace(const Flight& f) {
   std::istringstream in(f.jsonl);
   // The test's trace has no header line: check the events alone, after one of our own.
@@ -226,6 +237,29 @@ TEST(Separation, DronesOnSeparateCoursesNeverGiveWay) {
   EXPECT_EQ(count(f, "conflict"), 0);
 }
 
+// Both hover close to where their courses cross and set off at once: from their first samples,
+// standing or slow, nothing seems to come, and by the time their speeds show it, braking is too
+// late. Along their goals, at the speed they are about to fly, B sees it before either moves.
+TEST(Separation, TwoDronesSettingOffFromAStopOnCrossingCoursesGiveWayBeforeEitherMoves) {
+  for (const char* near : {"6", "8", "10"}) {
+    const std::string home = std::string("-") + near;
+    Flight f = fly_sampled(crossing(near, near), fleet_of("drones:\n  A: {home: [" + home + ", 0, 0]}\n  B: {home: [0, " +
+                                                           home + ", 0]}\n"));
+    ASSERT_TRUE(f.result.completed) << near << ": " << f.result.error;
+    Closest c = closest(f);
+    EXPECT_FALSE(c.lost) << near << " m short: " << c.pair << " came within " << c.horizontal << " m";
+    EXPECT_EQ(count(f, "give_way"), 1) << near;
+    EXPECT_EQ(count(f, "resume"), 1) << near;
+    // 6 m short, the conflict is less than kLastMomentS away when they set off: whoever looks
+    // first gives way; further out, the lower priority does.
+    if (std::string(near) == "6") continue;
+    EXPECT_EQ(count(f, "give_way", "B"), 1) << near;
+    // B sees the conflict before it has moved: from its samples alone it would see it only
+    // once its speed shows, half a metre or more on.
+    EXPECT_LT(flown_before(f, "give_way", "B", {0, -std::stod(near), 5}), 0.2) << near;
+  }
+}
+
 // A flies straight at B, which hovers, and stops 6 m short of it: its course ends at its goal,
 // so nothing gives way (a course run on past the goal would hold A for ever, then fail over).
 TEST(Separation, ADroneThatStopsShortOfAHoveringOneDoesNotGiveWay) {
@@ -359,5 +393,94 @@ TEST(SeparationGuard, AnAbsurdSpeedLooksThroughTheOccupiedCellsOnly) {
   EXPECT_EQ(g.guard->pairs_predicted(), 2u);
 }
 
+
+TEST(SeparationPrediction, ADroneStandingWithAGoalAheadIsPredictedToMove) {
+  fleet::Separation min;  // 2 m, 1 m
+  fleet::Limits limits;   // 10 m/s, 4 m/s²
+  // Both hover 8 m short of the point where their courses cross, about to set off: from
+  // their samples (standing) nothing comes; along their goals both reach it in 2 s.
+  dex::Course a = dex::goal_course({-8, 0, 5}, {}, {8, 0, 5}, limits);
+  dex::Course b = dex::goal_course({0, -8, 5}, {}, {0, 8, 5}, limits);
+  EXPECT_FALSE(dex::predict({-8, 0, 5}, {}, {0, -8, 5}, {}, min, 3.0).conflict);
+  dex::Prediction p = dex::predict_courses(a, b, min, 3.0);
+  EXPECT_TRUE(p.conflict);
+  EXPECT_GT(p.in_s, 1.0);
+  EXPECT_LT(p.in_s, 2.0);
+  // Speeding up from a stop at 4 m/s² to 10 m/s, and stopping at the goal 16 m ahead.
+  EXPECT_NEAR(a.at(1.0).x, -6.0, 1e-9);
+  EXPECT_NEAR(a.at(2.0).x, 0.0, 1e-9);
+  EXPECT_NEAR(a.at(10.0).x, 8.0, 1e-9);
+  // A goal that ends short of the other drone is still no conflict.
+  dex::Course short_of = dex::goal_course({0, 0, 5}, {}, {10, 0, 5}, limits);
+  EXPECT_FALSE(dex::predict_courses(short_of, dex::Course{.p = {20, 0, 5}}, min, 3.0).conflict);
+}
+
+// A flown here on the simulator (armed, 5 m up, flying east to x = 200), B fed by hand: B
+// stands in A's way, A gives way to it, then B comes alongside A, within the minimum.
+struct HeldBeside : Guarded {
+  mid::SubscriptionId sub = 0;
+  double t = 0.0;
+  HeldBeside() : Guarded(2) {
+    sub = a->subscribe([this](const mid::DroneState& s) { guard->update(0, s); });
+    fly({"Arm", {}});
+    fly({"Takeoff", {5}});
+    a->start({"FlyTo", {200, 0, 5}}, [](const mid::ActionEnd&) {});
+    for (t = loop.now(); !a->motion_held() && t < 60.0; t += 0.05) {
+      sample(1, t, 40.0);
+      at(t);
+    }
+    // Braked to a stop short of B.
+    for (double t0 = t; t < t0 + 4.0; t += 0.05) {
+      sample(1, t, 40.0);
+      at(t);
+    }
+  }
+  ~HeldBeside() { a->unsubscribe(sub); }
+  void fly(const mid::ActionRequest& r) {
+    bool done = false;
+    a->start(r, [&](const mid::ActionEnd&) { done = true; });
+    while (!done) at(loop.now() + 0.05);
+  }
+  /// B at (x, y) from A now, for `s` seconds, `vy` m/s north; the first resume, if any.
+  const dex::TraceEvent* beside(double x, double y, double vy, double s) {
+    const mid::DroneState here = a->state();
+    for (double t0 = t; t < t0 + s; t += 0.05) {
+      sample(1, t, here.x + x, here.y + y + vy * (t - t0));
+      at(t);
+      for (const dex::TraceEvent& e : trace.events)
+        if (e.event == "resume") return &e;
+    }
+    return nullptr;
+  }
+};
+
+// B flies off north from beside A, 0.5 m away: the two part, and a course that parts was once
+// enough to fly on, within the minimum. A flies on only once B is 2 m away.
+TEST(SeparationGuard, AHeldDroneDoesNotFlyOnInsideTheMinimumOfTheDroneItGaveWayTo) {
+  HeldBeside g;
+  ASSERT_TRUE(g.a->motion_held());
+  const dex::TraceEvent* resume = g.beside(0.0, 0.5, 1.0, 5.0);
+  ASSERT_NE(resume, nullptr);
+  ASSERT_TRUE(resume->distance.has_value());
+  EXPECT_GE(*resume->distance, 2.0);
+}
+
+// B stands 1 m behind A: A's course leads away from it, and it flies on at once.
+TEST(SeparationGuard, AHeldDroneFliesOnAwayFromADroneStandingWithinTheMinimum) {
+  HeldBeside g;
+  ASSERT_TRUE(g.a->motion_held());
+  const dex::TraceEvent* resume = g.beside(-1.0, 0.0, 0.0, 2.0);
+  ASSERT_NE(resume, nullptr);
+  ASSERT_TRUE(resume->distance.has_value());
+  EXPECT_LT(*resume->distance, 2.0);
+}
+
+// The same drone standing 1 m ahead of A, in its way: A stays held.
+TEST(SeparationGuard, AHeldDroneStaysHeldWithADroneStandingWithinTheMinimumAhead) {
+  HeldBeside g;
+  ASSERT_TRUE(g.a->motion_held());
+  EXPECT_EQ(g.beside(1.0, 0.0, 0.0, 2.0), nullptr);
+  EXPECT_TRUE(g.a->motion_held());
+}
 }  // namespace
 }  // namespace eamos::test

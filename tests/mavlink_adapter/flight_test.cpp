@@ -606,5 +606,32 @@ TEST(MavlinkAdapter, VirtualTimeAndMissingConnectionAreRefused) {
   EXPECT_NE(r.message.find("no scheme"), std::string::npos) << r.message;
 }
 
+
+// Separation predicts a drone along the line to its goal (mid::Drone::motion_goal): a FlyTo's
+// target while it flies, the ground below for a Land, none once it ended.
+TEST(MavlinkFlight, TheGoalOfTheRunningMotionIsItsTargetAndGoneWithIt) {
+  test::VehicleThread vehicle(25447, 1, kSpeed);
+  Flight f(25447);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded);
+  ASSERT_EQ(f.fly("Takeoff", {3}).outcome, mid::Outcome::succeeded);
+  EXPECT_FALSE(f.drone->motion_goal().has_value());
+  bool ended = false;
+  f.drone->start({"FlyTo", {6, 2, 3}}, [&](const mid::ActionEnd&) { ended = true; });
+  f.loop.run_until(f.loop.now() + 0.5);
+  ASSERT_FALSE(ended);
+  ASSERT_TRUE(f.drone->motion_goal().has_value());
+  EXPECT_NEAR(f.drone->motion_goal()->x, 6.0, 1e-9);
+  EXPECT_NEAR(f.drone->motion_goal()->y, 2.0, 1e-9);
+  EXPECT_NEAR(f.drone->motion_goal()->z, 3.0, 1e-9);
+  for (int i = 0; !ended && i < 120; ++i) f.loop.run_until(f.loop.now() + 0.5);
+  ASSERT_TRUE(ended);
+  EXPECT_FALSE(f.drone->motion_goal().has_value());
+  f.drone->start({"Land", {}}, [](const mid::ActionEnd&) {});
+  f.loop.run_until(f.loop.now() + 0.5);
+  ASSERT_TRUE(f.drone->motion_goal().has_value());
+  EXPECT_NEAR(f.drone->motion_goal()->z, 0.0, 1e-9);
+}
+
 }  // namespace
 }  // namespace eamos::mavlink_adapter

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "monitor/live_sink.h"
 #include "monitor/server.h"
 #include "monitor/trace_file.h"
 #include "support/eamos_process.h"
@@ -25,6 +26,50 @@ std::string write_temp(const std::string& name, const std::string& text) {
   fs::path p = fs::temp_directory_path() / (std::to_string(getpid()) + "-" + name);
   std::ofstream(p) << text;
   return p.string();
+}
+
+// Telemetry of `fleet_size` drones at 5 Hz for 3 s, one landing at 3.2 s and an action's
+// start: how many events the live page is sent.
+std::size_t live_events_of(std::size_t fleet_size) {
+  eamos::monitor::MonitorServer server;
+  std::vector<std::string> fleet;
+  for (std::size_t d = 0; d < fleet_size; ++d) fleet.push_back("D" + std::to_string(d));
+  eamos::monitor::LiveSink sink(server, fleet);
+  auto sample = [&](double t, bool landed) {
+    eamos::dex::TraceEvent e;
+    e.t = t;
+    e.event = "telemetry";
+    e.drone = "D1";
+    e.state = eamos::mid::DroneState{};
+    e.state->armed = true;
+    e.state->landed = landed;
+    sink.record(e);
+  };
+  for (int k = 0; k <= 15; ++k) sample(k * 0.2, false);
+  sample(3.2, true);
+  eamos::dex::TraceEvent start, message;
+  start.t = message.t = 3.2;
+  start.event = "start";
+  start.drone = "D1";
+  sink.record(start);
+  message.event = "message";
+  message.kind = "trigger";
+  message.from = 0;
+  message.to = 1;
+  sink.record(message);
+  return server.event_count();
+}
+
+TEST(MonitorLive, AThousandDroneFleetsPageGetsEachDronesTelemetryOnceASecondAndNoMessages) {
+  // 0, 1, 2 and 3 s, the landing and the start; a small fleet's page gets every sample and the message.
+  EXPECT_EQ(live_events_of(1000), 6u);
+  EXPECT_EQ(live_events_of(61), 6u);
+  EXPECT_EQ(live_events_of(60), 19u);
+  EXPECT_EQ(live_events_of(20), 19u);
+  eamos::monitor::MonitorServer server;
+  EXPECT_FALSE(eamos::monitor::LiveSink(server, std::vector<std::string>(61, "D")).takes_messages())
+      << "the runner then builds none";
+  EXPECT_TRUE(eamos::monitor::LiveSink(server, std::vector<std::string>(60, "D")).takes_messages());
 }
 
 TEST(MonitorTrace, EveryBadLineIsReportedWithItsLineNumber) {

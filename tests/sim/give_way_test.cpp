@@ -65,5 +65,33 @@ TEST_F(GiveWay, AFailsafeEndsAHeldMotionAndNothingResumes) {
   EXPECT_TRUE(d().state().landed);
 }
 
+
+// Separation predicts a drone along the line to its goal: the goal is there from the start
+// of the motion, held or not, and gone with it; Hover has none.
+TEST_F(GiveWay, TheGoalOfTheRunningMotionIsKnownHeldOrNotAndGoneWithIt) {
+  auto goal_is = [this](double x, double y, double z) {
+    const std::optional<fleet::Vec3> g = d().motion_goal();
+    return g && g->x == x && g->y == y && g->z == z;
+  };
+  airborne(5);
+  EXPECT_FALSE(d().motion_goal().has_value());
+  auto fly = start("FlyTo", {40, 10, 5});
+  ASSERT_TRUE(d().motion_goal().has_value());
+  EXPECT_TRUE(goal_is(40, 10, 5));
+  loop.run_until(loop.now() + 2);
+  ASSERT_TRUE(d().hold_motion(0.0));
+  ASSERT_TRUE(d().motion_goal().has_value());
+  EXPECT_TRUE(goal_is(40, 10, 5));
+  ASSERT_TRUE(d().resume_motion());
+  run_until_ended(*fly);
+  EXPECT_FALSE(d().motion_goal().has_value());
+  auto hover = start("Hover");
+  loop.run_until(loop.now() + 1);
+  EXPECT_FALSE(d().motion_goal().has_value());
+  auto land = start("Land");
+  ASSERT_TRUE(d().motion_goal().has_value());
+  EXPECT_DOUBLE_EQ(d().motion_goal()->z, 0.0);
+}
+
 }  // namespace
 }  // namespace eamos::sim

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -161,6 +162,114 @@ TEST(Plot, TenDronesGetTenColours) {
   ASSERT_EQ(colours.size(), 10u);
   std::sort(colours.begin(), colours.end());
   EXPECT_EQ(std::unique(colours.begin(), colours.end()), colours.end());
+}
+
+// A fleet of `drones`: each arms, takes off, flies `k + 1` m east (drone k) and lands, then all
+// disarm together (a fleet-wide barrier: every drone waits for the one that flew farthest).
+// `first` replaces drone 0's flight when given.
+std::string fleet_mission(int drones, const std::string& first = "") {
+  std::string text, par, down;
+  for (int d = 0; d < drones; ++d) {
+    std::string n = "D" + std::to_string(d);
+    text += "var " + n + " Quad\n";
+    par += "SEQ_" + n + "(); ";
+    down += n + ".Disarm(); ";
+  }
+  text += "func INIT() { PAR_go(); PAR_down() }\nfunc PAR_go() { " + par + "}\nfunc PAR_down() { " + down + "}\n";
+  for (int d = 0; d < drones; ++d) {
+    std::string n = "D" + std::to_string(d);
+    std::string flight = d == 0 && !first.empty() ? first
+                                                  : n + ".Takeoff(3); " + n + ".FlyByX(" + std::to_string(d + 1) + "); ";
+    text += "func SEQ_" + n + "() { " + n + ".Arm(); " + flight + n + ".Land() }\n";
+  }
+  return text;
+}
+
+std::vector<int> numbers(const std::string& list) {
+  std::vector<int> out;
+  std::istringstream in(list);
+  for (int v; in >> v;) out.push_back(v);
+  return out;
+}
+
+TEST(Plot, FortyDronesKeepARowEachAndNoSummary) {
+  test::Flight f = test::fly(fleet_mission(40));
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  std::string svg = trace::plot_svg(f.result, f.events);
+  EXPECT_EQ(count(svg, "<g class=\"row\""), 40);
+  EXPECT_EQ(count(svg, "class=\"altitude\""), 40);
+  EXPECT_EQ(count(svg, "class=\"state-band\""), 0);
+  EXPECT_EQ(count(svg, "class=\"thin-track\""), 0);
+}
+
+TEST(Plot, FiftyDronesAreSummarisedByStateAndTheTenThatHeldTheFleetUpGetRows) {
+  test::Flight f = test::fly(fleet_mission(50));
+  ASSERT_TRUE(f.result.completed) << f.result.error;
+  std::string svg = trace::plot_svg(f.result, f.events);
+  // Rows: the ten that flew farthest (all end together at the last barrier).
+  std::vector<std::string> rows = attrs(svg, "<g class=\"row\"", "data-drone");
+  std::vector<std::string> farthest;
+  for (int d = 40; d < 50; ++d) farthest.push_back("D" + std::to_string(d));
+  EXPECT_EQ(rows, farthest);
+  EXPECT_EQ(attrs(svg, "class=\"altitude\"", "data-drone"), farthest);
+  EXPECT_EQ(count(svg, "class=\"altitude-range\""), 1);
+  EXPECT_EQ(count(svg, "class=\"thin-track\""), 50);
+  EXPECT_EQ(attrs(svg, "class=\"track-name\"", "x").size(), 10u);
+  // Every column of the state band counts each of the 50 drones once.
+  std::vector<std::string> states = attrs(svg, "<path class=\"state\"", "data-state");
+  EXPECT_EQ(states, (std::vector<std::string>{"flying", "waiting", "done", "failed"}));
+  std::vector<std::string> counts = attrs(svg, "<path class=\"state\"", "data-counts");
+  ASSERT_EQ(counts.size(), 4u);
+  std::vector<std::vector<int>> per_state;
+  for (const std::string& c : counts) per_state.push_back(numbers(c));
+  ASSERT_GT(per_state[0].size(), 100u);
+  for (std::size_t k = 0; k < per_state[0].size(); ++k)
+    EXPECT_EQ(per_state[0][k] + per_state[1][k] + per_state[2][k] + per_state[3][k], 50) << "column " << k;
+  EXPECT_EQ(per_state[0].front(), 50) << "all fly (arm, take off) at the start";
+  EXPECT_EQ(per_state[2].back(), 50) << "all are done at the end";
+  EXPECT_EQ(*std::max_element(per_state[3].begin(), per_state[3].end()), 0) << "none failed";
+  EXPECT_GT(*std::max_element(per_state[1].begin(), per_state[1].end()), 40) << "all but the last wait at the barrier";
+  // D40 waited at the barrier on the drones still flying, D49 among them (named in full in data-on).
+  std::vector<std::string> who = attrs(svg, "<g class=\"wait\"", "data-drone");
+  std::vector<std::string> on = attrs(svg, "<g class=\"wait\"", "data-on");
+  auto d40 = std::find(who.begin(), who.end(), "D40");
+  ASSERT_NE(d40, who.end()) << svg;
+  EXPECT_NE(on[d40 - who.begin()].find("D49"), std::string::npos) << on[d40 - who.begin()];
+  EXPECT_EQ(count(svg, "class=\"trigger\""), 0) << "no arrows across the few rows";
+}
+
+TEST(Plot, InASummaryTheDroneWhoseActionFailedHasARowAndTheBandCountsTheFailsafes) {
+  test::Flight f = test::fly(fleet_mission(50, "D0.Takeoff(5); D0.Takeoff(D0.Z() + 195); "));
+  ASSERT_FALSE(f.result.completed);
+  std::string svg = trace::plot_svg(f.result, f.events);
+  std::vector<std::string> rows = attrs(svg, "<g class=\"row\"", "data-drone");
+  ASSERT_FALSE(rows.empty());
+  EXPECT_EQ(rows.front(), "D0");
+  EXPECT_LE(rows.size(), 10u);
+  EXPECT_GE(count(svg, "data-outcome=\"failed\""), 1);
+  std::vector<std::string> counts = attrs(svg, "<path class=\"state\"", "data-counts");
+  ASSERT_EQ(counts.size(), 4u);
+  std::vector<int> failed = numbers(counts[3]);
+  EXPECT_EQ(failed.front(), 0);
+  EXPECT_EQ(failed.back(), 50) << "every drone ends in its failsafe";
+}
+
+// The run keeps for the picture what it draws: a 1,000-drone show's k² barrier messages
+// held 19 GB, and telemetry is never drawn (the tracks come from the run's result).
+TEST(Plot, TheRunKeepsNoTelemetryForThePictureAndNoMessagesBeyondFortyDrones) {
+  dex::TraceEvent message, telemetry, start;
+  message.event = "message";
+  telemetry.event = "telemetry";
+  start.event = "start";
+  trace::PlotTrace small(40), large(41);
+  for (trace::PlotTrace* p : {&small, &large})
+    for (const dex::TraceEvent* e : {&message, &telemetry, &start}) p->record(*e);
+  EXPECT_TRUE(small.takes_messages());
+  EXPECT_FALSE(large.takes_messages()) << "the runner then builds none";
+  ASSERT_EQ(small.events.size(), 2u);
+  EXPECT_EQ(small.events[0].event, "message");
+  ASSERT_EQ(large.events.size(), 1u);
+  EXPECT_EQ(large.events[0].event, "start");
 }
 
 }  // namespace

@@ -13,7 +13,7 @@ const DOM_LANES_MAX = 60;  // more drones: lanes on a canvas, no element per bar
 const S = {
   mission: null, live: false, finished: false, events: [], clock: 0, playing: false, speed: 1,
   follow: true, selected: null, dirty: true, structureDirty: true, itemsDirty: true, graphIndex: 0,
-  liveFrom: Infinity, undrawn: [], latencies: [], arrivals: [], serverDelays: [],
+  liveFrom: Infinity, undrawn: [], latencies: [], arrivals: [], serverDelays: [], renderTimes: [],
 };
 const LATENCIES_MAX = 200000;  // the newest this many; enough for any percentile worth asking
 
@@ -37,6 +37,9 @@ function resetDerived() {
     messages: [], nodeHistory: new Map(), end: 0, outcome: '', failures: [], eventTimes: [], violations: [],
     nodeKey: new Map(), nodes: new Map(), lastIngested: 0, missionReason: '', missionT: null, failMarks: [],
     waitSpans: new Map(), giveWays: [],
+    // Where the telemetry has been so far, kept as it comes: a frame must not walk every
+    // sample of a thousand drones to scale the map.
+    seen: { minX: Infinity, maxX: -Infinity, minY: Infinity, maxY: -Infinity, maxZ: 1 },
   };
   const m = S.mission || {};
   for (const d of Array.isArray(m.drones) ? m.drones : []) addDrone(str(d.name), d);
@@ -117,8 +120,12 @@ function ingest(e) {
     S.itemsDirty = true;
   } else if (e.event === 'telemetry') {
     if (!D.telemetry.has(e.drone)) D.telemetry.set(e.drone, []);
-    D.telemetry.get(e.drone).push({ t, x: num(e.x, 0), y: num(e.y, 0), z: num(e.z, 0), battery: e.battery,
-                                    mode: str(e.mode), armed: e.armed, landed: e.landed });
+    const sample = { t, x: num(e.x, 0), y: num(e.y, 0), z: num(e.z, 0), battery: e.battery, mode: str(e.mode),
+                     armed: e.armed, landed: e.landed };
+    D.telemetry.get(e.drone).push(sample);
+    const b = D.seen;
+    b.minX = Math.min(b.minX, sample.x); b.maxX = Math.max(b.maxX, sample.x);
+    b.minY = Math.min(b.minY, sample.y); b.maxY = Math.max(b.maxY, sample.y); b.maxZ = Math.max(b.maxZ, sample.z);
   } else if (e.event === 'message') {
     D.messages.push({ kind: str(e.kind), from: str(e.from), to: str(e.to), node: e.node,
                       sent: num(e.sent, t), received: num(e.received, t) });
@@ -236,6 +243,7 @@ function tick(prev) {
 // ---- drawing ----
 
 function render() {
+  const started = performance.now();
   S.dirty = false;
   // Layout is read once, before anything is written: a read after a write forces the
   // browser to lay the page out again, and one per trigger arrow made a 20-drone page lag.
@@ -250,6 +258,8 @@ function render() {
   renderSourceActive();
   document.body.dataset.clock = S.clock.toFixed(3);
   noteDrawn();
+  S.renderTimes.push(performance.now() - started);
+  if (S.renderTimes.length > LATENCIES_MAX) S.renderTimes.splice(0, S.renderTimes.length - LATENCIES_MAX);
 }
 
 // Live latency: from eamos emitting an event to the end of the render that drew it (the
@@ -746,10 +756,13 @@ function renderLanes() {
 // Level of detail for large fleets: one pixel row group per drone, bars merged below a pixel.
 function renderLanesCanvas() {
   const canvas = $('lanes-canvas');
-  const rowH = Math.max(2, Math.min(8, Math.floor(4000 / D.drones.length)));
+  // At most 1,200 px tall: the browser paints the whole canvas each frame, and a thousand
+  // rows of 4 px (6 million pixels) made a live page fall seconds behind.
+  const rowH = Math.max(1, Math.min(8, Math.floor(1200 / D.drones.length)));
   const w = Math.max(400, $('lanes-scroll').clientWidth - 4);
-  canvas.width = w;
-  canvas.height = rowH * D.drones.length;
+  // Resizing a canvas reallocates it (4,000 rows of a thousand drones): only when it changes.
+  if (canvas.width !== w) canvas.width = w;
+  if (canvas.height !== rowH * D.drones.length) canvas.height = rowH * D.drones.length;
   const g = canvas.getContext('2d');
   g.clearRect(0, 0, w, canvas.height);
   const end = missionEnd(), now = S.clock;
@@ -794,8 +807,8 @@ function worldBounds() {
   for (const d of D.drones) {
     if (d.home) take(d.home[0], d.home[1], d.home[2]);
     if (d.geofence && Array.isArray(d.geofence.polygon)) for (const p of d.geofence.polygon) take(num(p[0], 0), num(p[1], 0), 0);
-    for (const s of D.telemetry.get(d.name) || []) take(s.x, s.y, s.z);
   }
+  if (D.telemetry.size) { take(D.seen.minX, D.seen.minY, D.seen.maxZ); take(D.seen.maxX, D.seen.maxY, 0); }
   for (const v of D.violations) if (isFinite(v.x) && isFinite(v.y)) take(v.x, v.y, 0);
   if (!isFinite(minX)) { minX = -10; maxX = 10; minY = -10; maxY = 10; }
   const pad = Math.max(2, 0.08 * Math.max(maxX - minX, maxY - minY));
@@ -1313,6 +1326,8 @@ window.eamosMonitor = {
   liveLatency: () => latencyStats(S.latencies),
   arrivalLatency: () => latencyStats(S.arrivals),
   serverLatency: () => latencyStats(S.serverDelays),
+  // How long each render took, ms (the page's own work per frame).
+  renderTimes: () => latencyStats(S.renderTimes),
   // The drones marked failed on the map and in their lanes at the clock.
   failedDrones: () => D.drones.filter(d => failedBy(d.name, S.clock)).map(d => d.name),
   triggers: () => (D.triggerList || []).map(t => ({ from: t.from, to: t.to, sent: t.sent, received: t.received, wait: t.received - t.waitFrom })),

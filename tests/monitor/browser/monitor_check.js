@@ -1,6 +1,6 @@
 // Drives Debian's chromium headless against a running `eamos monitor` / `eamos run --monitor`
 // and checks what the page shows, through its DOM. Called by tests/monitor/browser_test.cpp:
-//   node monitor_check.js replay|live|live20|launch|v1|scale|violation|failed|waits|giveway|palette URL SCREENSHOT_DIR CHROMIUM
+//   node monitor_check.js replay|live|live20|live200|live1000|launch|v1|scale|violation|failed|waits|giveway|palette URL SCREENSHOT_DIR CHROMIUM
 // Prints "ok: ..." lines and exits 0, or prints "FAIL: what" and exits 1.
 'use strict';
 const fs = require('fs');
@@ -303,6 +303,31 @@ async function live20(browser) {
   await page.screenshot({ path: path.join(shots, 'live-20-drones.png') });
 }
 
+// A large fleet live at high speed (lanes on a canvas; `drones` of them): p95 of
+// emitted-to-drawn below `bound` ms over 2,000 live events (telemetry included). Prints the
+// page's render times. The test stops the run after.
+async function liveScale(browser, drones, bound) {
+  const page = await open(browser, '');
+  await page.waitForFunction(() => window.eamosMonitor.liveLatency().count >= 2000, { timeout: 90000, polling: 200 });
+  const r = await page.evaluate(() => {
+    const canvas = document.getElementById('lanes-canvas');
+    return { drones: Number(canvas.dataset.drones), hidden: canvas.hidden, mode: document.getElementById('mode').dataset.mode,
+             frames: window.eamosMonitor.renderTimes(), events: Number(document.body.dataset.events || 0) };
+  });
+  check(r.drones === drones && !r.hidden, `${drones} lanes on the canvas (${r.drones})`);
+  check(r.mode === 'live' || r.mode === 'ended', `a live mission (${r.mode})`);
+  const l = await page.evaluate(() => window.eamosMonitor.liveLatency());
+  const a = await page.evaluate(() => window.eamosMonitor.arrivalLatency());
+  const v = await page.evaluate(() => window.eamosMonitor.serverLatency());
+  console.log(`info: ${l.count} live events of ${r.events}; emitted to drawn: median ${ms(l.median)}, p95 ${ms(l.p95)}, max ${ms(l.max)}`);
+  console.log(`info: emitted to arrived: median ${ms(a.median)}, p95 ${ms(a.p95)}, max ${ms(a.max)}; ` +
+              `to sent by the server: median ${ms(v.median)}, p95 ${ms(v.p95)}, max ${ms(v.max)}`);
+  console.log(`info: renders: ${r.frames.count}, median ${ms(r.frames.median)}, p95 ${ms(r.frames.p95)}, max ${ms(r.frames.max)}`);
+  console.log(`info: load average ${os.loadavg().map(x => x.toFixed(1)).join(' ')} on ${os.cpus().length} cores`);
+  check(l.p95 !== null && l.p95 < bound, `p95 of emitted-to-drawn below ${bound} ms: ${ms(l.p95)}`);
+  await page.screenshot({ path: path.join(shots, `live-${drones}-drones.png`) });
+}
+
 // `eamos launch DIR --monitor`: the ground's events of a deployment's DEX processes reach the
 // page live and it ends with the mission, its graphs from the manifest's source.
 async function launchLive(browser) {
@@ -435,6 +460,8 @@ async function waits(browser) {
     if (mode === 'replay') await replay(browser);
     else if (mode === 'live') await live(browser);
     else if (mode === 'live20') await live20(browser);
+    else if (mode === 'live200') await liveScale(browser, 200, 1000);
+    else if (mode === 'live1000') await liveScale(browser, 1000, 100);
     else if (mode === 'launch') await launchLive(browser);
     else if (mode === 'v1') await v1(browser);
     else if (mode === 'scale') await scale(browser);
