@@ -110,7 +110,7 @@ int launch_with_monitor(const launch::LaunchOptions& options, const RunCommandOp
   if (!start_monitor(server, r.monitor, view)) return 1;
   std::cout << "eamos: monitor at " << server.url() << "\n" << std::flush;
   std::vector<dex::Mission> missions = deployed_missions(options.dir);
-  monitor::LiveSink page(server, missions.empty() ? std::vector<std::string>{} : missions[0].fleet);
+  monitor::LiveSink page(server, missions.empty() ? std::vector<std::string>{} : missions[0].fleet.get());
   dex::LiveLog log(std::cout);
   dex::TeeTrace tee;
   if (r.log) tee.add(&log);

@@ -295,6 +295,8 @@ class Reader {
       return false;
     }
     bool ok = true;
+    std::vector<std::string> names;
+    names.reserve(fleet->size());
     for (std::size_t i = 0; i < fleet->size(); ++i) {
       std::string name;
       if (!f_.string_value((*fleet)[i], at("/fleet", i), name)) {
@@ -305,9 +307,10 @@ class Reader {
         d_.add(at("/fleet", i), name.empty() ? "empty drone name" : "drone \"" + name + "\" is listed twice");
         ok = false;
       }
-      fleet_index_.emplace(name, static_cast<int>(m_.fleet.size()));
-      m_.fleet.push_back(name);
+      fleet_index_.emplace(name, static_cast<int>(names.size()));
+      names.push_back(std::move(name));
     }
+    m_.fleet = dex::SharedTable<std::vector<std::string>>(std::move(names));
     return ok;
   }
 
@@ -322,9 +325,10 @@ class Reader {
     if (list->size() != m_.fleet.size())
       return d_.add("/priorities", "holds " + std::to_string(list->size()) + " priorities for a fleet of " +
                                        std::to_string(m_.fleet.size()));
-    m_.priorities.assign(list->size(), 0);
+    std::vector<int> priorities(list->size(), 0);
     for (std::size_t i = 0; i < list->size(); ++i)
-      f_.integer_value((*list)[i], at("/priorities", i), m_.priorities[i], 1, 1000000);
+      f_.integer_value((*list)[i], at("/priorities", i), priorities[i], 1, 1000000);
+    m_.priorities = dex::SharedTable<std::vector<int>>(std::move(priorities));
   }
 
   /// `drone_sets`: each a list of [first, last] drone index ranges, ascending and apart.
@@ -337,7 +341,7 @@ class Reader {
       const json& ranges = (*list)[i];
       if (f_.array(ranges, where))
         for (std::size_t r = 0; r < ranges.size(); ++r) drone_range(ranges[r], at(where, r), set);
-      m_.drone_sets.push_back(std::move(set));
+      m_.drone_sets.emplace_back(std::move(set));
     }
   }
 
@@ -364,7 +368,7 @@ class Reader {
       return d_.add(where, "only a sync point (init or fork) waits for or notifies drones"), false;
     if (n.waits >= 0 && !n.internal) return d_.add(at(where, "waits"), "an external node waits for nothing"), false;
     if (n.waits >= 0) {
-      const std::vector<int>& set = m_.drone_sets[n.waits];
+      const std::vector<int>& set = m_.drone_sets[n.waits].get();
       n.waits_count = static_cast<int>(set.size()) - (std::binary_search(set.begin(), set.end(), m_.self) ? 1 : 0);
     }
     return true;

@@ -15,7 +15,10 @@ using lang::ControlKind;
 
 Engine::Engine(const Mission& mission, mid::Drone& drone, mid::EventLoop& loop, EngineHooks hooks)
     : m_(mission), drone_(drone), loop_(loop), hooks_(std::move(hooks)), state_(mission.nodes.size()),
-      board_(mission.fleet.size()) {
+      board_drones_(mission.reads) {
+  std::sort(board_drones_.begin(), board_drones_.end());
+  board_drones_.erase(std::unique(board_drones_.begin(), board_drones_.end()), board_drones_.end());
+  board_.resize(board_drones_.size());
   for (std::size_t i = 0; i < m_.nodes.size(); ++i) reset_counters(static_cast<int>(i));
   if (hooks_.trace) {
     drone_.set_message_sink([this](const std::string& text) {
@@ -63,8 +66,14 @@ double property_of(const mid::DroneState& s, const std::string& name) {
 
 double Engine::property(int drone, const std::string& name) const {
   if (drone == m_.self) return property_of(drone_.state(), name);
-  if (drone < 0 || drone >= static_cast<int>(board_.size()) || !board_[drone]) return NAN;
-  return property_of(board_[drone]->state, name);
+  int slot = board_slot(drone);
+  if (slot < 0 || !board_[slot]) return NAN;
+  return property_of(board_[slot]->state, name);
+}
+
+int Engine::board_slot(int drone) const {
+  auto it = std::lower_bound(board_drones_.begin(), board_drones_.end(), drone);
+  return it != board_drones_.end() && *it == drone ? static_cast<int>(it - board_drones_.begin()) : -1;
 }
 
 void Engine::trace(const Node& n, const std::string& event, const std::string& outcome) {
@@ -217,6 +226,27 @@ void Engine::receive_arrival(int node, const Message& msg) {
   drain();
 }
 
+void Engine::count_arrival(int node, const Message& msg) {
+  if (halted_ || node < 0) return;
+  // Outside every Repeat/Do body there are no runs to learn or refresh (current() and
+  // refresh() change nothing), and a barrier still waiting has nothing else to do.
+  if (msg.scope < 0 && msg.body_epoch == 0 && m_.nodes[node].scope < 0 && !draining_ && queue_.empty()) {
+    State& s = state_[node];
+    if (m_.nodes[node].waits_count > 0 && (!s.local_ready || s.arrivals_pending > 1)) {
+      --s.arrivals_pending;
+      return;
+    }
+  }
+  receive_arrival(node, msg);
+}
+
+int Engine::add_arrivals(int node, int n) {
+  if (node < 0) return 0;
+  State& s = state_[node];
+  if (!halted_) s.arrivals_pending -= n;
+  return s.arrivals_pending;
+}
+
 // Learns the runs `msg` names; false when it belongs to a run that is over here (stale).
 bool Engine::current(const Message& msg) {
   if (msg.scope >= 0) {
@@ -253,9 +283,13 @@ void Engine::receive(const Message& msg) {
 }
 
 void Engine::receive(std::shared_ptr<const Telemetry> t) {
-  if (!t || t->mission_hash != m_.hash || t->from < 0 || t->from >= static_cast<int>(board_.size())) return;
+  if (!t || t->mission_hash != m_.hash) return;
+  // Telemetry of a drone this mission never reads changes nothing here (no condition or
+  // argument reads it): it is not kept.
+  int slot = board_slot(t->from);
+  if (slot < 0) return;
   int from = t->from;
-  board_[from] = std::move(t);
+  board_[slot] = std::move(t);
   properties_changed(from);
 }
 

@@ -56,6 +56,14 @@ class Engine {
   /// in the Mission), found by a transport that delivers many: receive() finds it itself.
   /// The caller has checked the mission hash.
   void receive_arrival(int node, const Message& m);
+  /// receive_arrival for a transport that settles the run itself after delivering to a whole
+  /// set (the in-process one): an arrival that leaves the barrier waiting only counts, with
+  /// no queue, drain or on_idle. A fleet-wide barrier delivers k - 1 of them per arrival.
+  void count_arrival(int node, const Message& m);
+  /// `n` more arrivals at sync-point clone `node` (outside every Repeat/Do body), counted by
+  /// a transport that tells them in one go: the barrier is not passed here, the next
+  /// arrival or this drone's own does it. Returns the arrivals still missing.
+  int add_arrivals(int node, int n);
   /// InBridge: another drone's telemetry; re-evaluates the conditions that read it.
   void receive(std::shared_ptr<const Telemetry> t);
   /// A property of `drone` changed: re-evaluate the conditions that wait on it.
@@ -141,7 +149,13 @@ class Engine {
   std::uint64_t next_instance_ = 0;
   std::uint64_t activations_ = 0;
   std::vector<int> watched_;  ///< condition nodes currently watching
-  std::vector<std::shared_ptr<const Telemetry>> board_;  ///< other drones' newest telemetry
+  /// The newest telemetry of each drone this one reads (Mission::reads, in board_drones_'s
+  /// order): sized by what the mission reads, not by the fleet, which at 10,000 drones would
+  /// be 10⁸ pointers over one process.
+  std::vector<std::shared_ptr<const Telemetry>> board_;
+  std::vector<int> board_drones_;  ///< sorted
+  /// board_'s slot for `drone`, or -1 when this drone does not read it.
+  int board_slot(int drone) const;
   /// Runs of each Repeat/Do body (by the condition's MEG id) this drone knows of: a body's
   /// nodes reset their counters when a new run reaches them, and messages from an older
   /// run are dropped. This is what keeps a cancelled do-branch or a finished iteration from

@@ -4,7 +4,10 @@
 // (the paper's "setup part", IV.D.1) by deploy::read_mission, which checks every index
 // and enum in it; the engine relies on that and never changes it.
 #include <cstdint>
+#include <initializer_list>
 #include <map>
+#include <optional>
+#include <memory>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -14,6 +17,36 @@
 #include "vocab/kinds.h"
 
 namespace eamos::dex {
+
+/// A read-only table that the Missions of one process may hold in common: the fleet's
+/// names, its priorities, a drone set. Every drone's file carries them whole, so a fleet of
+/// k drones in one process would hold each k times (at 10,000 drones, 10⁸ names);
+/// MissionTables makes equal tables one. Read like the vector it holds.
+template <typename T>
+class SharedTable {
+ public:
+  SharedTable() = default;
+  explicit SharedTable(T v) : p_(std::make_shared<const T>(std::move(v))) {}
+  SharedTable(std::initializer_list<typename T::value_type> v) : SharedTable(T(v)) {}
+
+  const T& get() const { return p_ ? *p_ : none(); }
+  operator const T&() const { return get(); }
+  auto begin() const { return get().begin(); }
+  auto end() const { return get().end(); }
+  std::size_t size() const { return get().size(); }
+  bool empty() const { return get().empty(); }
+  const typename T::value_type& operator[](std::size_t i) const { return get()[i]; }
+  bool operator==(const SharedTable& o) const { return p_ == o.p_ || get() == o.get(); }
+  /// Whether both hold the very same table (not only equal ones).
+  bool same_as(const SharedTable& o) const { return p_ == o.p_; }
+
+ private:
+  static const T& none() {
+    static const T empty_table;
+    return empty_table;
+  }
+  std::shared_ptr<const T> p_;
+};
 
 struct Node {
   int meg = 0;                 ///< MEG id: the node's name across drones
@@ -51,17 +84,17 @@ struct Mission {
   std::string hash;                    ///< SHA-256 of the whole compiled mission
   std::string source;                  ///< mission file path, for messages
   int self = 0;                        ///< this drone's index in `fleet`
-  std::vector<std::string> fleet;      ///< every drone's name, by index
+  SharedTable<std::vector<std::string>> fleet;  ///< every drone's name, by index
   fleet::DroneSettings settings;       ///< this drone's settings
   fleet::DroneType type;               ///< its capabilities, as the compiler checked them
   std::vector<int> reads;              ///< drones whose telemetry this drone needs
   std::vector<Node> nodes;
   std::vector<Arc> arcs;
-  std::vector<std::vector<int>> drone_sets;  ///< sorted drone lists named by Node::waits and notify
+  std::vector<SharedTable<std::vector<int>>> drone_sets;  ///< sorted drone lists named by Node::waits and notify
   /// The fleet's `safety: min_separation`, which every drone keeps in flight (dex/separation.h).
   fleet::Separation separation;
   /// Each drone's `priority:` by fleet index (docs/fleet.md); empty: declaration order.
-  std::vector<int> priorities;
+  SharedTable<std::vector<int>> priorities;
 
   /// Index of the node with MEG id `meg` held by `drone`, or -1.
   int find(int meg, int drone) const;
@@ -75,6 +108,19 @@ struct Mission {
     return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(meg)) << 32) | static_cast<std::uint32_t>(drone);
   }
   std::unordered_map<std::uint64_t, int> index;  ///< key(meg, drone) → node index
+};
+
+/// Makes the tables of the Missions it is given, one after the other, shared where equal:
+/// each mission's fleet names and priorities with the first one's, and each drone set with
+/// an equal set of an earlier mission. Given each mission as soon as it is read, the peak
+/// stays linear in the fleet.
+class MissionTables {
+ public:
+  void share(Mission& m);
+
+ private:
+  std::optional<Mission> first_;  ///< holds the first mission's fleet and priorities
+  std::unordered_map<std::size_t, std::vector<SharedTable<std::vector<int>>>> sets_;  ///< by content hash
 };
 
 }  // namespace eamos::dex

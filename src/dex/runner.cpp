@@ -44,15 +44,12 @@ class InProcessTransport : public Transport {
   /// events, not k².
   void send_to_set(const std::vector<int>& to, const Message& m) override {
     ++in_flight_;
-    loop_.after(0.0, [this, &to, m] {
+    Barrier* b = counted_barrier(to, m);
+    if (b) announced(*b, m.from);
+    loop_.after(0.0, [this, &to, m, b] {
       --in_flight_;
-      const std::vector<int>& clones = clones_of(m.meg, to);
-      for (std::size_t i = 0; i < to.size(); ++i) {
-        int d = to[i];
-        if (d == m.from) continue;
-        if (trace_messages_) trace_->record(message_event(missions_[d], m, d, loop_.now()));
-        engines_[d]->receive_arrival(clones[i], m);  // one mission, one hash: checked at the start
-      }
+      if (b) deliver_counted(*b, m);
+      else deliver_each(to, m);
       on_delivered_();
     });
   }
@@ -67,6 +64,91 @@ class InProcessTransport : public Transport {
   const std::vector<int>& readers_of(int d) const { return readers_[d]; }
 
  private:
+  /// A sync point outside every Repeat/Do body (reached once per drone) whose arrivals all go
+  /// to one set, in a run whose trace keeps no messages. Its clones' arrivals are counted
+  /// here, in arrays the size of the set, and an engine hears of them only when it matters:
+  /// when it arrives itself (it learns how many came before) and when the last arrival it
+  /// waits for comes (the barrier passes, at the same instant and in the same order as with
+  /// every arrival delivered). A fleet-wide barrier costs k engine calls instead of k².
+  struct Barrier {
+    const std::vector<int>* to = nullptr;  ///< interned (MissionTables): one set, one address
+    std::vector<int> clones;     ///< per drone of `to`: its clone's node index, or -1
+    std::vector<char> counted;   ///< the clone's arrivals are counted here
+    std::vector<char> arrived;   ///< its drone has arrived (announced) itself
+    std::vector<int> untold;     ///< arrivals counted here, not yet told its engine
+    std::vector<int> missing;    ///< after its drone arrived: arrivals it still waits for
+    bool each = false;           ///< another set reached it: every arrival goes to every engine
+  };
+
+  Barrier* counted_barrier(const std::vector<int>& to, const Message& m) {
+    if (trace_messages_ || m.scope >= 0 || m.body_epoch != 0) return nullptr;
+    auto [it, added] = barriers_.try_emplace(m.meg);
+    Barrier& b = it->second;
+    if (added) start_barrier(b, to, m.meg);
+    if (!b.each && b.to != &to) tell_all(b);
+    return b.each ? nullptr : &b;
+  }
+
+  void start_barrier(Barrier& b, const std::vector<int>& to, int meg) {
+    b.to = &to;
+    std::size_t k = to.size();
+    b.counted.assign(k, 0), b.arrived.assign(k, 0), b.untold.assign(k, 0), b.missing.assign(k, 0);
+    for (std::size_t i = 0; i < k; ++i) {
+      int clone = missions_[to[i]].find(meg, to[i]);
+      b.clones.push_back(clone);
+      if (clone < 0) continue;
+      const Node& n = missions_[to[i]].nodes[clone];
+      // Counted only where the engine's own arrival is what readies it (dex::Engine::arrive).
+      b.counted[i] = n.scope < 0 && n.internal && n.notify >= 0 && n.exec_in > 0 && n.waits_count > 0;
+    }
+  }
+
+  /// Tells every engine what was counted for it and delivers each arrival from now on.
+  void tell_all(Barrier& b) {
+    for (std::size_t i = 0; i < b.clones.size(); ++i)
+      if (b.untold[i] > 0) engines_[(*b.to)[i]]->add_arrivals(b.clones[i], b.untold[i]);
+    b.each = true;
+  }
+
+  /// Drone `d` arrives (inside its engine's arrive(), before it looks at its count): its
+  /// engine learns the arrivals counted so far, and from now on this counts down what it lacks.
+  void announced(Barrier& b, int d) {
+    auto at = std::lower_bound(b.to->begin(), b.to->end(), d);
+    if (at == b.to->end() || *at != d) return;
+    std::size_t i = at - b.to->begin();
+    if (!b.counted[i]) return;
+    b.missing[i] = engines_[d]->add_arrivals(b.clones[i], b.untold[i]);
+    b.untold[i] = 0;
+    b.arrived[i] = 1;
+  }
+
+  void deliver_counted(Barrier& b, const Message& m) {
+    const std::vector<int>& to = *b.to;
+    for (std::size_t i = 0; i < to.size(); ++i) {
+      int d = to[i];
+      if (d == m.from || b.clones[i] < 0) continue;
+      if (b.counted[i] && (!b.arrived[i] || b.missing[i] > 1)) {
+        ++b.untold[i];
+        if (b.arrived[i]) --b.missing[i];
+        continue;
+      }
+      if (b.counted[i] && b.untold[i] > 0) engines_[d]->add_arrivals(b.clones[i], b.untold[i]);
+      b.untold[i] = 0;
+      b.missing[i] = 0;
+      engines_[d]->count_arrival(b.clones[i], m);  // the last one it waits for: it passes
+    }
+  }
+
+  void deliver_each(const std::vector<int>& to, const Message& m) {
+    const std::vector<int>& clones = clones_of(m.meg, to);
+    for (std::size_t i = 0; i < to.size(); ++i) {
+      int d = to[i];
+      if (d == m.from) continue;
+      if (trace_messages_) trace_->record(message_event(missions_[d], m, d, loop_.now()));
+      engines_[d]->count_arrival(clones[i], m);  // one mission, one hash: checked at the start
+    }
+  }
+
   /// Where each drone of `to` holds its clone of sync point `meg`, found once per sync point:
   /// a fleet-wide barrier delivers every arrival to every drone.
   const std::vector<int>& clones_of(int meg, const std::vector<int>& to) {
@@ -89,6 +171,7 @@ class InProcessTransport : public Transport {
   TraceSink* trace_;
   bool trace_messages_;
   std::unordered_map<int, std::vector<int>> clones_;  ///< sync point → clone index per drone of its set
+  std::unordered_map<int, Barrier> barriers_;  ///< by sync point (MEG id): see Barrier
   std::vector<std::vector<int>> readers_;  ///< per drone: the drones that read its telemetry
   std::function<void()> on_delivered_;
   int in_flight_ = 0;  ///< triggers and cancels sent, not yet handled

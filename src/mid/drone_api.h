@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "fleet/fleet.h"
+#include "mid/sensor_values.h"
 
 namespace eamos::mid {
 
@@ -76,7 +77,7 @@ struct DroneState {
   double battery = 0.0;  ///< %
   bool armed = false;
   bool landed = true;
-  std::map<std::string, double> sensors;  ///< "Sensor1" … "SensorN" of the drone's type
+  SensorValues sensors;  ///< "Sensor1" … "SensorN" of the drone's type, in name order
   int pictures = 0;      ///< TakePicture actions that succeeded
   /// Degrees clockwise from north (0 ≤ heading < 360); NaN while the adapter does not know
   /// it. Telemetry for people (trace, monitor): no mission property reads it.

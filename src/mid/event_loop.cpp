@@ -38,10 +38,31 @@ EventLoop::EventLoop(ClockOptions options) : options_(options) {
 TimerId EventLoop::at(double t, std::function<void()> fn) {
   if (!std::isfinite(t)) return kNoTimer;
   if (t < now_) t = now_;
-  std::uint64_t seq = next_seq_++;
-  queue_.push({t, seq});
-  callbacks_.emplace(seq, std::move(fn));
-  return seq;
+  std::uint32_t slot;
+  if (free_slots_.empty()) {
+    slot = static_cast<std::uint32_t>(slots_.size());
+    slots_.emplace_back();
+  } else {
+    slot = free_slots_.back();
+    free_slots_.pop_back();
+  }
+  Slot& s = slots_[slot];
+  s.fn = std::move(fn);
+  s.live = true;
+  ++s.gen;  // a TimerId of the slot's earlier callback no longer names it
+  ++live_;
+  queue_.push({t, next_seq_++, slot, s.gen});
+  return (static_cast<TimerId>(s.gen) << 32) | (static_cast<TimerId>(slot) + 1);
+}
+
+std::function<void()> EventLoop::take(std::uint32_t slot) {
+  Slot& s = slots_[slot];
+  std::function<void()> fn = std::move(s.fn);
+  s.fn = nullptr;
+  s.live = false;
+  free_slots_.push_back(slot);
+  --live_;
+  return fn;
 }
 
 TimerId EventLoop::after(double dt, std::function<void()> fn) {
@@ -54,7 +75,11 @@ TimerId EventLoop::defer(std::function<void()> fn) {
   return at(t, std::move(fn));
 }
 
-bool EventLoop::cancel(TimerId id) { return callbacks_.erase(id) != 0; }
+bool EventLoop::cancel(TimerId id) {
+  if (id == kNoTimer || !live(slot_of(id), gen_of(id))) return false;
+  take(slot_of(id));  // its heap entry stays and is skipped when popped: cancel is O(1)
+  return true;
+}
 
 std::size_t EventLoop::run_until_idle() {
   std::size_t ran = run(0.0, false);
@@ -80,7 +105,7 @@ std::size_t EventLoop::run(double limit, bool bounded) {
   running_ = true;
   while (!stop_requested_) {
     take_posted();
-    while (!queue_.empty() && callbacks_.count(queue_.top().seq) == 0) queue_.pop();  // cancelled
+    while (!queue_.empty() && !live(queue_.top().slot, queue_.top().gen)) queue_.pop();  // cancelled
     // A real-time run bounded by `limit` waits for posted input until then, even when no
     // timer is due: that is how a DEX idles between messages.
     if (queue_.empty() || (bounded && queue_.top().time > limit)) {
@@ -91,11 +116,9 @@ std::size_t EventLoop::run(double limit, bool bounded) {
     if (!wait_for(next.time)) continue;
     if (real && stalled_before(next.time)) continue;  // the handler may have cancelled it
     queue_.pop();
-    auto it = callbacks_.find(next.seq);
-    if (it == callbacks_.end()) continue;
-    // Take the callback out first: it may schedule or cancel timers, rehashing the map.
-    std::function<void()> fn = std::move(it->second);
-    callbacks_.erase(it);
+    if (!live(next.slot, next.gen)) continue;
+    // Take the callback out first: it may schedule or cancel timers, growing the slots.
+    std::function<void()> fn = take(next.slot);
     now_ = std::max(now_, next.time);  // after a stall, overdue callbacks run at its end
     run_callback(fn);
     ++ran;

@@ -96,6 +96,7 @@ void check_args(const RunArgs& a) {
 
 std::vector<dex::Mission> load_missions(const graph::Compilation& c, const std::string& hash) {
   std::vector<dex::Mission> missions(c.drone_count());
+  dex::MissionTables tables;  // one copy of the fleet's names, not one a drone
   for (int d = 0; d < c.drone_count(); ++d) {
     std::vector<std::string> errors;
     if (!deploy::read_mission(deploy::mission_text(c, d, hash), c.drone_name(d) + "/mission.json", missions[d],
@@ -104,6 +105,7 @@ std::vector<dex::Mission> load_missions(const graph::Compilation& c, const std::
       for (const std::string& e : errors) all += e + "\n";
       throw std::runtime_error(all);
     }
+    tables.share(missions[d]);
   }
   return missions;
 }

@@ -377,6 +377,7 @@ mid::DroneState SimDrone::state() const {
   s.battery = battery_.at(loop_.now());
   s.armed = armed_;
   s.landed = landed_;
+  s.sensors.reserve(sensor_models_.size());
   for (std::size_t k = 0; k < sensor_models_.size(); ++k)
     s.sensors.emplace_hint(s.sensors.end(), sensor_models_[k].first, sensor_value(static_cast<int>(k) + 1));
   s.pictures = pictures_;

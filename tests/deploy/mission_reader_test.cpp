@@ -125,7 +125,7 @@ TEST_F(MissionReader, ReadsTheSeparationAndPrioritiesAndRefusesAPriorityOutOfRan
   EXPECT_EQ(m.separation.horizontal_m, 4.0);
   EXPECT_EQ(m.separation.vertical_m, 2.5);
   ASSERT_EQ(m.priorities.size(), doc_["fleet"].size());
-  EXPECT_EQ(m.priorities.back(), 1);
+  EXPECT_EQ(m.priorities.get().back(), 1);
   std::string bad = reseal(replace_once(with, "\"priorities\":[", "\"priorities\":[0,"));
   EXPECT_NE(defects(bad).find("error: /priorities: holds"), std::string::npos) << defects(bad);
   bad = reseal(replace_once(with, "\"vertical\":2.5", "\"vertical\":-1"));

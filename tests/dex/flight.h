@@ -70,6 +70,7 @@ inline std::vector<dex::Mission> missions_of(const std::string& text, const flee
   }
   std::string hash = deploy::mission_hash(c);
   std::vector<dex::Mission> missions(c.drone_count());
+  dex::MissionTables tables;  // as `eamos run` loads them
   for (int d = 0; d < c.drone_count(); ++d) {
     std::string text = deploy::mission_text(c, d, hash);
     if (edit) {
@@ -80,6 +81,7 @@ inline std::vector<dex::Mission> missions_of(const std::string& text, const flee
     std::vector<std::string> errors;
     EXPECT_TRUE(deploy::read_mission(text, c.drone_name(d), missions[d], errors))
         << (errors.empty() ? "" : errors.front());
+    tables.share(missions[d]);
   }
   return missions;
 }

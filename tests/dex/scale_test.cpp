@@ -3,6 +3,9 @@
 // with the fleet, not with its square (docs/architecture.md, "A sync point is a barrier
 // that costs O(k)"; docs/performance.md has the figures at scale).
 #include <gtest/gtest.h>
+#include <malloc.h>
+
+#include <sstream>
 
 #include "flight.h"
 #include "stress/generator.h"
@@ -57,6 +60,73 @@ TEST(Scale, AShowsMissionFilesGrowLinearlyWithItsFleet) {
   EXPECT_LE(large.external_nodes, small.external_nodes * 2 + 8)
       << small.external_nodes << " -> " << large.external_nodes;
   EXPECT_GT(large.messages, small.messages * 3) << "arrivals reach every other drone";
+}
+
+/// Keeps every event but the messages, as `eamos run` without --trace: the run then counts
+/// a barrier's arrivals itself instead of delivering each to every engine.
+struct AllButMessages : dex::TraceSink {
+  std::vector<std::string> events;
+  void record(const dex::TraceEvent& e) override {
+    std::ostringstream line;
+    line << e.t << ' ' << e.drone << ' ' << e.event << ' ' << e.name << ' ' << e.node << ' ' << e.instance << ' '
+         << e.outcome << ' ' << e.branch << ' ' << e.reason;
+    events.push_back(line.str());
+  }
+  bool takes_messages() const override { return false; }
+};
+
+std::vector<std::string> without_messages(const test::Flight& f) {
+  AllButMessages kept;
+  for (const dex::TraceEvent& e : f.events)
+    if (e.event != "message") kept.record(e);
+  return kept.events;
+}
+
+// The same actions, nodes and barrier passes at the same instants and in the same order,
+// whether or not a sink keeps the messages: shapes whose barriers are outside every loop
+// (counted by the run) and examples whose barriers are inside Repeats and Dos (delivered).
+TEST(Scale, ARunWithoutMessagesPassesEveryBarrierAsARunThatTracesThem) {
+  std::vector<std::string> missions = {generated(stress::Shape::show, 24, 24 * 8),
+                                       generated(stress::Shape::squads, 30, 1500),
+                                       generated(stress::Shape::cross, 30, 1500), test::example("survey.eamos"),
+                                       test::example("relay.eamos"), test::example("patrol.eamos")};
+  for (const std::string& text : missions) {
+    test::Flight traced = test::fly(text);
+    mid::AdapterRegistry adapters;
+    sim::register_adapter(adapters);
+    AllButMessages sink;
+    dex::RunOptions options;
+    options.time_limit_s = 600;
+    dex::RunResult r = dex::run_in_process(test::missions_of(text), adapters, &sink, options);
+    EXPECT_TRUE(r.completed) << r.error;
+    EXPECT_EQ(r.duration, traced.result.duration);
+    EXPECT_EQ(sink.events, without_messages(traced)) << text.substr(0, 80);
+  }
+}
+
+/// Bytes the process holds in malloc's blocks now.
+std::size_t held_bytes() {
+  struct mallinfo2 i = mallinfo2();
+  return i.uordblks + i.hblkhd;
+}
+
+// Every drone's file names the whole fleet and carries its fleet-wide drone sets: loaded as
+// `eamos run` loads them, the missions of one process hold each such table once, so what
+// they hold grows with the fleet and the nodes, not with the fleet's square (unshared, the
+// names alone would be 32 bytes × 500 per drone here, beside about 13 KB of its own).
+TEST(Scale, FiveHundredDronesMissionsHoldTheFleetsNamesAndSetsOnce) {
+  std::string text = generated(stress::Shape::show, 500, 2000);
+  std::size_t before = held_bytes();
+  std::vector<dex::Mission> missions = test::missions_of(text);
+  std::size_t per_drone = (held_bytes() - before) / 500;
+  ASSERT_EQ(missions.size(), 500u);
+  for (const dex::Mission& m : missions) {
+    ASSERT_TRUE(m.fleet.same_as(missions[0].fleet)) << m.fleet[m.self];
+    ASSERT_EQ(m.drone_sets.size(), missions[0].drone_sets.size());
+    for (std::size_t s = 0; s < m.drone_sets.size(); ++s)
+      if (m.drone_sets[s] == missions[0].drone_sets[s]) EXPECT_TRUE(m.drone_sets[s].same_as(missions[0].drone_sets[s]));
+  }
+  EXPECT_LT(per_drone, 20u * 1024) << "bytes held per drone";
 }
 
 }  // namespace

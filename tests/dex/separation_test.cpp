@@ -310,7 +310,9 @@ struct Guarded {
 
   explicit Guarded(int drones) {
     sim::register_adapter(adapters);
-    for (int i = 0; i < drones; ++i) mission.fleet.push_back(i < 26 ? std::string(1, char('A' + i)) : "D" + std::to_string(i));
+    std::vector<std::string> names;
+    for (int i = 0; i < drones; ++i) names.push_back(i < 26 ? std::string(1, char('A' + i)) : "D" + std::to_string(i));
+    mission.fleet = dex::SharedTable<std::vector<std::string>>(std::move(names));
     fleet::DroneSettings s;
     s.name = "A";
     s.adapter = "sim";
