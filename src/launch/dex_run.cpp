@@ -223,6 +223,9 @@ void DexProcess::check_finished() {
     std::uint64_t wave = termination_->start_wave();
     termination_->report({mission_.self, wave, false, transport_->sent(), received_});
     publish_status(true);  // asks every drone for its answer
+    // A wave nobody else answers (a fleet of one) is complete already: no status will come
+    // in to wake this check, so it goes on by itself.
+    if (termination_->wave_complete()) schedule_settle();
     return;
   }
   double idle_since = std::max(last_status_ ? last_status_->since : loop_->now(), c.others_idle_since);

@@ -169,6 +169,10 @@ TEST_F(Distributed, RelayGivesTheSameEventsPerDroneAsInProcess) { expect_same_as
 
 TEST_F(Distributed, PatrolGivesTheSameEventsPerDroneAsInProcess) { expect_same_as_in_process("patrol.eamos", "", 25); }
 
+TEST_F(Distributed, AFleetOfOneCompletesAsInProcess) {
+  expect_same_as_in_process_at(std::string(EAMOS_SOURCE_DIR) + "/tests/launch/missions/one_drone.eamos", "", 206);
+}
+
 TEST_F(Distributed, TwentyDronesAndTheGroundFitOnOneHost) {
   // 21 participants on loopback: more than Cyclone's default of 9 automatic participant
   // indices, which the shipped configuration raises.
