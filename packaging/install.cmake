@@ -45,7 +45,7 @@ eamos_export(eamos_fleet fleet fleet catalog.h fleet.h)
 eamos_export(eamos_lang lang lang ast.h token.h lexer.h parser.h checker.h)
 eamos_export(eamos_graph graph graph amt.h meg.h mdg.h pipeline.h export.h)
 eamos_export(eamos_deploy deploy deploy mission_file.h synthesize.h drone_package.h)
-eamos_export(eamos_mid mid mid drone_api.h event_loop.h adapter_registry.h adapter_drone.h action_tracker.h
+eamos_export(eamos_mid mid mid drone_api.h sensor_values.h event_loop.h adapter_registry.h adapter_drone.h action_tracker.h
              requests.h mover.h state_broker.h location_validator.h timeouts.h vec.h)
 eamos_export(eamos_dex dex dex bridge.h engine.h expr.h failsafe.h failure.h latency.h mission.h observer.h runner.h trace.h
              trace_writers.h)
