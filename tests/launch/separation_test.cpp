@@ -107,4 +107,25 @@ TEST_F(SeparationDistributed, HeadOnSwapEndsInTheFailsafeApartAfterTheBound) {
   EXPECT_EQ(schema_errors(), "");
 }
 
+TEST_F(SeparationDistributed, ADroneHoveringOnAnothersPathIsWaitedForAndBothComplete) {
+  eamos_test::Output r = fly("separation_hover_on_path", 172);
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(count(trace(), "give_way", "A"), 1) << r.out;
+  EXPECT_EQ(count(trace(), "resume", "A"), 1);
+  EXPECT_EQ(count(trace(), "give_way", "B"), 0);
+  EXPECT_GE(closest_horizontal(trace()), 2.0);
+  EXPECT_EQ(schema_errors(), "");
+}
+
+TEST_F(SeparationDistributed, ThreeConvergingDronesPassOneAtATime) {
+  eamos_test::Output r = fly("separation_three", 173);
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(count(trace(), "give_way", "A"), 0) << r.out;
+  EXPECT_GE(count(trace(), "give_way", "B") + count(trace(), "give_way", "C"), 2) << r.out;
+  EXPECT_EQ(count(trace(), "give_way", "B") + count(trace(), "give_way", "C"),
+            count(trace(), "resume", "B") + count(trace(), "resume", "C"));
+  EXPECT_GE(closest_horizontal(trace()), 2.0);
+  EXPECT_EQ(schema_errors(), "");
+}
+
 }  // namespace
