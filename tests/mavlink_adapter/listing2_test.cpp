@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 
 #include <nlohmann/json.hpp>
@@ -231,17 +232,20 @@ void expect_homes_refused(const std::string& out, const fs::path& trace) {
   }
 }
 
-TEST(MavlinkHomes, VehiclesOnOneSpotWhileTheFleetPutsThemApartAreRefusedBeforeArming) {
-  fs::path dir = fs::temp_directory_path() / ("eamos-mavlink-homes-" + std::to_string(::getpid()));
+/// Flies Listing 2 on three sim-vehicles standing on one spot (ports 25`tens`1..3, fleet
+/// ports rewritten to match) with `extra` options (`dir` is its folder), and expects the homes refused.
+void fly_on_one_spot(const std::string& name, const std::string& tens,
+                     const std::function<std::string(const fs::path& dir)>& extra) {
+  fs::path dir = fs::temp_directory_path() / ("eamos-mavlink-" + name + "-" + std::to_string(::getpid()));
   fs::create_directories(dir);
   std::string fleet = read_text(fs::path(EAMOS_TEST_DATA) / "data/listing2-mavlink.yaml");
-  for (size_t at; (at = fleet.find(":2532")) != std::string::npos;) fleet.replace(at, 5, ":2542");
+  for (size_t at; (at = fleet.find(":2532")) != std::string::npos;) fleet.replace(at, 5, ":25" + tens);
   std::ofstream(dir / "fleet.yaml") << fleet;
   std::vector<pid_t> vehicles;
-  for (int i = 1; i <= 3; ++i) vehicles.push_back(spawn_vehicle(25420 + i, i, "60", "100", 0.0));
+  for (int i = 1; i <= 3; ++i) vehicles.push_back(spawn_vehicle(std::stoi("25" + tens + "0") + i, i, "60", "100", 0.0));
   std::string out;
   int status = run("run " + std::string(EAMOS_SOURCE_DIR) + "/examples/listing2.eamos --fleet " +
-                       (dir / "fleet.yaml").string() + " --speed 4 --trace " + (dir / "trace.jsonl").string(),
+                       (dir / "fleet.yaml").string() + extra(dir) + " --speed 4 --trace " + (dir / "trace.jsonl").string(),
                    out);
   for (pid_t pid : vehicles) {
     kill(pid, SIGTERM);
@@ -252,28 +256,16 @@ TEST(MavlinkHomes, VehiclesOnOneSpotWhileTheFleetPutsThemApartAreRefusedBeforeAr
   fs::remove_all(dir);
 }
 
+TEST(MavlinkHomes, VehiclesOnOneSpotWhileTheFleetPutsThemApartAreRefusedBeforeArming) {
+  fly_on_one_spot("homes", "42", [](const fs::path&) { return std::string(); });
+}
+
 // The same field with one DEX per drone (domain 78, used by no other test): each DEX reports
 // where its vehicle stands with its READY, and the ground refuses the start barrier.
 TEST(MavlinkHomes, OneDexPerDroneTheGroundRefusesTheStartWhenTheVehiclesStandElsewhere) {
-  fs::path dir = fs::temp_directory_path() / ("eamos-mavlink-homes-dist-" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  std::string fleet = read_text(fs::path(EAMOS_TEST_DATA) / "data/listing2-mavlink.yaml");
-  for (size_t at; (at = fleet.find(":2532")) != std::string::npos;) fleet.replace(at, 5, ":2543");
-  std::ofstream(dir / "fleet.yaml") << fleet;
-  std::vector<pid_t> vehicles;
-  for (int i = 1; i <= 3; ++i) vehicles.push_back(spawn_vehicle(25430 + i, i, "60", "100", 0.0));
-  std::string out;
-  int status = run("run " + std::string(EAMOS_SOURCE_DIR) + "/examples/listing2.eamos --fleet " +
-                       (dir / "fleet.yaml").string() + " --distributed --domain 78 --speed 4 --deploy-dir " +
-                       (dir / "deploy").string() + " --trace " + (dir / "trace.jsonl").string(),
-                   out);
-  for (pid_t pid : vehicles) {
-    kill(pid, SIGTERM);
-    waitpid(pid, nullptr, 0);
-  }
-  EXPECT_EQ(status, 1) << out;
-  expect_homes_refused(out, dir / "trace.jsonl");
-  fs::remove_all(dir);
+  fly_on_one_spot("homes-dist", "43", [](const fs::path& dir) {
+    return " --distributed --domain 78 --deploy-dir " + (dir / "deploy").string();
+  });
 }
 
 }  // namespace
