@@ -72,19 +72,10 @@ void print_diagnostics(const Diagnostics& diags, bool on_stdout) {
 }
 
 bool load_compiled_missions(const graph::Compilation& c, std::vector<dex::Mission>& missions) {
-  std::string hash = deploy::mission_hash(c);
-  missions.assign(c.drone_count(), dex::Mission{});
-  dex::MissionTables tables;  // each file names the whole fleet: one copy in memory, not one a drone
-  for (int d = 0; d < c.drone_count(); ++d) {
-    std::vector<std::string> errors;
-    if (!deploy::read_mission(deploy::mission_text(c, d, hash), c.drone_name(d) + "/mission.json", missions[d],
-                              errors)) {
-      for (const std::string& e : errors) std::cerr << e << "\n";
-      return false;
-    }
-    tables.share(missions[d]);
-  }
-  return true;
+  std::vector<std::string> errors;
+  if (deploy::read_compiled_missions(c, missions, errors)) return true;
+  for (const std::string& e : errors) std::cerr << e << "\n";
+  return false;
 }
 
 bool write_output(const std::string& path, const std::string& text) {

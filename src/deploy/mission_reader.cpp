@@ -248,7 +248,7 @@ bool contains(const std::vector<std::string>& list, const std::string& s) {
 /// Reads one mission document into a dex::Mission, member by member.
 class Reader {
  public:
-  Reader(Defects& d, dex::Mission& m) : f_(d), d_(d), m_(m) {}
+  Reader(Defects& d, dex::Mission& m, FleetTables& tables) : f_(d), d_(d), m_(m), t_(tables) {}
 
   void read(const json& file) {
     if (!f_.object(file, "")) return;
@@ -286,9 +286,14 @@ class Reader {
     }
   }
 
+  /// `fleet`: required, unless the tables shared with earlier reads hold it already.
   bool fleet(const json& file) {
-    const json* fleet = f_.member(file, "fleet", "");
-    if (!fleet || !f_.array(*fleet, "/fleet")) return false;
+    const json* fleet = f_.member(file, "fleet", "", t_.fleet.empty());
+    if (!fleet) {
+      m_.fleet = t_.fleet;
+      return !t_.fleet.empty();
+    }
+    if (!f_.array(*fleet, "/fleet")) return false;
     if (fleet->empty() || fleet->size() > kMaxDrones) {
       d_.add("/fleet", "a fleet of " + std::to_string(fleet->size()) + " drones (expected 1 to " +
                            std::to_string(kMaxDrones) + ")");
@@ -297,20 +302,25 @@ class Reader {
     bool ok = true;
     std::vector<std::string> names;
     names.reserve(fleet->size());
+    std::unordered_map<std::string, int> index;
     for (std::size_t i = 0; i < fleet->size(); ++i) {
       std::string name;
       if (!f_.string_value((*fleet)[i], at("/fleet", i), name)) {
         ok = false;
         continue;
       }
-      if (name.empty() || fleet_index_.count(name) > 0) {
+      if (name.empty() || index.count(name) > 0) {
         d_.add(at("/fleet", i), name.empty() ? "empty drone name" : "drone \"" + name + "\" is listed twice");
         ok = false;
       }
-      fleet_index_.emplace(name, static_cast<int>(names.size()));
+      index.emplace(name, static_cast<int>(names.size()));
       names.push_back(std::move(name));
     }
-    m_.fleet = dex::SharedTable<std::vector<std::string>>(std::move(names));
+    // This file's fleet is the one its later members name, and the one later reads share.
+    t_ = FleetTables{};
+    t_.fleet = dex::SharedTable<std::vector<std::string>>(std::move(names));
+    t_.index = std::move(index);
+    m_.fleet = t_.fleet;
     return ok;
   }
 
@@ -321,6 +331,7 @@ class Reader {
       f_.number(*s, "vertical", "/separation", m_.separation.vertical_m, 1e-9, kAny);
     }
     const json* list = f_.member(file, "priorities", "", false);
+    if (!list) m_.priorities = t_.priorities;  // none, or the ones a shared read took
     if (!list || !f_.array(*list, "/priorities")) return;
     if (list->size() != m_.fleet.size())
       return d_.add("/priorities", "holds " + std::to_string(list->size()) + " priorities for a fleet of " +
@@ -328,34 +339,48 @@ class Reader {
     std::vector<int> priorities(list->size(), 0);
     for (std::size_t i = 0; i < list->size(); ++i)
       f_.integer_value((*list)[i], at("/priorities", i), priorities[i], 1, 1000000);
-    m_.priorities = dex::SharedTable<std::vector<int>>(std::move(priorities));
+    m_.priorities = t_.priorities = dex::SharedTable<std::vector<int>>(std::move(priorities));
   }
 
   /// `drone_sets`: each a list of [first, last] drone index ranges, ascending and apart.
+  /// A set is expanded once per list of ranges (FleetTables::sets): k drones that all wait
+  /// at a fleet-wide barrier hold one list of k drones, built once.
   void drone_sets(const json& file) {
     const json* list = f_.member(file, "drone_sets", "", false);
     if (!list || !f_.array(*list, "/drone_sets")) return;
     for (std::size_t i = 0; i < list->size(); ++i) {
       std::string where = at("/drone_sets", i);
-      std::vector<int> set;
-      const json& ranges = (*list)[i];
-      if (f_.array(ranges, where))
-        for (std::size_t r = 0; r < ranges.size(); ++r) drone_range(ranges[r], at(where, r), set);
-      m_.drone_sets.emplace_back(std::move(set));
+      std::vector<std::pair<int, int>> ranges;
+      const json& list_i = (*list)[i];
+      bool ok = f_.array(list_i, where);
+      for (std::size_t r = 0; ok && r < list_i.size(); ++r) ok = drone_range(list_i[r], at(where, r), ranges);
+      if (!ok) {
+        m_.drone_sets.emplace_back();
+        continue;
+      }
+      auto [it, added] = t_.sets.try_emplace(std::move(ranges));
+      if (added) {
+        std::vector<int> set;
+        for (auto [first, last] : it->first)
+          for (int d = first; d <= last; ++d) set.push_back(d);
+        it->second = dex::SharedTable<std::vector<int>>(std::move(set));
+      }
+      m_.drone_sets.push_back(it->second);
     }
   }
 
-  void drone_range(const json& j, const std::string& where, std::vector<int>& set) {
-    if (!f_.array(j, where)) return;
-    if (j.size() != 2) return d_.add(where, "a drone range is [first, last]");
+  bool drone_range(const json& j, const std::string& where, std::vector<std::pair<int, int>>& ranges) {
+    if (!f_.array(j, where)) return false;
+    if (j.size() != 2) return d_.add(where, "a drone range is [first, last]"), false;
     int last_drone = static_cast<int>(m_.fleet.size()) - 1;
     int first = 0, last = 0;
     if (!f_.integer_value(j[0], at(where, 0), first, 0, last_drone) ||
         !f_.integer_value(j[1], at(where, 1), last, first, last_drone))
-      return;
-    if (!set.empty() && first <= set.back() + 1)
-      return d_.add(where, "ranges must ascend with a gap between them");
-    for (int d = first; d <= last; ++d) set.push_back(d);
+      return false;
+    if (!ranges.empty() && first <= ranges.back().second + 1)
+      return d_.add(where, "ranges must ascend with a gap between them"), false;
+    ranges.emplace_back(first, last);
+    return true;
   }
 
   /// A sync point's `waits` (internal clones) and `notify` (its drone's arrival).
@@ -378,8 +403,8 @@ class Reader {
   int drone_index(const json& j, const Loc& where) {
     std::string name;
     if (!f_.string_value(j, where, name)) return -1;
-    auto it = fleet_index_.find(name);
-    if (it == fleet_index_.end()) {
+    auto it = t_.index.find(name);
+    if (it == t_.index.end()) {
       d_.add(where, "drone \"" + name + "\" is not in the mission's fleet");
       return -1;
     }
@@ -772,7 +797,7 @@ class Reader {
   Fields f_;
   Defects& d_;
   dex::Mission& m_;
-  std::unordered_map<std::string, int> fleet_index_;  ///< drone name → its index in the fleet
+  FleetTables& t_;  ///< the fleet's names, priorities and drone sets (one file's, or shared)
 };
 
 /// Where the file hash member starts (at its comma) and its value, or npos when the file
@@ -849,20 +874,41 @@ json parse_bounded(std::string_view text, Defects& d) {
 }  // namespace
 
 bool read_mission(std::string_view text, const std::string& file, dex::Mission& out,
-                  std::vector<std::string>& errors) {
+                  std::vector<std::string>& errors, FleetTables& tables) {
   std::size_t before = errors.size();
   std::vector<std::string> found;
   Defects d{file, found};
   out = dex::Mission{};
   check_file_hash(text, d);
   json doc = parse_bounded(text, d);
-  if (!doc.is_discarded()) Reader(d, out).read(doc);
+  if (!doc.is_discarded()) Reader(d, out, tables).read(doc);
   if (d.dropped > 0)
     found.push_back(file + ": error: " + std::to_string(d.dropped) + " more defects not shown");
   errors.insert(errors.end(), found.begin(), found.end());
   if (errors.size() == before) return true;
   out = dex::Mission{};
   return false;
+}
+
+bool read_mission(std::string_view text, const std::string& file, dex::Mission& out,
+                  std::vector<std::string>& errors) {
+  FleetTables own;  // a file alone holds its whole fleet
+  return read_mission(text, file, out, errors, own);
+}
+
+bool read_compiled_missions(const graph::Compilation& c, std::vector<dex::Mission>& out,
+                            std::vector<std::string>& errors, std::size_t* text_bytes) {
+  const std::string hash = mission_hash(c);
+  out.assign(c.drone_count(), dex::Mission{});
+  FleetTables tables;
+  std::size_t bytes = 0;
+  for (int d = 0; d < c.drone_count(); ++d) {
+    std::string text = mission_text(c, d, hash, d == 0 ? FleetMembers::written : FleetMembers::shared);
+    bytes += text.size();
+    if (!read_mission(text, c.drone_name(d) + "/mission.json", out[d], errors, tables)) return false;
+  }
+  if (text_bytes) *text_bytes = bytes;
+  return true;
 }
 
 bool read_mission_file(const std::string& path, dex::Mission& out, std::vector<std::string>& errors) {

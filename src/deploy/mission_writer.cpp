@@ -141,7 +141,7 @@ void write_settings(JsonWriter& w, const fleet::DroneSettings& s, int index) {
 
 /// `separation` (min_separation, when not the default) and `priorities` (when any drone
 /// sets `priority:`): written only then, so a mission without them keeps its file and hash.
-void write_separation(JsonWriter& w, const Compilation& c) {
+void write_separation(JsonWriter& w, const Compilation& c, FleetMembers fleet_members = FleetMembers::written) {
   const fleet::Separation& s = c.fleet.safety.min_separation;
   if (s.horizontal_m != fleet::Separation{}.horizontal_m || s.vertical_m != fleet::Separation{}.vertical_m) {
     w.key("separation");
@@ -150,6 +150,7 @@ void write_separation(JsonWriter& w, const Compilation& c) {
     w.member("vertical", s.vertical_m);
     w.end_object();
   }
+  if (fleet_members == FleetMembers::shared) return;
   bool any = false;
   for (const fleet::DroneSettings& d : c.settings) any |= d.priority > 0;
   if (!any) return;
@@ -361,7 +362,8 @@ class DigestBuffer : public std::streambuf {
 // The file hash is the last member, over every byte before it (docs/architecture.md,
 // "Mission file"): the reader checks it without a canonical form of its own, and any edit
 // of the file, even of white space, is caught.
-bool write_drone_mission(std::ostream& out, const Compilation& c, int drone, const std::string& hash) {
+bool write_drone_mission(std::ostream& out, const Compilation& c, int drone, const std::string& hash,
+                         FleetMembers fleet_members) {
   Sha256 sha;
   DigestBuffer tee(sha, &out);
   std::ostream both(&tee);
@@ -380,14 +382,16 @@ bool write_drone_mission(std::ostream& out, const Compilation& c, int drone, con
   write_settings(w, c.settings[drone], drone);
   w.key("type");
   write_type(w, c.checked.drone_types[drone]);
-  w.key("fleet");
-  w.begin_array();
-  for (int d = 0; d < c.drone_count(); ++d) w.value(c.drone_name(d));
-  w.end_array();
+  if (fleet_members == FleetMembers::written) {
+    w.key("fleet");
+    w.begin_array();
+    for (int d = 0; d < c.drone_count(); ++d) w.value(c.drone_name(d));
+    w.end_array();
+  }
   const graph::Mdg& g = c.mdgs[drone];
   w.key("reads");
   write_drone_names(w, c, g.reads);
-  write_separation(w, c);
+  write_separation(w, c, fleet_members);
   write_mdg(w, c, g);
   if (!w.flush()) return false;
   tee.stop_digest();
@@ -396,9 +400,9 @@ bool write_drone_mission(std::ostream& out, const Compilation& c, int drone, con
   return w.flush() && static_cast<bool>(out);
 }
 
-std::string mission_text(const Compilation& c, int drone, const std::string& hash) {
+std::string mission_text(const Compilation& c, int drone, const std::string& hash, FleetMembers fleet_members) {
   std::ostringstream out;
-  write_drone_mission(out, c, drone, hash);
+  write_drone_mission(out, c, drone, hash, fleet_members);
   return out.str();
 }
 

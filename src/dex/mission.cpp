@@ -30,31 +30,4 @@ long long Mission::messages_per_pass() const {
   return pass;
 }
 
-namespace {
-
-std::size_t hash_of(const std::vector<int>& set) {
-  std::size_t h = set.size();
-  for (int d : set) h = h * 1000003u ^ static_cast<std::size_t>(d);
-  return h;
-}
-
-}  // namespace
-
-void MissionTables::share(Mission& m) {
-  if (!first_) {
-    first_.emplace();
-    first_->fleet = m.fleet;
-    first_->priorities = m.priorities;
-  } else {
-    if (m.fleet == first_->fleet) m.fleet = first_->fleet;
-    if (m.priorities == first_->priorities) m.priorities = first_->priorities;
-  }
-  for (SharedTable<std::vector<int>>& set : m.drone_sets) {
-    std::vector<SharedTable<std::vector<int>>>& same_hash = sets_[hash_of(set.get())];
-    auto it = std::find(same_hash.begin(), same_hash.end(), set);
-    if (it == same_hash.end()) same_hash.push_back(set);
-    else set = *it;
-  }
-}
-
 }  // namespace eamos::dex

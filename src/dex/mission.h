@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <initializer_list>
 #include <map>
-#include <optional>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -20,8 +19,8 @@ namespace eamos::dex {
 
 /// A read-only table that the Missions of one process may hold in common: the fleet's
 /// names, its priorities, a drone set. Every drone's file carries them whole, so a fleet of
-/// k drones in one process would hold each k times (at 10,000 drones, 10⁸ names);
-/// MissionTables makes equal tables one. Read like the vector it holds.
+/// k drones in one process would hold each k times (at 10,000 drones, 10⁸ names); the
+/// reads of one process share one (deploy::FleetTables). Read like the vector it holds.
 template <typename T>
 class SharedTable {
  public:
@@ -108,19 +107,6 @@ struct Mission {
     return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(meg)) << 32) | static_cast<std::uint32_t>(drone);
   }
   std::unordered_map<std::uint64_t, int> index;  ///< key(meg, drone) → node index
-};
-
-/// Makes the tables of the Missions it is given, one after the other, shared where equal:
-/// each mission's fleet names and priorities with the first one's, and each drone set with
-/// an equal set of an earlier mission. Given each mission as soon as it is read, the peak
-/// stays linear in the fleet.
-class MissionTables {
- public:
-  void share(Mission& m);
-
- private:
-  std::optional<Mission> first_;  ///< holds the first mission's fleet and priorities
-  std::unordered_map<std::size_t, std::vector<SharedTable<std::vector<int>>>> sets_;  ///< by content hash
 };
 
 }  // namespace eamos::dex

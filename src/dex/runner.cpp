@@ -71,7 +71,7 @@ class InProcessTransport : public Transport {
   /// waits for comes (the barrier passes, at the same instant and in the same order as with
   /// every arrival delivered). A fleet-wide barrier costs k engine calls instead of k².
   struct Barrier {
-    const std::vector<int>* to = nullptr;  ///< interned (MissionTables): one set, one address
+    const std::vector<int>* to = nullptr;  ///< interned (deploy::FleetTables): one set, one address
     std::vector<int> clones;     ///< per drone of `to`: its clone's node index, or -1
     std::vector<char> counted;   ///< the clone's arrivals are counted here
     std::vector<char> arrived;   ///< its drone has arrived (announced) itself

@@ -94,18 +94,13 @@ void check_args(const RunArgs& a) {
     throw py::type_error("on_event must be a callable taking one event (a dict), or None");
 }
 
-std::vector<dex::Mission> load_missions(const graph::Compilation& c, const std::string& hash) {
-  std::vector<dex::Mission> missions(c.drone_count());
-  dex::MissionTables tables;  // one copy of the fleet's names, not one a drone
-  for (int d = 0; d < c.drone_count(); ++d) {
-    std::vector<std::string> errors;
-    if (!deploy::read_mission(deploy::mission_text(c, d, hash), c.drone_name(d) + "/mission.json", missions[d],
-                              errors)) {
-      std::string all;
-      for (const std::string& e : errors) all += e + "\n";
-      throw std::runtime_error(all);
-    }
-    tables.share(missions[d]);
+std::vector<dex::Mission> load_missions(const graph::Compilation& c) {
+  std::vector<dex::Mission> missions;
+  std::vector<std::string> errors;
+  if (!deploy::read_compiled_missions(c, missions, errors)) {
+    std::string all;
+    for (const std::string& e : errors) all += e + "\n";
+    throw std::runtime_error(all);
   }
   return missions;
 }
@@ -183,8 +178,8 @@ py::dict run(const CompiledMission& m, const RunArgs& a) {
   if (!m.ok) throw std::runtime_error("the mission did not compile: " + m.diags.format());
   check_args(a);
   const graph::Compilation& c = m.c;
-  std::string hash = deploy::mission_hash(c);
-  std::vector<dex::Mission> missions = load_missions(c, hash);
+  std::vector<dex::Mission> missions = load_missions(c);
+  const std::string hash = missions.front().hash;  // deploy::mission_hash(c), as every file carries it
   // The output is checked before anything flies.
   std::ofstream trace_file;
   if (a.trace) {

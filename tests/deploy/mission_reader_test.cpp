@@ -208,6 +208,52 @@ TEST_F(MissionReader, StopsListingDefectsAfterFifty) {
   EXPECT_NE(errors.back().find("more defects not shown"), std::string::npos) << errors.back();
 }
 
+// `eamos run` reads its drones' texts without the members every file holds alike; such a
+// text is no mission file, and read alone it is refused as one missing its fleet.
+TEST_F(MissionReader, ATextThatLeavesItsFleetToAnEarlierReadIsRefusedAlone) {
+  std::string text = deploy::mission_text(*c_, 1, deploy::mission_hash(*c_), deploy::FleetMembers::shared);
+  EXPECT_EQ(defects(text), "Drone1/mission.json: error: member \"fleet\" is missing\n");
+}
+
+// Every drone's whole file holds the same `fleet` and `priorities`, byte for byte, so one
+// process may read them once: each drone's mission is then what its file alone gives.
+TEST(FleetMissions, ReadTogetherEachDroneHoldsWhatItsWholeFileHolds) {
+  auto c = test::compile_mission(test::listing2_text(), std::string(test::kListing2Fleet) + "    priority: 1\n");
+  ASSERT_TRUE(c);
+  std::vector<dex::Mission> together;
+  std::vector<std::string> errors;
+  ASSERT_TRUE(deploy::read_compiled_missions(*c, together, errors)) << errors.front();
+  ASSERT_EQ(together.size(), 3u);
+  std::string hash = deploy::mission_hash(*c);
+  json first = json::parse(deploy::mission_text(*c, 0, hash));
+  ASSERT_TRUE(first.contains("priorities"));
+  for (int d = 0; d < 3; ++d) {
+    std::string text = deploy::mission_text(*c, d, hash);
+    json whole = json::parse(text);
+    EXPECT_EQ(whole["fleet"].dump(), first["fleet"].dump());
+    EXPECT_EQ(whole["priorities"].dump(), first["priorities"].dump());
+    dex::Mission alone;
+    ASSERT_TRUE(deploy::read_mission(text, "f", alone, errors)) << errors.front();
+    const dex::Mission& m = together[d];
+    EXPECT_TRUE(m.fleet.same_as(together[0].fleet));
+    EXPECT_EQ(m.fleet.get(), alone.fleet.get());
+    EXPECT_EQ(m.priorities.get(), alone.priorities.get());
+    EXPECT_EQ(m.priorities.get(), (std::vector<int>{1, 1, 3}));  // Drone2 ranks with Drone1
+    EXPECT_EQ(m.self, alone.self);
+    EXPECT_EQ(m.reads, alone.reads);
+    EXPECT_EQ(m.hash, alone.hash);
+    ASSERT_EQ(m.nodes.size(), alone.nodes.size());
+    for (std::size_t i = 0; i < m.nodes.size(); ++i) {
+      EXPECT_EQ(m.nodes[i].text, alone.nodes[i].text);
+      EXPECT_EQ(m.nodes[i].drone, alone.nodes[i].drone);
+      EXPECT_EQ(m.nodes[i].waits_count, alone.nodes[i].waits_count);
+    }
+    EXPECT_EQ(m.arcs.size(), alone.arcs.size());
+    ASSERT_EQ(m.drone_sets.size(), alone.drone_sets.size());
+    for (std::size_t s = 0; s < m.drone_sets.size(); ++s) EXPECT_EQ(m.drone_sets[s].get(), alone.drone_sets[s].get());
+  }
+}
+
 TEST_F(MissionReader, RefusesAFileThatCannotBeRead) {
   dex::Mission m;
   std::vector<std::string> errors;

@@ -68,20 +68,20 @@ inline std::vector<dex::Mission> missions_of(const std::string& text, const flee
     ADD_FAILURE() << diags.format();
     return {};
   }
+  std::vector<dex::Mission> missions;
+  std::vector<std::string> errors;
+  if (!edit) {  // as `eamos run` loads them
+    EXPECT_TRUE(deploy::read_compiled_missions(c, missions, errors)) << (errors.empty() ? "" : errors.front());
+    return missions;
+  }
   std::string hash = deploy::mission_hash(c);
-  std::vector<dex::Mission> missions(c.drone_count());
-  dex::MissionTables tables;  // as `eamos run` loads them
+  missions.resize(c.drone_count());
+  deploy::FleetTables tables;
   for (int d = 0; d < c.drone_count(); ++d) {
-    std::string text = deploy::mission_text(c, d, hash);
-    if (edit) {
-      nlohmann::json file = nlohmann::json::parse(text);
-      edit(file);
-      text = eamos_test::sealed(file);
-    }
-    std::vector<std::string> errors;
-    EXPECT_TRUE(deploy::read_mission(text, c.drone_name(d), missions[d], errors))
+    nlohmann::json file = nlohmann::json::parse(deploy::mission_text(c, d, hash));
+    edit(file);
+    EXPECT_TRUE(deploy::read_mission(eamos_test::sealed(file), c.drone_name(d), missions[d], errors, tables))
         << (errors.empty() ? "" : errors.front());
-    tables.share(missions[d]);
   }
   return missions;
 }

@@ -129,5 +129,26 @@ TEST(Scale, FiveHundredDronesMissionsHoldTheFleetsNamesAndSetsOnce) {
   EXPECT_LT(per_drone, 20u * 1024) << "bytes held per drone";
 }
 
+/// Bytes of mission text `eamos run` reads to load every drone of `text`.
+std::size_t text_bytes_loaded(const std::string& text) {
+  graph::Compilation c;
+  Diagnostics diags;
+  EXPECT_TRUE(graph::compile(std::make_shared<SourceFile>("show.eamos", text), {}, diags, c)) << diags.format();
+  std::vector<dex::Mission> missions;
+  std::vector<std::string> errors;
+  std::size_t bytes = 0;
+  EXPECT_TRUE(deploy::read_compiled_missions(c, missions, errors, &bytes)) << (errors.empty() ? "" : errors[0]);
+  return bytes;
+}
+
+// Loading a show of twice the drones reads twice the text, not four times: were each drone's
+// text to name the whole fleet, 10,000 drones would write, hash and parse 10⁸ names.
+TEST(Scale, LoadingAFleetReadsTextLinearInItsDrones) {
+  std::size_t small = text_bytes_loaded(generated(stress::Shape::show, 200, 200 * 4));
+  std::size_t large = text_bytes_loaded(generated(stress::Shape::show, 400, 400 * 4));
+  ASSERT_GT(small, 0u);
+  EXPECT_LE(large, small * 2 + small / 50) << small << " -> " << large << " bytes";
+}
+
 }  // namespace
 }  // namespace eamos
