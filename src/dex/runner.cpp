@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
+#include <set>
 #include <unordered_map>
+#include <utility>
 
 #include "diag/log.h"
 #include "mid/home_check.h"
@@ -66,17 +69,22 @@ class InProcessTransport : public Transport {
  private:
   /// A sync point outside every Repeat/Do body (reached once per drone) whose arrivals all go
   /// to one set, in a run whose trace keeps no messages. Its clones' arrivals are counted
-  /// here, in arrays the size of the set, and an engine hears of them only when it matters:
-  /// when it arrives itself (it learns how many came before) and when the last arrival it
-  /// waits for comes (the barrier passes, at the same instant and in the same order as with
-  /// every arrival delivered). A fleet-wide barrier costs k engine calls instead of k².
+  /// here, and an engine hears of them only when it matters: when it arrives itself (it
+  /// learns how many came before) and when the last arrival it waits for comes (the barrier
+  /// passes, at the same instant and in the same order as with every arrival delivered). A
+  /// delivery looks only at the drones it must tell, not at the whole set: a fleet-wide
+  /// barrier costs O(k log k), where k engine calls per arrival cost k², and a loop over the
+  /// set per arrival still k² cheap steps (5·10⁹ for 52 barriers of 10,000 drones).
   struct Barrier {
     const std::vector<int>* to = nullptr;  ///< interned (deploy::FleetTables): one set, one address
     std::vector<int> clones;     ///< per drone of `to`: its clone's node index, or -1
     std::vector<char> counted;   ///< the clone's arrivals are counted here
     std::vector<char> arrived;   ///< its drone has arrived (announced) itself
-    std::vector<int> untold;     ///< arrivals counted here, not yet told its engine
-    std::vector<int> missing;    ///< after its drone arrived: arrivals it still waits for
+    std::vector<int> missing;    ///< at its drone's arrival: arrivals it still waited for
+    std::vector<long long> pass_at;  ///< while it waits: the delivery (by number) it passes at
+    long long delivered = 0;     ///< arrivals delivered so far: what a drone not yet arrived is untold
+    std::set<std::pair<long long, int>> due;  ///< (pass_at, i) of the drones still waiting
+    std::set<int> every;         ///< told of every delivery: clones not counted, drones no longer waiting
     bool each = false;           ///< another set reached it: every arrival goes to every engine
   };
 
@@ -92,7 +100,7 @@ class InProcessTransport : public Transport {
   void start_barrier(Barrier& b, const std::vector<int>& to, int meg) {
     b.to = &to;
     std::size_t k = to.size();
-    b.counted.assign(k, 0), b.arrived.assign(k, 0), b.untold.assign(k, 0), b.missing.assign(k, 0);
+    b.counted.assign(k, 0), b.arrived.assign(k, 0), b.missing.assign(k, 0), b.pass_at.assign(k, -1);
     for (std::size_t i = 0; i < k; ++i) {
       int clone = missions_[to[i]].find(meg, to[i]);
       b.clones.push_back(clone);
@@ -100,41 +108,68 @@ class InProcessTransport : public Transport {
       const Node& n = missions_[to[i]].nodes[clone];
       // Counted only where the engine's own arrival is what readies it (dex::Engine::arrive).
       b.counted[i] = n.scope < 0 && n.internal && n.notify >= 0 && n.exec_in > 0 && n.waits_count > 0;
+      if (!b.counted[i]) b.every.insert(static_cast<int>(i));
     }
+  }
+
+  /// Arrivals counted here for drone `i` and not yet told its engine.
+  static long long untold(const Barrier& b, std::size_t i) {
+    if (!b.counted[i]) return 0;
+    if (!b.arrived[i]) return b.delivered;
+    // Waiting: its pass_at lies `missing` deliveries (not its own) after its arrival.
+    return b.pass_at[i] < 0 ? 0 : b.missing[i] - (b.pass_at[i] - b.delivered);
   }
 
   /// Tells every engine what was counted for it and delivers each arrival from now on.
   void tell_all(Barrier& b) {
     for (std::size_t i = 0; i < b.clones.size(); ++i)
-      if (b.untold[i] > 0) engines_[(*b.to)[i]]->add_arrivals(b.clones[i], b.untold[i]);
+      if (long long n = untold(b, i); n > 0) engines_[(*b.to)[i]]->add_arrivals(b.clones[i], static_cast<int>(n));
     b.each = true;
   }
 
   /// Drone `d` arrives (inside its engine's arrive(), before it looks at its count): its
-  /// engine learns the arrivals counted so far, and from now on this counts down what it lacks.
+  /// engine learns the arrivals counted so far, and from now on it waits for the delivery
+  /// that brings the last arrival it lacks.
   void announced(Barrier& b, int d) {
     auto at = std::lower_bound(b.to->begin(), b.to->end(), d);
     if (at == b.to->end() || *at != d) return;
     std::size_t i = at - b.to->begin();
     if (!b.counted[i]) return;
-    b.missing[i] = engines_[d]->add_arrivals(b.clones[i], b.untold[i]);
-    b.untold[i] = 0;
+    b.missing[i] = engines_[d]->add_arrivals(b.clones[i], static_cast<int>(b.delivered));
     b.arrived[i] = 1;
+    if (b.missing[i] <= 1) {
+      b.every.insert(static_cast<int>(i));
+      return;
+    }
+    b.pass_at[i] = b.delivered + b.missing[i];
+    b.due.emplace(b.pass_at[i], static_cast<int>(i));
   }
 
   void deliver_counted(Barrier& b, const Message& m) {
     const std::vector<int>& to = *b.to;
-    for (std::size_t i = 0; i < to.size(); ++i) {
+    auto from = std::lower_bound(to.begin(), to.end(), m.from);
+    if (from != to.end() && *from == m.from) {
+      std::size_t f = from - to.begin();
+      if (b.pass_at[f] >= 0 && b.due.erase({b.pass_at[f], static_cast<int>(f)}) > 0)
+        b.due.emplace(++b.pass_at[f], static_cast<int>(f));  // its own arrival is none it waits for
+    }
+    ++b.delivered;
+    std::vector<int> passing;  // the drones this delivery brings their last awaited arrival
+    while (!b.due.empty() && b.due.begin()->first == b.delivered) {
+      passing.push_back(b.due.begin()->second);
+      b.due.erase(b.due.begin());
+    }
+    std::vector<int> told(b.every.begin(), b.every.end());
+    std::vector<int> all;  // in the set's order, as a delivery to each drone would reach them
+    std::merge(told.begin(), told.end(), passing.begin(), passing.end(), std::back_inserter(all));
+    for (int i : all) {
       int d = to[i];
       if (d == m.from || b.clones[i] < 0) continue;
-      if (b.counted[i] && (!b.arrived[i] || b.missing[i] > 1)) {
-        ++b.untold[i];
-        if (b.arrived[i]) --b.missing[i];
-        continue;
+      if (b.pass_at[i] >= 0) {
+        if (b.missing[i] > 1) engines_[d]->add_arrivals(b.clones[i], b.missing[i] - 1);
+        b.pass_at[i] = -1;
+        b.every.insert(i);
       }
-      if (b.counted[i] && b.untold[i] > 0) engines_[d]->add_arrivals(b.clones[i], b.untold[i]);
-      b.untold[i] = 0;
-      b.missing[i] = 0;
       engines_[d]->count_arrival(b.clones[i], m);  // the last one it waits for: it passes
     }
   }
