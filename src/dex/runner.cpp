@@ -63,6 +63,7 @@ class InProcessTransport : public Transport {
     }
   }
   int in_flight() const { return in_flight_; }
+  std::uint64_t set_delivery_steps() const { return set_steps_; }
   /// The drones whose mission reads drone `d`'s telemetry.
   const std::vector<int>& readers_of(int d) const { return readers_[d]; }
 
@@ -162,6 +163,7 @@ class InProcessTransport : public Transport {
     std::vector<int> told(b.every.begin(), b.every.end());
     std::vector<int> all;  // in the set's order, as a delivery to each drone would reach them
     std::merge(told.begin(), told.end(), passing.begin(), passing.end(), std::back_inserter(all));
+    set_steps_ += all.size();
     for (int i : all) {
       int d = to[i];
       if (d == m.from || b.clones[i] < 0) continue;
@@ -176,6 +178,7 @@ class InProcessTransport : public Transport {
 
   void deliver_each(const std::vector<int>& to, const Message& m) {
     const std::vector<int>& clones = clones_of(m.meg, to);
+    set_steps_ += to.size();
     for (std::size_t i = 0; i < to.size(); ++i) {
       int d = to[i];
       if (d == m.from) continue;
@@ -210,6 +213,7 @@ class InProcessTransport : public Transport {
   std::vector<std::vector<int>> readers_;  ///< per drone: the drones that read its telemetry
   std::function<void()> on_delivered_;
   int in_flight_ = 0;  ///< triggers and cancels sent, not yet handled
+  std::uint64_t set_steps_ = 0;  ///< RunResult::set_delivery_steps
 };
 
 /// The trace's last event: how the mission ended, at the instant it did.
@@ -542,6 +546,7 @@ void InProcessRun::summarise() {
     result_.drones.push_back({missions_[d].settings.name, drones_[d]->state(), std::move(tracks_[d])});
     result_.activations += engines_[d]->activations();
   }
+  result_.set_delivery_steps = transport_.set_delivery_steps();
 }
 
 }  // namespace

@@ -87,6 +87,9 @@ struct RunResult {
   std::string error;                  ///< human summary of the failure
   std::vector<DroneSummary> drones;
   std::uint64_t activations = 0;      ///< node activations over all drones
+  /// In process: drones that deliveries of sync-point arrivals to drone sets looked at, summed;
+  /// with messages traced, (k - 1) per arrival at a fleet-wide barrier; without, about one.
+  std::uint64_t set_delivery_steps = 0;
   /// Distributed runs: how late the messages between drones were (in process they take no time).
   std::optional<MessageLatency> latency;
 };

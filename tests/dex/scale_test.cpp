@@ -104,6 +104,26 @@ TEST(Scale, ARunWithoutMessagesPassesEveryBarrierAsARunThatTracesThem) {
   }
 }
 
+// Without a message trace, delivering an arrival looks only at the drones it must tell:
+// a show's steps grow with its fleet (the barriers stay the same), not with its square. A
+// look at the whole set per arrival would be 10⁸ steps per barrier of 10,000 drones.
+TEST(Scale, AnUntracedBarrierLooksAtTheDronesItTellsNotAtItsWholeSet) {
+  auto steps = [](int drones) {
+    mid::AdapterRegistry adapters;
+    sim::register_adapter(adapters);
+    AllButMessages sink;
+    dex::RunOptions options;
+    options.time_limit_s = 600;
+    dex::RunResult r = dex::run_in_process(test::missions_of(generated(stress::Shape::show, drones, drones * 6)),
+                                           adapters, &sink, options);
+    EXPECT_TRUE(r.completed) << r.error;
+    return r.set_delivery_steps;
+  };
+  std::uint64_t small = steps(16), large = steps(64);
+  ASSERT_GT(small, 0u);
+  EXPECT_LE(large, small * 6) << small << " -> " << large << " steps for 4 times the drones";
+}
+
 /// Bytes the process holds in malloc's blocks now.
 std::size_t held_bytes() {
   struct mallinfo2 i = mallinfo2();
