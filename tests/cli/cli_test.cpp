@@ -151,6 +151,14 @@ TEST_F(Cli, ADistributedOnlyRunOptionWithoutDistributedIsRefusedBeforeAnythingFl
   }
 }
 
+TEST_F(Cli, ALaunchStoppedBeforeTheFlightSaysWhyOnceAndNoEmptyFailureReason) {
+  ASSERT_EQ(eamos("compile -q --insecure " + kListing2 + " -o " + (dir_ / "deploy").string()).status, 0);
+  Output r = eamos("launch " + (dir_ / "deploy").string() + " --drones Nobody");
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("--drones names 'Nobody'"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("mission failed: \n"), std::string::npos) << "a failure without its reason: " << r.out;
+}
+
 TEST_F(Cli, StatsCountsNodesPerDrone) {
   Output r = eamos("stats -q " + kListing2);
   ASSERT_EQ(r.status, 0) << r.out;
