@@ -316,6 +316,11 @@ class Reader {
       index.emplace(name, static_cast<int>(names.size()));
       names.push_back(std::move(name));
     }
+    fleet_in_file_ = true;
+    if (ok && t_.fleet.get() == names) {  // the fleet an earlier read shares: keep its tables
+      m_.fleet = t_.fleet;
+      return true;
+    }
     // This file's fleet is the one its later members name, and the one later reads share.
     t_ = FleetTables{};
     t_.fleet = dex::SharedTable<std::vector<std::string>>(std::move(names));
@@ -331,7 +336,7 @@ class Reader {
       f_.number(*s, "vertical", "/separation", m_.separation.vertical_m, 1e-9, kAny);
     }
     const json* list = f_.member(file, "priorities", "", false);
-    if (!list) m_.priorities = t_.priorities;  // none, or the ones a shared read took
+    if (!list && !fleet_in_file_) m_.priorities = t_.priorities;  // the ones an earlier read took
     if (!list || !f_.array(*list, "/priorities")) return;
     if (list->size() != m_.fleet.size())
       return d_.add("/priorities", "holds " + std::to_string(list->size()) + " priorities for a fleet of " +
@@ -798,6 +803,7 @@ class Reader {
   Defects& d_;
   dex::Mission& m_;
   FleetTables& t_;  ///< the fleet's names, priorities and drone sets (one file's, or shared)
+  bool fleet_in_file_ = false;  ///< then its priorities are the file's own too (none when absent)
 };
 
 /// Where the file hash member starts (at its comma) and its value, or npos when the file
