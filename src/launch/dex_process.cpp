@@ -205,6 +205,7 @@ bool DexProcess::wait_for_start() {
       err_ << "eamos dex: error: " << name() << ": the ground gave up before the start: " << *gave_up << "\n";
       return false;
     }
+    publish_heard();
     if (!ready_sent) ready_sent = ready_when_all_seen();
     if (!ready_sent && wall_s() > unready_deadline) return leave_unready();
     for (const LifecycleSample& s : starts)
@@ -215,6 +216,16 @@ bool DexProcess::wait_for_start() {
       return false;
     }
   }
+}
+
+// How many drones this DEX has heard from, for the ground's waves: when it changed, at
+// most once a second (every other DEX reads the status too).
+void DexProcess::publish_heard() {
+  int heard = static_cast<int>(inbox_.latest().size());
+  if (heard == heard_published_ || wall_s() < heard_published_at_ + 1.0) return;
+  heard_published_ = heard;
+  heard_published_at_ = wall_s();
+  publish_status(true);
 }
 
 // With DDS Security, a drone not heard from by now has a handshake with this DEX that does

@@ -87,6 +87,7 @@ class DexProcess {
   bool wait_for_start();
   /// Writes READY when every other drone has been heard from; whether it did.
   bool ready_when_all_seen();
+  void publish_heard();
   /// Gives up waiting for the other drones (DexProcessOptions::unready_limit_s); false.
   bool leave_unready();
   /// A START seen while waiting: true when it starts this process's run, false when this
@@ -214,6 +215,8 @@ class DexProcess {
   std::set<std::string> rejected_;                        ///< what was logged as ignored
   std::optional<LifecycleSample> pending_finished_;       ///< a FINISHED this DEX does not agree with (yet)
   double joined_at_ = 0.0;  ///< wall time the DDS participant was created
+  int heard_published_ = 0;            ///< other drones heard from, as last published (status)
+  double heard_published_at_ = -1e300;  ///< wall time of that status
   double state_period_s = 0.0;                 ///< mission seconds between published states; 0: every change
   double state_published_at_ = -1e300;         ///< mission time of the last published state
   std::optional<mid::DroneState> state_due_;   ///< newest state not yet published; a timer is set for it

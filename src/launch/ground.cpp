@@ -47,6 +47,7 @@ struct DroneEntry {
   double started_at = 0.0;  ///< wall time its DEX process was started
   bool started = false;     ///< its DEX process was started (by this launch, in its wave)
   bool heard = false;       ///< the ground has a sample of its DEX: their handshake is done
+  int heard_drones = 0;     ///< other drones its DEX has heard from while waiting (its status)
 };
 
 bool read_manifest(const std::string& dir, std::string& hash, std::vector<DroneEntry>& drones, std::string& error) {
@@ -419,22 +420,27 @@ bool Ground::start_processes() {
   wave_size_ = o_.start_wave > 0 ? o_.start_wave : start_wave_for(local, !o_.insecure);
   if (wave_size_ < local)
     out_ << "ground: starting " << local << " DEX processes in waves of " << wave_size_
-         << ", each once the ground has heard from every DEX before it\n";
+         << ", each once the DEXes before it have heard from each other\n";
   return start_next_wave();
 }
 
 bool Ground::start_next_wave() {
-  for (const auto& d : drones_)
-    if (d.started && !d.heard) return true;  // the last wave is still joining
   int started = 0, waiting = 0;
   for (const auto& d : drones_) {
     started += d.started;
     waiting += d.local && !d.started;
   }
   if (waiting == 0) return true;
-  if (started > 0)
-    out_ << "ground: heard from the " << started << " DEX processes started so far; starting "
-         << std::min(waiting, wave_size_) << " more\n";
+  // The last wave is still joining until the ground has heard from each DEX started so far
+  // and each of them from all the others.
+  for (const auto& d : drones_)
+    if (d.started && (!d.heard || (d.heard_drones < started - 1 && !d.ready_nonce))) return true;
+  if (started > 0) {
+    char took[64];
+    std::snprintf(took, sizeof took, "%.1f", wall_s() - (barrier_deadline_ - o_.barrier_timeout_s));
+    out_ << "ground: the " << started << " DEX processes started so far have heard from each other (" << took
+         << " s after the first was started); starting " << std::min(waiting, wave_size_) << " more\n";
+  }
   std::string exe = o_.exe.empty() ? self_exe() : o_.exe;
   int n = 0;
   for (auto& d : drones_) {
@@ -768,7 +774,11 @@ void Ground::check_pending_finished() {
 
 void Ground::on_status(const StatusSample& s) {
   // Statuses of waiting DEXes (run 0) say nothing the barrier needs: READY does.
-  if (stage_ == Stage::barrier && s.mission_hash == hash_) return refuse_second_launch(s);
+  if (stage_ == Stage::barrier && s.mission_hash == hash_) {
+    if (s.run_id == 0 && s.phase == Phase::waiting && s.drone >= 0 && s.drone < static_cast<int>(drones_.size()))
+      drones_[s.drone].heard_drones = std::max(drones_[s.drone].heard_drones, s.heard);
+    return refuse_second_launch(s);
+  }
   if (stage_ != Stage::running) return;
   if (!ours(s.mission_hash) || s.run_id != r_.run_id || s.drone < 0 || s.drone >= static_cast<int>(drones_.size()))
     return;

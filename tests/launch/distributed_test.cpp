@@ -275,15 +275,16 @@ TEST_F(Distributed, StartBarrierTimeoutAbortsWithTheMissingDrones) {
 
 // A fleet started all at once floods every participant with discovery and DDS Security
 // handshakes at the same instant (thirty secure DEXes on a 2-core host were not ready in
-// 85 s). In waves, a DEX starts only once the ground has heard from every one before it.
+// 85 s). In waves, a DEX starts only once the ground has heard from every one before it and
+// they from each other (their handshakes done).
 TEST_F(Distributed, AFleetStartedInWavesStartsEachWaveOnceTheGroundHeardTheOnesBefore) {
   fs::path deploy = deploy_listing2(dir_);
   Output r = eamos("launch " + deploy.string() + " --start-wave 1 --speed 5 --domain 42");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("starting 3 DEX processes in waves of 1"), std::string::npos) << r.out;
   auto at = [&](const std::string& s) { return r.out.find(s); };
-  std::size_t first = at("started the DEX of Drone1"), heard1 = at("heard from the 1 DEX processes started so far"),
-              second = at("started the DEX of Drone2"), heard2 = at("heard from the 2 DEX processes started so far"),
+  std::size_t first = at("started the DEX of Drone1"), heard1 = at("the 1 DEX processes started so far have heard from each other"),
+              second = at("started the DEX of Drone2"), heard2 = at("the 2 DEX processes started so far have heard from each other"),
               third = at("started the DEX of Drone3");
   ASSERT_NE(third, std::string::npos) << r.out;
   EXPECT_LT(first, heard1) << r.out;
