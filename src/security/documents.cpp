@@ -24,8 +24,8 @@ std::string governance_xml() {
   // liveliness and whole RTPS messages, each with its sender participant's key, so every
   // submessage and payload is inside one. Protecting submessages and payloads once more
   // (metadata/data protection) would add no secret, yet costs every matched pair of
-  // endpoints its own key exchange: 16 more DDS Security messages per pair of drones, and a
-  // fleet of 100 on one host no longer authenticated within Cyclone's handshake timeout.
+  // endpoints its own key exchange: 16 more DDS Security messages per pair of drones, which
+  // slowed the start of a fleet on one host (docs/performance.md).
   return R"(<?xml version="1.0" encoding="UTF-8"?>
 <dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-SECURITY/20170901/omg_shared_ca_governance.xsd">
   <domain_access_rules>
