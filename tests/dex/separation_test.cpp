@@ -408,8 +408,8 @@ TEST(SeparationGuard, ADroneOnARowFartherThanEitherCanFlyIsNotForeseen) {
       g.sample(0, t, 10.0 * t);
     }
     EXPECT_GE(g.guard->pairs_predicted(), 1u) << north;
-    if (north == 40.0) EXPECT_EQ(g.guard->pairs_foreseen(), 0u);
-    else EXPECT_EQ(g.guard->pairs_foreseen(), g.guard->pairs_predicted());
+    const std::uint64_t foreseen = north == 40.0 ? 0u : g.guard->pairs_predicted();
+    EXPECT_EQ(g.guard->pairs_foreseen(), foreseen) << north;
     EXPECT_EQ(g.conflicts(), 0);
   }
 }
