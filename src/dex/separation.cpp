@@ -110,17 +110,8 @@ double reach_within(const Course& c, double horizon_s) {
 
 Box Box::of(Vec a, Vec b) { return {std::min(a.x, b.x), std::max(a.x, b.x), std::min(a.y, b.y), std::max(a.y, b.y)}; }
 
-Box Box::around(Vec c, double r) { return {c.x - r, c.x + r, c.y - r, c.y + r}; }
-
 Box Box::with(const Box& o) const {
   return {std::min(x0, o.x0), std::max(x1, o.x1), std::min(y0, o.y0), std::max(y1, o.y1)};
-}
-
-bool Box::apart(const Box& o, double horizontal_m) const {
-  // The margin keeps a pair whose rounding could put it on the boundary: only pairs clearly
-  // apart are skipped, so no prediction differs from a full look.
-  const double h = horizontal_m + kApartMarginM;
-  return o.x0 - x1 >= h || x0 - o.x1 >= h || o.y0 - y1 >= h || y0 - o.y1 >= h;
 }
 
 Box sweep(const Course& c, double horizon_s) { return Box::of(c.at(0.0), c.at(horizon_s)); }

@@ -74,16 +74,22 @@ struct Course {
 /// its horizontal, climb and descent speeds, reached at max_accel.
 Course goal_course(Vec p, Vec v, Vec goal, const fleet::Limits& limits);
 /// The smallest box, east-west and north-south, holding a stretch of course.
+inline constexpr double kApartMarginM = 1e-3;
 struct Box {
   double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
   static Box of(Vec a, Vec b);
-  static Box around(Vec c, double r);  ///< c ± r east and north
-  Box with(const Box& o) const;        ///< both
+  static Box around(Vec c, double r) { return {c.x - r, c.x + r, c.y - r, c.y + r}; }  ///< c ± r east and north
+  Box with(const Box& o) const;  ///< both
   /// Whether every point of one is at least `horizontal_m` (and a margin) east, west, north or
   /// south of every point of the other: no two points of them come within horizontal_m.
-  bool apart(const Box& o, double horizontal_m) const;
+  /// The margin keeps a pair whose rounding could put it on the boundary: only pairs clearly
+  /// apart are let go, so no prediction differs from a full look. Inline: it runs for every
+  /// neighbour of every look.
+  bool apart(const Box& o, double horizontal_m) const {
+    const double h = horizontal_m + kApartMarginM;
+    return o.x0 - x1 >= h || x0 - o.x1 >= h || o.y0 - y1 >= h || y0 - o.y1 >= h;
+  }
 };
-inline constexpr double kApartMarginM = 1e-3;
 /// Where `c` goes within `horizon_s`: every position on it lies on the line between these.
 Box sweep(const Course& c, double horizon_s);
 /// As predict(), for courses that need not be straight: each kCourseStepS of the horizon is
