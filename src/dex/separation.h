@@ -73,8 +73,8 @@ struct Course {
 /// The course of a drone at `p` (velocity `v`) flying to `goal` as fast as `limits` let it:
 /// its horizontal, climb and descent speeds, reached at max_accel.
 Course goal_course(Vec p, Vec v, Vec goal, const fleet::Limits& limits);
+inline constexpr double kApartMarginM = 1e-3;  ///< how clearly apart Box::apart wants two boxes
 /// The smallest box, east-west and north-south, holding a stretch of course.
-inline constexpr double kApartMarginM = 1e-3;
 struct Box {
   double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
   static Box of(Vec a, Vec b);
