@@ -111,6 +111,31 @@ void BM_Fly5000Nodes20Drones(benchmark::State& state) {
 }
 BENCHMARK(BM_Fly5000Nodes20Drones)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+/// A drone show in one process, as `eamos run` flies it (separation kept, no trace): 200
+/// drones, FlyTo after FlyTo between 26 fleet-wide barriers. Loading the mission files is
+/// outside the timing; scripts/bench.sh times the whole `eamos run` process at 1,000 drones.
+void BM_FlyShow200Drones(benchmark::State& state) {
+  eamos::stress::StressOptions o;
+  o.shape = eamos::stress::Shape::show;
+  o.drones = 200;
+  o.work_per_step = 1;
+  o.target_nodes = 5200;
+  auto c = compile(eamos::stress::generate_mission(o));
+  std::vector<eamos::dex::Mission> missions(c->files.size());
+  eamos::dex::MissionTables tables;  // as `eamos run` loads them: one fleet table, shared sets
+  for (std::size_t d = 0; d < c->files.size(); ++d) {
+    std::vector<std::string> errors;
+    eamos::deploy::read_mission(c->files[d], "bench", missions[d], errors);
+    tables.share(missions[d]);
+  }
+  eamos::mid::AdapterRegistry adapters;
+  eamos::sim::register_adapter(adapters);
+  Totals t = fly_repeatedly(state, missions, adapters);
+  state.counters["sim_s_per_wall_s"] = benchmark::Counter(t.simulated / t.wall);
+  state.counters["mission_s"] = t.simulated / static_cast<double>(state.iterations());
+}
+BENCHMARK(BM_FlyShow200Drones)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 /// The engine alone, no physics: a RepeatFor whose body is a zero-second pause, so every
 /// activation is the engine's own work (condition, pause timer, terminal, back arc).
 void BM_EngineActivations(benchmark::State& state) {

@@ -28,6 +28,18 @@ awk '/"per_drone"/ {in_drones = 1} in_drones && /^        "nodes":/ {
 "$BUILD/bench/bench_dex" --benchmark_out=out/bench/dex.json --benchmark_out_format=json \
   --benchmark_repetitions=${REPS:-5} --benchmark_report_aggregates_only=true
 
+# `eamos run` of a 1,000-drone show (50 fleet-wide barriers) and of 1,000 drones in squads:
+# the whole process (compile and load included), CPU = user + sys, real-time factor = mission
+# seconds per CPU second.
+"$BUILD/src/cli/eamos" gen-stress --shape show --drones 1000 --work 1 --nodes 52000 -o out/bench/show-1000.eamos
+"$BUILD/src/cli/eamos" gen-stress --nodes 100000 --drones 1000 -o out/bench/squads-1000.eamos
+for m in show-1000 squads-1000; do
+  /usr/bin/time -f '%U %S %M' -o out/bench/$m.time "$BUILD/src/cli/eamos" run out/bench/$m.eamos > out/bench/$m.log
+  awk -v m="$m" -v t="$(sed -n 's/^mission completed in \([0-9.]*\) s.*/\1/p' out/bench/$m.log)" \
+    '{ printf "run %s: %.1f mission s in %.2f CPU s (%.0fx real time), %d MB peak\n", m, t, $1 + $2, t / ($1 + $2), $3 / 1000 }' \
+    out/bench/$m.time
+done | tee out/bench/run-1000.txt
+
 # Distributed execution. Cross-drone trigger latency through eamos's DDS
 # transport and event loops, then ddsperf ping/pong on the same loopback configuration in
 # the same run (ddsperf prints RTT/2).

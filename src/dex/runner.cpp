@@ -51,7 +51,9 @@ class InProcessTransport : public Transport {
     if (b) announced(*b, m.from);
     loop_.after(0.0, [this, &to, m, b] {
       --in_flight_;
-      if (b) deliver_counted(*b, m);
+      // Another set may have reached the barrier since: every engine was told its count
+      // then, and from then on hears of each arrival, this one too.
+      if (b && !b->each) deliver_counted(*b, m);
       else deliver_each(to, m);
       on_delivered_();
     });

@@ -108,6 +108,14 @@ double reach_within(const Course& c, double horizon_s) {
 
 }  // namespace
 
+Box Box::of(Vec a, Vec b) { return {std::min(a.x, b.x), std::max(a.x, b.x), std::min(a.y, b.y), std::max(a.y, b.y)}; }
+
+Box Box::with(const Box& o) const {
+  return {std::min(x0, o.x0), std::max(x1, o.x1), std::min(y0, o.y0), std::max(y1, o.y1)};
+}
+
+Box sweep(const Course& c, double horizon_s) { return Box::of(c.at(0.0), c.at(horizon_s)); }
+
 Prediction predict_courses(const Course& a, const Course& b, const fleet::Separation& min, double horizon_s) {
   if (!a.to_goal && !b.to_goal) return predict(a.p, a.v, b.p, b.v, min, horizon_s);
   // Two drones too far apart to close in within the horizon need no step-by-step look: in a
@@ -115,6 +123,11 @@ Prediction predict_courses(const Course& a, const Course& b, const fleet::Separa
   const double reach = reach_within(a, horizon_s) + reach_within(b, horizon_s);
   const Vec d = b.p - a.p;
   if (std::sqrt(d.x * d.x + d.y * d.y) - reach >= min.horizontal_m || std::abs(d.z) - reach >= min.vertical_m) return {};
+  // Each course stays on the line from where it is to where the horizon ends it: two such
+  // lines whose boxes lie a minimum apart east-west or north-south (two drones on parallel
+  // rows of a show) never come closer.
+  Box boxes[2] = {sweep(a, horizon_s), sweep(b, horizon_s)};
+  if (boxes[0].apart(boxes[1], min.horizontal_m)) return {};
   Vec pa = a.at(0.0), pb = b.at(0.0);
   for (double t0 = 0.0; t0 < horizon_s; t0 += kCourseStepS) {
     const double t1 = std::min(t0 + kCourseStepS, horizon_s), dt = t1 - t0;
@@ -283,7 +296,8 @@ void SeparationGuard::update(int d, const mid::DroneState& s) {
   k.p = p;
   k.t = s.t;
   k.airborne = !s.landed && !s.link_lost;
-  fastest_seen_ = std::max(fastest_seen_, std::hypot(k.v.x, k.v.y));
+  k.speed_h = std::hypot(k.v.x, k.v.y);
+  fastest_seen_ = std::max(fastest_seen_, k.speed_h);
   place(d);
   if (halted_ || !k.airborne || loop_.now() - k.checked_at < kSeparationCheckS) return;
   k.checked_at = loop_.now();
@@ -293,12 +307,13 @@ void SeparationGuard::update(int d, const mid::DroneState& s) {
 void SeparationGuard::check(int d) {
   const Track& k = tracks_[d];
   const bool own = k.drone != nullptr;
-  const double reach = min_.horizontal_m + kSeparationHorizonS * (std::hypot(k.v.x, k.v.y) + fastest_seen_);
+  const double reach = min_.horizontal_m + kSeparationHorizonS * (k.speed_h + fastest_seen_);
   if (own && holding(d)) try_resume(d);
+  Mine mine;
   for_neighbours(d, reach, [&](int n) {
     // A drone this process flies looks at its own pairs when its own state comes in; a pair
     // with a drone flown elsewhere is looked at from that drone's telemetry too.
-    if (own) consider(d, n);
+    if (own) consider(d, n, &mine);
     if (!tracks_[n].drone) return;
     if (!own) consider(n, d);
     // A held drone stands still and publishes seldom: whoever moves near it looks again.
@@ -309,12 +324,12 @@ void SeparationGuard::check(int d) {
 // Towards its goal as fast as it may fly (a drone still speeding up is where it will be), and
 // as its samples go, ending at its goal (a vehicle slower than its limits is where it is
 // going now): the earlier conflict of the two.
-Prediction SeparationGuard::foresee(int a, const Course& mine, int b, double horizon_s) const {
+Prediction SeparationGuard::foresee(int a, const Course& mine, double left, int b, double horizon_s) const {
   const Track& A = tracks_[a];
   const Track& B = tracks_[b];
+  ++foreseen_;
   const Course other = course_of(b);
   Prediction p = predict_courses(mine, other, min_, horizon_s);
-  const double left = A.drone->motion_distance_left();
   Prediction sampled;
   if (!other.to_goal) {
     sampled = predict_to_goal(now_at(A), A.v, left, now_at(B), B.v, min_, horizon_s);
@@ -328,14 +343,40 @@ Prediction SeparationGuard::foresee(int a, const Course& mine, int b, double hor
   return p;
 }
 
-// From drone a's side (this process flies it): does it give way to b?
-void SeparationGuard::consider(int a, int b) {
+SeparationGuard::Mine SeparationGuard::mine(int a) const {
+  const Track& A = tracks_[a];
+  Mine m{.ready = true, .moving = moving(a)};
+  if (!m.moving) return m;
+  m.course = course_of(a);
+  m.left = A.drone->motion_distance_left();
+  const Vec here = now_at(A);
+  m.box = sweep(m.course, kSeparationHorizonS).with(Box::of(here, here + A.v * kSeparationHorizonS));
+  return m;
+}
+
+Box SeparationGuard::reach_box(int b) const {
+  const Track& B = tracks_[b];
+  double speed = B.speed_h;
+  if (B.drone) speed = std::isfinite(B.max_speed) ? std::max(speed, B.max_speed) : HUGE_VAL;
+  return Box::around(now_at(B), speed * kSeparationHorizonS);
+}
+
+// From drone a's side (this process flies it): does it give way to b? `mine`, when given, is
+// a's side worked out by the first pair of this look that needed it: a cannot change course
+// within one look but by giving way, after which it looks at no more pairs.
+void SeparationGuard::consider(int a, int b, Mine* given) {
   if (halted_ || holding(a)) return;
   Track& A = tracks_[a];
   const Track& B = tracks_[b];
-  if (!A.airborne || !B.airborne || !moving(a)) return;
+  if (!A.airborne || !B.airborne) return;
+  Mine local;
+  Mine& m = given ? *given : local;
+  if (!m.ready) m = mine(a);
+  if (!m.moving) return;
   ++pairs_;
-  const Prediction p = foresee(a, course_of(a), b, kSeparationHorizonS);
+  const Prediction p = m.box.apart(reach_box(b), min_.horizontal_m)
+                           ? Prediction{}
+                           : foresee(a, m.course, m.left, b, kSeparationHorizonS);
   if (!p.conflict) {
     if (A.unheld_with == b) A.unheld_with = -1;
     return;
@@ -395,7 +436,7 @@ void SeparationGuard::try_resume(int h) {
     const Course theirs = course_of(n);
     Course mine = goal_course(here, H.v, Vec{goal->x, goal->y, goal->z}, H.limits);
     // What consider() will see once it flies on, so that it does not give way again at once.
-    if (foresee(h, mine, n, horizon).conflict) blocker = n;
+    if (foresee(h, mine, left, n, horizon).conflict) blocker = n;
     mine.accel = 0.0;
     for (double share : {0.25, 0.5, 0.75, 1.0}) {
       Course steady = mine;

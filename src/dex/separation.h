@@ -73,6 +73,25 @@ struct Course {
 /// The course of a drone at `p` (velocity `v`) flying to `goal` as fast as `limits` let it:
 /// its horizontal, climb and descent speeds, reached at max_accel.
 Course goal_course(Vec p, Vec v, Vec goal, const fleet::Limits& limits);
+inline constexpr double kApartMarginM = 1e-3;  ///< how clearly apart Box::apart wants two boxes
+/// The smallest box, east-west and north-south, holding a stretch of course.
+struct Box {
+  double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+  static Box of(Vec a, Vec b);
+  static Box around(Vec c, double r) { return {c.x - r, c.x + r, c.y - r, c.y + r}; }  ///< c ± r east and north
+  Box with(const Box& o) const;  ///< both
+  /// Whether every point of one is at least `horizontal_m` (and a margin) east, west, north or
+  /// south of every point of the other: no two points of them come within horizontal_m.
+  /// The margin keeps a pair whose rounding could put it on the boundary: only pairs clearly
+  /// apart are let go, so no prediction differs from a full look. Inline: it runs for every
+  /// neighbour of every look.
+  bool apart(const Box& o, double horizontal_m) const {
+    const double h = horizontal_m + kApartMarginM;
+    return o.x0 - x1 >= h || x0 - o.x1 >= h || o.y0 - y1 >= h || y0 - o.y1 >= h;
+  }
+};
+/// Where `c` goes within `horizon_s`: every position on it lies on the line between these.
+Box sweep(const Course& c, double horizon_s);
 /// As predict(), for courses that need not be straight: each kCourseStepS of the horizon is
 /// taken as a straight piece.
 Prediction predict_courses(const Course& a, const Course& b, const fleet::Separation& min, double horizon_s);
@@ -101,6 +120,8 @@ class SeparationGuard {
 
   /// Pairs predicted so far: what the grid saves (tests).
   std::uint64_t pairs_predicted() const { return pairs_; }
+  /// Of those, pairs whose courses were worked out: the rest were too far apart for that.
+  std::uint64_t pairs_foreseen() const { return foreseen_; }
 
  private:
   struct Track {
@@ -108,6 +129,7 @@ class SeparationGuard {
     bool airborne = false;
     double t = 0.0;
     Vec p, v;
+    double speed_h = 0.0;  ///< m/s, horizontally: |v|
     Vec v_p;          ///< the position and time the velocity was last measured from
     double v_t = 0.0;
     long long cell = 0;
@@ -142,8 +164,22 @@ class SeparationGuard {
   template <typename Fn>
   void for_neighbours(int d, double reach_m, Fn fn);
   void check(int d);
-  Prediction foresee(int a, const Course& mine, int b, double horizon_s) const;
-  void consider(int a, int b);
+  /// Drone a's side of its pairs, the same for every neighbour of one look (check): whether
+  /// it moves, its course, the distance left to its goal, and the box both of its predicted
+  /// courses (towards its goal, and along its samples) stay in over the horizon.
+  struct Mine {
+    bool ready = false;
+    bool moving = false;
+    Course course;
+    double left = 0.0;
+    Box box;
+  };
+  Mine mine(int a) const;
+  /// Where drone b can be within the horizon, whatever course it takes: a box around it as
+  /// wide as it flies at most (its samples' speed, or its speed limit when it has a goal).
+  Box reach_box(int b) const;
+  Prediction foresee(int a, const Course& mine, double left, int b, double horizon_s) const;
+  void consider(int a, int b, Mine* mine = nullptr);
   void give_way(int a, int b, const Prediction& p);
   void try_resume(int h);
   void too_long(int h, double since);
@@ -160,6 +196,7 @@ class SeparationGuard {
   std::unordered_map<long long, std::vector<int>> grid_;
   bool halted_ = false;
   std::uint64_t pairs_ = 0;
+  mutable std::uint64_t foreseen_ = 0;
 };
 
 }  // namespace eamos::dex

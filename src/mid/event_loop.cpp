@@ -51,7 +51,7 @@ TimerId EventLoop::at(double t, std::function<void()> fn) {
   s.live = true;
   ++s.gen;  // a TimerId of the slot's earlier callback no longer names it
   ++live_;
-  queue_.push({t, next_seq_++, slot, s.gen});
+  push({t, next_seq_++, slot, s.gen});
   return (static_cast<TimerId>(s.gen) << 32) | (static_cast<TimerId>(slot) + 1);
 }
 
@@ -78,7 +78,49 @@ TimerId EventLoop::defer(std::function<void()> fn) {
 bool EventLoop::cancel(TimerId id) {
   if (id == kNoTimer || !live(slot_of(id), gen_of(id))) return false;
   take(slot_of(id));  // its heap entry stays and is skipped when popped: cancel is O(1)
+  if (heap_.size() > 2 * live_ + 1024) compact();
   return true;
+}
+
+void EventLoop::push(const Entry& e) {
+  std::size_t i = heap_.size();
+  heap_.push_back(e);
+  while (i > 0) {
+    const std::size_t parent = (i - 1) / 4;
+    if (!e.before(heap_[parent])) break;
+    heap_[i] = heap_[parent];
+    i = parent;
+  }
+  heap_[i] = e;
+}
+
+void EventLoop::pop() {
+  const Entry last = heap_.back();
+  heap_.pop_back();
+  const std::size_t n = heap_.size();
+  if (n == 0) return;
+  std::size_t i = 0;
+  for (;;) {
+    const std::size_t first = 4 * i + 1;
+    if (first >= n) break;
+    std::size_t best = first;
+    const std::size_t end = std::min(first + 4, n);
+    for (std::size_t c = first + 1; c < end; ++c)
+      if (heap_[c].before(heap_[best])) best = c;
+    if (!heap_[best].before(last)) break;
+    heap_[i] = heap_[best];
+    i = best;
+  }
+  heap_[i] = last;
+}
+
+void EventLoop::compact() {
+  std::vector<Entry> kept;
+  kept.reserve(live_);
+  for (const Entry& e : heap_)
+    if (live(e.slot, e.gen)) kept.push_back(e);
+  heap_.clear();
+  for (const Entry& e : kept) push(e);
 }
 
 std::size_t EventLoop::run_until_idle() {
@@ -105,17 +147,17 @@ std::size_t EventLoop::run(double limit, bool bounded) {
   running_ = true;
   while (!stop_requested_) {
     take_posted();
-    while (!queue_.empty() && !live(queue_.top().slot, queue_.top().gen)) queue_.pop();  // cancelled
+    while (!heap_.empty() && !live(heap_.front().slot, heap_.front().gen)) pop();  // cancelled
     // A real-time run bounded by `limit` waits for posted input until then, even when no
     // timer is due: that is how a DEX idles between messages.
-    if (queue_.empty() || (bounded && queue_.top().time > limit)) {
+    if (heap_.empty() || (bounded && heap_.front().time > limit)) {
       if (bounded && real && !wait_for(limit)) continue;
       break;
     }
-    Entry next = queue_.top();
+    Entry next = heap_.front();
     if (!wait_for(next.time)) continue;
     if (real && stalled_before(next.time)) continue;  // the handler may have cancelled it
-    queue_.pop();
+    pop();
     if (!live(next.slot, next.gen)) continue;
     // Take the callback out first: it may schedule or cancel timers, growing the slots.
     std::function<void()> fn = take(next.slot);

@@ -33,6 +33,12 @@ SimDrone::SimDrone(fleet::DroneSettings settings, fleet::DroneType type, mid::Ev
     std::string name = "Sensor" + std::to_string(k);
     auto it = settings_.sensors.find(name);
     sensor_models_.push_back({name, it == settings_.sensors.end() ? nullptr : &it->second});
+    sensor_names_.emplace_hint(sensor_names_.end(), name, 0.0);
+  }
+  // In the names' order (Sensor10 before Sensor2), as a state lists them.
+  for (const auto& [name, zero] : sensor_names_) {
+    auto it = settings_.sensors.find(name);
+    sensor_names_models_.push_back(it == settings_.sensors.end() ? nullptr : &it->second);
   }
 }
 
@@ -377,9 +383,13 @@ mid::DroneState SimDrone::state() const {
   s.battery = battery_.at(loop_.now());
   s.armed = armed_;
   s.landed = landed_;
-  s.sensors.reserve(sensor_models_.size());
-  for (std::size_t k = 0; k < sensor_models_.size(); ++k)
-    s.sensors.emplace_hint(s.sensors.end(), sensor_models_[k].first, sensor_value(static_cast<int>(k) + 1));
+  // The names copied in one go, in order, then the readings: no name is compared or built.
+  s.sensors = sensor_names_;
+  auto model = sensor_names_models_.begin();
+  for (auto& reading : s.sensors) {
+    const fleet::SensorModel* m = *model++;
+    reading.second = m ? m->base + dot(m->gradient, kin_.position) : 0.0;
+  }
   s.pictures = pictures_;
   s.heading = heading_;
   s.mode = mode_name();

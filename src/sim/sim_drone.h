@@ -85,6 +85,8 @@ class SimDrone final : public mid::AdapterDrone {
   /// "Sensor1" … "SensorN" of the type and the fleet file's model of each (null: reads 0),
   /// looked up once: a state is built on every step of every drone.
   std::vector<std::pair<std::string, const fleet::SensorModel*>> sensor_models_;
+  mid::SensorValues sensor_names_;  ///< the same names, each reading 0: what a state starts from
+  std::vector<const fleet::SensorModel*> sensor_names_models_;  ///< each of sensor_names_'s model
   SimOptions options_;
 
   mid::Kinematics kin_;

@@ -124,6 +124,33 @@ TEST(Scale, AnUntracedBarrierLooksAtTheDronesItTellsNotAtItsWholeSet) {
   EXPECT_LE(large, small * 6) << small << " -> " << large << " steps for 4 times the drones";
 }
 
+// Missions loaded each on its own (no shared deploy::FleetTables: each holds its own copy of a barrier's
+// drone set, as a program embedding the runner may load them) pass their barriers as shared
+// ones do: the second copy of a set to reach a barrier turns it to delivering every arrival,
+// and an arrival sent before that is delivered too, not counted where no engine hears of it
+// (the show hung at its first barrier until its time limit).
+TEST(Scale, MissionsThatShareNoTablesPassTheirBarriersAsSharedOnesDo) {
+  std::string text = generated(stress::Shape::show, 12, 12 * 6);
+  graph::Compilation c;
+  Diagnostics diags;
+  ASSERT_TRUE(graph::compile(std::make_shared<SourceFile>("t.eamos", text), fleet::Fleet{}, diags, c));
+  std::vector<dex::Mission> missions(c.drone_count());
+  for (int d = 0; d < c.drone_count(); ++d) {
+    std::vector<std::string> errors;
+    ASSERT_TRUE(deploy::read_mission(deploy::mission_text(c, d, deploy::mission_hash(c)), "m", missions[d], errors));
+  }
+  mid::AdapterRegistry adapters;
+  sim::register_adapter(adapters);
+  dex::RunOptions options;
+  options.time_limit_s = 600;
+  dex::RunResult alone = dex::run_in_process(missions, adapters, nullptr, options);
+  dex::RunResult shared = dex::run_in_process(test::missions_of(text), adapters, nullptr, options);
+  EXPECT_TRUE(alone.completed) << alone.error;
+  EXPECT_TRUE(shared.completed) << shared.error;
+  EXPECT_EQ(alone.duration, shared.duration);
+  EXPECT_EQ(alone.activations, shared.activations);
+}
+
 /// Bytes the process holds in malloc's blocks now.
 std::size_t held_bytes() {
   struct mallinfo2 i = mallinfo2();

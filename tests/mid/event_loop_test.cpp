@@ -39,6 +39,55 @@ TEST(EventLoop, EqualTimesRunInSchedulingOrder) {
   EXPECT_EQ(order, "cabd");
 }
 
+// Many timers at few distinct times (a fleet's motion steps share their instants), some
+// scheduled from callbacks and some cancelled: each runs at its time, equal times in the
+// order they were scheduled, the cancelled never.
+TEST(EventLoop, ThousandsOfTimersRunInTimeThenSchedulingOrder) {
+  EventLoop loop;
+  std::uint64_t seed = 7;
+  auto below = [&seed](int n) {
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<int>((seed >> 33) % static_cast<std::uint64_t>(n));
+  };
+  struct Ran {
+    double t;
+    int order;  ///< when it was scheduled
+  };
+  std::vector<Ran> ran;
+  int scheduled = 0;
+  std::function<void(double)> schedule = [&](double t) {
+    const int order = scheduled++;
+    TimerId id = loop.at(t, [&, t, order] {
+      ran.push_back({loop.now(), order});
+      EXPECT_EQ(loop.now(), t);
+      if (scheduled < 20000) schedule(loop.now() + 0.05 * below(5));
+    });
+    if (below(4) == 0) loop.cancel(id);
+  };
+  for (int i = 0; i < 5000; ++i) schedule(0.05 * below(40));
+  loop.run_until_idle();
+  ASSERT_GT(ran.size(), 10000u);
+  for (std::size_t i = 1; i < ran.size(); ++i) {
+    ASSERT_LE(ran[i - 1].t, ran[i].t) << i;
+    if (ran[i - 1].t == ran[i].t) {
+      ASSERT_LT(ran[i - 1].order, ran[i].order) << i;
+    }
+  }
+}
+
+// A run that schedules a timeout for every action and cancels it when the action ends (a
+// long mission, thousands of actions) keeps in its queue what is pending, not every timer it
+// ever cancelled.
+TEST(EventLoop, CancelledTimersDoNotPileUpInTheQueue) {
+  EventLoop loop;
+  TimerId keep = loop.at(1e6, [] {});
+  for (int i = 0; i < 100000; ++i) loop.cancel(loop.at(1000.0 + i, [] {}));
+  EXPECT_EQ(loop.size(), 1u);
+  EXPECT_LT(loop.queued(), 2000u);
+  EXPECT_TRUE(loop.pending(keep));
+  EXPECT_EQ(loop.run_until_idle(), 1u);
+}
+
 // The schedule a callback builds depends only on what ran before it, so two loops fed the
 // same program produce the same trace: the basis of deterministic simulated missions.
 TEST(EventLoop, EventLoopRunsSameScheduleIdentically) {

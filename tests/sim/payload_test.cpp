@@ -57,6 +57,28 @@ TEST_F(Payload, ConstantSensorAndUndescribedSensors) {
   EXPECT_DOUBLE_EQ(s.sensors.at("Sensor8"), 0.0);
 }
 
+// Twelve sensors: a state lists them in name order (Sensor10 before Sensor2), each with its
+// own model's reading, as the state built at every motion step does.
+TEST_F(Payload, AStateWithTenOrMoreSensorsGivesEachItsOwnReading) {
+  fleet::set_sensors(type, 12);
+  config.sensors["Sensor2"] = {2.0, {}};
+  config.sensors["Sensor10"] = {10.0, {1, 0, 0}};
+  config.sensors["Sensor12"] = {12.0, {}};
+  airborne(4);
+  ASSERT_EQ(run("FlyByX", {3}).end.outcome, Outcome::succeeded);
+  mid::DroneState s = d().state();
+  ASSERT_EQ(s.sensors.size(), 12u);
+  std::vector<std::string> names;
+  for (const auto& [name, value] : s.sensors) names.push_back(name);
+  EXPECT_EQ(names[1], "Sensor10");
+  EXPECT_EQ(names[4], "Sensor2");
+  EXPECT_DOUBLE_EQ(s.sensors.at("Sensor2"), 2.0);
+  EXPECT_DOUBLE_EQ(s.sensors.at("Sensor10"), 13.0);
+  EXPECT_DOUBLE_EQ(s.sensors.at("Sensor12"), 12.0);
+  EXPECT_DOUBLE_EQ(s.sensors.at("Sensor11"), 0.0);
+  EXPECT_DOUBLE_EQ(*run("Sensor10").end.value, 13.0);
+}
+
 TEST_F(Payload, SensorReadIsShortAndNeedsNoArming) {
   double t0 = loop.now();
   test::Result r = run("Sensor3");
