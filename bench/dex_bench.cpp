@@ -121,13 +121,9 @@ void BM_FlyShow200Drones(benchmark::State& state) {
   o.work_per_step = 1;
   o.target_nodes = 5200;
   auto c = compile(eamos::stress::generate_mission(o));
-  std::vector<eamos::dex::Mission> missions(c->files.size());
-  eamos::dex::MissionTables tables;  // as `eamos run` loads them: one fleet table, shared sets
-  for (std::size_t d = 0; d < c->files.size(); ++d) {
-    std::vector<std::string> errors;
-    eamos::deploy::read_mission(c->files[d], "bench", missions[d], errors);
-    tables.share(missions[d]);
-  }
+  std::vector<eamos::dex::Mission> missions;
+  std::vector<std::string> errors;  // as `eamos run` loads them: one fleet table, shared sets
+  if (!eamos::deploy::read_compiled_missions(c->c, missions, errors)) throw std::runtime_error(errors.front());
   eamos::mid::AdapterRegistry adapters;
   eamos::sim::register_adapter(adapters);
   Totals t = fly_repeatedly(state, missions, adapters);
