@@ -17,10 +17,11 @@ bool compile(std::shared_ptr<SourceFile> source, const fleet::Fleet& fleet, Diag
                                                   out.mission.drones[d].type, d));
   out.amt = build_amt(out.mission);
   out.meg = build_meg(out.amt, out.mission);
+  // The AMT is as large as the MEG; freed before the logic check and the MDGs reuse its memory.
+  if (keep == Keep::deployment_graphs) out.amt = Amt{};
   // Like the checker's warnings, only on a mission without errors: the MEG needs one.
   check_mission_logic({out.meg, out.mission, out.fleet, out.checked.drone_types, out.settings}, diags);
   if (diags.has_errors()) return false;
-  if (keep == Keep::deployment_graphs) out.amt = Amt{};
   out.mdgs = build_mdgs(out.meg);
   return true;
 }
