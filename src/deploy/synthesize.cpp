@@ -70,6 +70,23 @@ bool write_text(const std::filesystem::path& path, const std::string& text, Diag
   return out ? true : cannot_write(path, diags);
 }
 
+/// The header holds the mission's whole source: serialised straight into the file, as
+/// dump(2) would print it, so that a large mission's text is not held twice more in memory
+/// (the dump and the dump with its newline). Mission and fleet text may hold any byte:
+/// replaced, not thrown, as in the trace itself.
+bool write_trace_header(const graph::Compilation& c, const std::filesystem::path& path, const std::string& hash,
+                        Diagnostics& diags) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  {
+    nlohmann::detail::serializer<nlohmann::ordered_json> writer(nlohmann::detail::output_adapter<char>(out), ' ',
+                                                               json::error_handler_t::replace);
+    writer.dump(trace_header(c, hash, 0), true, false, 2);
+  }
+  out << "\n";
+  out.close();
+  return out ? true : cannot_write(path, diags);
+}
+
 }  // namespace
 
 bool write_deployment(const graph::Compilation& c, const std::string& dir, Diagnostics& diags) {
@@ -86,9 +103,7 @@ bool write_deployment(const graph::Compilation& c, const std::string& dir, const
     return false;
   }
   if (!write_text(fs::path(dir) / "manifest.json", manifest(c, hash).dump(2) + "\n", diags)) return false;
-  // Mission and fleet text may hold any byte: replaced, not thrown, as in the trace itself.
-  std::string header = trace_header(c, hash, 0).dump(2, ' ', false, json::error_handler_t::replace);
-  if (!write_text(fs::path(dir) / "trace-header.json", header + "\n", diags)) return false;
+  if (!write_trace_header(c, fs::path(dir) / "trace-header.json", hash, diags)) return false;
   for (int d = 0; d < c.drone_count(); ++d) {
     fs::path folder = fs::path(dir) / c.drone_name(d);
     fs::create_directories(folder, ec);

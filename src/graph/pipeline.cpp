@@ -5,6 +5,25 @@
 
 namespace eamos::graph {
 
+namespace {
+
+/// After the last check, a deployment needs of the statements only their expressions (the
+/// MEG's arguments and conditions point to them): the rest, a fifth of a large mission's
+/// memory, is freed before the MDGs and the files are made, which reuse it.
+void drop_statements(Compilation& c) {
+  std::size_t count = 0;
+  for (const lang::Function& f : c.mission.functions)
+    for (const lang::Statement& s : f.body) count += s.args.size();
+  c.expressions.reserve(count);
+  for (lang::Function& f : c.mission.functions) {
+    for (lang::Statement& s : f.body)
+      for (std::unique_ptr<lang::Expr>& e : s.args) c.expressions.push_back(std::move(e));
+    std::vector<lang::Statement>().swap(f.body);
+  }
+}
+
+}  // namespace
+
 bool compile(std::shared_ptr<SourceFile> source, const fleet::Fleet& fleet, Diagnostics& diags,
              Compilation& out, const lang::CheckLimits& limits, Keep keep) {
   out.source = std::move(source);
@@ -17,10 +36,12 @@ bool compile(std::shared_ptr<SourceFile> source, const fleet::Fleet& fleet, Diag
                                                   out.mission.drones[d].type, d));
   out.amt = build_amt(out.mission);
   out.meg = build_meg(out.amt, out.mission);
+  // The AMT is as large as the MEG; freed before the logic check and the MDGs reuse its memory.
+  if (keep == Keep::deployment_graphs) out.amt = Amt{};
   // Like the checker's warnings, only on a mission without errors: the MEG needs one.
   check_mission_logic({out.meg, out.mission, out.fleet, out.checked.drone_types, out.settings}, diags);
   if (diags.has_errors()) return false;
-  if (keep == Keep::deployment_graphs) out.amt = Amt{};
+  if (keep == Keep::deployment_graphs) drop_statements(out);
   out.mdgs = build_mdgs(out.meg);
   return true;
 }

@@ -25,6 +25,9 @@ struct Compilation {
   Amt amt;
   Meg meg;
   std::vector<Mdg> mdgs;
+  /// With Keep::deployment_graphs, the mission's expressions, which the MEG points to,
+  /// once the statements that held them are freed.
+  std::vector<std::unique_ptr<lang::Expr>> expressions;
 
   int drone_count() const { return static_cast<int>(mission.drones.size()); }
   const std::string& drone_name(int d) const { return mission.drones[d].name; }
@@ -36,7 +39,7 @@ struct Compilation {
 /// lowers the peak memory of a compile by about a tenth.
 enum class Keep {
   all_graphs,
-  deployment_graphs,  ///< the AMT is emptied once the MEG is built
+  deployment_graphs,  ///< the AMT is emptied once the MEG is built, the statements once it is checked
 };
 
 /// Runs every stage on `source`; stops after the first stage that reported errors.

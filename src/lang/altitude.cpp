@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace eamos::lang {
 namespace {
@@ -48,10 +49,10 @@ class AltitudeCheck {
     std::optional<double> value = literal(arg);
     if (!value) return;
     const DroneDecl& drone = m_.drones[s.drone_index];
-    fleet::DroneSettings settings = fleet_.settings_for(drone.name, drone.type, s.drone_index);
-    double ground = settings.home.z;
+    const Bounds& bounds = bounds_of(s.drone_index);
+    double ground = bounds.ground;
     double z = takeoff ? ground + *value : *value;
-    double ceiling = settings.limits.max_altitude_m;
+    double ceiling = bounds.ceiling;
     if (z > ground + ceiling + 1e-9) {
       std::string over = takeoff ? "takeoff altitude " + metres(*value) : "target z = " + metres(z);
       report(s, arg,
@@ -61,7 +62,7 @@ class AltitudeCheck {
              limit_location(fleet_, drone).at, "");
       return;
     }
-    const fleet::Geofence* fence = fleet_.geofence_for(drone.name);
+    const fleet::Geofence* fence = bounds.fence;
     if (fence && fence->max_altitude_m && z > *fence->max_altitude_m + 1e-9)
       report(s, arg,
              s.drone + "." + s.callee + ": target z = " + metres(z) + " is above the geofence's max_altitude of " +
@@ -70,7 +71,29 @@ class AltitudeCheck {
              fence->max_altitude_at, "the geofence of " + s.drone + " ends here");
   }
 
+  int settings_made() const { return settings_made_; }
+
  private:
+  struct Bounds {
+    bool known = false;
+    double ground = 0.0;   ///< home z
+    double ceiling = 0.0;  ///< max_altitude over home
+    const fleet::Geofence* fence = nullptr;
+  };
+
+  /// A drone's settings are made once, not per statement: making them copies its type's
+  /// whole catalogue, and a show has hundreds of FlyTos per drone.
+  const Bounds& bounds_of(int drone) {
+    if (bounds_.size() < m_.drones.size()) bounds_.resize(m_.drones.size());
+    Bounds& b = bounds_[drone];
+    if (b.known) return b;
+    const DroneDecl& decl = m_.drones[drone];
+    fleet::DroneSettings settings = fleet_.settings_for(decl.name, decl.type, drone);
+    ++settings_made_;
+    b = {true, settings.home.z, settings.limits.max_altitude_m, fleet_.geofence_for(decl.name)};
+    return b;
+  }
+
   void report(const Statement& s, const Expr* arg, std::string message, std::optional<SourceLocation> at,
               std::string note) {
     diags_.error(m_.file, arg->loc, std::move(message));
@@ -84,14 +107,18 @@ class AltitudeCheck {
   const Mission& m_;
   const fleet::Fleet& fleet_;
   Diagnostics& diags_;
+  std::vector<Bounds> bounds_;
+  int settings_made_ = 0;
 };
 
 }  // namespace
 
-void check_literal_altitudes(const Mission& mission, const fleet::Fleet& fleet, Diagnostics& diags) {
+void check_literal_altitudes(const Mission& mission, const fleet::Fleet& fleet, Diagnostics& diags,
+                             int* settings_made) {
   AltitudeCheck check(mission, fleet, diags);
   for (const Function& f : mission.functions)
     for (const Statement& s : f.body) check.statement(s);
+  if (settings_made) *settings_made = check.settings_made();
 }
 
 }  // namespace eamos::lang

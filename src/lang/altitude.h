@@ -11,7 +11,9 @@ namespace eamos::lang {
 /// An error at each Takeoff(alt) whose literal alt is above the drone's limits'
 /// max_altitude (metres over its home), and each Takeoff or FlyTo whose literal target z
 /// is above that or above its geofence's max_altitude (z of the mission frame); a note
-/// points at the fleet file's max_altitude when the file sets it.
-void check_literal_altitudes(const Mission& mission, const fleet::Fleet& fleet, Diagnostics& diags);
+/// points at the fleet file's max_altitude when the file sets it. `settings_made`, when
+/// given, receives how many drones' settings that needed (at most one per drone).
+void check_literal_altitudes(const Mission& mission, const fleet::Fleet& fleet, Diagnostics& diags,
+                             int* settings_made = nullptr);
 
 }  // namespace eamos::lang

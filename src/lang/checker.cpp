@@ -144,6 +144,7 @@ class Checker {
   // thousands of blocks, and Mission::find_* would compare against every one per call.
   std::unordered_map<std::string_view, int> function_index_;
   std::unordered_map<std::string_view, int> drone_index_;
+  std::vector<int> first_function_;  ///< per function: the first function of its name
   /// Per function, the blocks it calls (check_call_graph fills it, check_unused reads it).
   std::vector<std::vector<std::pair<int, SourceLocation>>> calls_;
 };
@@ -169,8 +170,9 @@ CheckedMission Checker::run() {
 void Checker::index_names() {
   function_index_.reserve(m_.functions.size());
   drone_index_.reserve(m_.drones.size());
+  first_function_.reserve(m_.functions.size());
   for (std::size_t i = 0; i < m_.functions.size(); ++i)
-    function_index_.emplace(m_.functions[i].name, static_cast<int>(i));
+    first_function_.push_back(function_index_.emplace(m_.functions[i].name, static_cast<int>(i)).first->second);
   for (std::size_t i = 0; i < m_.drones.size(); ++i)
     drone_index_.emplace(m_.drones[i].name, static_cast<int>(i));
 }
@@ -229,7 +231,7 @@ void Checker::check_drones() {
 void Checker::check_functions() {
   for (std::size_t i = 0; i < m_.functions.size(); ++i) {
     Function& f = m_.functions[i];
-    int first = find_function(f.name);
+    int first = first_function_[i];
     if (first != static_cast<int>(i)) {
       error(f.loc, "function '" + f.name + "' is defined twice (first at line " +
                        std::to_string(m_.functions[first].loc.line) + "); rename or remove one");

@@ -3,7 +3,9 @@
 
 #include <filesystem>
 
+#include "deploy/mission_file.h"
 #include "deploy/synthesize.h"
+#include "graph/pipeline.h"
 #include "helpers.h"
 
 namespace eamos {
@@ -48,6 +50,24 @@ TEST_F(Deployment, WritesAManifestAndOneMissionFilePerDrone) {
     EXPECT_EQ(mission["drone"]["name"], c->drone_name(d));
     EXPECT_EQ(test::read_text(file.string()), deploy::mission_text(*c, d, deploy::mission_hash(*c)) + "\n");
   }
+}
+
+// `eamos compile` frees the statements once the MEG is checked: the files must not change.
+TEST(DeploymentCompile, FreesTheStatementsButWritesTheSameMissionFiles) {
+  std::string text = test::stress_text(600, 6);
+  auto full = test::compile_mission(text);
+  ASSERT_TRUE(full);
+  graph::Compilation lean;
+  Diagnostics diags;
+  ASSERT_TRUE(graph::compile(std::make_shared<SourceFile>("mission.eamos", text), fleet::Fleet{}, diags, lean, {},
+                             graph::Keep::deployment_graphs))
+      << diags.format();
+  for (const lang::Function& f : lean.mission.functions) EXPECT_TRUE(f.body.empty()) << f.name;
+  EXPECT_FALSE(lean.expressions.empty());
+  std::string hash = deploy::mission_hash(*full);
+  ASSERT_EQ(deploy::mission_hash(lean), hash);
+  for (int d = 0; d < full->drone_count(); ++d)
+    EXPECT_EQ(deploy::mission_text(lean, d, hash), deploy::mission_text(*full, d, hash)) << full->drone_name(d);
 }
 
 TEST_F(Deployment, ReportsAnOutputFolderThatCannotBeCreated) {

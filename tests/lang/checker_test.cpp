@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "graph/pipeline.h"
+#include "lang/altitude.h"
 #include "lang/arming.h"
 
 namespace eamos {
@@ -187,6 +188,20 @@ TEST(Checker, TheArmedStateRuleGrowsWithTheFleetNotWithItsSquare) {
   EXPECT_LE(large, 2 * small + 10) << "20 drones: " << small << " visits; 40 drones: " << large;
   // A PAR visits its drone's sibling twice (alone, then from what the others set).
   EXPECT_LE(large, 8 * 40 * 5) << "each drone visits a few times its own statements and the blocks leading to them";
+}
+
+// A drone's settings copy its type's whole catalogue; made per FlyTo, they were most of a
+// 500,000-statement show's check.
+TEST(Checker, TheAltitudeRuleMakesEachDronesSettingsOnceNotPerStatement) {
+  graph::Compilation c;
+  Diagnostics d;
+  ASSERT_TRUE(graph::compile(std::make_shared<SourceFile>("show.eamos", show_mission(3, 20)), fleet::Fleet{}, d, c))
+      << d.format();
+  Diagnostics again;
+  int made = 0;
+  lang::check_literal_altitudes(c.mission, c.fleet, again, &made);
+  EXPECT_EQ(again.error_count(), 0u) << again.format();
+  EXPECT_EQ(made, 3) << "one per drone, not one per Takeoff or FlyTo (60 here)";
 }
 
 }  // namespace
