@@ -782,7 +782,7 @@ function renderLanesCanvas() {
   g.fillRect((now / end) * w, 0, 2, canvas.height);
   canvas.dataset.drones = String(D.drones.length);
   canvas.dataset.bars = String(drawn);
-  $('playhead').style.height = '0px';
+  put($('playhead'), 'height', '0px');
 }
 
 // ---- map ----
@@ -865,8 +865,8 @@ function renderMap() {
   drawFailures(g, X, Y);
   renderSide(B);
   const hasTelemetry = D.telemetry.size > 0;
-  $('map-note').textContent = hasTelemetry ? '' : (D.drones.some(d => d.home) ?
-    'this trace has no telemetry: homes only' : 'this trace has no telemetry and names no homes');
+  putText($('map-note'), hasTelemetry ? '' : (D.drones.some(d => d.home) ?
+    'this trace has no telemetry: homes only' : 'this trace has no telemetry and names no homes'));
 }
 
 // The failed action of `drone`, once the clock has passed it; null otherwise.
@@ -962,8 +962,12 @@ function currentAction(name) {
 function renderDroneList() {
   const list = $('drone-list');
   if (D.drones.length > DOM_LANES_MAX) {
-    list.textContent = '';
-    list.appendChild(el('li', '', D.drones.length + ' drones (too many to list; hover the lanes)'));
+    // Written when the fleet grows, not every frame: a rewritten list is laid out again.
+    const summary = D.drones.length + ' drones (too many to list; hover the lanes)';
+    if (list.children.length !== 1 || list.firstChild.textContent !== summary) {
+      list.textContent = '';
+      list.appendChild(el('li', '', summary));
+    }
     return;
   }
   if (list.children.length !== D.drones.length) {
@@ -1169,26 +1173,37 @@ function renderGraphStates() {
 
 // ---- mission text and selection ----
 
+// The mission text in blocks of SOURCE_BLOCK lines that the browser lays out and paints only
+// when in view (content-visibility): a generated mission of 27,000 lines is 108,000 layout
+// objects, and walking them every frame is what made a thousand-drone live page lag seconds.
+const SOURCE_BLOCK = 200;
 function buildSource() {
   const pre = $('source');
   pre.textContent = '';
   S.activeLines = new Set();
+  S.sourceRows = [];
+  S.selectedRow = null;
   const text = S.mission ? str(S.mission.source) : '';
   if (!text) { pre.textContent = 'the mission text is not in this trace'; return; }
+  let block = null;
   text.split('\n').forEach((line, i) => {
+    if (i % SOURCE_BLOCK === 0) { block = el('div', 'src-block'); pre.appendChild(block); }
     const row = el('span', 'src-line');
     row.dataset.line = String(i + 1);
     row.appendChild(el('span', 'ln', String(i + 1)));
     row.appendChild(document.createTextNode(line));
-    pre.appendChild(row);
+    block.appendChild(row);
+    S.sourceRows.push(row);
   });
+  // A block out of view keeps the height of its lines (one line each: the text does not wrap).
+  for (const b of pre.children) b.style.containIntrinsicSize = `auto ${(b.children.length * 1.4).toFixed(1)}em`;
 }
 
 // Only the rows whose state changed are touched: a generated mission has tens of thousands.
 function renderSourceActive() {
   const active = new Set();
   for (const b of D.bars) if (b.start <= S.clock + 1e-9 && (b.end === null || b.end > S.clock + 1e-9)) active.add(b.line);
-  const rows = $('source').children, before = S.activeLines || new Set();
+  const rows = S.sourceRows || [], before = S.activeLines || new Set();
   for (const line of before) if (!active.has(line) && rows[line - 1]) rows[line - 1].classList.remove('active');
   for (const line of active) if (!before.has(line) && rows[line - 1]) rows[line - 1].classList.add('active');
   S.activeLines = active;
@@ -1201,12 +1216,11 @@ function select(what) {
   for (const b of D.bars) if (b.el) b.el.classList.toggle('selected', sameBar(b));
   for (const c of D.conds) if (c.el) c.el.classList.toggle('selected', nodes.size ? c.nodes.some(n => nodes.has(n)) : c.line === what.line);
   for (const g of $('graph').querySelectorAll('g.node')) g.classList.toggle('selected', nodes.has(Number(g.dataset.node)));
-  let lineRow = null;
-  for (const row of $('source').children) {
-    const on = Number(row.dataset.line) === what.line;
-    row.classList.toggle('selected', on);
-    if (on) lineRow = row;
-  }
+  const rows = S.sourceRows || [];
+  if (S.selectedRow) S.selectedRow.classList.remove('selected');
+  const lineRow = what.line > 0 ? rows[what.line - 1] || null : null;
+  if (lineRow) lineRow.classList.add('selected');
+  S.selectedRow = lineRow;
   if (lineRow) lineRow.scrollIntoView({ block: 'nearest' });
   const g = $('graph').querySelector('g.node.selected');
   if (g) bringIntoView(g);
