@@ -33,7 +33,7 @@ function str(v) { return typeof v === 'string' ? v : ''; }
 
 function resetDerived() {
   D = {
-    drones: [], droneIndex: new Map(), bars: [], openBars: new Map(), conds: [], telemetry: new Map(),
+    drones: [], droneIndex: new Map(), bars: [], barsEnded: 0, openBars: new Map(), conds: [], telemetry: new Map(),
     messages: [], nodeHistory: new Map(), end: 0, outcome: '', failures: [], eventTimes: [], violations: [],
     nodeKey: new Map(), nodes: new Map(), lastIngested: 0, missionReason: '', missionT: null, failMarks: [],
     waitSpans: new Map(), giveWays: [],
@@ -41,6 +41,8 @@ function resetDerived() {
     // sample of a thousand drones to scale the map.
     seen: { minX: Infinity, maxX: -Infinity, minY: Infinity, maxY: -Infinity, maxZ: 1 },
   };
+  S.mapBounds = null;  // a new mission: the map and its tracks' layer start again
+  S.trails = null;
   const m = S.mission || {};
   for (const d of Array.isArray(m.drones) ? m.drones : []) addDrone(str(d.name), d);
   for (const n of Array.isArray(m.nodes) ? m.nodes : []) {
@@ -55,7 +57,10 @@ function addDrone(name, info) {
   if (!name || D.droneIndex.has(name)) return D.droneIndex.get(name);
   const i = D.drones.length;
   const home = info && Array.isArray(info.home) ? info.home.map(v => num(v, 0)) : null;
-  D.drones.push({ name, index: i, home, geofence: info ? info.geofence : null, colour: droneColour(i) });
+  const geofence = info ? info.geofence : null;
+  const fenceKey = geofence && Array.isArray(geofence.polygon) && geofence.polygon.length > 2 ?
+    JSON.stringify(geofence.polygon) : '';  // the fleet's drones share one fence: drawn once
+  D.drones.push({ name, index: i, home, geofence, fenceKey, colour: droneColour(i) });
   D.droneIndex.set(name, i);
   S.structureDirty = true;
   return i;
@@ -106,7 +111,7 @@ function ingest(e) {
   } else if (e.event === 'end') {
     const open = D.openBars.get(key);
     const bar = open && open.length ? open.pop() : null;
-    if (bar) { bar.end = t; bar.outcome = str(e.outcome); bar.reason = str(e.reason); bar.changed = true; }
+    if (bar) { bar.end = t; bar.outcome = str(e.outcome); bar.reason = str(e.reason); bar.changed = true; D.barsEnded++; }
     if (e.outcome === 'failed') {
       const f = { t, kind: 'action', drone: str(e.drone), name: str(e.name), text: str(e.text) || str(e.name),
                   line: e.line | 0, reason: str(e.reason), nodes: nodesOf(e) };
@@ -435,6 +440,7 @@ function buildLanes() {
   lanes.hidden = !useDom;
   $('lanes-canvas').hidden = useDom;
   lanes.dataset.drones = String(D.drones.length);
+  $('lanes-canvas')._drawn = null;
   for (const item of [...D.bars, ...D.conds, ...D.violations, ...D.failMarks, ...D.giveWays]) item.el = null;
   for (const w of D.waitSpans ? D.waitSpans.values() : []) w.el = null;
   D.waitSpans = new Map();
@@ -756,6 +762,7 @@ function renderLanes() {
 // Level of detail for large fleets: one pixel row group per drone, bars merged below a pixel.
 function renderLanesCanvas() {
   const canvas = $('lanes-canvas');
+  put($('playhead'), 'height', '0px');
   // At most 1,200 px tall: the browser paints the whole canvas each frame, and a thousand
   // rows of 4 px (6 million pixels) made a live page fall seconds behind.
   const rowH = Math.max(1, Math.min(8, Math.floor(1200 / D.drones.length)));
@@ -763,9 +770,15 @@ function renderLanesCanvas() {
   // Resizing a canvas reallocates it (4,000 rows of a thousand drones): only when it changes.
   if (canvas.width !== w) canvas.width = w;
   if (canvas.height !== rowH * D.drones.length) canvas.height = rowH * D.drones.length;
+  // Drawn again only when its picture changes (a bar started or ended, the clock moved half a
+  // pixel): the browser copies a changed canvas of a thousand rows whole on every frame. A live
+  // run's axis has headroom (axisEnd) so the bars stay put while the clock moves on.
+  const end = axisEnd(), now = S.clock;
+  const key = [w, canvas.height, end, Math.round((now / end) * w * 2), D.bars.length, D.barsEnded].join(' ');
+  if (canvas._drawn === key) return;
+  canvas._drawn = key;
   const g = canvas.getContext('2d');
   g.clearRect(0, 0, w, canvas.height);
-  const end = missionEnd(), now = S.clock;
   const colours = { succeeded: '#2e7d32', failed: '#c62828', preempted: '#ef6c00', cancelled: '#757575', running: '#1565c0' };
   let drawn = 0;
   for (const b of D.bars) {
@@ -782,7 +795,6 @@ function renderLanesCanvas() {
   g.fillRect((now / end) * w, 0, 2, canvas.height);
   canvas.dataset.drones = String(D.drones.length);
   canvas.dataset.bars = String(drawn);
-  put($('playhead'), 'height', '0px');
 }
 
 // ---- map ----
@@ -817,7 +829,7 @@ function worldBounds() {
 
 function renderMap() {
   const canvas = $('map'), g = canvas.getContext('2d');
-  const W = canvas.width, H = canvas.height, B = worldBounds();
+  const W = canvas.width, H = canvas.height, B = mapBounds();
   const scale = Math.min(W / (B.maxX - B.minX), H / (B.maxY - B.minY));
   const X = x => (x - B.minX) * scale + (W - (B.maxX - B.minX) * scale) / 2;
   const Y = y => H - ((y - B.minY) * scale + (H - (B.maxY - B.minY) * scale) / 2);
@@ -827,32 +839,37 @@ function renderMap() {
   const seenFences = new Set();
   for (const d of D.drones) {
     const f = d.geofence;
-    if (f && Array.isArray(f.polygon) && f.polygon.length > 2 && !seenFences.has(JSON.stringify(f.polygon))) {
-      seenFences.add(JSON.stringify(f.polygon));
+    if (d.fenceKey && !seenFences.has(d.fenceKey)) {
+      seenFences.add(d.fenceKey);
       g.strokeStyle = '#c62828'; g.setLineDash([6, 4]); g.beginPath();
       f.polygon.forEach((p, i) => (i ? g.lineTo : g.moveTo).call(g, X(num(p[0], 0)), Y(num(p[1], 0))));
       g.closePath(); g.stroke(); g.setLineDash([]);
     }
   }
+  if (many) g.drawImage(trailLayer(W, H, B, X, Y), 0, 0);
+  const failedNow = failedDronesAt(S.clock);
   for (const d of D.drones) {
     const samples = D.telemetry.get(d.name) || [];
+    const p = positionAt(d, S.clock);
     if (samples.length > 1) {
       g.strokeStyle = d.colour; g.globalAlpha = 0.6; g.lineWidth = 1.5; g.beginPath();
-      const step = many ? Math.max(1, Math.floor(samples.length / 50)) : 1;
       let first = true;
-      for (let i = 0; i < samples.length && samples[i].t <= S.clock; i += step) {
-        (first ? g.moveTo : g.lineTo).call(g, X(samples[i].x), Y(samples[i].y)); first = false;
+      if (many) {  // the layer has the track to its last sample: only the way from there
+        const last = d.trailFrom;
+        if (last) { g.moveTo(X(last.x), Y(last.y)); first = false; }
+      } else {
+        for (let i = 0; i < samples.length && samples[i].t <= S.clock; i++) {
+          (first ? g.moveTo : g.lineTo).call(g, X(samples[i].x), Y(samples[i].y)); first = false;
+        }
       }
-      const p = positionAt(d, S.clock);
       if (p && !first) g.lineTo(X(p.x), Y(p.y));
       g.stroke(); g.globalAlpha = 1;
     }
     if (d.home && !many) { g.strokeStyle = d.colour; g.strokeRect(X(d.home[0]) - 4, Y(d.home[1]) - 4, 8, 8); }
-    const p = positionAt(d, S.clock);
     if (!p) continue;
     g.fillStyle = d.colour;
     g.beginPath(); g.arc(X(p.x), Y(p.y), many ? 2 : 5, 0, 2 * Math.PI); g.fill();
-    const failed = failedBy(d.name, S.clock);
+    const failed = failedNow.get(d.name);
     if (failed) { g.strokeStyle = '#d50000'; g.lineWidth = 2; g.beginPath(); g.arc(X(p.x), Y(p.y), 9, 0, 2 * Math.PI);
                   g.stroke(); g.lineWidth = 1; }
     if (!many) {
@@ -867,6 +884,63 @@ function renderMap() {
   const hasTelemetry = D.telemetry.size > 0;
   putText($('map-note'), hasTelemetry ? '' : (D.drones.some(d => d.home) ?
     'this trace has no telemetry: homes only' : 'this trace has no telemetry and names no homes'));
+}
+
+// Large fleets: every track so far sits on a layer of its own that each frame extends with
+// the samples that came in since (a few per frame), instead of drawing a thousand tracks
+// again. Drawn again from the start, thinned to 50 points a track, when the map's scale
+// changes or the clock goes back. d.trailFrom is the last sample on the layer.
+function trailLayer(W, H, B, X, Y) {
+  const key = [W, H, B.minX, B.maxX, B.minY, B.maxY].join(' ');
+  let L = S.trails;
+  if (!L || L.key !== key || S.clock < L.clock) {
+    const canvas = L ? L.canvas : document.createElement('canvas');
+    canvas.width = W; canvas.height = H;  // also clears it
+    L = S.trails = { key, canvas, clock: 0, upTo: new Map() };
+  }
+  const g = L.canvas.getContext('2d');
+  g.globalAlpha = 0.6; g.lineWidth = 1.5;
+  for (const d of D.drones) {
+    const samples = D.telemetry.get(d.name);
+    const from = L.upTo.get(d.name) || 0;
+    let to = from;
+    while (samples && to < samples.length && samples[to].t <= S.clock) to++;
+    if (to > from) {
+      const step = Math.max(1, Math.floor((to - from) / 50));
+      const start = from > 0 ? from - 1 : 0;
+      g.strokeStyle = d.colour; g.beginPath();
+      g.moveTo(X(samples[start].x), Y(samples[start].y));
+      for (let i = start + step; i < to; i += step) g.lineTo(X(samples[i].x), Y(samples[i].y));
+      g.lineTo(X(samples[to - 1].x), Y(samples[to - 1].y));
+      g.stroke();
+      L.upTo.set(d.name, to);
+    }
+    d.trailFrom = to ? samples[to - 1] : null;
+  }
+  L.clock = S.clock;
+  return L.canvas;
+}
+
+// The map of a large fleet keeps its scale while the drones fly inside it and grows with a
+// margin when one leaves it, so the tracks' layer is rarely drawn again; a small fleet's map
+// fits it exactly.
+function mapBounds() {
+  const B = worldBounds();
+  if (D.drones.length <= 100) return B;
+  const K = S.mapBounds;
+  if (K && B.minX >= K.minX && B.maxX <= K.maxX && B.minY >= K.minY && B.maxY <= K.maxY && B.maxZ <= K.maxZ) return K;
+  const m = 0.1 * Math.max(B.maxX - B.minX, B.maxY - B.minY);
+  const U = K || B;
+  S.mapBounds = { minX: Math.min(U.minX, B.minX - m), maxX: Math.max(U.maxX, B.maxX + m), minY: Math.min(U.minY, B.minY - m),
+                  maxY: Math.max(U.maxY, B.maxY + m), maxZ: Math.max(U.maxZ, B.maxZ * 1.2) };
+  return S.mapBounds;
+}
+
+// Each drone's failed action once the clock has passed it (the first, as failedBy).
+function failedDronesAt(t) {
+  const out = new Map();
+  for (const f of D.failMarks) if (f.t <= t + 1e-9 && !out.has(f.drone)) out.set(f.drone, f);
+  return out;
 }
 
 // The failed action of `drone`, once the clock has passed it; null otherwise.
