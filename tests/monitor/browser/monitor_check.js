@@ -1,6 +1,6 @@
 // Drives Debian's chromium headless against a running `eamos monitor` / `eamos run --monitor`
 // and checks what the page shows, through its DOM. Called by tests/monitor/browser_test.cpp:
-//   node monitor_check.js replay|live|live20|live200|live1000|launch|v1|scale|violation|failed|waits|giveway|palette URL SCREENSHOT_DIR CHROMIUM
+//   node monitor_check.js replay|live|live20|live1000|launch|v1|scale|violation|failed|waits|giveway|palette URL SCREENSHOT_DIR CHROMIUM
 // Prints "ok: ..." lines and exits 0, or prints "FAIL: what" and exits 1.
 'use strict';
 const fs = require('fs');
@@ -460,7 +460,6 @@ async function waits(browser) {
     if (mode === 'replay') await replay(browser);
     else if (mode === 'live') await live(browser);
     else if (mode === 'live20') await live20(browser);
-    else if (mode === 'live200') await liveScale(browser, 200, 1000);
     else if (mode === 'live1000') await liveScale(browser, 1000, 100);
     else if (mode === 'launch') await launchLive(browser);
     else if (mode === 'v1') await v1(browser);
