@@ -851,16 +851,12 @@ function renderMap() {
   for (const d of D.drones) {
     const samples = D.telemetry.get(d.name) || [];
     const p = positionAt(d, S.clock);
-    if (samples.length > 1) {
+    // A large fleet's tracks are on the layer, up to each drone's last sample.
+    if (samples.length > 1 && !many) {
       g.strokeStyle = d.colour; g.globalAlpha = 0.6; g.lineWidth = 1.5; g.beginPath();
       let first = true;
-      if (many) {  // the layer has the track to its last sample: only the way from there
-        const last = d.trailFrom;
-        if (last) { g.moveTo(X(last.x), Y(last.y)); first = false; }
-      } else {
-        for (let i = 0; i < samples.length && samples[i].t <= S.clock; i++) {
-          (first ? g.moveTo : g.lineTo).call(g, X(samples[i].x), Y(samples[i].y)); first = false;
-        }
+      for (let i = 0; i < samples.length && samples[i].t <= S.clock; i++) {
+        (first ? g.moveTo : g.lineTo).call(g, X(samples[i].x), Y(samples[i].y)); first = false;
       }
       if (p && !first) g.lineTo(X(p.x), Y(p.y));
       g.stroke(); g.globalAlpha = 1;
@@ -868,7 +864,10 @@ function renderMap() {
     if (d.home && !many) { g.strokeStyle = d.colour; g.strokeRect(X(d.home[0]) - 4, Y(d.home[1]) - 4, 8, 8); }
     if (!p) continue;
     g.fillStyle = d.colour;
-    g.beginPath(); g.arc(X(p.x), Y(p.y), many ? 2 : 5, 0, 2 * Math.PI); g.fill();
+    // A square of 4 px for each of a thousand drones: the browser rasterises a canvas's
+    // shapes when it hands the frame on, and a thousand round dots cost as much as the rest.
+    if (many) g.fillRect(X(p.x) - 2, Y(p.y) - 2, 4, 4);
+    else { g.beginPath(); g.arc(X(p.x), Y(p.y), 5, 0, 2 * Math.PI); g.fill(); }
     const failed = failedNow.get(d.name);
     if (failed) { g.strokeStyle = '#d50000'; g.lineWidth = 2; g.beginPath(); g.arc(X(p.x), Y(p.y), 9, 0, 2 * Math.PI);
                   g.stroke(); g.lineWidth = 1; }
@@ -888,8 +887,9 @@ function renderMap() {
 
 // Large fleets: every track so far sits on a layer of its own that each frame extends with
 // the samples that came in since (a few per frame), instead of drawing a thousand tracks
-// again. Drawn again from the start, thinned to 50 points a track, when the map's scale
-// changes or the clock goes back. d.trailFrom is the last sample on the layer.
+// again; a track ends at the drone's last sample, the dot goes on between samples. Drawn
+// again from the start, thinned to 50 points a track, when the map's scale changes or the
+// clock goes back.
 function trailLayer(W, H, B, X, Y) {
   const key = [W, H, B.minX, B.maxX, B.minY, B.maxY].join(' ');
   let L = S.trails;
@@ -915,7 +915,6 @@ function trailLayer(W, H, B, X, Y) {
       g.stroke();
       L.upTo.set(d.name, to);
     }
-    d.trailFrom = to ? samples[to - 1] : null;
   }
   L.clock = S.clock;
   return L.canvas;
@@ -1022,7 +1021,8 @@ function renderSide(B) {
     const p = positionAt(d, S.clock);
     if (!p) continue;
     g.fillStyle = d.colour;
-    g.beginPath(); g.arc(X(p.x), Z(p.z), D.drones.length > 100 ? 2 : 4, 0, 2 * Math.PI); g.fill();
+    if (D.drones.length > 100) g.fillRect(X(p.x) - 2, Z(p.z) - 2, 4, 4);  // as on the map
+    else { g.beginPath(); g.arc(X(p.x), Z(p.z), 4, 0, 2 * Math.PI); g.fill(); }
   }
   g.fillStyle = '#888'; g.font = '10px sans-serif'; g.fillText(B.maxZ.toFixed(1) + ' m', 2, 10);
 }
