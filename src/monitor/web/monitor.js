@@ -779,22 +779,50 @@ function renderLanesCanvas() {
   canvas._drawn = key;
   const g = canvas.getContext('2d');
   g.clearRect(0, 0, w, canvas.height);
-  const colours = { succeeded: '#2e7d32', failed: '#c62828', preempted: '#ef6c00', cancelled: '#757575', running: '#1565c0' };
-  let drawn = 0;
-  for (const b of D.bars) {
+  const layer = endedBarsLayer(w, canvas.height, end, rowH);
+  g.drawImage(layer.canvas, 0, 0);
+  let drawn = layer.count;
+  for (const b of D.bars) {  // the bars still running at the clock
+    if (b.layer === layer.id) continue;
     const state = barState(b);
     if (state === 'future') continue;
     drawn++;
-    const row = D.droneIndex.get(b.drone);
-    const stop = state === 'running' ? now : b.end;
-    g.fillStyle = colours[state] || '#2e7d32';
-    const x = (b.start / end) * w;
-    g.fillRect(x, row * rowH, Math.max(1, ((stop - b.start) / end) * w), rowH - (rowH > 3 ? 1 : 0));
+    drawBarRow(g, b, state === 'running' ? now : b.end, state, end, w, rowH);
   }
   g.fillStyle = '#d50000';
   g.fillRect((now / end) * w, 0, 2, canvas.height);
   canvas.dataset.drones = String(D.drones.length);
   canvas.dataset.bars = String(drawn);
+}
+
+const BAR_COLOURS = { succeeded: '#2e7d32', failed: '#c62828', preempted: '#ef6c00', cancelled: '#757575', running: '#1565c0' };
+function drawBarRow(g, b, stop, state, end, w, rowH) {
+  g.fillStyle = BAR_COLOURS[state] || '#2e7d32';
+  const row = D.droneIndex.get(b.drone);
+  g.fillRect((b.start / end) * w, row * rowH, Math.max(1, ((stop - b.start) / end) * w), rowH - (rowH > 3 ? 1 : 0));
+}
+
+// The bars that ended by the clock, on a layer of their own that each frame extends with the
+// ones that ended since: a frame then draws the layer and the running bars, not every bar of
+// the mission (5,000 of a thousand-drone show). Drawn again when the axis changes or the
+// clock goes back.
+function endedBarsLayer(w, h, end, rowH) {
+  const key = [w, h, end, rowH, D.drones.length].join(' ');
+  let L = S.barLayer;
+  if (!L || L.key !== key || S.clock < L.clock || L.bars !== D.bars) {
+    const canvas = L ? L.canvas : document.createElement('canvas');
+    canvas.width = w; canvas.height = h;  // also clears it
+    L = S.barLayer = { key, canvas, clock: 0, count: 0, bars: D.bars, id: (L ? L.id : 0) + 1 };
+  }
+  const g = L.canvas.getContext('2d');
+  for (const b of D.bars) {
+    if (b.layer === L.id || b.end === null || b.end > S.clock + 1e-9 || b.start > S.clock + 1e-9) continue;
+    drawBarRow(g, b, b.end, b.outcome || 'succeeded', end, w, rowH);
+    b.layer = L.id;
+    L.count++;
+  }
+  L.clock = S.clock;
+  return L;
 }
 
 // ---- map ----
