@@ -268,11 +268,13 @@ function render() {
 }
 
 // Live latency: from eamos emitting an event to the end of the render that drew it (the
-// browser paints that frame right after). Only events emitted after the page got its history
-// count: what happened before it connected is old news, not lateness.
+// browser paints that frame right after). Only events emitted after the page had drawn its
+// history count: what happened before it connected is old news, and until that first draw
+// the page is loading (a thousand drones' mission text, graphs and history), not lagging.
 function noteDrawn() {
-  if (!S.undrawn.length) return;
   const now = wallNow();
+  if (S.historyIn && S.liveFrom === Infinity) S.liveFrom = now;
+  if (!S.undrawn.length) return;
   for (const emitted of S.undrawn) S.latencies.push(now - emitted);
   S.undrawn = [];
   if (S.latencies.length > LATENCIES_MAX) S.latencies.splice(0, S.latencies.length - LATENCIES_MAX);
@@ -1364,6 +1366,7 @@ function onMessage(text) {
     S.arrivals = [];
     S.serverDelays = [];
     S.liveFrom = Infinity;
+    S.historyIn = false;
     resetDerived();
     $('mission-name').textContent = str(S.mission.mission);
     buildSource();
@@ -1382,8 +1385,7 @@ function onMessage(text) {
       }
       if (S.arrivals.length > LATENCIES_MAX) S.arrivals.splice(0, S.arrivals.length - LATENCIES_MAX);
       if (S.serverDelays.length > LATENCIES_MAX) S.serverDelays.splice(0, S.serverDelays.length - LATENCIES_MAX);
-      // What happened before the page had shown the mission and its history is old news, not lateness.
-      if (S.liveFrom === Infinity) S.liveFrom = arrived;
+      S.historyIn = true;
     }
     // A page in a background tab gets no animation frames: keep its DOM current anyway.
     if (document.hidden) { if (S.live && !S.finished && S.follow) S.clock = missionEnd(); render(); }
