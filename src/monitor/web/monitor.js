@@ -1278,39 +1278,71 @@ function renderGraphStates() {
 // ---- mission text and selection ----
 
 // The mission text in blocks of SOURCE_BLOCK lines that the browser lays out and paints only
-// when in view (content-visibility): a generated mission of 27,000 lines is 108,000 layout
-// objects, and walking them every frame is what made a thousand-drone live page lag seconds.
+// when in view (content-visibility). A block is one text node until it comes near the view,
+// when it gets an element per line (numbered, for the highlights): a generated mission of
+// 27,000 lines as elements is 108,000 objects to build, style and lay out, and laying them
+// out every frame is what made a thousand-drone live page lag seconds. Every line stays in
+// the page as text, so the browser's find still finds it.
 const SOURCE_BLOCK = 200;
 function buildSource() {
   const pre = $('source');
   pre.textContent = '';
+  if (S.sourceObserver) S.sourceObserver.disconnect();
   S.activeLines = new Set();
-  S.sourceRows = [];
-  S.selectedRow = null;
+  S.sourceBlocks = [];
+  S.selectedLine = 0;
   const text = S.mission ? str(S.mission.source) : '';
   if (!text) { pre.textContent = 'the mission text is not in this trace'; return; }
-  let block = null;
-  text.split('\n').forEach((line, i) => {
-    if (i % SOURCE_BLOCK === 0) { block = el('div', 'src-block'); pre.appendChild(block); }
-    const row = el('span', 'src-line');
-    row.dataset.line = String(i + 1);
-    row.appendChild(el('span', 'ln', String(i + 1)));
+  const lines = text.split('\n');
+  S.sourceObserver = new IntersectionObserver(entries => {
+    for (const e of entries) if (e.isIntersecting) fillBlock(e.target.block);
+  }, { root: pre, rootMargin: '400px 0px' });
+  for (let first = 0; first < lines.length; first += SOURCE_BLOCK) {
+    const el_ = el('div', 'src-block');
+    const block = { el: el_, first, lines: lines.slice(first, first + SOURCE_BLOCK), rows: null };
+    el_.block = block;
+    el_.textContent = block.lines.join('\n') + '\n';
+    // A block out of view keeps the height of its lines (one line each: the text does not wrap).
+    el_.style.containIntrinsicSize = `auto ${(block.lines.length * 1.4).toFixed(1)}em`;
+    pre.appendChild(el_);
+    S.sourceBlocks.push(block);
+    S.sourceObserver.observe(el_);
+  }
+  fillBlock(S.sourceBlocks[0]);  // the top is in view: numbered at once
+}
+
+// A block's element per line, with its highlights as they are now.
+function fillBlock(block) {
+  if (!block || block.rows) return;
+  block.rows = block.lines.map((line, k) => {
+    const n = block.first + k + 1, row = el('span', 'src-line');
+    row.dataset.line = String(n);
+    row.appendChild(el('span', 'ln', String(n)));
     row.appendChild(document.createTextNode(line));
-    block.appendChild(row);
-    S.sourceRows.push(row);
+    if (S.activeLines.has(n)) row.classList.add('active');
+    if (S.selectedLine === n) row.classList.add('selected');
+    return row;
   });
-  // A block out of view keeps the height of its lines (one line each: the text does not wrap).
-  for (const b of pre.children) b.style.containIntrinsicSize = `auto ${(b.children.length * 1.4).toFixed(1)}em`;
+  block.el.textContent = '';
+  block.el.append(...block.rows);
+}
+
+// Line n's element, when its block has them (`fill`: give it them now).
+function sourceRow(n, fill) {
+  const block = (S.sourceBlocks || [])[Math.floor((n - 1) / SOURCE_BLOCK)];
+  if (!block || n < 1) return null;
+  if (fill) fillBlock(block);
+  return block.rows ? block.rows[(n - 1) % SOURCE_BLOCK] || null : null;
 }
 
 // Only the rows whose state changed are touched: a generated mission has tens of thousands.
 function renderSourceActive() {
   const active = new Set();
   for (const b of D.bars) if (b.start <= S.clock + 1e-9 && (b.end === null || b.end > S.clock + 1e-9)) active.add(b.line);
-  const rows = S.sourceRows || [], before = S.activeLines || new Set();
-  for (const line of before) if (!active.has(line) && rows[line - 1]) rows[line - 1].classList.remove('active');
-  for (const line of active) if (!before.has(line) && rows[line - 1]) rows[line - 1].classList.add('active');
-  S.activeLines = active;
+  const before = S.activeLines || new Set();
+  S.activeLines = active;  // a block filled later takes its highlights from here
+  for (const line of before) if (!active.has(line)) { const r = sourceRow(line); if (r) r.classList.remove('active'); }
+  for (const line of active) if (!before.has(line)) { const r = sourceRow(line); if (r) r.classList.add('active'); }
 }
 
 function select(what) {
@@ -1320,11 +1352,11 @@ function select(what) {
   for (const b of D.bars) if (b.el) b.el.classList.toggle('selected', sameBar(b));
   for (const c of D.conds) if (c.el) c.el.classList.toggle('selected', nodes.size ? c.nodes.some(n => nodes.has(n)) : c.line === what.line);
   for (const g of $('graph').querySelectorAll('g.node')) g.classList.toggle('selected', nodes.has(Number(g.dataset.node)));
-  const rows = S.sourceRows || [];
-  if (S.selectedRow) S.selectedRow.classList.remove('selected');
-  const lineRow = what.line > 0 ? rows[what.line - 1] || null : null;
+  const before = sourceRow(S.selectedLine || 0);
+  if (before) before.classList.remove('selected');
+  S.selectedLine = what.line > 0 ? what.line : 0;
+  const lineRow = sourceRow(S.selectedLine, true);
   if (lineRow) lineRow.classList.add('selected');
-  S.selectedRow = lineRow;
   if (lineRow) lineRow.scrollIntoView({ block: 'nearest' });
   const g = $('graph').querySelector('g.node.selected');
   if (g) bringIntoView(g);
