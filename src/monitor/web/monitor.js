@@ -1298,15 +1298,15 @@ function buildSource() {
     for (const e of entries) if (e.isIntersecting) fillBlock(e.target.block);
   }, { root: pre, rootMargin: '400px 0px' });
   for (let first = 0; first < lines.length; first += SOURCE_BLOCK) {
-    const el_ = el('div', 'src-block');
-    const block = { el: el_, first, lines: lines.slice(first, first + SOURCE_BLOCK), rows: null };
-    el_.block = block;
-    el_.textContent = block.lines.join('\n') + '\n';
+    const div = el('div', 'src-block');
+    const block = { el: div, first, lines: lines.slice(first, first + SOURCE_BLOCK), rows: null };
+    div.block = block;
+    div.textContent = block.lines.join('\n') + '\n';
     // A block out of view keeps the height of its lines (one line each: the text does not wrap).
-    el_.style.containIntrinsicSize = `auto ${(block.lines.length * 1.4).toFixed(1)}em`;
-    pre.appendChild(el_);
+    div.style.containIntrinsicSize = `auto ${(block.lines.length * 1.4).toFixed(1)}em`;
+    pre.appendChild(div);
     S.sourceBlocks.push(block);
-    S.sourceObserver.observe(el_);
+    S.sourceObserver.observe(div);
   }
   fillBlock(S.sourceBlocks[0]);  // the top is in view: numbered at once
 }

@@ -232,6 +232,22 @@ async function scale(browser) {
   check(r.bars === 0 && r.elements < 100, `no element per bar (${r.elements} elements in the timeline)`);
   // Generous for two shared cores: a frame budget is 16 ms, a person notices a stall at about 0.5 s.
   check(r.perRender < 500, `a clock change redraws in ${r.perRender.toFixed(1)} ms`);
+  // The mission text: every line in the page as text, numbered lines only near the view (an
+  // element per line of 20,000 would be built, styled and laid out), and the end numbered
+  // once it is scrolled to.
+  const text = await page.evaluate(() => {
+    const source = document.getElementById('source');
+    return { far: source.textContent.includes('var D999 Quad'), rows: source.querySelectorAll('.src-line').length,
+             blocks: source.querySelectorAll('.src-block').length };
+  });
+  check(text.far && text.rows > 0 && text.rows < 2000 && text.blocks > 50,
+        `the mission text is all in the page, ${text.rows} lines of it numbered (${text.blocks} blocks)`);
+  await page.evaluate(() => { const s = document.getElementById('source'); s.scrollTop = s.scrollHeight; });
+  const end = await page.waitForFunction(() => {
+    const rows = document.querySelectorAll('#source .src-block:last-child .src-line');
+    return rows.length ? Number(rows[rows.length - 1].dataset.line) : 0;
+  }, { timeout: 10000, polling: 100 }).then(h => h.jsonValue(), () => 0);
+  check(end > 200 * (text.blocks - 1), `scrolled to its end, the mission text numbers its last line (${end})`);
   await page.screenshot({ path: path.join(shots, 'replay-1000-drones.png') });
 }
 
