@@ -42,6 +42,10 @@ struct ServerLimits {
   double ping_interval_s = 2.0;      ///< the server pings every page this often
   double answer_timeout_s = 6.0;     ///< a page that leaves a ping unanswered this long is dropped
   double max_lag_s = 30.0;           ///< a page not yet sent an event appended this long ago is dropped
+  /// After a message of events, a page's writer lets this long pass before the next, so that
+  /// the events in between go out together: a browser handles each message as a task of its
+  /// own, and a thousand drones emit thousands of events a second (one message each before).
+  double batch_interval_s = 0.008;
 };
 
 class MonitorServer {

@@ -189,10 +189,13 @@ void MonitorServer::write_loop(Client* c) {
     return stopping_ || c->closing || c->cursor < events_.size() || (finished_ && !c->sent_finish) ||
            (!c->ping_outstanding && now - c->last_ping >= std::chrono::duration<double>(limits_.ping_interval_s));
   };
+  auto gone = [&] { return stopping_ || c->closing; };
   while (ok) {
     changed_.wait_for(lock, std::chrono::milliseconds(250), due);
-    if (stopping_ || c->closing) return;
+    if (gone()) return;
+    std::size_t before = c->cursor;
     ok = write_pending(c, lock);
+    if (ok && c->cursor != before) changed_.wait_for(lock, std::chrono::duration<double>(limits_.batch_interval_s), gone);
   }
   drop(*c);  // a write that failed or made no progress for the header timeout
 }

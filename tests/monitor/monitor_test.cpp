@@ -11,10 +11,12 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "monitor/live_sink.h"
 #include "monitor/server.h"
 #include "monitor/trace_file.h"
+#include "raw_client.h"
 #include "support/eamos_process.h"
 #include "support/run_eamos.h"
 
@@ -249,6 +251,53 @@ TEST(MonitorServer, ServesOnlyThePageAndRefusesEverythingThatWouldChangeSomethin
   EXPECT_TRUE(e.exited);
   EXPECT_EQ(e.status, 0);
   fs::remove(trace);
+}
+
+// How many events a message of the server carries (each is a JSON object with an "event").
+std::size_t events_in(const std::string& message) {
+  std::size_t n = 0;
+  for (std::size_t at = message.find("\"event\":"); at != std::string::npos; at = message.find("\"event\":", at + 1)) ++n;
+  return n;
+}
+
+// The events that come while a page's last message is being written and read go out together
+// as the next one: a browser handles each message as a task of its own, and a thousand-drone
+// run, one message per event, kept a page's main thread busy with messages alone.
+TEST(MonitorServer, EventsThatComeTogetherReachAPageInOneMessage) {
+  eamos::monitor::ServerLimits limits;
+  limits.batch_interval_s = 1.0;  // far longer than appending 200 events takes
+  eamos::monitor::MonitorServer server(limits);
+  server.set_mission("{}");
+  eamos::monitor::Endpoint at;
+  at.port = 0;
+  std::string error;
+  ASSERT_TRUE(server.start(at, error)) << error;
+  int port = port_of(server.url());
+  eamos_test::RawClient page;
+  eamos_test::Deadline until = eamos_test::after(20);
+  ASSERT_TRUE(page.connect_to(port) && page.websocket_handshake(port, until) && page.send_text("hello"));
+  std::string text;
+  ASSERT_TRUE(page.next_text(text, until));
+  ASSERT_NE(text.find("\"type\":\"mission\""), std::string::npos) << text;
+  auto event = [](int i) { return "{\"t\":" + std::to_string(i) + ",\"event\":\"start\",\"drone\":\"D1\",\"line\":1}"; };
+  server.append(event(0), 1);
+  ASSERT_TRUE(page.next_text(text, until));
+  EXPECT_EQ(events_in(text), 1u) << text;
+  // A run that emits an event every 2 ms for 0.4 s (the pace is the test's input, not a wait).
+  std::thread run([&] {
+    auto next = std::chrono::steady_clock::now();
+    for (int i = 1; i <= 200; ++i) {
+      next += std::chrono::milliseconds(2);
+      std::this_thread::sleep_until(next);
+      server.append(event(i), 1);
+    }
+  });
+  std::size_t messages = 0, events = 0;
+  while (events < 200 && page.next_text(text, until)) ++messages, events += events_in(text);
+  run.join();
+  EXPECT_EQ(events, 200u);
+  EXPECT_LE(messages, 3u) << "the 200 events came in " << messages << " messages, not together";
+  server.stop();
 }
 
 // The distributed run (one DEX process per drone over DDS) serves its ground's events the same way.

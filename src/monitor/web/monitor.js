@@ -33,7 +33,7 @@ function str(v) { return typeof v === 'string' ? v : ''; }
 
 function resetDerived() {
   D = {
-    drones: [], droneIndex: new Map(), bars: [], openBars: new Map(), conds: [], telemetry: new Map(),
+    drones: [], droneIndex: new Map(), bars: [], barsEnded: 0, openBars: new Map(), conds: [], telemetry: new Map(),
     messages: [], nodeHistory: new Map(), end: 0, outcome: '', failures: [], eventTimes: [], violations: [],
     nodeKey: new Map(), nodes: new Map(), lastIngested: 0, missionReason: '', missionT: null, failMarks: [],
     waitSpans: new Map(), giveWays: [],
@@ -41,6 +41,8 @@ function resetDerived() {
     // sample of a thousand drones to scale the map.
     seen: { minX: Infinity, maxX: -Infinity, minY: Infinity, maxY: -Infinity, maxZ: 1 },
   };
+  S.mapBounds = null;  // a new mission: the map and its tracks' layer start again
+  S.trails = null;
   const m = S.mission || {};
   for (const d of Array.isArray(m.drones) ? m.drones : []) addDrone(str(d.name), d);
   for (const n of Array.isArray(m.nodes) ? m.nodes : []) {
@@ -55,7 +57,10 @@ function addDrone(name, info) {
   if (!name || D.droneIndex.has(name)) return D.droneIndex.get(name);
   const i = D.drones.length;
   const home = info && Array.isArray(info.home) ? info.home.map(v => num(v, 0)) : null;
-  D.drones.push({ name, index: i, home, geofence: info ? info.geofence : null, colour: droneColour(i) });
+  const geofence = info ? info.geofence : null;
+  const fenceKey = geofence && Array.isArray(geofence.polygon) && geofence.polygon.length > 2 ?
+    JSON.stringify(geofence.polygon) : '';  // the fleet's drones share one fence: drawn once
+  D.drones.push({ name, index: i, home, geofence, fenceKey, colour: droneColour(i) });
   D.droneIndex.set(name, i);
   S.structureDirty = true;
   return i;
@@ -106,7 +111,7 @@ function ingest(e) {
   } else if (e.event === 'end') {
     const open = D.openBars.get(key);
     const bar = open && open.length ? open.pop() : null;
-    if (bar) { bar.end = t; bar.outcome = str(e.outcome); bar.reason = str(e.reason); bar.changed = true; }
+    if (bar) { bar.end = t; bar.outcome = str(e.outcome); bar.reason = str(e.reason); bar.changed = true; D.barsEnded++; }
     if (e.outcome === 'failed') {
       const f = { t, kind: 'action', drone: str(e.drone), name: str(e.name), text: str(e.text) || str(e.name),
                   line: e.line | 0, reason: str(e.reason), nodes: nodesOf(e) };
@@ -263,11 +268,13 @@ function render() {
 }
 
 // Live latency: from eamos emitting an event to the end of the render that drew it (the
-// browser paints that frame right after). Only events emitted after the page got its history
-// count: what happened before it connected is old news, not lateness.
+// browser paints that frame right after). Only events emitted after the page had drawn its
+// history count: what happened before it connected is old news, and until that first draw
+// the page is loading (a thousand drones' mission text, graphs and history), not lagging.
 function noteDrawn() {
-  if (!S.undrawn.length) return;
   const now = wallNow();
+  if (S.historyIn && S.liveFrom === Infinity) S.liveFrom = now;
+  if (!S.undrawn.length) return;
   for (const emitted of S.undrawn) S.latencies.push(now - emitted);
   S.undrawn = [];
   if (S.latencies.length > LATENCIES_MAX) S.latencies.splice(0, S.latencies.length - LATENCIES_MAX);
@@ -435,6 +442,7 @@ function buildLanes() {
   lanes.hidden = !useDom;
   $('lanes-canvas').hidden = useDom;
   lanes.dataset.drones = String(D.drones.length);
+  $('lanes-canvas')._drawn = null;
   for (const item of [...D.bars, ...D.conds, ...D.violations, ...D.failMarks, ...D.giveWays]) item.el = null;
   for (const w of D.waitSpans ? D.waitSpans.values() : []) w.el = null;
   D.waitSpans = new Map();
@@ -756,6 +764,7 @@ function renderLanes() {
 // Level of detail for large fleets: one pixel row group per drone, bars merged below a pixel.
 function renderLanesCanvas() {
   const canvas = $('lanes-canvas');
+  put($('playhead'), 'height', '0px');
   // At most 1,200 px tall: the browser paints the whole canvas each frame, and a thousand
   // rows of 4 px (6 million pixels) made a live page fall seconds behind.
   const rowH = Math.max(1, Math.min(8, Math.floor(1200 / D.drones.length)));
@@ -763,26 +772,59 @@ function renderLanesCanvas() {
   // Resizing a canvas reallocates it (4,000 rows of a thousand drones): only when it changes.
   if (canvas.width !== w) canvas.width = w;
   if (canvas.height !== rowH * D.drones.length) canvas.height = rowH * D.drones.length;
+  // Drawn again only when its picture changes (a bar started or ended, the clock moved half a
+  // pixel): the browser copies a changed canvas of a thousand rows whole on every frame. A live
+  // run's axis has headroom (axisEnd) so the bars stay put while the clock moves on.
+  const end = axisEnd(), now = S.clock;
+  const key = [w, canvas.height, end, Math.round((now / end) * w * 2), D.bars.length, D.barsEnded].join(' ');
+  if (canvas._drawn === key) return;
+  canvas._drawn = key;
   const g = canvas.getContext('2d');
   g.clearRect(0, 0, w, canvas.height);
-  const end = missionEnd(), now = S.clock;
-  const colours = { succeeded: '#2e7d32', failed: '#c62828', preempted: '#ef6c00', cancelled: '#757575', running: '#1565c0' };
-  let drawn = 0;
-  for (const b of D.bars) {
+  const layer = endedBarsLayer(w, canvas.height, end, rowH);
+  g.drawImage(layer.canvas, 0, 0);
+  let drawn = layer.count;
+  for (const b of D.bars) {  // the bars still running at the clock
+    if (b.layer === layer.id) continue;
     const state = barState(b);
     if (state === 'future') continue;
     drawn++;
-    const row = D.droneIndex.get(b.drone);
-    const stop = state === 'running' ? now : b.end;
-    g.fillStyle = colours[state] || '#2e7d32';
-    const x = (b.start / end) * w;
-    g.fillRect(x, row * rowH, Math.max(1, ((stop - b.start) / end) * w), rowH - (rowH > 3 ? 1 : 0));
+    drawBarRow(g, b, state === 'running' ? now : b.end, state, end, w, rowH);
   }
   g.fillStyle = '#d50000';
   g.fillRect((now / end) * w, 0, 2, canvas.height);
   canvas.dataset.drones = String(D.drones.length);
   canvas.dataset.bars = String(drawn);
-  $('playhead').style.height = '0px';
+}
+
+const BAR_COLOURS = { succeeded: '#2e7d32', failed: '#c62828', preempted: '#ef6c00', cancelled: '#757575', running: '#1565c0' };
+function drawBarRow(g, b, stop, state, end, w, rowH) {
+  g.fillStyle = BAR_COLOURS[state] || '#2e7d32';
+  const row = D.droneIndex.get(b.drone);
+  g.fillRect((b.start / end) * w, row * rowH, Math.max(1, ((stop - b.start) / end) * w), rowH - (rowH > 3 ? 1 : 0));
+}
+
+// The bars that ended by the clock, on a layer of their own that each frame extends with the
+// ones that ended since: a frame then draws the layer and the running bars, not every bar of
+// the mission (5,000 of a thousand-drone show). Drawn again when the axis changes or the
+// clock goes back.
+function endedBarsLayer(w, h, end, rowH) {
+  const key = [w, h, end, rowH, D.drones.length].join(' ');
+  let L = S.barLayer;
+  if (!L || L.key !== key || S.clock < L.clock || L.bars !== D.bars) {
+    const canvas = L ? L.canvas : document.createElement('canvas');
+    canvas.width = w; canvas.height = h;  // also clears it
+    L = S.barLayer = { key, canvas, clock: 0, count: 0, bars: D.bars, id: (L ? L.id : 0) + 1 };
+  }
+  const g = L.canvas.getContext('2d');
+  for (const b of D.bars) {
+    if (b.layer === L.id || b.end === null || b.end > S.clock + 1e-9 || b.start > S.clock + 1e-9) continue;
+    drawBarRow(g, b, b.end, b.outcome || 'succeeded', end, w, rowH);
+    b.layer = L.id;
+    L.count++;
+  }
+  L.clock = S.clock;
+  return L;
 }
 
 // ---- map ----
@@ -817,7 +859,7 @@ function worldBounds() {
 
 function renderMap() {
   const canvas = $('map'), g = canvas.getContext('2d');
-  const W = canvas.width, H = canvas.height, B = worldBounds();
+  const W = canvas.width, H = canvas.height, B = mapBounds();
   const scale = Math.min(W / (B.maxX - B.minX), H / (B.maxY - B.minY));
   const X = x => (x - B.minX) * scale + (W - (B.maxX - B.minX) * scale) / 2;
   const Y = y => H - ((y - B.minY) * scale + (H - (B.maxY - B.minY) * scale) / 2);
@@ -827,32 +869,36 @@ function renderMap() {
   const seenFences = new Set();
   for (const d of D.drones) {
     const f = d.geofence;
-    if (f && Array.isArray(f.polygon) && f.polygon.length > 2 && !seenFences.has(JSON.stringify(f.polygon))) {
-      seenFences.add(JSON.stringify(f.polygon));
+    if (d.fenceKey && !seenFences.has(d.fenceKey)) {
+      seenFences.add(d.fenceKey);
       g.strokeStyle = '#c62828'; g.setLineDash([6, 4]); g.beginPath();
       f.polygon.forEach((p, i) => (i ? g.lineTo : g.moveTo).call(g, X(num(p[0], 0)), Y(num(p[1], 0))));
       g.closePath(); g.stroke(); g.setLineDash([]);
     }
   }
+  if (many) g.drawImage(trailLayer(W, H, B, X, Y), 0, 0);
+  const failedNow = failedDronesAt(S.clock);
   for (const d of D.drones) {
     const samples = D.telemetry.get(d.name) || [];
-    if (samples.length > 1) {
+    const p = positionAt(d, S.clock);
+    // A large fleet's tracks are on the layer, up to each drone's last sample.
+    if (samples.length > 1 && !many) {
       g.strokeStyle = d.colour; g.globalAlpha = 0.6; g.lineWidth = 1.5; g.beginPath();
-      const step = many ? Math.max(1, Math.floor(samples.length / 50)) : 1;
       let first = true;
-      for (let i = 0; i < samples.length && samples[i].t <= S.clock; i += step) {
+      for (let i = 0; i < samples.length && samples[i].t <= S.clock; i++) {
         (first ? g.moveTo : g.lineTo).call(g, X(samples[i].x), Y(samples[i].y)); first = false;
       }
-      const p = positionAt(d, S.clock);
       if (p && !first) g.lineTo(X(p.x), Y(p.y));
       g.stroke(); g.globalAlpha = 1;
     }
     if (d.home && !many) { g.strokeStyle = d.colour; g.strokeRect(X(d.home[0]) - 4, Y(d.home[1]) - 4, 8, 8); }
-    const p = positionAt(d, S.clock);
     if (!p) continue;
     g.fillStyle = d.colour;
-    g.beginPath(); g.arc(X(p.x), Y(p.y), many ? 2 : 5, 0, 2 * Math.PI); g.fill();
-    const failed = failedBy(d.name, S.clock);
+    // A square of 4 px for each of a thousand drones: the browser rasterises a canvas's
+    // shapes when it hands the frame on, and a thousand round dots cost as much as the rest.
+    if (many) g.fillRect(X(p.x) - 2, Y(p.y) - 2, 4, 4);
+    else { g.beginPath(); g.arc(X(p.x), Y(p.y), 5, 0, 2 * Math.PI); g.fill(); }
+    const failed = failedNow.get(d.name);
     if (failed) { g.strokeStyle = '#d50000'; g.lineWidth = 2; g.beginPath(); g.arc(X(p.x), Y(p.y), 9, 0, 2 * Math.PI);
                   g.stroke(); g.lineWidth = 1; }
     if (!many) {
@@ -865,8 +911,65 @@ function renderMap() {
   drawFailures(g, X, Y);
   renderSide(B);
   const hasTelemetry = D.telemetry.size > 0;
-  $('map-note').textContent = hasTelemetry ? '' : (D.drones.some(d => d.home) ?
-    'this trace has no telemetry: homes only' : 'this trace has no telemetry and names no homes');
+  putText($('map-note'), hasTelemetry ? '' : (D.drones.some(d => d.home) ?
+    'this trace has no telemetry: homes only' : 'this trace has no telemetry and names no homes'));
+}
+
+// Large fleets: every track so far sits on a layer of its own that each frame extends with
+// the samples that came in since (a few per frame), instead of drawing a thousand tracks
+// again; a track ends at the drone's last sample, the dot goes on between samples. Drawn
+// again from the start, thinned to 50 points a track, when the map's scale changes or the
+// clock goes back.
+function trailLayer(W, H, B, X, Y) {
+  const key = [W, H, B.minX, B.maxX, B.minY, B.maxY].join(' ');
+  let L = S.trails;
+  if (!L || L.key !== key || S.clock < L.clock) {
+    const canvas = L ? L.canvas : document.createElement('canvas');
+    canvas.width = W; canvas.height = H;  // also clears it
+    L = S.trails = { key, canvas, clock: 0, upTo: new Map() };
+  }
+  const g = L.canvas.getContext('2d');
+  g.globalAlpha = 0.6; g.lineWidth = 1.5;
+  for (const d of D.drones) {
+    const samples = D.telemetry.get(d.name);
+    const from = L.upTo.get(d.name) || 0;
+    let to = from;
+    while (samples && to < samples.length && samples[to].t <= S.clock) to++;
+    if (to > from) {
+      const step = Math.max(1, Math.floor((to - from) / 50));
+      const start = from > 0 ? from - 1 : 0;
+      g.strokeStyle = d.colour; g.beginPath();
+      g.moveTo(X(samples[start].x), Y(samples[start].y));
+      for (let i = start + step; i < to; i += step) g.lineTo(X(samples[i].x), Y(samples[i].y));
+      g.lineTo(X(samples[to - 1].x), Y(samples[to - 1].y));
+      g.stroke();
+      L.upTo.set(d.name, to);
+    }
+  }
+  L.clock = S.clock;
+  return L.canvas;
+}
+
+// The map of a large fleet keeps its scale while the drones fly inside it and grows with a
+// margin when one leaves it, so the tracks' layer is rarely drawn again; a small fleet's map
+// fits it exactly.
+function mapBounds() {
+  const B = worldBounds();
+  if (D.drones.length <= 100) return B;
+  const K = S.mapBounds;
+  if (K && B.minX >= K.minX && B.maxX <= K.maxX && B.minY >= K.minY && B.maxY <= K.maxY && B.maxZ <= K.maxZ) return K;
+  const m = 0.1 * Math.max(B.maxX - B.minX, B.maxY - B.minY);
+  const U = K || B;
+  S.mapBounds = { minX: Math.min(U.minX, B.minX - m), maxX: Math.max(U.maxX, B.maxX + m), minY: Math.min(U.minY, B.minY - m),
+                  maxY: Math.max(U.maxY, B.maxY + m), maxZ: Math.max(U.maxZ, B.maxZ * 1.2) };
+  return S.mapBounds;
+}
+
+// Each drone's failed action once the clock has passed it (the first, as failedBy).
+function failedDronesAt(t) {
+  const out = new Map();
+  for (const f of D.failMarks) if (f.t <= t + 1e-9 && !out.has(f.drone)) out.set(f.drone, f);
+  return out;
 }
 
 // The failed action of `drone`, once the clock has passed it; null otherwise.
@@ -948,7 +1051,8 @@ function renderSide(B) {
     const p = positionAt(d, S.clock);
     if (!p) continue;
     g.fillStyle = d.colour;
-    g.beginPath(); g.arc(X(p.x), Z(p.z), D.drones.length > 100 ? 2 : 4, 0, 2 * Math.PI); g.fill();
+    if (D.drones.length > 100) g.fillRect(X(p.x) - 2, Z(p.z) - 2, 4, 4);  // as on the map
+    else { g.beginPath(); g.arc(X(p.x), Z(p.z), 4, 0, 2 * Math.PI); g.fill(); }
   }
   g.fillStyle = '#888'; g.font = '10px sans-serif'; g.fillText(B.maxZ.toFixed(1) + ' m', 2, 10);
 }
@@ -962,8 +1066,12 @@ function currentAction(name) {
 function renderDroneList() {
   const list = $('drone-list');
   if (D.drones.length > DOM_LANES_MAX) {
-    list.textContent = '';
-    list.appendChild(el('li', '', D.drones.length + ' drones (too many to list; hover the lanes)'));
+    // Written when the fleet grows, not every frame: a rewritten list is laid out again.
+    const summary = D.drones.length + ' drones (too many to list; hover the lanes)';
+    if (list.children.length !== 1 || list.firstChild.textContent !== summary) {
+      list.textContent = '';
+      list.appendChild(el('li', '', summary));
+    }
     return;
   }
   if (list.children.length !== D.drones.length) {
@@ -1169,29 +1277,72 @@ function renderGraphStates() {
 
 // ---- mission text and selection ----
 
+// The mission text in blocks of SOURCE_BLOCK lines that the browser lays out and paints only
+// when in view (content-visibility). A block is one text node until it comes near the view,
+// when it gets an element per line (numbered, for the highlights): a generated mission of
+// 27,000 lines as elements is 108,000 objects to build, style and lay out, and laying them
+// out every frame is what made a thousand-drone live page lag seconds. Every line stays in
+// the page as text, so the browser's find still finds it.
+const SOURCE_BLOCK = 200;
 function buildSource() {
   const pre = $('source');
   pre.textContent = '';
+  if (S.sourceObserver) S.sourceObserver.disconnect();
   S.activeLines = new Set();
+  S.sourceBlocks = [];
+  S.selectedLine = 0;
   const text = S.mission ? str(S.mission.source) : '';
   if (!text) { pre.textContent = 'the mission text is not in this trace'; return; }
-  text.split('\n').forEach((line, i) => {
-    const row = el('span', 'src-line');
-    row.dataset.line = String(i + 1);
-    row.appendChild(el('span', 'ln', String(i + 1)));
+  const lines = text.split('\n');
+  S.sourceObserver = new IntersectionObserver(entries => {
+    for (const e of entries) if (e.isIntersecting) fillBlock(e.target.block);
+  }, { root: pre, rootMargin: '400px 0px' });
+  for (let first = 0; first < lines.length; first += SOURCE_BLOCK) {
+    const div = el('div', 'src-block');
+    const block = { el: div, first, lines: lines.slice(first, first + SOURCE_BLOCK), rows: null };
+    div.block = block;
+    div.textContent = block.lines.join('\n') + '\n';
+    // A block out of view keeps the height of its lines (one line each: the text does not wrap).
+    div.style.containIntrinsicSize = `auto ${(block.lines.length * 1.4).toFixed(1)}em`;
+    pre.appendChild(div);
+    S.sourceBlocks.push(block);
+    S.sourceObserver.observe(div);
+  }
+  fillBlock(S.sourceBlocks[0]);  // the top is in view: numbered at once
+}
+
+// A block's element per line, with its highlights as they are now.
+function fillBlock(block) {
+  if (!block || block.rows) return;
+  block.rows = block.lines.map((line, k) => {
+    const n = block.first + k + 1, row = el('span', 'src-line');
+    row.dataset.line = String(n);
+    row.appendChild(el('span', 'ln', String(n)));
     row.appendChild(document.createTextNode(line));
-    pre.appendChild(row);
+    if (S.activeLines.has(n)) row.classList.add('active');
+    if (S.selectedLine === n) row.classList.add('selected');
+    return row;
   });
+  block.el.textContent = '';
+  block.el.append(...block.rows);
+}
+
+// Line n's element, when its block has them (`fill`: give it them now).
+function sourceRow(n, fill) {
+  const block = (S.sourceBlocks || [])[Math.floor((n - 1) / SOURCE_BLOCK)];
+  if (!block || n < 1) return null;
+  if (fill) fillBlock(block);
+  return block.rows ? block.rows[(n - 1) % SOURCE_BLOCK] || null : null;
 }
 
 // Only the rows whose state changed are touched: a generated mission has tens of thousands.
 function renderSourceActive() {
   const active = new Set();
   for (const b of D.bars) if (b.start <= S.clock + 1e-9 && (b.end === null || b.end > S.clock + 1e-9)) active.add(b.line);
-  const rows = $('source').children, before = S.activeLines || new Set();
-  for (const line of before) if (!active.has(line) && rows[line - 1]) rows[line - 1].classList.remove('active');
-  for (const line of active) if (!before.has(line) && rows[line - 1]) rows[line - 1].classList.add('active');
-  S.activeLines = active;
+  const before = S.activeLines || new Set();
+  S.activeLines = active;  // a block filled later takes its highlights from here
+  for (const line of before) if (!active.has(line)) { const r = sourceRow(line); if (r) r.classList.remove('active'); }
+  for (const line of active) if (!before.has(line)) { const r = sourceRow(line); if (r) r.classList.add('active'); }
 }
 
 function select(what) {
@@ -1201,12 +1352,11 @@ function select(what) {
   for (const b of D.bars) if (b.el) b.el.classList.toggle('selected', sameBar(b));
   for (const c of D.conds) if (c.el) c.el.classList.toggle('selected', nodes.size ? c.nodes.some(n => nodes.has(n)) : c.line === what.line);
   for (const g of $('graph').querySelectorAll('g.node')) g.classList.toggle('selected', nodes.has(Number(g.dataset.node)));
-  let lineRow = null;
-  for (const row of $('source').children) {
-    const on = Number(row.dataset.line) === what.line;
-    row.classList.toggle('selected', on);
-    if (on) lineRow = row;
-  }
+  const before = sourceRow(S.selectedLine || 0);
+  if (before) before.classList.remove('selected');
+  S.selectedLine = what.line > 0 ? what.line : 0;
+  const lineRow = sourceRow(S.selectedLine, true);
+  if (lineRow) lineRow.classList.add('selected');
   if (lineRow) lineRow.scrollIntoView({ block: 'nearest' });
   const g = $('graph').querySelector('g.node.selected');
   if (g) bringIntoView(g);
@@ -1248,6 +1398,7 @@ function onMessage(text) {
     S.arrivals = [];
     S.serverDelays = [];
     S.liveFrom = Infinity;
+    S.historyIn = false;
     resetDerived();
     $('mission-name').textContent = str(S.mission.mission);
     buildSource();
@@ -1266,8 +1417,7 @@ function onMessage(text) {
       }
       if (S.arrivals.length > LATENCIES_MAX) S.arrivals.splice(0, S.arrivals.length - LATENCIES_MAX);
       if (S.serverDelays.length > LATENCIES_MAX) S.serverDelays.splice(0, S.serverDelays.length - LATENCIES_MAX);
-      // What happened before the page had shown the mission and its history is old news, not lateness.
-      if (S.liveFrom === Infinity) S.liveFrom = arrived;
+      S.historyIn = true;
     }
     // A page in a background tab gets no animation frames: keep its DOM current anyway.
     if (document.hidden) { if (S.live && !S.finished && S.follow) S.clock = missionEnd(); render(); }
