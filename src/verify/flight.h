@@ -59,9 +59,8 @@ struct Flight {
 
 /// Flies one path: conditions in `forced` take the given outcome (where the fleet's sensor
 /// ranges allow it), every drone's actions take `factors[d]` times as long. `whole_trace`
-/// keeps every trace event in `Flight::events`, messages included (for the picture and
-/// --trace); without it the checks' flights keep none, which spares the runner building a
-/// message event per barrier arrival (k² for a fleet-wide barrier of k drones).
+/// keeps every trace event in `Flight::events` (for the picture and --trace); the checks need
+/// none of them, and a flight of a hundred drones records tens of thousands.
 Flight fly(const Setup& setup, const Assignment& forced, const std::vector<double>& factors, bool whole_trace = false);
 
 /// Every violation of the rules on `f`, each with f's path.
