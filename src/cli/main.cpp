@@ -178,8 +178,9 @@ CLI::App* add_run(CLI::App& app, Options& o) {
 
 // `run --distributed`: the options of `launch` it takes, each marked so in the help.
 void add_run_distributed(CLI::App* run, Options& o) {
-  run->add_flag("--distributed", o.distributed,
-                "One DEX process per drone over Cyclone DDS, as `eamos launch` (real time)");
+  CLI::Option* distributed = run->add_flag("--distributed", o.distributed,
+                                           "One DEX process per drone over Cyclone DDS, as `eamos launch` (real time)");
+  std::size_t before = run->get_options().size();
   run->add_option("--deploy-dir", o.launch.dir, "With --distributed: where to write the deployment (default: a temporary folder)");
   run->add_option("--barrier-timeout", o.launch.barrier_timeout_s, "With --distributed: seconds to wait for every DEX to be ready")
       ->check(eamos::cli::positive());
@@ -189,6 +190,10 @@ void add_run_distributed(CLI::App* run, Options& o) {
   add_dds(run, o.launch.dds);
   add_latency(run, o.launch, "With --distributed: ");
   add_security(run, o.security);
+  // Without --distributed they would be accepted and ignored: a user who asked for a deployment
+  // folder or a DDS domain must learn that the run used neither.
+  std::vector<CLI::Option*> options = run->get_options();
+  for (std::size_t i = before; i < options.size(); ++i) options[i]->needs(distributed);
 }
 
 CLI::App* add_verify(CLI::App& app, Options& o) {

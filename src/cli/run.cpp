@@ -207,8 +207,10 @@ bool report_run(const RunCommandOptions& r, const dex::RunResult& result, const 
   if (result.latency) print_latency(*result.latency);
   if (result.completed)
     std::cout << "mission completed in " << result.duration << " s (mission time)\n";
-  else
+  else if (!result.error.empty())
     std::cerr << "eamos: mission failed: " << result.error << "\n";
+  else  // a launch that stopped before the flight: its reason is already on standard error
+    std::cerr << "eamos: mission failed (see the error above)\n";
   return true;
 }
 

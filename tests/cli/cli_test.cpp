@@ -140,6 +140,25 @@ TEST_F(Cli, GraphOfMdgNeedsAKnownDrone) {
   EXPECT_EQ(nlohmann::json::parse(ok.out)["drone"], "Drone2");
 }
 
+TEST_F(Cli, ADistributedOnlyRunOptionWithoutDistributedIsRefusedBeforeAnythingFlies) {
+  for (const std::string& option : {"--deploy-dir " + (dir_ / "deploy").string(), std::string("--domain 7"),
+                                   std::string("--insecure"), std::string("--barrier-timeout 20")}) {
+    Output r = eamos("run -q " + kListing2 + " " + option + " --summary " + (dir_ / "s.json").string());
+    EXPECT_EQ(r.status, 1) << option << ": " << r.out;
+    EXPECT_NE(r.out.find("--distributed"), std::string::npos) << "the refusal names the flag it needs: " << r.out;
+    EXPECT_FALSE(fs::exists(dir_ / "s.json")) << option << ": nothing flew";
+    EXPECT_FALSE(fs::exists(dir_ / "deploy")) << option;
+  }
+}
+
+TEST_F(Cli, ALaunchStoppedBeforeTheFlightSaysWhyOnceAndNoEmptyFailureReason) {
+  ASSERT_EQ(eamos("compile -q --insecure " + kListing2 + " -o " + (dir_ / "deploy").string()).status, 0);
+  Output r = eamos("launch " + (dir_ / "deploy").string() + " --drones Nobody");
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("--drones names 'Nobody'"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("mission failed: \n"), std::string::npos) << "a failure without its reason: " << r.out;
+}
+
 TEST_F(Cli, StatsCountsNodesPerDrone) {
   Output r = eamos("stats -q " + kListing2);
   ASSERT_EQ(r.status, 0) << r.out;
