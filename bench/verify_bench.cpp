@@ -52,7 +52,7 @@ void BM_VerifyListing2AllPaths(benchmark::State& state) {
   o.jitter = state.range(0) != 0;
   run(state, *p, o);
 }
-BENCHMARK(BM_VerifyListing2AllPaths)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_VerifyListing2AllPaths)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 
 void BM_VerifyStressOnePath(benchmark::State& state) {
   eamos::stress::StressOptions so;
@@ -63,7 +63,7 @@ void BM_VerifyStressOnePath(benchmark::State& state) {
   o.max_paths = 1;
   run(state, *p, o);
 }
-BENCHMARK(BM_VerifyStressOnePath)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_VerifyStressOnePath)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 
 std::unique_ptr<Prepared> hundred_drones(eamos::stress::Shape shape) {
   eamos::stress::StressOptions so;
@@ -86,7 +86,7 @@ void BM_VerifyShow100(benchmark::State& state) {
   static auto p = hundred_drones(eamos::stress::Shape::show);
   run(state, *p, {});
 }
-BENCHMARK(BM_VerifyShow100)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_VerifyShow100)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 
 }  // namespace
 
