@@ -8,6 +8,7 @@
 #include <cmath>
 #include <deque>
 #include <set>
+#include <system_error>
 #include <thread>
 
 #include "verify/flight.h"
@@ -126,7 +127,13 @@ std::vector<Checked> fly_all(const Setup& setup, const Assignment& forced,
   };
   std::size_t threads = std::min<std::size_t>(batch.size(), static_cast<std::size_t>(std::max(jobs, 1)));
   std::vector<std::thread> pool;
-  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(worker);
+  for (std::size_t t = 1; t < threads; ++t) {
+    try {
+      pool.emplace_back(worker);
+    } catch (const std::system_error&) {
+      break;  // no more threads to be had: the ones running (and this one) take the rest
+    }
+  }
   worker();
   for (std::thread& t : pool) t.join();
   for (const std::exception_ptr& e : errors)
