@@ -299,9 +299,10 @@ bool waits_for(const dex::Node& n, bool value) {
   }
 }
 
-std::string last_reads(const ConditionSeen& c) {
+std::string last_reads(const Setup& s, int drone, const ConditionSeen& c) {
   std::string out;
-  for (const auto& [what, value] : c.reads) out += (out.empty() ? "" : ", ") + what + " = " + num(value);
+  for (const auto& [read, value] : c.reads)
+    out += (out.empty() ? "" : ", ") + s.missions[drone].fleet[read->drone] + "." + read->property + " = " + num(value);
   return out;
 }
 
@@ -318,7 +319,7 @@ void check_never_ends(const Setup& s, const Flight& f, std::vector<Violation>& o
                        {c.node->line, c.node->col,
                         std::string(lang::control_name(c.node->control)) + " on `" + c.node->text +
                             "` never ends: still waiting at the " +
-                            limit + " time limit; it last read " + last_reads(c) + " (at " + seconds(c.t) +
+                            limit + " time limit; it last read " + last_reads(s, key.first, c) + " (at " + seconds(c.t) +
                             "); make sure something makes `" + c.node->text + "` come true, or raise --time-limit"});
     out.push_back(std::move(v));
   }

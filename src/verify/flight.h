@@ -39,7 +39,7 @@ struct ConditionSeen {
   const dex::Node* node = nullptr;
   double t = 0.0;
   bool value = false;
-  std::vector<std::pair<std::string, double>> reads;  ///< "Drone1.X" → value read
+  std::vector<std::pair<const dex::Expr*, double>> reads;  ///< each property read (Drone1.X) → its value
 };
 
 struct Flight {

@@ -77,13 +77,14 @@ class Observer : public dex::RunObserver, public dex::TraceSink {
     a.request = request;
     a.state = state;
     a.start = t;
-    const fleet::ActionSpec* spec = setup_.missions[drone].type.find_action(node.name);
-    a.motion = spec && spec->action_class == fleet::ActionClass::motion;
     auto [open, added] = open_.try_emplace({drone, node.meg});
-    if (added) {
+    if (added) {  // the first run of this node: what it is, and where its ends will say they are
+      const fleet::ActionSpec* spec = setup_.missions[drone].type.find_action(node.name);
+      motion_[{drone, node.meg}] = spec && spec->action_class == fleet::ActionClass::motion;
       std::vector<int>& megs = megs_at_[{drone, node.line, node.col}];
       megs.insert(std::upper_bound(megs.begin(), megs.end(), node.meg), node.meg);
     }
+    a.motion = motion_.at({drone, node.meg});
     open->second.push_back(f_.actions.size());
     if (f_.actions_of.size() <= static_cast<std::size_t>(drone)) f_.actions_of.resize(drone + 1);
     f_.actions_of[drone].push_back(f_.actions.size());
@@ -95,10 +96,10 @@ class Observer : public dex::RunObserver, public dex::TraceSink {
     seen.node = &node;
     seen.t = t;
     seen.reads.clear();
-    std::vector<const dex::Expr*> reads;
-    collect_reads(node.condition, reads);
-    for (const dex::Expr* r : reads)
-      seen.reads.emplace_back(setup_.missions[drone].fleet[r->drone] + "." + r->property, read(r->drone, r->property));
+    auto [known, added] = reads_.try_emplace(&node);
+    if (added) collect_reads(node.condition, known->second);
+    const std::vector<const dex::Expr*>& reads = known->second;
+    for (const dex::Expr* r : reads) seen.reads.emplace_back(r, read(r->drone, r->property));
     bool value = decide(drone, node, computed, read);
     seen.value = value;
     note_timing(t, drone, node, value, reads);
@@ -225,6 +226,8 @@ class Observer : public dex::RunObserver, public dex::TraceSink {
   std::map<std::pair<int, int>, std::vector<std::size_t>> open_;  ///< (drone, meg) → running runs
   std::map<std::tuple<int, int, int>, std::vector<int>> megs_at_;  ///< (drone, line, col) → its MEG ids, sorted
   std::unordered_map<std::string, int> index_of_;                 ///< drone name → fleet index
+  std::map<std::pair<int, int>, bool> motion_;                     ///< (drone, meg) → a motion action
+  std::unordered_map<const dex::Node*, std::vector<const dex::Expr*>> reads_;  ///< condition → its property reads
 };
 
 /// Every drone flies in the built-in simulator, whatever adapter the fleet names: verify
