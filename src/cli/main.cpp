@@ -225,6 +225,14 @@ CLI::App* add_launch(CLI::App& app, Options& o) {
                      "Seconds to wait for every DEX to be ready (default: 30, plus 0.5 per drone beyond 20; with DDS "
                      "Security at most 85)")
       ->check(eamos::cli::positive());
+  launch->add_option("--start-wave", l.start_wave,
+                     "Start this many DEX processes at once, the next ones when the ground has heard from them "
+                     "(default: the whole fleet up to 10 drones with DDS Security, 25 without; then waves of that size)")
+      ->check(eamos::cli::whole_number(1, 100000));
+  launch->add_option("--state-rate", l.state_rate_hz,
+                     "Each DEX publishes its drone's state to the others at most this many times a wall second "
+                     "(default: 20 up to 20 drones, then 20 * (20 / drones)^2, at least 1)")
+      ->check(eamos::cli::positive());
   launch->add_option("--drones", l.local, "Start only these drones here; the others run their DEX elsewhere")
       ->delimiter(',');
   launch->add_flag("--remote-only", l.remote_only,
@@ -255,6 +263,10 @@ CLI::App* add_dex(CLI::App& app, Options& o) {
                      "With DDS Security: leave (exit 1) when not every other drone was heard from within this many "
                      "seconds of joining DDS, before Cyclone DDS gives its handshakes up (default and most: 90)")
       ->check(eamos::cli::number_between(0.1, eamos::launch::kSecureUnreadyLimitS));
+  dexcmd->add_option("--state-rate", d.state_rate_hz,
+                     "Publish this drone's state to the other drones at most this many times a wall second, "
+                     "20 or more: at every change (default: 20 up to 20 drones, then 20 * (20 / drones)^2, at least 1)")
+      ->check(eamos::cli::positive());
   dexcmd->add_option("--trace", d.trace_file, "Also write this drone's trace as JSON Lines to this file");
   dexcmd->add_option("--launch-id", d.launch_id,
                      "Take a start only from the `eamos launch` with this id (set by the launch that starts the DEX)");

@@ -205,6 +205,7 @@ bool DexProcess::wait_for_start() {
       err_ << "eamos dex: error: " << name() << ": the ground gave up before the start: " << *gave_up << "\n";
       return false;
     }
+    publish_heard();
     if (!ready_sent) ready_sent = ready_when_all_seen();
     if (!ready_sent && wall_s() > unready_deadline) return leave_unready();
     for (const LifecycleSample& s : starts)
@@ -215,6 +216,16 @@ bool DexProcess::wait_for_start() {
       return false;
     }
   }
+}
+
+// How many drones this DEX has heard from, for the ground's waves: when it changed, at
+// most once a second (every other DEX reads the status too).
+void DexProcess::publish_heard() {
+  int heard = static_cast<int>(inbox_.latest().size());
+  if (heard == heard_published_ || wall_s() < heard_published_at_ + 1.0) return;
+  heard_published_ = heard;
+  heard_published_at_ = wall_s();
+  publish_status(true);
 }
 
 // With DDS Security, a drone not heard from by now has a handshake with this DEX that does
@@ -296,6 +307,8 @@ bool DexProcess::begin() {
   // What the status reports (triggers sent) and a failed write are acted on as they happen.
   transport_->on_change([this] { schedule_settle(); });
   open_traces();
+  const double rate = o_.state_rate_hz > 0 ? o_.state_rate_hz : state_rate_for(static_cast<int>(mission_.fleet.size()));
+  state_period_s = rate >= kFullStateRateHz ? 0.0 : o_.speed / rate;
   make_engine();
   watch_run();
   publish_status(true);
@@ -384,8 +397,38 @@ void DexProcess::make_engine() {
   drone_->subscribe([this](const mid::DroneState& s) {
     separation_->update(mission_.self, s);
     engine_->properties_changed(mission_.self);
-    transport_->publish(std::make_shared<const dex::Telemetry>(dex::Telemetry{mission_.hash, mission_.self, s}));
+    publish_state(s);
   });
+}
+
+void DexProcess::publish_state(const mid::DroneState& s) {
+  if (state_due_) {  // the period's timer is set: it sends the newest
+    state_due_ = s;
+    return;
+  }
+  // A tolerance, or a timer due at the period's end could find itself a rounding short of
+  // it and set itself again for the same instant, for ever.
+  const double now = loop_->now();
+  if (state_period_s <= 0.0 || now - state_published_at_ >= state_period_s - 1e-9) return send_state(s);
+  // The newest state goes out at the period's end: a drone that stopped is not left
+  // standing elsewhere in the others' view.
+  state_due_ = s;
+  loop_->at(state_published_at_ + state_period_s, [this] {
+    mid::DroneState due = *state_due_;
+    state_due_.reset();
+    send_state(due);
+  });
+}
+
+void DexProcess::send_state(const mid::DroneState& s) {
+  state_published_at_ = loop_->now();
+  transport_->publish(std::make_shared<const dex::Telemetry>(dex::Telemetry{mission_.hash, mission_.self, s}));
+}
+
+double state_rate_for(int drones) {
+  if (drones <= kFullRateDrones) return kFullStateRateHz;
+  double ratio = static_cast<double>(kFullRateDrones) / drones;
+  return std::max(1.0, kFullStateRateHz * ratio * ratio);
 }
 
 void DexProcess::watch_run() {

@@ -19,6 +19,14 @@ namespace eamos::launch {
 /// handshake timeout, for a DEX that started its handshakes a little after joining.
 inline constexpr double kSecureUnreadyLimitS = transport::kHandshakeGiveUpS - 10.0;
 
+/// How often a DEX publishes its drone's state to the others by default: every change (the
+/// simulator's 20 Hz while moving) up to kFullRateDrones drones; beyond, the fleet's
+/// telemetry grows with the square of its size (every drone's state to every other drone),
+/// so the rate falls with it: 20 Hz * (kFullRateDrones / drones)^2, at least 1 Hz.
+inline constexpr int kFullRateDrones = 20;
+inline constexpr double kFullStateRateHz = 20.0;
+double state_rate_for(int drones);
+
 struct DexProcessOptions {
   std::string folder;             ///< the drone's deployment folder (holds mission.json)
   transport::DdsOptions dds;
@@ -39,6 +47,9 @@ struct DexProcessOptions {
   /// must have been heard from (all its handshakes done); otherwise the DEX leaves with an
   /// error before Cyclone's handshake timeout (transport::kHandshakeGiveUpS).
   double unready_limit_s = kSecureUnreadyLimitS;
+  /// Times per wall second at most that this drone's state goes to the other drones (the
+  /// newest state, never later than one period); 0: state_rate_for(the fleet's size).
+  double state_rate_hz = 0.0;
 };
 
 /// Runs the process; returns its exit status: 0 when the mission completed, 1 otherwise

@@ -193,6 +193,7 @@ StatusSample DexProcess::status_now(Phase phase) const {
   s.wave = termination_ ? termination_->wave() : wave_answered_;
   s.since = last_status_ && last_status_->busy == s.busy ? last_status_->since : (loop_ ? loop_->now() : 0.0);
   s.state = drone_->state();
+  s.heard = heard_published_;
   return s;
 }
 

@@ -87,6 +87,7 @@ class DexProcess {
   bool wait_for_start();
   /// Writes READY when every other drone has been heard from; whether it did.
   bool ready_when_all_seen();
+  void publish_heard();
   /// Gives up waiting for the other drones (DexProcessOptions::unready_limit_s); false.
   bool leave_unready();
   /// A START seen while waiting: true when it starts this process's run, false when this
@@ -114,6 +115,10 @@ class DexProcess {
   bool too_late(const dex::TraceEvent& event);
   void on_telemetry(const TelemetrySample& s);
   void start_separation();
+  /// Publishes this drone's newest state now or, within a period of the last one
+  /// (DexProcessOptions::state_rate_hz), at the period's end.
+  void publish_state(const mid::DroneState& s);
+  void send_state(const mid::DroneState& s);
   void seed_telemetry(const TelemetrySample& s);
   void on_lifecycle(const LifecycleSample& s);
   /// A START of another run: refused when it names this process (it runs one already).
@@ -210,6 +215,11 @@ class DexProcess {
   std::set<std::string> rejected_;                        ///< what was logged as ignored
   std::optional<LifecycleSample> pending_finished_;       ///< a FINISHED this DEX does not agree with (yet)
   double joined_at_ = 0.0;  ///< wall time the DDS participant was created
+  int heard_published_ = 0;            ///< other drones heard from, as last published (status)
+  double heard_published_at_ = -1e300;  ///< wall time of that status
+  double state_period_s = 0.0;                 ///< mission seconds between published states; 0: every change
+  double state_published_at_ = -1e300;         ///< mission time of the last published state
+  std::optional<mid::DroneState> state_due_;   ///< newest state not yet published; a timer is set for it
   double pending_since_ = 0.0;                            ///< wall time it came
 
   // Last, so it goes first: its listener threads use everything above.

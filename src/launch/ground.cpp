@@ -45,6 +45,9 @@ struct DroneEntry {
   double lost_at = 0.0;                       ///< wall time it was lost
   std::string log;
   double started_at = 0.0;  ///< wall time its DEX process was started
+  bool started = false;     ///< its DEX process was started (by this launch, in its wave)
+  bool heard = false;       ///< the ground has a sample of its DEX: their handshake is done
+  int heard_drones = 0;     ///< other drones its DEX has heard from while waiting (its status)
 };
 
 bool read_manifest(const std::string& dir, std::string& hash, std::vector<DroneEntry>& drones, std::string& error) {
@@ -146,6 +149,10 @@ class Ground {
   double mission_now() const { return (unix_ns() - start_at_ns_) / 1e9 * o_.speed; }
   void record_lifecycle(const LifecycleSample& s);
   bool start_processes();
+  /// Starts the next wave of DEX processes once every DEX started so far has been heard
+  /// from (its discovery, and with DDS Security its handshakes, done); false on a failed spawn.
+  bool start_next_wave();
+  bool start_one(DroneEntry& d, const std::string& exe);
   /// Looks at what may have changed: a signal, the barrier, the flight's end. After every
   /// input that can change them, after a DEX process ended (poll_children first) and at
   /// each deadline; never on a timer of its own (the ground idles while the drones fly).
@@ -206,6 +213,8 @@ class Ground {
   /// This launch: its DEXes' READYs and its START carry it, so that a second launch of the
   /// same deployment does not take the first one's READYs (or the reverse).
   std::uint64_t launch_id_ = 0;
+  int wave_size_ = 0;  ///< DEX processes started together: start_wave_for, or --start-wave
+  bool polling_ = false;  ///< poll_on_timer runs: a child could not be watched by pidfd
   bool interrupted_ = false;
   Collect collect_;
   dex::TelemetryRecorder telemetry_;
@@ -325,11 +334,6 @@ bool Ground::fly() {
   std::signal(SIGCHLD, SIG_DFL);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  if (!start_processes()) {
-    stop_all(SIGTERM);
-    node_.reset();
-    return false;
-  }
   barrier_deadline_ = wall_s() + o_.barrier_timeout_s;
   watch_ = std::make_unique<ProcessWatch>([this] {
     loop_.post([this] {
@@ -337,11 +341,13 @@ bool Ground::fly() {
       check();
     });
   });
-  bool watched = true;
-  for (auto& d : drones_)
-    if (d.local) watched = watch_->watch(d.child.pid) && watched;
   watch_->start();
-  if (!watched) poll_on_timer();
+  if (!start_processes()) {
+    stop_all(SIGTERM);
+    watch_.reset();
+    node_.reset();
+    return false;
+  }
   check_after(o_.barrier_timeout_s);
   // From inside the run: a stop() before it would be forgotten.
   loop_.post([this] {
@@ -410,39 +416,81 @@ int Ground::exit_status() {
 }
 
 bool Ground::start_processes() {
+  int local = static_cast<int>(std::count_if(drones_.begin(), drones_.end(), [](const DroneEntry& d) { return d.local; }));
+  wave_size_ = o_.start_wave > 0 ? o_.start_wave : start_wave_for(local, !o_.insecure);
+  if (wave_size_ < local)
+    out_ << "ground: starting " << local << " DEX processes in waves of " << wave_size_
+         << ", each once the DEXes before it have heard from each other\n";
+  return start_next_wave();
+}
+
+bool Ground::start_next_wave() {
+  int started = 0, waiting = 0;
+  for (const auto& d : drones_) {
+    started += d.started;
+    waiting += d.local && !d.started;
+  }
+  if (waiting == 0) return true;
+  // The last wave is still joining until the ground has heard from each DEX started so far
+  // and each of them from all the others.
+  for (const auto& d : drones_)
+    if (d.started && (!d.heard || (d.heard_drones < started - 1 && !d.ready_nonce))) return true;
+  if (started > 0) {
+    char took[64];
+    std::snprintf(took, sizeof took, "%.1f", wall_s() - (barrier_deadline_ - o_.barrier_timeout_s));
+    out_ << "ground: the " << started << " DEX processes started so far have heard from each other (" << took
+         << " s after the first was started); starting " << std::min(waiting, wave_size_) << " more\n";
+  }
   std::string exe = o_.exe.empty() ? self_exe() : o_.exe;
-  char number[64];
+  int n = 0;
   for (auto& d : drones_) {
-    if (!d.local) continue;
-    std::vector<std::string> argv = {exe, "dex", d.folder, "--domain", std::to_string(o_.dds.domain)};
-    if (!o_.dds.interface.empty()) argv.insert(argv.end(), {"--interface", o_.dds.interface});
-    if (!o_.dds.config_file.empty()) argv.insert(argv.end(), {"--dds-config", o_.dds.config_file});
-    std::snprintf(number, sizeof number, "%.17g", o_.speed);
-    argv.insert(argv.end(), {"--speed", number});
-    std::snprintf(number, sizeof number, "%.17g", o_.dds.lease_s);
-    argv.insert(argv.end(), {"--liveliness-timeout", number});
-    std::snprintf(number, sizeof number, "%.17g", o_.time_limit_s);
-    argv.insert(argv.end(), {"--time-limit", number});
-    std::snprintf(number, sizeof number, "%.17g", o_.barrier_timeout_s + 5.0);
-    argv.insert(argv.end(), {"--start-timeout", number});
-    if (o_.insecure) argv.push_back("--insecure");
-    if (o_.max_trigger_latency_s > 0) {
-      std::snprintf(number, sizeof number, "%.17g", o_.max_trigger_latency_s);
-      argv.insert(argv.end(), {"--max-trigger-latency", number});
+    if (!d.local || d.started) continue;
+    if (n++ == wave_size_) break;
+    if (!start_one(d, exe)) return false;
+    if (!watch_->watch(d.child.pid) && !polling_) {
+      polling_ = true;
+      poll_on_timer();
     }
-    argv.insert(argv.end(), {"--launch-id", std::to_string(launch_id_)});
-    d.log = d.folder + "/dex.log";
-    std::remove(d.log.c_str());
-    std::string error;
-    d.started_at = wall_s();
-    d.child = spawn(argv, d.log, error);
-    if (d.child.pid < 0) {
-      err_ << "eamos launch: error: " << error << "\n";
-      return false;
-    }
-    out_ << "ground: started the DEX of " << d.name << " (pid " << d.child.pid << ", log " << d.log << ")\n";
   }
   out_ << std::flush;
+  return true;
+}
+
+bool Ground::start_one(DroneEntry& d, const std::string& exe) {
+  char number[64];
+  std::vector<std::string> argv = {exe, "dex", d.folder, "--domain", std::to_string(o_.dds.domain)};
+  if (!o_.dds.interface.empty()) argv.insert(argv.end(), {"--interface", o_.dds.interface});
+  if (!o_.dds.config_file.empty()) argv.insert(argv.end(), {"--dds-config", o_.dds.config_file});
+  std::snprintf(number, sizeof number, "%.17g", o_.speed);
+  argv.insert(argv.end(), {"--speed", number});
+  std::snprintf(number, sizeof number, "%.17g", o_.dds.lease_s);
+  argv.insert(argv.end(), {"--liveliness-timeout", number});
+  std::snprintf(number, sizeof number, "%.17g", o_.time_limit_s);
+  argv.insert(argv.end(), {"--time-limit", number});
+  // The barrier's deadline counts from the first wave: a later DEX waits no longer.
+  std::snprintf(number, sizeof number, "%.17g", std::max(1.0, barrier_deadline_ - wall_s()) + 5.0);
+  argv.insert(argv.end(), {"--start-timeout", number});
+  if (o_.insecure) argv.push_back("--insecure");
+  if (o_.state_rate_hz > 0) {
+    std::snprintf(number, sizeof number, "%.17g", o_.state_rate_hz);
+    argv.insert(argv.end(), {"--state-rate", number});
+  }
+  if (o_.max_trigger_latency_s > 0) {
+    std::snprintf(number, sizeof number, "%.17g", o_.max_trigger_latency_s);
+    argv.insert(argv.end(), {"--max-trigger-latency", number});
+  }
+  argv.insert(argv.end(), {"--launch-id", std::to_string(launch_id_)});
+  d.log = d.folder + "/dex.log";
+  std::remove(d.log.c_str());
+  std::string error;
+  d.started_at = wall_s();
+  d.child = spawn(argv, d.log, error);
+  d.started = true;
+  if (d.child.pid < 0) {
+    err_ << "eamos launch: error: " << error << "\n";
+    return false;
+  }
+  out_ << "ground: started the DEX of " << d.name << " (pid " << d.child.pid << ", log " << d.log << ")\n";
   return true;
 }
 
@@ -488,6 +536,7 @@ void Ground::poll_children() {
 // The start barrier: START once every drone is READY; a DEX that died first or a barrier
 // past its deadline fails the launch before anything moved.
 void Ground::watch_barrier() {
+  if (!start_next_wave()) return fail_barrier("a DEX process could not be started");
   for (auto& d : drones_)
     if (d.local && d.child.exit_status && !d.ready_nonce)
       return fail_barrier("the DEX of " + d.name + " exited with status " + std::to_string(*d.child.exit_status) +
@@ -586,7 +635,10 @@ void Ground::send_start() {
   stage_ = Stage::running;
   wall_guard_ = wall_s() + o_.start_delay_s + o_.time_limit_s / o_.speed + 700.0 / o_.speed + 30.0;
   check_after(wall_guard_ - wall_s());
-  out_ << "ground: every drone is ready; starting run " << start.run_id << "\n" << std::flush;
+  char took[64];
+  std::snprintf(took, sizeof took, "%.1f", wall_s() - (barrier_deadline_ - o_.barrier_timeout_s));
+  out_ << "ground: every drone is ready; starting run " << start.run_id << " (" << took
+       << " s after the first DEX was started)\n" << std::flush;
 }
 
 void Ground::fail_barrier(const std::string& why) {
@@ -722,7 +774,11 @@ void Ground::check_pending_finished() {
 
 void Ground::on_status(const StatusSample& s) {
   // Statuses of waiting DEXes (run 0) say nothing the barrier needs: READY does.
-  if (stage_ == Stage::barrier && s.mission_hash == hash_) return refuse_second_launch(s);
+  if (stage_ == Stage::barrier && s.mission_hash == hash_) {
+    if (s.run_id == 0 && s.phase == Phase::waiting && s.drone >= 0 && s.drone < static_cast<int>(drones_.size()))
+      drones_[s.drone].heard_drones = std::max(drones_[s.drone].heard_drones, s.heard);
+    return refuse_second_launch(s);
+  }
   if (stage_ != Stage::running) return;
   if (!ours(s.mission_hash) || s.run_id != r_.run_id || s.drone < 0 || s.drone >= static_cast<int>(drones_.size()))
     return;
@@ -775,6 +831,10 @@ void Ground::on_telemetry(const TelemetrySample& s) {
   // Run 0 is a waiting DEX's initial state: the drone's, before the start; during the run
   // it can only come from a DEX started again, which does not fly.
   if (s.run_id != (stage_ == Stage::barrier ? 0 : r_.run_id)) return;
+  if (stage_ == Stage::barrier && !drones_[t.from].heard) {
+    drones_[t.from].heard = true;  // its DEX's first sample: the next wave may start
+    loop_.post([this] { check(); });
+  }
   dex::record_sample(drones_[t.from].track, t.state);
   drones_[t.from].last_state = t.state;
   // The DEXes publish on every change (20 Hz while moving): the trace keeps telemetry_hz.
@@ -796,6 +856,14 @@ void Ground::record_lifecycle(const LifecycleSample& s) {
 }
 
 }  // namespace
+
+int start_wave_for(int drones, bool secure) {
+  // Each DEX that joins authenticates with every participant already there (and they with
+  // it): a wave of w joining n costs w * n + w * (w - 1) / 2 handshakes at once. Twenty
+  // secure DEXes at once were ready on this 2-core host, thirty were not.
+  int wave = secure ? kSecureStartWave : kInsecureStartWave;
+  return drones <= wave ? std::max(1, drones) : wave;
+}
 
 double barrier_timeout_for(int drones, bool secure) {
   double s = 30.0 + 0.5 * std::max(0, drones - 20);

@@ -24,6 +24,11 @@ struct LaunchOptions {
   double barrier_timeout_s = 0.0;
   double time_limit_s = 3600.0;     ///< mission seconds, passed to every DEX
   double start_delay_s = 0.5;       ///< wall seconds between START and mission time 0
+  /// DEX processes started at once; the next wave starts when the ground has heard from
+  /// every DEX started before it. 0: start_wave_for(the drones started here, secure).
+  int start_wave = 0;
+  /// Passed to every DEX started here (DexProcessOptions::state_rate_hz); 0: its default.
+  double state_rate_hz = 0.0;
   std::vector<std::string> local;   ///< drones to start here; empty = all of them (unless remote_only)
   bool remote_only = false;         ///< start none here: every DEX runs elsewhere (on its drone)
   std::string exe;                  ///< the eamos program for DEX processes ("" = this one)
@@ -46,6 +51,14 @@ struct LaunchOptions {
 /// is the barrier's plus 5 s) and the ground itself leave the domain before Cyclone gives
 /// up a pending handshake (transport::kHandshakeGiveUpS), which can crash Debian's build.
 inline constexpr double kMaxSecureBarrierS = 85.0;
+
+/// DEX processes `eamos launch` starts at once by default, with and without DDS Security.
+inline constexpr int kSecureStartWave = 10;
+inline constexpr int kInsecureStartWave = 25;
+
+/// The default wave of DEX processes started together: the whole fleet up to the default
+/// wave size, otherwise waves of that size.
+int start_wave_for(int drones, bool secure);
 
 /// The start barrier's default: 30 s, and half a second more per drone beyond 20 (each
 /// participant discovers and, with DDS Security, authenticates every other one); with DDS

@@ -15,6 +15,7 @@ namespace {
 std::atomic<int> g_wake_fd{-1};
 constexpr char kStop = 'q';
 constexpr char kSignal = 's';
+constexpr char kRescan = 'r';  // a child was added: poll its pidfd too
 }  // namespace
 
 ProcessWatch::ProcessWatch(std::function<void()> wake) : wake_(std::move(wake)) {
@@ -38,7 +39,12 @@ ProcessWatch::~ProcessWatch() {
 bool ProcessWatch::watch(pid_t pid) {
   int fd = static_cast<int>(syscall(SYS_pidfd_open, pid, 0));
   if (fd < 0) return false;
-  pidfds_.push_back(fd);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pidfds_.push_back(fd);
+  }
+  char rescan = kRescan;
+  if (thread_.joinable()) (void)!write(pipe_[1], &rescan, 1);  // a full pipe already wakes it
   return true;
 }
 
@@ -57,8 +63,11 @@ void ProcessWatch::signal_arrived() {
 void ProcessWatch::run() {
   for (;;) {
     std::vector<pollfd> fds{{pipe_[0], POLLIN, 0}};
-    for (int fd : pidfds_)
-      if (fd >= 0) fds.push_back({fd, POLLIN, 0});
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (int fd : pidfds_)
+        if (fd >= 0) fds.push_back({fd, POLLIN, 0});
+    }
     if (::poll(fds.data(), fds.size(), -1) < 0) {
       if (errno == EINTR) continue;
       return;
@@ -70,18 +79,21 @@ void ProcessWatch::run() {
       while ((n = read(pipe_[0], buf, sizeof buf)) > 0)
         for (ssize_t i = 0; i < n; ++i) {
           if (buf[i] == kStop) return;
-          woke = true;
+          if (buf[i] == kSignal) woke = true;
         }
     }
     // A pidfd stays readable once its process ended: it is watched no more.
-    for (std::size_t i = 1; i < fds.size(); ++i)
-      if (fds[i].revents)
-        for (int& fd : pidfds_)
-          if (fd == fds[i].fd) {
-            close(fd);
-            fd = -1;
-            woke = true;
-          }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (std::size_t i = 1; i < fds.size(); ++i)
+        if (fds[i].revents)
+          for (int& fd : pidfds_)
+            if (fd == fds[i].fd) {
+              close(fd);
+              fd = -1;
+              woke = true;
+            }
+    }
     if (woke) wake_();
   }
 }

@@ -6,6 +6,7 @@
 #include <sys/types.h>
 
 #include <functional>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -20,8 +21,8 @@ class ProcessWatch {
   ProcessWatch(const ProcessWatch&) = delete;
   ProcessWatch& operator=(const ProcessWatch&) = delete;
 
-  /// Watches `pid` (before start()); false when the kernel has no pidfds for it, and then
-  /// the caller must look at that child on a timer of its own.
+  /// Watches `pid`, before or after start() (DEXes started in waves); false when the kernel
+  /// has no pidfds for it, and then the caller must look at that child on a timer of its own.
   bool watch(pid_t pid);
   /// Starts the thread; from now on signal_arrived() wakes it.
   void start();
@@ -33,6 +34,7 @@ class ProcessWatch {
 
   std::function<void()> wake_;
   int pipe_[2] = {-1, -1};
+  std::mutex mutex_;  ///< pidfds_: watch() adds while the thread polls
   std::vector<int> pidfds_;
   std::thread thread_;
 };

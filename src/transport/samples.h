@@ -73,6 +73,9 @@ struct StatusSample {
   /// drone's answers it.
   std::uint64_t wave = 0;
   double since = 0.0;          ///< mission time the drone entered its current busy/idle state
+  /// While waiting for the start: how many other drones this DEX has heard from (the
+  /// ground starts the next wave of DEXes once every DEX has heard from all started before).
+  int heard = 0;
   mid::DroneState state;       ///< sensors not included
 };
 

@@ -322,6 +322,7 @@ eamos_wire_Status to_wire(const StatusSample& s) {
   w.activations = s.activations;
   w.wave = s.wave;
   w.since = s.since;
+  w.heard = s.heard;
   state_to_wire(s.state, w.t, w.x, w.y, w.z, w.battery, w.armed, w.landed, w.pictures);
   return w;
 }
@@ -345,6 +346,8 @@ bool from_wire(const eamos_wire_Status& w, const WireLimits& limits, StatusSampl
   s.wave = w.wave;
   check.finite("since", w.since);
   s.since = w.since;
+  check.in_range("heard", w.heard, 0, limits.drones > 0 ? limits.drones : kMaxWireDrones);
+  s.heard = w.heard;
   s.state = state_from_wire(w, check);
   return check.ok();
 }

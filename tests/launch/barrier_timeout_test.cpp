@@ -32,6 +32,29 @@ TEST(BarrierTimeout, ASecureBarrierEndsBeforeCycloneGivesAHandshakeUp) {
   EXPECT_LT(eamos::launch::kSecureUnreadyLimitS, eamos::transport::kHandshakeGiveUpS);
 }
 
+// A small fleet starts at once; a larger one in waves of the default size, smaller with
+// DDS Security (each joining DEX authenticates with every participant already there).
+TEST(StartWave, AFleetUpToTheWaveSizeStartsAtOnceALargerOneInWaves) {
+  using eamos::launch::start_wave_for;
+  EXPECT_EQ(start_wave_for(3, true), 3);
+  EXPECT_EQ(start_wave_for(eamos::launch::kSecureStartWave, true), eamos::launch::kSecureStartWave);
+  EXPECT_EQ(start_wave_for(100, true), eamos::launch::kSecureStartWave);
+  EXPECT_EQ(start_wave_for(100, false), eamos::launch::kInsecureStartWave);
+  EXPECT_LT(eamos::launch::kSecureStartWave, eamos::launch::kInsecureStartWave);
+  EXPECT_EQ(start_wave_for(0, true), 1);
+}
+
+// Every drone's state goes to every other drone: the fleet's telemetry grows with the
+// square of its size, so beyond twenty drones each publishes less often.
+TEST(StateRate, UpToTwentyDronesEveryChangeIsPublishedBeyondTheRateFallsWithTheSquareOfTheFleet) {
+  using eamos::launch::state_rate_for;
+  EXPECT_DOUBLE_EQ(state_rate_for(3), eamos::launch::kFullStateRateHz);
+  EXPECT_DOUBLE_EQ(state_rate_for(20), eamos::launch::kFullStateRateHz);
+  EXPECT_DOUBLE_EQ(state_rate_for(40), 5.0);
+  EXPECT_DOUBLE_EQ(state_rate_for(100), 1.0);   // 0.8 by the square, at least 1
+  EXPECT_DOUBLE_EQ(state_rate_for(1000), 1.0);
+}
+
 }  // namespace
 
 namespace {

@@ -273,6 +273,53 @@ TEST_F(Distributed, StartBarrierTimeoutAbortsWithTheMissingDrones) {
   EXPECT_EQ(log.find("Drone1   start"), std::string::npos) << log;  // nothing flew
 }
 
+// A fleet started all at once floods every participant with discovery and DDS Security
+// handshakes at the same instant (thirty secure DEXes on a 2-core host were not ready in
+// 85 s). In waves, a DEX starts only once the ground has heard from every one before it and
+// they from each other (their handshakes done).
+TEST_F(Distributed, AFleetStartedInWavesStartsEachWaveOnceTheGroundHeardTheOnesBefore) {
+  fs::path deploy = deploy_listing2(dir_);
+  Output r = eamos("launch " + deploy.string() + " --start-wave 1 --speed 5 --domain 42");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("starting 3 DEX processes in waves of 1"), std::string::npos) << r.out;
+  auto at = [&](const std::string& s) { return r.out.find(s); };
+  std::size_t first = at("started the DEX of Drone1"), heard1 = at("the 1 DEX processes started so far have heard from each other"),
+              second = at("started the DEX of Drone2"), heard2 = at("the 2 DEX processes started so far have heard from each other"),
+              third = at("started the DEX of Drone3");
+  ASSERT_NE(third, std::string::npos) << r.out;
+  EXPECT_LT(first, heard1) << r.out;
+  EXPECT_LT(heard1, second) << r.out;
+  EXPECT_LT(second, heard2) << r.out;
+  EXPECT_LT(heard2, third) << r.out;
+  EXPECT_NE(at("every drone is ready; starting run"), std::string::npos) << r.out;
+}
+
+// A large fleet's DEXes publish their drones' states less often (--state-rate): each state
+// still gets out, the newest at the end of the period, and the mission completes. A timer
+// that found itself a rounding short of the period's end once set itself again for the
+// same instant for ever, and the DEX's loop never went past its first takeoff.
+TEST_F(Distributed, ADexPublishesItsDronesStateAtMostAtItsStateRate) {
+  fs::path deploy = deploy_listing2(dir_);
+  Output r = eamos("launch " + deploy.string() + " --state-rate 2 --speed 5 --domain 43 --trace " +
+                   (dir_ / "t.jsonl").string() + " --summary " + (dir_ / "summary.json").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  nlohmann::json summary = read_json(dir_ / "summary.json");
+  double duration = summary["duration"].get<double>();
+  // At 2 states a wall second and 5 mission seconds per wall second: one per 2.5 mission s
+  // (the trace itself samples at 5 Hz, which every change at 20 Hz would fill).
+  std::map<std::string, int> samples;
+  std::ifstream in(dir_ / "t.jsonl");
+  for (std::string line; std::getline(in, line);) {
+    nlohmann::json e = nlohmann::json::parse(line);
+    if (e["event"] == "telemetry") ++samples[e["drone"].get<std::string>()];
+  }
+  ASSERT_EQ(samples.size(), 3u) << r.out;
+  for (const auto& [drone, n] : samples) {
+    EXPECT_GE(n, 2) << drone;
+    EXPECT_LE(n, duration / 2.5 + 2) << drone;
+  }
+}
+
 // Debian 12's Cyclone DDS can crash when it gives up a DDS Security handshake (100 s; 50
 // secure DEXes on one 2-core host got there and one died with SIGSEGV): nothing of eamos
 // may wait that long with a handshake pending.

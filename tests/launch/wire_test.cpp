@@ -161,6 +161,7 @@ TEST(Wire, StatusKeepsCountersAndState) {
   s.received = 99;
   s.activations = 1000;
   s.since = 4.5;
+  s.heard = 3;
   s.state.z = 12;
   s.state.landed = false;
   StatusSample back = back_from<StatusSample>(to_wire(s));
@@ -171,6 +172,7 @@ TEST(Wire, StatusKeepsCountersAndState) {
   EXPECT_EQ(back.received, 99u);
   EXPECT_EQ(back.activations, 1000u);
   EXPECT_EQ(back.since, 4.5);
+  EXPECT_EQ(back.heard, 3);
   EXPECT_EQ(back.state.z, 12);
   EXPECT_FALSE(back.state.landed);
 }
@@ -289,6 +291,9 @@ TEST(WireRules, RefusesTooManySensorsAndNegativeCounts) {
   StatusSample st;
   st.state.pictures = -1;
   EXPECT_EQ(refusal<StatusSample>(to_wire(st)), "pictures -1 is below 0");
+  st.state.pictures = 0;
+  st.heard = -1;  // the ground's waves count on it
+  EXPECT_EQ(refusal<StatusSample>(to_wire(st)).rfind("heard -1 is outside 0 to ", 0), 0u);
   TraceSample tr;
   eamos_wire_TraceRecord tw = to_wire(tr);
   tw.value = 2;
