@@ -1,7 +1,9 @@
 // `eamos verify` performance: Listing 2 with every path its fleet allows (the If
-// on Drone1's sensor both ways, with and without --jitter) under 100 ms, and one path of the
-// 5,000-node / 20-drone stress mission under 1 s. Each iteration verifies from the compiled
-// mission files, as `eamos verify` does after compiling.
+// on Drone1's sensor both ways, with and without --jitter) under 100 ms, one path of the
+// 5,000-node / 20-drone stress mission under 1 s, and the 100-drone missions: the squads'
+// 64 paths (the default --paths) under 10 s, the show's one path well under. Each iteration
+// verifies from the compiled mission files, as `eamos verify` does after compiling; the
+// 100-drone ones take the number of flights flown at once as their argument (0: one per core).
 #include <benchmark/benchmark.h>
 
 #include "deploy/mission_file.h"
@@ -50,7 +52,7 @@ void BM_VerifyListing2AllPaths(benchmark::State& state) {
   o.jitter = state.range(0) != 0;
   run(state, *p, o);
 }
-BENCHMARK(BM_VerifyListing2AllPaths)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_VerifyListing2AllPaths)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 
 void BM_VerifyStressOnePath(benchmark::State& state) {
   eamos::stress::StressOptions so;
@@ -61,7 +63,30 @@ void BM_VerifyStressOnePath(benchmark::State& state) {
   o.max_paths = 1;
   run(state, *p, o);
 }
-BENCHMARK(BM_VerifyStressOnePath)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_VerifyStressOnePath)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+
+std::unique_ptr<Prepared> hundred_drones(eamos::stress::Shape shape) {
+  eamos::stress::StressOptions so;
+  so.shape = shape;
+  so.drones = 100;
+  so.target_nodes = shape == eamos::stress::Shape::show ? 5200 : 10000;
+  if (shape == eamos::stress::Shape::show) so.work_per_step = 1;
+  return prepare("", "", eamos::stress::generate_mission(so));
+}
+
+void BM_VerifySquads100(benchmark::State& state) {
+  static auto p = hundred_drones(eamos::stress::Shape::squads);
+  eamos::verify::VerifyOptions o;
+  o.jobs = static_cast<int>(state.range(0));
+  run(state, *p, o);
+}
+BENCHMARK(BM_VerifySquads100)->Arg(1)->Arg(0)->Iterations(1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+
+void BM_VerifyShow100(benchmark::State& state) {
+  static auto p = hundred_drones(eamos::stress::Shape::show);
+  run(state, *p, {});
+}
+BENCHMARK(BM_VerifyShow100)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 
 }  // namespace
 

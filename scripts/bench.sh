@@ -27,6 +27,10 @@ awk '/"per_drone"/ {in_drones = 1} in_drones && /^        "nodes":/ {
   --benchmark_repetitions=${REPS:-5} --benchmark_report_aggregates_only=true
 "$BUILD/bench/bench_dex" --benchmark_out=out/bench/dex.json --benchmark_out_format=json \
   --benchmark_repetitions=${REPS:-5} --benchmark_report_aggregates_only=true
+# Pre-flight verification: Listing 2's paths, one stress path, the 100-drone squads' 64 paths
+# (one flight at a time, then one per core) and the 100-drone show (about 25 s of CPU a repetition).
+"$BUILD/bench/bench_verify" --benchmark_out=out/bench/verify.json --benchmark_out_format=json \
+  --benchmark_repetitions=${REPS:-5} --benchmark_report_aggregates_only=true
 
 # `eamos run` of a 1,000-drone show (50 fleet-wide barriers) and of 1,000 drones in squads:
 # the whole process (compile and load included), CPU = user + sys, real-time factor = mission

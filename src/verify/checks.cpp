@@ -6,6 +6,7 @@
 
 #include "mid/requests.h"
 #include "verify/flight.h"
+#include "verify/sweep.h"
 
 namespace eamos::verify {
 
@@ -19,9 +20,12 @@ Located at_action(const ActionRun& a, std::string message) { return {a.node->lin
 /// then, else the last one it started before.
 const ActionRun* responsible(const Flight& f, int drone, double t) {
   if (const ActionRun* a = running_at(f, drone, t)) return a;
+  if (drone < 0 || static_cast<std::size_t>(drone) >= f.actions_of.size()) return nullptr;
   const ActionRun* last = nullptr;
-  for (const ActionRun& a : f.actions)
-    if (a.drone == drone && a.start <= t) last = &a;
+  for (std::size_t i : f.actions_of[drone]) {
+    if (f.actions[i].start > t) break;  // in start order
+    last = &f.actions[i];
+  }
   return last;
 }
 
@@ -44,51 +48,46 @@ bool rest_of_flight(const Flight& f, double t) { return f.abandoned_at >= 0 && t
 
 // --- separation ----------------------------------------------------------------------------
 
-void check_pair(const Setup& s, const Flight& f, int a, int b, std::vector<Violation>& out) {
-  const auto& ta = f.result.drones[a].track;
-  const auto& tb = f.result.drones[b].track;
-  std::vector<double> times;
-  for (const auto& x : ta) times.push_back(x.t);
-  for (const auto& x : tb) times.push_back(x.t);
-  std::sort(times.begin(), times.end());
+/// The violation for drones a and b (a < b) coming too near at t: blamed on the action that
+/// started last (the other drone was already doing its part), the lower-numbered on a tie.
+Violation separation_violation(const Setup& s, const Flight& f, const Approach& near) {
   const fleet::Separation& sep = s.c.fleet.safety.min_separation;
-  bool close = false;
-  for (double t : times) {
-    const dex::Sample* pa = sample_at(ta, t);
-    const dex::Sample* pb = sample_at(tb, t);
-    if (!pa || !pb) continue;
-    double h = std::hypot(pa->x - pb->x, pa->y - pb->y), v = std::abs(pa->z - pb->z);
-    bool now = !pa->landed && !pb->landed && h < sep.horizontal_m && v < sep.vertical_m;
-    if (now && !close) {
-      const ActionRun* ra = responsible(f, a, t);
-      const ActionRun* rb = responsible(f, b, t);
-      // Blame the action that started last: the other drone was already doing its part.
-      if (ra && rb && rb->start > ra->start) {
-        std::swap(ra, rb);
-        std::swap(a, b);
-        std::swap(pa, pb);
-      }
-      std::string what = name_of(s, a) + " and " + name_of(s, b) + " come within " + num(std::round(h * 100) / 100) +
-                         " m horizontally and " + num(std::round(v * 100) / 100) + " m vertically at " + seconds(t) +
-                         " (min_separation " + num(sep.horizontal_m) + " m horizontally or " + num(sep.vertical_m) +
-                         " m vertically)";
-      std::string fix = "; keep them apart in space or time (a different target or altitude, or a WaitUntil on the other drone)";
-      Violation viol = make("separation", t, {name_of(s, a), name_of(s, b)},
-                            ra ? at_action(*ra, what + " while " + name_of(s, a) + " runs " + ra->node->text + fix)
-                               : Located{0, 0, what + fix});
-      if (rb) viol.notes.push_back(at_action(*rb, name_of(s, b) + " is running " + rb->node->text + " then, at " +
-                                                     point(pb->x, pb->y, pb->z)));
-      if (ra && rest_of_flight(f, t)) viol.notes.push_back({0, 0, "this happens during the failsafe"});
-      out.push_back(std::move(viol));
-    }
-    close = now;
+  int a = near.a, b = near.b;
+  const dex::Sample* pa = near.pa;
+  const dex::Sample* pb = near.pb;
+  double t = near.t;
+  const ActionRun* ra = responsible(f, a, t);
+  const ActionRun* rb = responsible(f, b, t);
+  if (ra && rb && rb->start > ra->start) {
+    std::swap(ra, rb);
+    std::swap(a, b);
+    std::swap(pa, pb);
   }
+  std::string what = name_of(s, a) + " and " + name_of(s, b) + " come within " +
+                     num(std::round(near.horizontal * 100) / 100) + " m horizontally and " +
+                     num(std::round(near.vertical * 100) / 100) + " m vertically at " + seconds(t) +
+                     " (min_separation " + num(sep.horizontal_m) + " m horizontally or " + num(sep.vertical_m) +
+                     " m vertically)";
+  std::string fix = "; keep them apart in space or time (a different target or altitude, or a WaitUntil on the other drone)";
+  Violation viol = make("separation", t, {name_of(s, a), name_of(s, b)},
+                        ra ? at_action(*ra, what + " while " + name_of(s, a) + " runs " + ra->node->text + fix)
+                           : Located{0, 0, what + fix});
+  if (rb)
+    viol.notes.push_back(
+        at_action(*rb, name_of(s, b) + " is running " + rb->node->text + " then, at " + point(pb->x, pb->y, pb->z)));
+  if (ra && rest_of_flight(f, t)) viol.notes.push_back({0, 0, "this happens during the failsafe"});
+  return viol;
 }
 
-void check_separation(const Setup& s, const Flight& f, std::vector<Violation>& out) {
-  int n = static_cast<int>(f.result.drones.size());
-  for (int a = 0; a < n; ++a)
-    for (int b = a + 1; b < n; ++b) check_pair(s, f, a, b, out);
+Timeline timeline_of(const Flight& f) {
+  std::vector<const std::vector<dex::Sample>*> tracks;
+  for (const dex::DroneSummary& d : f.result.drones) tracks.push_back(&d.track);
+  return timeline(std::move(tracks));
+}
+
+void check_separation(const Setup& s, const Flight& f, const Timeline& flight, std::vector<Violation>& out) {
+  for (const Approach& near : approaches(flight, s.c.fleet.safety.min_separation))
+    out.push_back(separation_violation(s, f, near));
 }
 
 // --- geofence ------------------------------------------------------------------------------
@@ -219,18 +218,24 @@ void check_rates(const Setup& s, const Flight& f, std::vector<Violation>& out) {
 
 // --- take-off and landing spots -----------------------------------------------------------
 
-/// Another drone standing on the ground within the horizontal separation of (x, y) at t.
-int standing_near(const Setup& s, const Flight& f, int self, double x, double y, double t) {
-  for (std::size_t o = 0; o < f.result.drones.size(); ++o) {
-    if (static_cast<int>(o) == self) continue;
-    const dex::Sample* p = sample_at(f.result.drones[o].track, t);
-    if (p && p->landed && std::hypot(p->x - x, p->y - y) < s.c.fleet.safety.min_separation.horizontal_m)
-      return static_cast<int>(o);
-  }
-  return -1;
+Violation spot_violation(const Setup& s, const Flight& f, const ActionRun& a, double t, int other) {
+  bool takeoff = a.node->name == "Takeoff";
+  const dex::Sample* here = sample_at(f.result.drones[a.drone].track, t);
+  const std::string& me = name_of(s, a.drone);
+  std::string what = takeoff ? me + " takes off at " + seconds(t) + " from " + point(here->x, here->y, here->z) +
+                                   ", where " + name_of(s, other) + " stands"
+                             : me + " lands at " + seconds(t) + " on " + point(here->x, here->y, here->z) +
+                                   ", where " + name_of(s, other) + " stands";
+  return make("occupied_home", t, {me, name_of(s, other)},
+              at_action(a, what + " (closer than " + num(s.c.fleet.safety.min_separation.horizontal_m) + " m); " +
+                               (takeoff ? "give the drones homes at least that far apart"
+                                        : "land elsewhere (FlyTo a free spot first) or wait until " +
+                                              name_of(s, other) + " has left")));
 }
 
-void check_spots(const Setup& s, const Flight& f, std::vector<Violation>& out) {
+void check_spots(const Setup& s, const Flight& f, const Timeline& flight, std::vector<Violation>& out) {
+  std::vector<const ActionRun*> runs;
+  std::vector<SpotQuery> queries;
   for (const ActionRun& a : f.actions) {
     bool takeoff = a.node->name == "Takeoff";
     bool landing = (a.node->name == "Land" || a.node->name == "ReturnHome") && a.outcome == "succeeded";
@@ -238,20 +243,13 @@ void check_spots(const Setup& s, const Flight& f, std::vector<Violation>& out) {
     double t = takeoff ? a.start : a.end;
     const dex::Sample* here = sample_at(f.result.drones[a.drone].track, t);
     if (!here) continue;
-    int other = standing_near(s, f, a.drone, here->x, here->y, t);
-    if (other < 0) continue;
-    const std::string& me = name_of(s, a.drone);
-    std::string what = takeoff ? me + " takes off at " + seconds(t) + " from " + point(here->x, here->y, here->z) +
-                                     ", where " + name_of(s, other) + " stands"
-                               : me + " lands at " + seconds(t) + " on " + point(here->x, here->y, here->z) +
-                                     ", where " + name_of(s, other) + " stands";
-    out.push_back(make("occupied_home", t, {me, name_of(s, other)},
-                       at_action(a, what + " (closer than " + num(s.c.fleet.safety.min_separation.horizontal_m) +
-                                        " m); " +
-                                        (takeoff ? "give the drones homes at least that far apart"
-                                                 : "land elsewhere (FlyTo a free spot first) or wait until " +
-                                                       name_of(s, other) + " has left"))));
+    runs.push_back(&a);
+    queries.push_back({a.drone, t, here->x, here->y});
   }
+  double radius = s.c.fleet.safety.min_separation.horizontal_m;
+  std::vector<int> others = standing_near(flight, queries, radius);
+  for (std::size_t i = 0; i < runs.size(); ++i)
+    if (others[i] >= 0) out.push_back(spot_violation(s, f, *runs[i], queries[i].t, others[i]));
 }
 
 // --- the end of the mission ------------------------------------------------------------------
@@ -301,9 +299,10 @@ bool waits_for(const dex::Node& n, bool value) {
   }
 }
 
-std::string last_reads(const ConditionSeen& c) {
+std::string last_reads(const Setup& s, int drone, const ConditionSeen& c) {
   std::string out;
-  for (const auto& [what, value] : c.reads) out += (out.empty() ? "" : ", ") + what + " = " + num(value);
+  for (const auto& [read, value] : c.reads)
+    out += (out.empty() ? "" : ", ") + s.missions[drone].fleet[read->drone] + "." + read->property + " = " + num(value);
   return out;
 }
 
@@ -320,7 +319,7 @@ void check_never_ends(const Setup& s, const Flight& f, std::vector<Violation>& o
                        {c.node->line, c.node->col,
                         std::string(lang::control_name(c.node->control)) + " on `" + c.node->text +
                             "` never ends: still waiting at the " +
-                            limit + " time limit; it last read " + last_reads(c) + " (at " + seconds(c.t) +
+                            limit + " time limit; it last read " + last_reads(s, key.first, c) + " (at " + seconds(c.t) +
                             "); make sure something makes `" + c.node->text + "` come true, or raise --time-limit"});
     out.push_back(std::move(v));
   }
@@ -349,11 +348,12 @@ std::vector<Violation> check_flight(const Setup& s, const Flight& f) {
   }
   check_failure(s, f, out);
   check_never_ends(s, f, out);
-  check_separation(s, f, out);
+  Timeline flight = timeline_of(f);
+  check_separation(s, f, flight, out);
   check_geofence(s, f, out);
   check_battery(s, f, out);
   check_rates(s, f, out);
-  check_spots(s, f, out);
+  check_spots(s, f, flight, out);
   check_end_state(s, f, out);
   for (Violation& v : out) v.path = f.decisions;
   return out;

@@ -39,13 +39,14 @@ struct ConditionSeen {
   const dex::Node* node = nullptr;
   double t = 0.0;
   bool value = false;
-  std::vector<std::pair<std::string, double>> reads;  ///< "Drone1.X" → value read
+  std::vector<std::pair<const dex::Expr*, double>> reads;  ///< each property read (Drone1.X) → its value
 };
 
 struct Flight {
   dex::RunResult result;
   std::vector<dex::TraceEvent> events;
   std::vector<ActionRun> actions;                      ///< in start order
+  std::vector<std::vector<std::size_t>> actions_of;    ///< per drone: its runs in `actions`, in start order
   std::map<std::pair<int, int>, ConditionSeen> conditions;  ///< (drone, meg) → last seen
   std::vector<Decision> decisions;                     ///< free conditions, first evaluation each
   std::vector<std::pair<int, int>> decision_keys;      ///< (drone, meg) of each decision
@@ -57,8 +58,10 @@ struct Flight {
 };
 
 /// Flies one path: conditions in `forced` take the given outcome (where the fleet's sensor
-/// ranges allow it), every drone's actions take `factors[d]` times as long.
-Flight fly(const Setup& setup, const Assignment& forced, const std::vector<double>& factors);
+/// ranges allow it), every drone's actions take `factors[d]` times as long. `whole_trace`
+/// keeps every trace event in `Flight::events` (for the picture and --trace); the checks need
+/// none of them, and a flight of a hundred drones records tens of thousands.
+Flight fly(const Setup& setup, const Assignment& forced, const std::vector<double>& factors, bool whole_trace = false);
 
 /// Every violation of the rules on `f`, each with f's path.
 std::vector<Violation> check_flight(const Setup& setup, const Flight& f);

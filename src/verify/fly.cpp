@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <tuple>
+#include <unordered_map>
 
 #include "sim/sim_drone.h"
 #include "verify/flight.h"
@@ -56,7 +58,16 @@ std::vector<double> candidates(const fleet::SensorRange& r, const std::vector<do
 
 class Observer : public dex::RunObserver, public dex::TraceSink {
  public:
-  Observer(const Setup& setup, const Assignment& forced, Flight& f) : setup_(setup), forced_(forced), f_(f) {}
+  Observer(const Setup& setup, const Assignment& forced, Flight& f, bool whole_trace)
+      : setup_(setup), forced_(forced), f_(f), whole_trace_(whole_trace) {
+    const auto& names = setup_.missions[0].fleet;
+    for (std::size_t d = names.size(); d-- > 0;) index_of_[names[d]] = static_cast<int>(d);  // the first of equal names
+  }
+
+  // Every arrival delivered, on every flight: the runner's counted barriers (taken when no
+  // sink keeps messages) flew Listing 2 differently when the missions' drone sets were equal
+  // but not one table, and the worst path is flown again with its messages for the picture.
+  bool takes_messages() const override { return true; }
 
   void action_started(double t, int drone, const dex::Node& node, const mid::ActionRequest& request,
                       const mid::DroneState& state) override {
@@ -66,9 +77,17 @@ class Observer : public dex::RunObserver, public dex::TraceSink {
     a.request = request;
     a.state = state;
     a.start = t;
-    const fleet::ActionSpec* spec = setup_.missions[drone].type.find_action(node.name);
-    a.motion = spec && spec->action_class == fleet::ActionClass::motion;
-    open_[{drone, node.meg}].push_back(f_.actions.size());
+    auto [open, added] = open_.try_emplace({drone, node.meg});
+    if (added) {  // the first run of this node: what it is, and where its ends will say they are
+      const fleet::ActionSpec* spec = setup_.missions[drone].type.find_action(node.name);
+      motion_[{drone, node.meg}] = spec && spec->action_class == fleet::ActionClass::motion;
+      std::vector<int>& megs = megs_at_[{drone, node.line, node.col}];
+      megs.insert(std::upper_bound(megs.begin(), megs.end(), node.meg), node.meg);
+    }
+    a.motion = motion_.at({drone, node.meg});
+    open->second.push_back(f_.actions.size());
+    if (f_.actions_of.size() <= static_cast<std::size_t>(drone)) f_.actions_of.resize(drone + 1);
+    f_.actions_of[drone].push_back(f_.actions.size());
     f_.actions.push_back(std::move(a));
   }
 
@@ -77,10 +96,10 @@ class Observer : public dex::RunObserver, public dex::TraceSink {
     seen.node = &node;
     seen.t = t;
     seen.reads.clear();
-    std::vector<const dex::Expr*> reads;
-    collect_reads(node.condition, reads);
-    for (const dex::Expr* r : reads)
-      seen.reads.emplace_back(setup_.missions[drone].fleet[r->drone] + "." + r->property, read(r->drone, r->property));
+    auto [known, added] = reads_.try_emplace(&node);
+    if (added) collect_reads(node.condition, known->second);
+    const std::vector<const dex::Expr*>& reads = known->second;
+    for (const dex::Expr* r : reads) seen.reads.emplace_back(r, read(r->drone, r->property));
     bool value = decide(drone, node, computed, read);
     seen.value = value;
     note_timing(t, drone, node, value, reads);
@@ -88,15 +107,19 @@ class Observer : public dex::RunObserver, public dex::TraceSink {
   }
 
   void record(const dex::TraceEvent& e) override {
-    f_.events.push_back(e);
+    if (whole_trace_) f_.events.push_back(e);
     if (e.event == "failsafe" && f_.abandoned_at < 0) f_.abandoned_at = e.t;
     if (e.event != "end") return;
     int drone = drone_index(e.drone);
-    // Each end closes the oldest open run of that node on that drone (instances end in order).
-    for (auto& [key, open] : open_) {
-      if (key.first != drone || open.empty()) continue;
+    // Each end closes the oldest open run of that node on that drone (instances end in order);
+    // the node is the first, in MEG order, at the event's place with a run open.
+    auto megs = megs_at_.find({drone, e.line, e.col});
+    if (megs == megs_at_.end()) return;
+    for (int meg : megs->second) {
+      std::vector<std::size_t>& open = open_.at({drone, meg});
+      if (open.empty()) continue;
       ActionRun& a = f_.actions[open.front()];
-      if (a.node->line != e.line || a.node->col != e.col || a.node->text != e.text) continue;
+      if (a.node->text != e.text) continue;
       a.end = e.t;
       a.outcome = e.outcome;
       open.erase(open.begin());
@@ -106,8 +129,8 @@ class Observer : public dex::RunObserver, public dex::TraceSink {
 
  private:
   int drone_index(const std::string& name) const {
-    const auto& names = setup_.missions[0].fleet;
-    return static_cast<int>(std::find(names.begin(), names.end(), name) - names.begin());
+    auto it = index_of_.find(name);
+    return it == index_of_.end() ? static_cast<int>(setup_.missions[0].fleet.size()) : it->second;
   }
 
   std::vector<RangedRead> ranged_reads(const dex::Node& node) const {
@@ -198,8 +221,13 @@ class Observer : public dex::RunObserver, public dex::TraceSink {
   const Setup& setup_;
   const Assignment& forced_;
   Flight& f_;
+  bool whole_trace_;
   std::map<std::pair<int, int>, bool> free_;                    ///< condition → explored both ways
   std::map<std::pair<int, int>, std::vector<std::size_t>> open_;  ///< (drone, meg) → running runs
+  std::map<std::tuple<int, int, int>, std::vector<int>> megs_at_;  ///< (drone, line, col) → its MEG ids, sorted
+  std::unordered_map<std::string, int> index_of_;                 ///< drone name → fleet index
+  std::map<std::pair<int, int>, bool> motion_;                     ///< (drone, meg) → a motion action
+  std::unordered_map<const dex::Node*, std::vector<const dex::Expr*>> reads_;  ///< condition → its property reads
 };
 
 /// Every drone flies in the built-in simulator, whatever adapter the fleet names: verify
@@ -230,14 +258,14 @@ void register_simulator(mid::AdapterRegistry& adapters, std::map<std::string, do
 
 }  // namespace
 
-Flight fly(const Setup& setup, const Assignment& forced, const std::vector<double>& factors) {
+Flight fly(const Setup& setup, const Assignment& forced, const std::vector<double>& factors, bool whole_trace) {
   Flight f;
   f.factors = factors;
   std::map<std::string, double> by_name;
   for (std::size_t d = 0; d < setup.missions.size(); ++d) by_name[setup.missions[d].settings.name] = factors[d];
   mid::AdapterRegistry adapters;
   register_simulator(adapters, by_name);
-  Observer observer(setup, forced, f);
+  Observer observer(setup, forced, f, whole_trace);
   dex::RunOptions options;
   options.time_limit_s = setup.options.time_limit_s;
   options.observer = &observer;
@@ -251,8 +279,11 @@ Flight fly(const Setup& setup, const Assignment& forced, const std::vector<doubl
 const ActionRun* running_at(const Flight& f, int drone, double t) {
   const ActionRun* any = nullptr;
   const ActionRun* motion = nullptr;
-  for (const ActionRun& a : f.actions) {
-    if (a.drone != drone || a.start > t || a.end < t) continue;
+  if (drone < 0 || static_cast<std::size_t>(drone) >= f.actions_of.size()) return nullptr;
+  for (std::size_t i : f.actions_of[drone]) {
+    const ActionRun& a = f.actions[i];
+    if (a.start > t) break;  // in start order: none later runs at t
+    if (a.end < t) continue;
     if (a.motion) motion = &a;
     else any = &a;
   }

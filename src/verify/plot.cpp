@@ -31,7 +31,7 @@ Flight fly_worst(const Setup& setup, const VerifyReport& report) {
   Assignment forced(report.worst.forced.begin(), report.worst.forced.end());
   std::vector<double> factors = report.worst.factors;
   if (factors.size() != setup.missions.size()) factors.assign(setup.missions.size(), 1.0);
-  return fly(setup, forced, factors);
+  return fly(setup, forced, factors, true);
 }
 
 /// Each violation of `f` at the position of the first drone it names (its last published one).

@@ -19,6 +19,9 @@ struct VerifyOptions {
   int max_paths = 64;         ///< runs at most; exploration stops there (incomplete)
   bool jitter = false;        ///< also fly each path with every drone 10 % slower and faster
   double time_limit_s = 3600; ///< a run still going then: "never ends"
+  /// Flights flown at once, each on its own thread; 0: one per core. The report is the same
+  /// whatever the number.
+  int jobs = 0;
 };
 
 /// One decision that made a path: condition `text` of `drone` (at line/col) went `value`.
