@@ -98,7 +98,7 @@ TEST(VerifyJobs, FlyingTimingsSideBySideReportsWhatFlyingThemInTurnReports) {
   }
 }
 
-// `eamos verify` reads the missions into shared tables (dex::MissionTables), a library user
+// `eamos verify` reads the missions into shared tables (deploy::read_compiled_missions), a library user
 // may not: the flights, and so the paths, must not depend on it. Listing 2's RepeatWhile
 // reads Drone3 while it takes off, so each outcome of its If is flown nominal and with Drone3
 // 25 % slower and faster: 6 paths (tests/verify/examples records the same through the CLI).
@@ -106,8 +106,8 @@ TEST(VerifyLibrary, FliesTheSamePathsWhetherOrNotTheMissionsShareTheirTables) {
   std::string examples = EAMOS_SOURCE_DIR "/examples/";
   auto own = compiled(examples + "listing2.eamos", examples + "listing2-range.yaml");
   auto shared = compiled(examples + "listing2.eamos", examples + "listing2-range.yaml");
-  dex::MissionTables tables;
-  for (dex::Mission& m : shared->missions) tables.share(m);
+  std::vector<std::string> errors;
+  ASSERT_TRUE(deploy::read_compiled_missions(shared->c, shared->missions, errors)) << errors.front();
   VerifyReport a = verify(own->c, own->missions), b = verify(shared->c, shared->missions);
   EXPECT_EQ(a.paths, 6);
   EXPECT_EQ(format_report(own->c, a), format_report(shared->c, b));
