@@ -447,7 +447,11 @@ TEST_P(Sitl, TheSitesMaxSpeedPacesAFlightAndATargetOutsideTheFenceIsRefused) {
   std::cout << "[sitl] FlyByX(8) took " << ended - began << " mission s, fastest second " << fastest << " m/s\n";
   EXPECT_GT(ended - began, 3.5) << f.run.out;  // 8 m at 2 m/s, not at the autopilot's cruise
   EXPECT_LT(fastest, 2.8) << f.run.out;
-  EXPECT_LT(x_after - x_at_refusal, 0.5) << f.run.out;  // no step toward x = 40
+  // No step toward x = 40, which at the site's 2 m/s would be 3–4 m in these 2 s. What PX4
+  // does move is its stop from the paced FlyByX, which ended within the 0.5 m tolerance of
+  // its goal while still flying: up to 0.65 m past the refusal's position on a loaded host.
+  std::cout << "[sitl] after the refusal: " << x_after - x_at_refusal << " m further in x\n";
+  EXPECT_LT(x_after - x_at_refusal, 1.5) << f.run.out;
 }
 
 // The mission's fence given to the autopilot itself (geofence `upload: true`), one instance:
