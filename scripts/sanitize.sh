@@ -7,7 +7,8 @@
 #   thread:  the threaded suites under ThreadSanitizer: the MAVLink link and its receive thread
 #            (tests/mavlink*, tests/sim_vehicle), Cyclone DDS calling back from its own threads
 #            (test_transport and four Distributed cases of real `eamos launch` runs), the
-#            monitor's live server and the signal watcher of `eamos run`.
+#            monitor's live server, the signal watcher of `eamos run`, and `eamos verify`
+#            flying a path's timings on several threads (test_verify_explore).
 # Every process the tests start (eamos, its DEXes, sim-vehicles) is instrumented too. A report
 # from any of them fails the run, whatever its exit status did to the test: the sanitizers
 # write each report to a file in the tree's sanitizer-logs/, which must stay empty.
@@ -22,12 +23,12 @@ JOBS=$(nproc)
 # The test executables each tree builds; ctest lists the others as `<target>_NOT_BUILT`,
 # which every run leaves out.
 ASAN_TESTS=(test_fleet test_lang test_graph test_deploy test_cli test_progress test_failure_reasons
-            test_dex test_mid test_sim test_verify test_mavlink test_mavlink_adapter
+            test_dex test_mid test_sim test_verify test_verify_sweep test_verify_explore test_mavlink test_mavlink_adapter
             test_mavlink_listing2 test_mavlink_failure_reasons test_mavlink_attacker
             test_sim_vehicle test_transport test_monitor test_interrupt test_lsp test_failsafe)
 TSAN_TESTS=(test_mavlink test_mavlink_adapter test_sim_vehicle test_mavlink_listing2
             test_mavlink_failure_reasons test_mavlink_attacker test_transport test_distributed
-            test_monitor test_interrupt)
+            test_monitor test_interrupt test_verify_explore)
 # Real-time cases, after the other cases and the TSan build, with nothing beside them: the
 # MAVLink cases that fly a sim-vehicle on the wall clock (two at a time, as in make test), then
 # one at a time the monitor's input checks and live server and the signal watcher of `eamos
