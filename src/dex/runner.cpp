@@ -162,9 +162,8 @@ class InProcessTransport : public Transport {
       passing.push_back(b.due.begin()->second);
       b.due.erase(b.due.begin());
     }
-    std::vector<int> told(b.every.begin(), b.every.end());
     std::vector<int> all;  // in the set's order, as a delivery to each drone would reach them
-    std::merge(told.begin(), told.end(), passing.begin(), passing.end(), std::back_inserter(all));
+    std::merge(b.every.begin(), b.every.end(), passing.begin(), passing.end(), std::back_inserter(all));
     set_steps_ += all.size();
     for (int i : all) {
       int d = to[i];
