@@ -74,6 +74,19 @@ class SeparationDistributed : public ::testing::Test {
                                  (dir_ / "summary.json").string());
   }
   fs::path trace() const { return dir_ / "trace.jsonl"; }
+  /// The mission completes with `yielder` giving way once and resuming, `other` never
+  /// giving way, and the two never closer than 2 m.
+  void fly_and_expect_one_give_way(const std::string& mission, int domain, const std::string& yielder,
+                                   const std::string& other) {
+    eamos_test::Output r = fly(mission, domain);
+    ASSERT_EQ(r.status, 0) << r.out;
+    EXPECT_EQ(count(trace(), "give_way", yielder), 1) << r.out;
+    EXPECT_EQ(count(trace(), "resume", yielder), 1);
+    EXPECT_EQ(count(trace(), "give_way", other), 0);
+    EXPECT_GE(closest_horizontal(trace()), 2.0);
+    EXPECT_EQ(schema_errors(), "");
+  }
+
   std::string schema_errors() const {
     std::ifstream in(trace());
     std::vector<std::string> errors = eamos::trace::check_trace(in, {.strict = true});
@@ -83,13 +96,7 @@ class SeparationDistributed : public ::testing::Test {
 };
 
 TEST_F(SeparationDistributed, CrossingPathsTheLaterDeclaredDroneGivesWayAndBothComplete) {
-  eamos_test::Output r = fly("separation_crossing", 170);
-  ASSERT_EQ(r.status, 0) << r.out;
-  EXPECT_EQ(count(trace(), "give_way", "B"), 1) << r.out;
-  EXPECT_EQ(count(trace(), "resume", "B"), 1);
-  EXPECT_EQ(count(trace(), "give_way", "A"), 0);
-  EXPECT_GE(closest_horizontal(trace()), 2.0);
-  EXPECT_EQ(schema_errors(), "");
+  fly_and_expect_one_give_way("separation_crossing", 170, "B", "A");
 }
 
 TEST_F(SeparationDistributed, HeadOnSwapEndsInTheFailsafeApartAfterTheBound) {
@@ -108,13 +115,7 @@ TEST_F(SeparationDistributed, HeadOnSwapEndsInTheFailsafeApartAfterTheBound) {
 }
 
 TEST_F(SeparationDistributed, ADroneHoveringOnAnothersPathIsWaitedForAndBothComplete) {
-  eamos_test::Output r = fly("separation_hover_on_path", 172);
-  ASSERT_EQ(r.status, 0) << r.out;
-  EXPECT_EQ(count(trace(), "give_way", "A"), 1) << r.out;
-  EXPECT_EQ(count(trace(), "resume", "A"), 1);
-  EXPECT_EQ(count(trace(), "give_way", "B"), 0);
-  EXPECT_GE(closest_horizontal(trace()), 2.0);
-  EXPECT_EQ(schema_errors(), "");
+  fly_and_expect_one_give_way("separation_hover_on_path", 172, "A", "B");
 }
 
 TEST_F(SeparationDistributed, ThreeConvergingDronesPassOneAtATime) {
