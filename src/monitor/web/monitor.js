@@ -14,6 +14,7 @@ const S = {
   mission: null, live: false, finished: false, events: [], clock: 0, playing: false, speed: 1,
   follow: true, selected: null, dirty: true, structureDirty: true, itemsDirty: true, graphIndex: 0,
   liveFrom: Infinity, undrawn: [], latencies: [], arrivals: [], serverDelays: [], renderTimes: [],
+  laneColumns: { renders: 0, drawn: 0, columns: 0 },
 };
 const LATENCIES_MAX = 200000;  // the newest this many; enough for any percentile worth asking
 
@@ -273,7 +274,12 @@ function render() {
 // the page is loading (a thousand drones' mission text, graphs and history), not lagging.
 function noteDrawn() {
   const now = wallNow();
-  if (S.historyIn && S.liveFrom === Infinity) S.liveFrom = now;
+  // The history is drawn when the frame with it has been laid out and painted, which the
+  // browser does after this render: the next frame's start is that moment. (For a thousand
+  // drones the first layout of the page is 50-150 ms of its own.)
+  if (S.historyIn && S.liveFrom === Infinity && !S.historyFrame)
+    if (document.hidden) S.liveFrom = now;  // no frames in a background tab
+    else S.historyFrame = requestAnimationFrame(() => { S.liveFrom = wallNow(); });
   if (!S.undrawn.length) return;
   for (const emitted of S.undrawn) S.latencies.push(now - emitted);
   S.undrawn = [];
@@ -442,7 +448,7 @@ function buildLanes() {
   lanes.hidden = !useDom;
   $('lanes-canvas').hidden = useDom;
   lanes.dataset.drones = String(D.drones.length);
-  $('lanes-canvas')._drawn = null;
+  S.laneTiles = null;
   for (const item of [...D.bars, ...D.conds, ...D.violations, ...D.failMarks, ...D.giveWays]) item.el = null;
   for (const w of D.waitSpans ? D.waitSpans.values() : []) w.el = null;
   D.waitSpans = new Map();
@@ -761,70 +767,86 @@ function renderLanes() {
   put(head, 'height', height + 'px');
 }
 
-// Level of detail for large fleets: one pixel row group per drone, bars merged below a pixel.
+// Level of detail for large fleets: one pixel row per drone (up to 8), bars merged below a
+// pixel. The picture is kept from frame to frame in columns of LANE_TILE px, each a canvas of
+// its own, and a frame draws only what changed since the last one: the bars that started or
+// ended and the running bars' growth up to the clock. The browser copies every changed canvas
+// whole when it hands a frame on; one canvas of a thousand rows cost 2.5 ms of the main
+// thread per frame, a few columns near the clock a fraction of it. The playhead is an element
+// over the columns, so moving it changes no canvas.
+const LANE_TILE = 128;
 function renderLanesCanvas() {
-  const canvas = $('lanes-canvas');
-  put($('playhead'), 'height', '0px');
-  // At most 1,200 px tall: the browser paints the whole canvas each frame, and a thousand
-  // rows of 4 px (6 million pixels) made a live page fall seconds behind.
+  const box = $('lanes-canvas'), head = $('playhead');
+  // At most 1,200 px tall: a thousand rows of 4 px (6 million pixels) made a live page fall
+  // seconds behind.
   const rowH = Math.max(1, Math.min(8, Math.floor(1200 / D.drones.length)));
-  const w = Math.max(400, $('lanes-scroll').clientWidth - 4);
-  // Resizing a canvas reallocates it (4,000 rows of a thousand drones): only when it changes.
-  if (canvas.width !== w) canvas.width = w;
-  if (canvas.height !== rowH * D.drones.length) canvas.height = rowH * D.drones.length;
-  // Drawn again only when its picture changes (a bar started or ended, the clock moved half a
-  // pixel): the browser copies a changed canvas of a thousand rows whole on every frame. A live
-  // run's axis has headroom (axisEnd) so the bars stay put while the clock moves on.
+  const w = Math.max(400, $('lanes-scroll').clientWidth - 4), h = rowH * D.drones.length;
   const end = axisEnd(), now = S.clock;
-  const key = [w, canvas.height, end, Math.round((now / end) * w * 2), D.bars.length, D.barsEnded].join(' ');
-  if (canvas._drawn === key) return;
-  canvas._drawn = key;
-  const g = canvas.getContext('2d');
-  g.clearRect(0, 0, w, canvas.height);
-  const layer = endedBarsLayer(w, canvas.height, end, rowH);
-  g.drawImage(layer.canvas, 0, 0);
-  let drawn = layer.count;
-  for (const b of D.bars) {  // the bars still running at the clock
-    if (b.layer === layer.id) continue;
-    const state = barState(b);
-    if (state === 'future') continue;
-    drawn++;
-    drawBarRow(g, b, state === 'running' ? now : b.end, state, end, w, rowH);
+  // Everything again when the picture's geometry changes (a new axis: a live run's has
+  // headroom, so that is rare), a new mission, or the clock goes back.
+  const key = [w, h, end, rowH].join(' ');
+  let L = S.laneTiles;
+  if (!L || L.key !== key || L.bars !== D.bars || now < L.clock - 1e-9) L = S.laneTiles = laneTiles(box, key, w, h, end, rowH);
+  const toX = t => (t / end) * w;
+  L.frame++;
+  // Bars drawn as running that have ended by now: their outcome over their whole span.
+  for (const b of L.running) {
+    if (b.end === null || b.end > now + 1e-9) continue;
+    laneSpan(L, b, toX(b.start), toX(b.end), b.outcome || 'succeeded');
+    L.running.delete(b);
   }
-  g.fillStyle = '#d50000';
-  g.fillRect((now / end) * w, 0, 2, canvas.height);
-  canvas.dataset.drones = String(D.drones.length);
-  canvas.dataset.bars = String(drawn);
+  // Bars that started by now and are not drawn yet (in a live run, the ones that came in).
+  for (; L.next < D.bars.length; L.next++) L.pending.push(D.bars[L.next]);
+  if (L.pending.length) L.pending = L.pending.filter(b => {
+    if (b.start > now + 1e-9) return true;
+    L.drawn++;
+    const ended = b.end !== null && b.end <= now + 1e-9;
+    laneSpan(L, b, toX(b.start), toX(ended ? b.end : now), ended ? (b.outcome || 'succeeded') : 'running');
+    if (!ended) L.running.add(b);
+    return false;
+  });
+  // The running bars grow to the clock: only the columns it crossed since.
+  const x = toX(now);
+  if (x >= L.x + 0.5) {
+    for (const b of L.running) laneSpan(L, b, Math.max(toX(b.start), L.x - 1), x, 'running');
+    L.x = x;
+  }
+  L.clock = now;
+  S.laneColumns.renders++;
+  S.laneColumns.columns = L.tiles.length;
+  put(head, 'left', x + 'px');
+  put(head, 'height', h + 'px');
+  box.dataset.drones = String(D.drones.length);
+  box.dataset.bars = String(L.drawn);
+}
+
+// The columns for a picture of width w and height h, cleared (built again when the width changes).
+function laneTiles(box, key, w, h, end, rowH) {
+  const count = Math.ceil(w / LANE_TILE);
+  const canvases = [...box.children];
+  while (canvases.length > count) box.removeChild(canvases.pop());
+  while (canvases.length < count) canvases.push(box.appendChild(document.createElement('canvas')));
+  const tiles = canvases.map((c, i) => {
+    const tw = Math.min(LANE_TILE, w - i * LANE_TILE);
+    if (c.width !== tw) c.width = tw;
+    if (c.height !== h) c.height = h; else c.getContext('2d').clearRect(0, 0, tw, h);
+    return { g: c.getContext('2d'), x0: i * LANE_TILE, w: tw };
+  });
+  return { key, tiles, rowH, bars: D.bars, next: 0, pending: [], running: new Set(), drawn: 0, clock: 0, x: 0, frame: 0 };
 }
 
 const BAR_COLOURS = { succeeded: '#2e7d32', failed: '#c62828', preempted: '#ef6c00', cancelled: '#757575', running: '#1565c0' };
-function drawBarRow(g, b, stop, state, end, w, rowH) {
-  g.fillStyle = BAR_COLOURS[state] || '#2e7d32';
-  const row = D.droneIndex.get(b.drone);
-  g.fillRect((b.start / end) * w, row * rowH, Math.max(1, ((stop - b.start) / end) * w), rowH - (rowH > 3 ? 1 : 0));
-}
-
-// The bars that ended by the clock, on a layer of their own that each frame extends with the
-// ones that ended since: a frame then draws the layer and the running bars, not every bar of
-// the mission (5,000 of a thousand-drone show). Drawn again when the axis changes or the
-// clock goes back.
-function endedBarsLayer(w, h, end, rowH) {
-  const key = [w, h, end, rowH, D.drones.length].join(' ');
-  let L = S.barLayer;
-  if (!L || L.key !== key || S.clock < L.clock || L.bars !== D.bars) {
-    const canvas = L ? L.canvas : document.createElement('canvas');
-    canvas.width = w; canvas.height = h;  // also clears it
-    L = S.barLayer = { key, canvas, clock: 0, count: 0, bars: D.bars, id: (L ? L.id : 0) + 1 };
+// Bar b's row from x0 to x1 (at least a pixel wide) in the colour of `state`, in each column it crosses.
+function laneSpan(L, b, x0, x1, state) {
+  x1 = Math.max(x1, x0 + 1);
+  const row = D.droneIndex.get(b.drone), y = row * L.rowH, rh = L.rowH - (L.rowH > 3 ? 1 : 0);
+  const first = Math.max(0, Math.floor(x0 / LANE_TILE)), last = Math.min(L.tiles.length - 1, Math.floor(x1 / LANE_TILE));
+  for (let i = first; i <= last; i++) {
+    const t = L.tiles[i];
+    if (t.frame !== L.frame) { t.frame = L.frame; S.laneColumns.drawn++; }
+    t.g.fillStyle = BAR_COLOURS[state] || '#2e7d32';
+    t.g.fillRect(x0 - t.x0, y, x1 - x0, rh);
   }
-  const g = L.canvas.getContext('2d');
-  for (const b of D.bars) {
-    if (b.layer === L.id || b.end === null || b.end > S.clock + 1e-9 || b.start > S.clock + 1e-9) continue;
-    drawBarRow(g, b, b.end, b.outcome || 'succeeded', end, w, rowH);
-    b.layer = L.id;
-    L.count++;
-  }
-  L.clock = S.clock;
-  return L;
 }
 
 // ---- map ----
@@ -878,9 +900,11 @@ function renderMap() {
   }
   if (many) g.drawImage(trailLayer(W, H, B, X, Y), 0, 0);
   const failedNow = failedDronesAt(S.clock);
+  // Each drone's position at the clock, found once for the map and the side view.
+  const at = D.drones.map(d => positionAt(d, S.clock));
   for (const d of D.drones) {
     const samples = D.telemetry.get(d.name) || [];
-    const p = positionAt(d, S.clock);
+    const p = at[d.index];
     // A large fleet's tracks are on the layer, up to each drone's last sample.
     if (samples.length > 1 && !many) {
       g.strokeStyle = d.colour; g.globalAlpha = 0.6; g.lineWidth = 1.5; g.beginPath();
@@ -909,7 +933,7 @@ function renderMap() {
   drawViolations(g, X, Y, many);
   drawGiveWays(g, X, Y, many);
   drawFailures(g, X, Y);
-  renderSide(B);
+  renderSide(B, at);
   const hasTelemetry = D.telemetry.size > 0;
   putText($('map-note'), hasTelemetry ? '' : (D.drones.some(d => d.home) ?
     'this trace has no telemetry: homes only' : 'this trace has no telemetry and names no homes'));
@@ -1037,7 +1061,7 @@ function drawGrid(g, W, H, B, X, Y) {
   }
 }
 
-function renderSide(B) {
+function renderSide(B, at) {
   const canvas = $('side'), g = canvas.getContext('2d');
   const W = canvas.width, H = canvas.height;
   const X = x => ((x - B.minX) / (B.maxX - B.minX)) * W;
@@ -1048,7 +1072,7 @@ function renderSide(B) {
   if (fence) { g.strokeStyle = '#c62828'; g.setLineDash([6, 4]); g.beginPath(); g.moveTo(0, Z(fence.max_altitude));
     g.lineTo(W, Z(fence.max_altitude)); g.stroke(); g.setLineDash([]); }
   for (const d of D.drones) {
-    const p = positionAt(d, S.clock);
+    const p = at[d.index];
     if (!p) continue;
     g.fillStyle = d.colour;
     if (D.drones.length > 100) g.fillRect(X(p.x) - 2, Z(p.z) - 2, 4, 4);  // as on the map
@@ -1399,6 +1423,8 @@ function onMessage(text) {
     S.serverDelays = [];
     S.liveFrom = Infinity;
     S.historyIn = false;
+    if (S.historyFrame) cancelAnimationFrame(S.historyFrame);
+    S.historyFrame = 0;
     resetDerived();
     $('mission-name').textContent = str(S.mission.mission);
     buildSource();
@@ -1474,10 +1500,16 @@ window.eamosMonitor = {
   // Live events: ms from eamos emitting one to this page having drawn it (see noteDrawn), and
   // to its arrival here (the part the network and the server take).
   liveLatency: () => latencyStats(S.latencies),
+  // The same for the first n live events only (the page catching up after it drew its history).
+  firstLiveLatency: n => latencyStats(S.latencies.slice(0, n)),
+  // ms from navigation to the end of the page's first frame with the history (null before).
+  liveSince: () => (S.liveFrom === Infinity ? null : S.liveFrom - performance.timeOrigin),
   arrivalLatency: () => latencyStats(S.arrivals),
   serverLatency: () => latencyStats(S.serverDelays),
   // How long each render took, ms (the page's own work per frame).
   renderTimes: () => latencyStats(S.renderTimes),
+  // Large fleets: the lanes canvas's renders, the columns they drew in all, and how many it has.
+  laneColumns: () => ({ ...S.laneColumns }),
   // The drones marked failed on the map and in their lanes at the clock.
   failedDrones: () => D.drones.filter(d => failedBy(d.name, S.clock)).map(d => d.name),
   triggers: () => (D.triggerList || []).map(t => ({ from: t.from, to: t.to, sent: t.sent, received: t.received, wait: t.received - t.waitFrom })),
