@@ -345,7 +345,7 @@ async function liveScale(browser, drones, bound, events) {
   console.log(`info: load average ${os.loadavg().map(x => x.toFixed(1)).join(' ')} on ${os.cpus().length} cores`);
   // The bounds are the page's on a host with cores for it. Other work beside it (the load
   // average counts what waits for a core) delays Chromium's processes more than the page's
-  // script: in real time at load 15-55 on 2 cores the p95 was 190-800 ms with renders of
+  // script: in real time at load 15-53 on 2 cores the p95 was 190-800 ms with renders of
   // 2-5 ms. A miss on such a host is reported and skipped, not failed.
   const load = os.loadavg()[0], cores = os.cpus().length;
   const timed = (held, what) => {
@@ -353,7 +353,7 @@ async function liveScale(browser, drones, bound, events) {
     else check(held, what);
   };
   timed(l.p95 !== null && l.p95 < bound, `p95 of emitted-to-drawn below ${bound} ms: ${ms(l.p95)}`);
-  // The page's own work (2.5-5 ms at load 4-67): half a frame at most.
+  // The page's own work (2.4-5.0 ms in real time at load 4-40): half a frame at most.
   timed(r.frames.median !== null && r.frames.median < 8, `the page renders in under 8 ms: ${ms(r.frames.median)} (median)`);
   // Read after the latencies: reading the canvases back takes the page's thread a while.
   // The lanes' picture is kept from frame to frame and a render draws only the columns that
