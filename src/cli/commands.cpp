@@ -199,7 +199,7 @@ int cmd_compile(const CommonOptions& o, const std::string& out_dir, const Securi
   c.reset();
   malloc_trim(0);
   if (!security.insecure && !make_credentials(drones, out_dir, hash, security)) return 1;
-  std::cout << "compiled " << o.mission << " → " << out_dir << "/ (" << count_of(static_cast<int>(drones.size()), "drone")
+  std::cout << "compiled " << o.mission << " → " << out_dir << "/ (" << count_of(drones.size(), "drone")
             << ", " << count_of(meg_nodes, "MEG node") << ")\n";
   if (package)
     std::cout << "packaged each drone's DEX as a systemd service: " << out_dir << "/<drone>/DEPLOY.txt says what to "
