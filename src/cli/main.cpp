@@ -402,6 +402,8 @@ std::string fly_program() {
   namespace fs = std::filesystem;
   std::error_code ec;
   fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  // Never a path relative to the working directory: that would run whatever lies there.
+  if (ec || !self.is_absolute()) return "/proc/self/exe/../eamos-fly";
   fs::path beside = self.parent_path() / "eamos-fly";
   if (fs::exists(beside, ec)) return beside.string();
   return (self.parent_path().parent_path() / "libexec" / "eamos" / "eamos-fly").string();
