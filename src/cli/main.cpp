@@ -4,7 +4,10 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <iostream>
 
 #include "cli/arguments.h"
@@ -392,12 +395,35 @@ bool outputs_usable(const Commands& c, const std::vector<std::string>& args, con
   return true;
 }
 
-/// Runs the command the line chose; its exit status.
-int dispatch(const Commands& c, Options& o) {
-  if (*c.check) return eamos::cli::cmd_check(o.common, o.list_caps);
-  if (*c.compile) return eamos::cli::cmd_compile(o.common, o.out_dir, o.security, o.packaged ? &o.package : nullptr);
-  if (*c.graph) return eamos::cli::cmd_graph(o.common, o.kind, o.drone, o.format, o.graph_out);
-  if (*c.stats) return eamos::cli::cmd_stats(o.common, o.stats_out);
+#ifdef EAMOS_FLY_ELSEWHERE
+/// eamos-fly: next to this program (the build tree, or both in bin/), else in
+/// ../libexec/eamos/ (the install tree and the Debian package).
+std::string fly_program() {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  // Never a path relative to the working directory: that would run whatever lies there.
+  if (ec || !self.is_absolute()) return "/proc/self/exe/../eamos-fly";
+  fs::path beside = self.parent_path() / "eamos-fly";
+  if (fs::exists(beside, ec)) return beside.string();
+  return (self.parent_path().parent_path() / "libexec" / "eamos" / "eamos-fly").string();
+}
+
+/// The commands that fly or serve (run, verify, launch, dex, sim-vehicle, monitor) live in
+/// eamos-fly, which links Cyclone DDS, civetweb and the MAVLink stack. This `eamos` links none
+/// of them, so check, compile and the other commands start without loading them
+/// (docs/performance.md); a flying command replaces it with eamos-fly: the same pid, terminal
+/// and arguments.
+int fly(const Commands&, Options&, char** argv) {
+  std::string program = fly_program();
+  argv[0] = program.data();
+  ::execv(program.c_str(), argv);
+  std::cerr << eamos::cli::error_prefix() << "cannot start " << program << ": " << std::strerror(errno)
+            << "; the installation is incomplete (reinstall eamos)\n";
+  return 1;
+}
+#else
+int fly(const Commands& c, Options& o, char**) {
   if (*c.run && o.distributed) {
     o.launch.speed = o.run.speed > 0 ? o.run.speed : 1.0;
     o.launch.time_limit_s = o.run.time_limit;
@@ -409,9 +435,19 @@ int dispatch(const Commands& c, Options& o) {
   if (*c.dex) return eamos::cli::cmd_dex(o.dex);
   if (*c.sim_vehicle) return eamos::cli::cmd_sim_vehicle(o.sim_vehicle);
   if (*c.monitor) return eamos::cli::cmd_monitor(o.monitor);
+  return 1;
+}
+#endif
+
+/// Runs the command the line chose; its exit status.
+int dispatch(const Commands& c, Options& o, char** argv) {
+  if (*c.check) return eamos::cli::cmd_check(o.common, o.list_caps);
+  if (*c.compile) return eamos::cli::cmd_compile(o.common, o.out_dir, o.security, o.packaged ? &o.package : nullptr);
+  if (*c.graph) return eamos::cli::cmd_graph(o.common, o.kind, o.drone, o.format, o.graph_out);
+  if (*c.stats) return eamos::cli::cmd_stats(o.common, o.stats_out);
   if (*c.gen) return eamos::cli::cmd_gen_stress(o.shape, o.nodes, o.drones, o.work_per_step, o.seed, o.gen_out);
   if (*c.lsp) return eamos::lsp::serve_stdio(o.lsp);
-  return 1;
+  return fly(c, o, argv);
 }
 
 }  // namespace
@@ -438,6 +474,10 @@ int main(int argc, char** argv) {
     std::cerr << eamos::cli::explain_parse_error(app, args, e);
     return 1;
   }
+#ifdef EAMOS_FLY_ELSEWHERE
+  // Handed over as parsed, before this process checks or writes anything: eamos-fly does it all.
+  if (*c.run || *c.verify || *c.launch || *c.dex || *c.sim_vehicle || *c.monitor) return fly(c, o, argv);
+#endif
   style.color_stderr = eamos::cli::use_color(o.color, STDERR_FILENO);
   style.diagnostics = o.diagnostics_format;
   eamos::cli::apply_log_level(o.log_level);
@@ -447,7 +487,7 @@ int main(int argc, char** argv) {
   // watches is now, not a buffer later, and a killed process loses at most half a line.
   if (*c.run || *c.launch || *c.dex || *c.sim_vehicle || *c.monitor) std::setvbuf(stdout, nullptr, _IOLBF, BUFSIZ);
   try {
-    return dispatch(c, o);
+    return dispatch(c, o, argv);
   } catch (const std::exception& e) {
     std::cerr << eamos::cli::error_prefix() << e.what() << "\n";
     return 1;

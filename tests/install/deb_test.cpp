@@ -78,15 +78,18 @@ TEST_F(DebianPackage, UnpackedCommandFliesAnInstalledExample) {
   for (const char* file : {"usr/lib/systemd/system/eamos-dex@.service", "usr/share/man/man1/eamos-dex.1.gz",
                            "usr/share/bash-completion/completions/eamos", "usr/share/zsh/vendor-completions/_eamos"})
     EXPECT_TRUE(fs::exists(root / file) || fs::exists(root / fs::path(file).replace_extension())) << file;
+  EXPECT_TRUE(fs::exists(root / "usr/libexec/eamos/eamos-fly")) << "`eamos run` above ran it";
   EXPECT_FALSE(fs::exists(root / "usr/include")) << "headers belong to eamos-dev";
 }
 
 TEST_F(DebianPackage, DependsOnThePackageOfEverySharedLibraryTheCommandLinks) {
   std::string depends = field(runtime_, "Depends");
+  // `eamos` and eamos-fly, to which it hands the commands that fly (src/cli/CMakeLists.txt).
   std::set<std::string> loaded = packages_linked_by(std::string(EAMOS_BINARY));
+  loaded.merge(packages_linked_by(std::string(EAMOS_FLY_BINARY)));
   // The ones a user would name: DDS, YAML, TLS, hashing, the monitor's web server.
   for (const char* expected : {"libddsc0debian", "libyaml-cpp0.7", "libssl3", "libnettle8", "libstdc++6", "libc6"})
-    EXPECT_TRUE(loaded.count(expected)) << expected << " not linked by eamos?";
+    EXPECT_TRUE(loaded.count(expected)) << expected << " not linked by eamos or eamos-fly?";
   for (const std::string& package : loaded)
     EXPECT_TRUE(std::regex_search(depends, std::regex("(^|, )" + std::regex_replace(package, std::regex("[.+]"), "\\$&") + "( \\(|,|$|\n)")))
         << package << " missing from Depends: " << depends;
