@@ -3,6 +3,7 @@
 // every block call expanded in place. Parents are sequential and parallel blocks and
 // control structures; leaves are drone actions and timed pauses.
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "diag/source.h"
@@ -29,7 +30,9 @@ struct AmtNode {
   int id = 0;
   AmtKind kind = AmtKind::seq;
   SourceLocation loc;      ///< the call site (or INIT's definition)
-  std::string name;        ///< block name, capability, or control structure name
+  /// Block name, capability, or control structure name: a view into the Mission (or a
+  /// literal), which outlives its AMT.
+  std::string_view name;
   int parent = -1;
   std::vector<int> children;
   Role role = Role::none;  ///< this node's role under a control parent

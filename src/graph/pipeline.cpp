@@ -7,19 +7,12 @@ namespace eamos::graph {
 
 namespace {
 
-/// After the last check, a deployment needs of the statements only their expressions (the
-/// MEG's arguments and conditions point to them): the rest, a fifth of a large mission's
-/// memory, is freed before the MDGs and the files are made, which reuse it.
+/// After the last check, a deployment needs of the statements nothing: the MEG's
+/// arguments and conditions point into Mission::expressions, which stays. The rest, a fifth
+/// of a large mission's memory, is freed before the MDGs and the files are made, which
+/// reuse it.
 void drop_statements(Compilation& c) {
-  std::size_t count = 0;
-  for (const lang::Function& f : c.mission.functions)
-    for (const lang::Statement& s : f.body) count += s.args.size();
-  c.expressions.reserve(count);
-  for (lang::Function& f : c.mission.functions) {
-    for (lang::Statement& s : f.body)
-      for (std::unique_ptr<lang::Expr>& e : s.args) c.expressions.push_back(std::move(e));
-    std::vector<lang::Statement>().swap(f.body);
-  }
+  for (lang::Function& f : c.mission.functions) std::vector<lang::Statement>().swap(f.body);
 }
 
 }  // namespace

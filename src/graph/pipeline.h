@@ -25,9 +25,6 @@ struct Compilation {
   Amt amt;
   Meg meg;
   std::vector<Mdg> mdgs;
-  /// With Keep::deployment_graphs, the mission's expressions, which the MEG points to,
-  /// once the statements that held them are freed.
-  std::vector<std::unique_ptr<lang::Expr>> expressions;
 
   int drone_count() const { return static_cast<int>(mission.drones.size()); }
   const std::string& drone_name(int d) const { return mission.drones[d].name; }

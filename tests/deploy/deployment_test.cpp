@@ -63,7 +63,7 @@ TEST(DeploymentCompile, FreesTheStatementsButWritesTheSameMissionFiles) {
                              graph::Keep::deployment_graphs))
       << diags.format();
   for (const lang::Function& f : lean.mission.functions) EXPECT_TRUE(f.body.empty()) << f.name;
-  EXPECT_FALSE(lean.expressions.empty());
+  EXPECT_GT(lean.mission.expressions.size(), 0u);  // the MEG points into them
   std::string hash = deploy::mission_hash(*full);
   ASSERT_EQ(deploy::mission_hash(lean), hash);
   for (int d = 0; d < full->drone_count(); ++d)
