@@ -36,7 +36,9 @@ struct Compilation {
 /// lowers the peak memory of a compile by about a tenth.
 enum class Keep {
   all_graphs,
-  deployment_graphs,  ///< the AMT is emptied once the MEG is built, the statements once it is checked
+  /// The statements other than control structures are freed once the AMT is built, the AMT
+  /// once the MEG is built, the rest of the statements once the MEG is checked.
+  deployment_graphs,
 };
 
 /// Runs every stage on `source`; stops after the first stage that reported errors.
