@@ -68,26 +68,27 @@ enum class StatementKind {
 };
 
 struct Statement {
+  // Ordered so that no field pads another: a large mission has a million statements.
   StatementKind kind = StatementKind::action;
+  // Filled by the checker:
+  int drone_index = -1;                      ///< action
+  int function_index = -1;                   ///< call / async_call of a block
+  ControlKind control = ControlKind::none;   ///< call of a control structure
   SourceLocation loc;         ///< first token
   SourceLocation callee_loc;  ///< the capability or function name
   std::string_view drone;     ///< action only; a view into the SourceFile, as Expr's names
   std::string_view callee;    ///< capability name, or block / control structure name
   std::vector<Expr*> args;    ///< owned by Mission::expressions
-  // Filled by the checker:
-  int drone_index = -1;                      ///< action
-  int function_index = -1;                   ///< call / async_call of a block
-  ControlKind control = ControlKind::none;   ///< call of a control structure
-  std::vector<int> branch_functions;         ///< control: functions named in the args, in order
+  std::vector<int> branch_functions;         ///< control, filled by the checker: functions named in the args, in order
 };
 
 enum class BlockKind { seq, par };
 
 struct Function {
   std::string name;
+  std::vector<Statement> body;
   SourceLocation loc;  ///< the name after `func`
   BlockKind block = BlockKind::seq;  ///< INIT and SEQ_* run in sequence, PAR_* in parallel
-  std::vector<Statement> body;
   bool called = false;  ///< filled by the checker
 };
 
