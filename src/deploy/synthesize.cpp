@@ -86,7 +86,7 @@ bool write_text(const std::filesystem::path& path, const std::string& text, Diag
 ///
 /// Nor is the source copied into the header: its text is lent to it for the dump and
 /// given back, the same bytes in the same buffer, so the AST's names, which are views into
-/// it, stay valid (a copy was 35 MB of the 520,000-statement show's peak).
+/// it, stay valid (a copy would be 35 MB of the 520,000-statement show's peak).
 bool write_trace_header(const graph::Compilation& c, const std::filesystem::path& path, const std::string& hash,
                         Diagnostics& diags) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);

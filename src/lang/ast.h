@@ -39,7 +39,7 @@ struct Expr {
   SourceLocation loc;
   double number = 0.0;
   // Views into the mission's SourceFile, which outlives the Mission: a large mission holds
-  // over a million expressions, and a copy of each name was a third of their memory.
+  // over a million expressions, and a copy of each name would be a third of their memory.
   std::string_view drone;     ///< property: the drone; name: the identifier
   std::string_view property;  ///< property: the property name
   Expr* lhs = nullptr;  ///< unary operand or left operand; owned by Mission::expressions

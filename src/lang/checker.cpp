@@ -106,7 +106,7 @@ class NameIndex {
  public:
   /// Adds `name` as entry `index` unless the name is there; returns its first entry's index.
   int insert(std::string_view name, int index) {
-    if ((count_ + 1) * 2 > slots_.size()) grow();
+    if ((count_ + 1) * 2 > slots_.size()) resize(slots_.empty() ? 16 : slots_.size() * 2);
     std::size_t h = std::hash<std::string_view>{}(name);
     for (std::size_t i = h & mask_;; i = (i + 1) & mask_) {
       Slot& s = slots_[i];
@@ -130,7 +130,9 @@ class NameIndex {
   }
 
   void reserve(std::size_t n) {
-    while (slots_.size() < 2 * n) grow();
+    std::size_t size = 16;
+    while (size < 2 * n) size *= 2;
+    if (size > slots_.size()) resize(size);
   }
 
  private:
@@ -140,9 +142,10 @@ class NameIndex {
     int index = -1;
   };
 
-  void grow() {
+  /// `size` is a power of two: a slot is the hash's low bits.
+  void resize(std::size_t size) {
     std::vector<Slot> old = std::move(slots_);
-    slots_.assign(old.empty() ? 16 : old.size() * 2, Slot{});
+    slots_.assign(size, Slot{});
     mask_ = slots_.size() - 1;
     count_ = 0;
     for (const Slot& s : old)
