@@ -26,7 +26,10 @@ json manifest(const graph::Compilation& c, const std::string& hash) {
           {"drones", drones}};
 }
 
-nlohmann::ordered_json trace_header(const graph::Compilation& c, const std::string& hash, double telemetry_hz) {
+namespace {
+
+nlohmann::ordered_json header_with(const graph::Compilation& c, const std::string& hash, double telemetry_hz,
+                                   std::string source) {
   nlohmann::ordered_json drones = nlohmann::ordered_json::array();
   for (int d = 0; d < c.drone_count(); ++d) {
     const fleet::DroneSettings& s = c.settings[d];
@@ -49,11 +52,17 @@ nlohmann::ordered_json trace_header(const graph::Compilation& c, const std::stri
   h["eamos"] = EAMOS_VERSION;
   h["mission"] = std::filesystem::path(c.source->path).filename().string();
   h["mission_hash"] = hash;
-  h["source"] = c.source->text;
+  h["source"] = std::move(source);
   h["fleet"] = c.fleet.source ? c.fleet.source->text : "";
   h["drones"] = drones;
   h["telemetry_hz"] = telemetry_hz;
   return h;
+}
+
+}  // namespace
+
+nlohmann::ordered_json trace_header(const graph::Compilation& c, const std::string& hash, double telemetry_hz) {
+  return header_with(c, hash, telemetry_hz, c.source->text);
 }
 
 namespace {
@@ -74,13 +83,25 @@ bool write_text(const std::filesystem::path& path, const std::string& text, Diag
 /// dump(2) would print it, so that a large mission's text is not held twice more in memory
 /// (the dump and the dump with its newline). Mission and fleet text may hold any byte:
 /// replaced, not thrown, as in the trace itself.
+///
+/// Nor is the source copied into the header: its text is lent to it for the dump and
+/// given back, the same bytes in the same buffer, so the AST's names, which are views into
+/// it, stay valid (a copy would be 35 MB of the 520,000-statement show's peak).
 bool write_trace_header(const graph::Compilation& c, const std::filesystem::path& path, const std::string& hash,
                         Diagnostics& diags) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   {
+    // Swapped in once the header is whole: adding a member may copy the others.
+    nlohmann::ordered_json header = header_with(c, hash, 0, std::string());
+    struct Lent {
+      std::string& owner;
+      std::string& borrower;
+      ~Lent() { owner.swap(borrower); }
+    } lent{c.source->text, header["source"].get_ref<std::string&>()};
+    lent.owner.swap(lent.borrower);
     nlohmann::detail::serializer<nlohmann::ordered_json> writer(nlohmann::detail::output_adapter<char>(out), ' ',
                                                                json::error_handler_t::replace);
-    writer.dump(trace_header(c, hash, 0), true, false, 2);
+    writer.dump(header, true, false, 2);
   }
   out << "\n";
   out.close();

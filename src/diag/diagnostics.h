@@ -3,6 +3,7 @@
 // stopping at the first problem, so a single run reports everything wrong with a file.
 #include <cstddef>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "diag/source.h"
@@ -78,6 +79,6 @@ class Diagnostics {
 std::string count_of(std::size_t n, const std::string& noun);
 
 /// The closest candidate by edit distance, or "" when none is close enough to suggest.
-std::string closest_match(const std::string& word, const std::vector<std::string>& candidates);
+std::string closest_match(std::string_view word, const std::vector<std::string>& candidates);
 
 }  // namespace eamos

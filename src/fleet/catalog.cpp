@@ -71,13 +71,13 @@ DroneType generic_multirotor(const std::string& type_name) {
   return type;
 }
 
-const ActionSpec* DroneType::find_action(const std::string& action) const {
+const ActionSpec* DroneType::find_action(std::string_view action) const {
   for (const auto& a : actions)
     if (a.name == action) return &a;
   return nullptr;
 }
 
-const PropertySpec* DroneType::find_property(const std::string& property) const {
+const PropertySpec* DroneType::find_property(std::string_view property) const {
   for (const auto& p : properties)
     if (p.name == property) return &p;
   return nullptr;

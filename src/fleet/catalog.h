@@ -3,6 +3,7 @@
 // it. The compiler checks every action call and property read against it, the way a
 // BehaviorTree.CPP factory rejects unknown node names at load time, not in flight.
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace eamos::fleet {
@@ -61,8 +62,8 @@ struct DroneType {
   GoalTolerance tolerance;
   bool generic = true;           ///< true: the built-in multirotor (not described by a file)
 
-  const ActionSpec* find_action(const std::string& name) const;
-  const PropertySpec* find_property(const std::string& name) const;
+  const ActionSpec* find_action(std::string_view name) const;
+  const PropertySpec* find_property(std::string_view name) const;
   /// Names of all actions and properties, for "did you mean" suggestions.
   std::vector<std::string> capability_names() const;
 };

@@ -87,7 +87,7 @@ class AmtBuilder {
     return size;
   }
 
-  int add(AmtKind kind, SourceLocation loc, const std::string& name, int parent) {
+  int add(AmtKind kind, SourceLocation loc, std::string_view name, int parent) {
     AmtNode n;
     n.id = static_cast<int>(amt_.nodes.size());
     n.kind = kind;
@@ -116,7 +116,7 @@ class AmtBuilder {
       case lang::StatementKind::action: {
         int id = add(AmtKind::action, s.loc, s.callee, parent);
         amt_.nodes[id].drone = s.drone_index;
-        for (const auto& a : s.args) amt_.nodes[id].args.push_back(a.get());
+        amt_.nodes[id].args.assign(s.args.begin(), s.args.end());
         return;
       }
       case lang::StatementKind::async_call: {
@@ -142,7 +142,7 @@ class AmtBuilder {
     }
     int id = add(AmtKind::control, s.loc, lang::control_name(s.control), parent);
     amt_.nodes[id].control = s.control;
-    amt_.nodes[id].condition = s.args[0].get();
+    amt_.nodes[id].condition = s.args[0];
     if (s.control == ControlKind::RepeatFor)
       amt_.nodes[id].count = static_cast<long long>(s.args[3]->number);
     std::vector<Role> roles = branch_roles(s.control);

@@ -3,6 +3,7 @@
 // every block call expanded in place. Parents are sequential and parallel blocks and
 // control structures; leaves are drone actions and timed pauses.
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "diag/source.h"
@@ -26,18 +27,21 @@ enum class Role { none, then_, else_, wait, repeat, after, do_, done };
 const char* role_name(Role r);
 
 struct AmtNode {
+  // Ordered so that no field pads another: a large mission has a million nodes.
   int id = 0;
   AmtKind kind = AmtKind::seq;
   SourceLocation loc;      ///< the call site (or INIT's definition)
-  std::string name;        ///< block name, capability, or control structure name
   int parent = -1;
-  std::vector<int> children;
   Role role = Role::none;  ///< this node's role under a control parent
+  int drone = -1;          ///< action
+  lang::ControlKind control = lang::ControlKind::none;  ///< control
+  /// Block name, capability, or control structure name: a view into the Mission (or a
+  /// literal), which outlives its AMT.
+  std::string_view name;
+  std::vector<int> children;
   // action:
-  int drone = -1;
   std::vector<const lang::Expr*> args;
   // control:
-  lang::ControlKind control = lang::ControlKind::none;
   const lang::Expr* condition = nullptr;
   long long count = 0;     ///< RepeatFor
   double seconds = 0.0;    ///< PauseFor

@@ -111,14 +111,14 @@ std::string meg_node_label(const Compilation& c, const MegNode& n) {
   switch (n.kind) {
     case MegKind::init: return "INIT";
     case MegKind::end: return "end";
-    case MegKind::action: return c.drone_name(n.drone) + "." + n.name + "(" + args_text(n.args) + ")";
-    case MegKind::fork: return "fork " + n.name;
+    case MegKind::action: return c.drone_name(n.drone) + "." + std::string(n.name) + "(" + args_text(n.args) + ")";
+    case MegKind::fork: return "fork " + std::string(n.name);
     case MegKind::condition: {
-      std::string s = n.name + " " + lang::expr_text(*n.condition);
+      std::string s = std::string(n.name) + " " + lang::expr_text(*n.condition);
       if (n.control == lang::ControlKind::RepeatFor) s += " ×" + std::to_string(n.count);
       return s;
     }
-    case MegKind::terminal: return "T " + n.name;
+    case MegKind::terminal: return "T " + std::string(n.name);
     case MegKind::pause: {
       std::ostringstream s;
       s << "PauseFor(" << n.seconds << ")";
@@ -138,8 +138,8 @@ std::string amt_dot(const Compilation& c) {
       case AmtKind::seq: label = n.name; shape = "box"; break;
       case AmtKind::par: label = n.name; shape = "box3d"; break;
       case AmtKind::async: label = "async"; shape = "cds"; break;
-      case AmtKind::control: label = n.name + "\n" + lang::expr_text(*n.condition); shape = "diamond"; break;
-      case AmtKind::action: label = c.drone_name(n.drone) + "." + n.name + "(" + args_text(n.args) + ")"; shape = "ellipse"; break;
+      case AmtKind::control: label = std::string(n.name) + "\n" + lang::expr_text(*n.condition); shape = "diamond"; break;
+      case AmtKind::action: label = c.drone_name(n.drone) + "." + std::string(n.name) + "(" + args_text(n.args) + ")"; shape = "ellipse"; break;
       case AmtKind::pause: {
         std::ostringstream s;
         s << "PauseFor(" << n.seconds << ")";

@@ -37,8 +37,8 @@ using Ends = std::vector<Pending>;
 void collect_reads(const lang::Expr* e, std::vector<int>& order) {
   if (!e) return;
   if (e->kind == lang::ExprKind::property && e->drone_index >= 0) order.push_back(e->drone_index);
-  collect_reads(e->lhs.get(), order);
-  collect_reads(e->rhs.get(), order);
+  collect_reads(e->lhs, order);
+  collect_reads(e->rhs, order);
 }
 
 std::vector<int> unique_drones(const std::vector<int>& order) {
@@ -140,7 +140,7 @@ class MegBuilder {
     const AmtNode& body = amt_.nodes[n.children.at(0)];
     Ends body_ends = build(body, ends);
     int t = meg_.add_node(MegKind::terminal, n.loc, n.id);
-    meg_.nodes[t].name = "async " + body.name;
+    meg_.nodes[t].name = "async " + std::string(body.name);
     int owner = first_action_drone(body.id);
     meg_.nodes[t].drone = owner >= 0 ? owner : std::max(0, drone_of(ends));
     connect(body_ends, t);
@@ -197,7 +197,7 @@ class MegBuilder {
     node.drone = meg_.nodes[condition].drone;
     node.owner_condition = condition;
     node.role = role;
-    node.name = std::string(role_name(role)) + " " + n.name;
+    node.name = std::string(role_name(role)) + " " + std::string(n.name);
     meg_.nodes[condition].terminals.push_back(t);
     return t;
   }

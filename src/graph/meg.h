@@ -33,6 +33,11 @@ struct MegNode {
   std::vector<const lang::Expr*> args;
   // condition:
   lang::ControlKind control = lang::ControlKind::none;
+  /// The innermost Repeat or Do condition whose body (repeat branch with its terminal, or
+  /// do-branch) holds this node, -1 for none. The DEX numbers each run of a body (an epoch)
+  /// so that a trigger left over from an earlier, cancelled or finished run is ignored.
+  /// (Here, beside `control`, it fills what would be padding.)
+  int scope = -1;
   const lang::Expr* condition = nullptr;
   std::vector<int> reads;  ///< drones whose properties the condition/arguments read
   long long count = 0;     ///< RepeatFor's iteration limit
@@ -43,10 +48,6 @@ struct MegNode {
   Role role = Role::none;      ///< which branch it ends
   // pause:
   double seconds = 0.0;
-  /// The innermost Repeat or Do condition whose body (repeat branch with its terminal, or
-  /// do-branch) holds this node, -1 for none. The DEX numbers each run of a body (an epoch)
-  /// so that a trigger left over from an earlier, cancelled or finished run is ignored.
-  int scope = -1;
 };
 
 struct Meg {

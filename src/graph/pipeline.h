@@ -25,9 +25,6 @@ struct Compilation {
   Amt amt;
   Meg meg;
   std::vector<Mdg> mdgs;
-  /// With Keep::deployment_graphs, the mission's expressions, which the MEG points to,
-  /// once the statements that held them are freed.
-  std::vector<std::unique_ptr<lang::Expr>> expressions;
 
   int drone_count() const { return static_cast<int>(mission.drones.size()); }
   const std::string& drone_name(int d) const { return mission.drones[d].name; }
@@ -39,7 +36,9 @@ struct Compilation {
 /// lowers the peak memory of a compile by about a tenth.
 enum class Keep {
   all_graphs,
-  deployment_graphs,  ///< the AMT is emptied once the MEG is built, the statements once it is checked
+  /// The statements other than control structures are freed once the AMT is built, the AMT
+  /// once the MEG is built, the rest of the statements once the MEG is checked.
+  deployment_graphs,
 };
 
 /// Runs every stage on `source`; stops after the first stage that reported errors.

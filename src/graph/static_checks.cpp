@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <string_view>
 #include <tuple>
 
 namespace eamos::graph {
@@ -292,7 +293,7 @@ class LogicChecker {
   /// an action that comes before `c` in the graph's order cannot wait for `c`, so either no
   /// relevant action comes before it, or the last that does is the Land (Disarm) it stands
   /// after. It spares the pass over the graph for almost every condition of a large mission.
-  bool may_be_known(int drone, const std::string& prop, int c) const {
+  bool may_be_known(int drone, std::string_view prop, int c) const {
     bool armed = prop == "Armed";
     if (prop != "X" && prop != "Y" && prop != "Z" && prop != "Landed" && !armed) return false;
     const std::vector<int>& relevant = armed ? arming_[drone] : moving_[drone];
@@ -306,7 +307,7 @@ class LogicChecker {
     if (!e) return false;
     if (e->kind == ExprKind::property && e->drone_index >= 0 && may_be_known(e->drone_index, e->property, c))
       return true;
-    return any_may_be_known(e->lhs.get(), c) || any_may_be_known(e->rhs.get(), c);
+    return any_may_be_known(e->lhs, c) || any_may_be_known(e->rhs, c);
   }
 
   /// Nodes a Do may cancel: a wait among them can end by cancellation, never for ever.
@@ -368,13 +369,13 @@ class LogicChecker {
   /// actions can have started stands where the mission started it; one whose last such
   /// action is a Land (or, for Armed, a Disarm) that has ended before `c`, every other
   /// having ended before that, stands where it landed.
-  Fact fact(int drone, const std::string& prop, int c, Knowledge& k) {
+  Fact fact(int drone, std::string_view prop, int c, Knowledge& k) {
     const std::string& name = in_.mission.drones[drone].name;
     Fact f;
     if (prop.rfind("Sensor", 0) == 0) {
-      if (const fleet::SensorRange* r = in_.fleet.sensor_range(name, prop)) {
+      if (const fleet::SensorRange* r = in_.fleet.sensor_range(name, std::string(prop))) {
         f.value = interval(r->low, r->high);
-        f.why = name + "." + prop + "() reads " + metres(r->low) + " to " + metres(r->high) +
+        f.why = name + "." + std::string(prop) + "() reads " + metres(r->low) + " to " + metres(r->high) +
                 " (its range in the fleet file)";
       }
       return f;
@@ -388,7 +389,7 @@ class LogicChecker {
     return armed ? disarmed(drone, st.last) : landed(drone, prop, st.last);
   }
 
-  Fact standing_at_start(int drone, const std::string& prop) const {
+  Fact standing_at_start(int drone, std::string_view prop) const {
     const std::string& name = in_.mission.drones[drone].name;
     const fleet::Vec3& home = in_.settings[drone].home;
     auto ov = in_.fleet.overrides.find(name);
@@ -408,13 +409,13 @@ class LogicChecker {
     } else if (home_declared) {  // X, Y: only a declared home says where it stands
       double v = prop == "X" ? home.x : home.y;
       f.value = interval(v - kStandingSlack, v + kStandingSlack);
-      f.why = start + ", so " + name + "." + prop + "() stays within " + metres(kStandingSlack) +
+      f.why = start + ", so " + name + "." + std::string(prop) + "() stays within " + metres(kStandingSlack) +
               " m of its home " + (prop == "X" ? "x" : "y") + " = " + metres(v);
     }
     return f;
   }
 
-  Fact landed(int drone, const std::string& prop, int land) const {
+  Fact landed(int drone, std::string_view prop, int land) const {
     const std::string& name = in_.mission.drones[drone].name;
     const fleet::Vec3& home = in_.settings[drone].home;
     std::string done = name + " has landed by then on every path (" + action_text(land) +
@@ -647,17 +648,17 @@ class LogicChecker {
     return t >= 0 && t != go_value(meg_.nodes[w].control);
   }
 
-  static void collect_reads(const Expr* e, std::set<std::pair<int, std::string>>& out) {
+  static void collect_reads(const Expr* e, std::set<std::pair<int, std::string_view>>& out) {
     if (!e) return;
     if (e->kind == ExprKind::property && e->drone_index >= 0) out.insert({e->drone_index, e->property});
-    collect_reads(e->lhs.get(), out);
-    collect_reads(e->rhs.get(), out);
+    collect_reads(e->lhs, out);
+    collect_reads(e->rhs, out);
   }
 
   /// Actions that could change what `w` reads: motions for positions and Landed, motions
   /// and system actions for Armed (sensors and Battery change by themselves).
   std::vector<int> enablers(int w) const {
-    std::set<std::pair<int, std::string>> reads;
+    std::set<std::pair<int, std::string_view>> reads;
     collect_reads(meg_.nodes[w].condition, reads);
     std::vector<int> out;
     for (const auto& [d, prop] : reads) {

@@ -12,7 +12,7 @@ std::optional<double> literal(const Expr* e) {
   if (!e) return std::nullopt;
   if (e->kind == ExprKind::number) return e->number;
   if (e->kind == ExprKind::unary && e->op == Op::neg)
-    if (auto v = literal(e->lhs.get())) return -*v;
+    if (auto v = literal(e->lhs)) return -*v;
   return std::nullopt;
 }
 
@@ -45,7 +45,7 @@ class AltitudeCheck {
     bool takeoff = s.callee == "Takeoff" && s.args.size() == 1;
     bool fly_to = s.callee == "FlyTo" && s.args.size() == 3;
     if (!takeoff && !fly_to) return;
-    const Expr* arg = s.args.back().get();
+    const Expr* arg = s.args.back();
     std::optional<double> value = literal(arg);
     if (!value) return;
     const DroneDecl& drone = m_.drones[s.drone_index];
@@ -56,7 +56,7 @@ class AltitudeCheck {
     if (z > ground + ceiling + 1e-9) {
       std::string over = takeoff ? "takeoff altitude " + metres(*value) : "target z = " + metres(z);
       report(s, arg,
-             s.drone + "." + s.callee + ": " + over + " is above " + s.drone + "'s max_altitude of " +
+             std::string(s.drone) + "." + std::string(s.callee) + ": " + over + " is above " + std::string(s.drone) + "'s max_altitude of " +
                  metres(ceiling) + " over its home (z = " + metres(ground) + "), and the drone refuses it; " +
                  "fly at most " + metres(takeoff ? ceiling : ground + ceiling) + " or raise max_altitude in the fleet file",
              limit_location(fleet_, drone).at, "");
@@ -65,10 +65,10 @@ class AltitudeCheck {
     const fleet::Geofence* fence = bounds.fence;
     if (fence && fence->max_altitude_m && z > *fence->max_altitude_m + 1e-9)
       report(s, arg,
-             s.drone + "." + s.callee + ": target z = " + metres(z) + " is above the geofence's max_altitude of " +
+             std::string(s.drone) + "." + std::string(s.callee) + ": target z = " + metres(z) + " is above the geofence's max_altitude of " +
                  metres(*fence->max_altitude_m) + "; fly at most " + metres(*fence->max_altitude_m) +
                  " or raise the geofence's max_altitude in the fleet file",
-             fence->max_altitude_at, "the geofence of " + s.drone + " ends here");
+             fence->max_altitude_at, "the geofence of " + std::string(s.drone) + " ends here");
   }
 
   int settings_made() const { return settings_made_; }

@@ -310,16 +310,16 @@ void check_armed_before_motion(const Mission& mission, const std::vector<fleet::
   for (const Finding& f : merge_visits(visits)) {
     if (!f.some) continue;
     const Statement& st = *f.statement;
-    std::string call = st.drone + "." + st.callee;
-    std::string fix = "call " + st.drone + ".Arm() before " + st.callee;
+    std::string call = std::string(st.drone) + "." + std::string(st.callee);
+    std::string fix = "call " + std::string(st.drone) + ".Arm() before " + std::string(st.callee);
     if (f.always)
       diags.error(mission.file, st.loc,
-                  call + " runs while " + st.drone + " is disarmed on every path that reaches it, and a drone " +
+                  call + " runs while " + std::string(st.drone) + " is disarmed on every path that reaches it, and a drone " +
                       "refuses motion actions until it is armed; " + fix);
     else
       diags.warning(mission.file, st.loc,
-                    call + " may run while " + st.drone + " is disarmed: on some path that reaches it no " +
-                        st.drone + ".Arm() has run since the start or the last " + st.drone + ".Disarm(); " + fix +
+                    call + " may run while " + std::string(st.drone) + " is disarmed: on some path that reaches it no " +
+                        std::string(st.drone) + ".Arm() has run since the start or the last " + std::string(st.drone) + ".Disarm(); " + fix +
                         " on every path");
   }
 }

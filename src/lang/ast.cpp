@@ -27,6 +27,15 @@ const char* op_text(Op op) {
   return "";
 }
 
+Expr* ExprArena::make() {
+  if (used_ == kChunk) {
+    chunks_.push_back(std::make_unique<Expr[]>(kChunk));
+    used_ = 0;
+  }
+  ++size_;
+  return &chunks_.back()[used_++];
+}
+
 int Mission::find_drone(const std::string& name) const {
   for (std::size_t i = 0; i < drones.size(); ++i)
     if (drones[i].name == name) return static_cast<int>(i);
@@ -69,8 +78,8 @@ std::string text_of(const Expr& e, int parent_precedence) {
   switch (e.kind) {
     case ExprKind::number: return number_text(e.number);
     case ExprKind::boolean: return e.boolean ? "true" : "false";
-    case ExprKind::property: return e.drone + "." + e.property + "()";
-    case ExprKind::name: return e.drone;
+    case ExprKind::property: return std::string(e.drone) + "." + std::string(e.property) + "()";
+    case ExprKind::name: return std::string(e.drone);
     case ExprKind::unary: return std::string(op_text(e.op)) + text_of(*e.lhs, 6);
     case ExprKind::binary: {
       int p = precedence(e.op);

@@ -4,6 +4,7 @@
 // structs owned by a Mission; later stages point into it and never copy expressions.
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "diag/source.h"
@@ -11,7 +12,7 @@
 
 namespace eamos::lang {
 
-enum class ExprKind {
+enum class ExprKind : unsigned char {
   number,    ///< 3, 4.5
   boolean,   ///< true, false
   property,  ///< Drone1.X() — a property read of a declared drone
@@ -20,29 +21,44 @@ enum class ExprKind {
   binary,    ///< e op e
 };
 
-enum class Op { none, neg, not_, add, sub, mul, div, lt, le, gt, ge, eq, ne, and_, or_ };
+enum class Op : unsigned char { none, neg, not_, add, sub, mul, div, lt, le, gt, ge, eq, ne, and_, or_ };
 const char* op_text(Op op);
 
-enum class ValueType { unknown, number, boolean };
+enum class ValueType : unsigned char { unknown, number, boolean };
 
 struct Expr {
   ExprKind kind = ExprKind::number;
-  SourceLocation loc;
-  double number = 0.0;
+  Op op = Op::none;
+  ValueType type = ValueType::unknown;  ///< filled by the checker
   bool integer_literal = false;  ///< written without '.' or exponent
   bool boolean = false;
   /// How deep it nests: 1 for a value, one more for each operator and each pair of
   /// parentheses on its deepest path (the parser's limit, Parser::kMaxExpressionDepth).
-  /// Here, beside the bools, it fills padding: a large mission holds many expressions.
-  int levels = 1;
-  std::string drone;     ///< property: the drone; name: the identifier
-  std::string property;  ///< property: the property name
-  Op op = Op::none;
-  std::unique_ptr<Expr> lhs;  ///< unary operand or left operand
-  std::unique_ptr<Expr> rhs;
-  // Filled by the checker:
-  int drone_index = -1;  ///< property: index into Mission::drones
-  ValueType type = ValueType::unknown;
+  short levels = 1;
+  int drone_index = -1;  ///< property: index into Mission::drones, filled by the checker
+  SourceLocation loc;
+  double number = 0.0;
+  // Views into the mission's SourceFile, which outlives the Mission: a large mission holds
+  // over a million expressions, and a copy of each name would be a third of their memory.
+  std::string_view drone;     ///< property: the drone; name: the identifier
+  std::string_view property;  ///< property: the property name
+  Expr* lhs = nullptr;  ///< unary operand or left operand; owned by Mission::expressions
+  Expr* rhs = nullptr;
+};
+
+/// Owns a mission's expressions in chunks: one allocation per few thousand instead of one
+/// each (a million separate allocations cost their headers and scatter a tree over the heap).
+/// Addresses stay valid as it grows and when it is moved.
+class ExprArena {
+ public:
+  Expr* make();
+  std::size_t size() const { return size_; }
+
+ private:
+  static constexpr std::size_t kChunk = 4096;
+  std::vector<std::unique_ptr<Expr[]>> chunks_;
+  std::size_t used_ = kChunk;  ///< in the last chunk
+  std::size_t size_ = 0;
 };
 
 enum class StatementKind {
@@ -52,26 +68,27 @@ enum class StatementKind {
 };
 
 struct Statement {
+  // Ordered so that no field pads another: a large mission has a million statements.
   StatementKind kind = StatementKind::action;
-  SourceLocation loc;         ///< first token
-  SourceLocation callee_loc;  ///< the capability or function name
-  std::string drone;          ///< action only
-  std::string callee;         ///< capability name, or block / control structure name
-  std::vector<std::unique_ptr<Expr>> args;
   // Filled by the checker:
   int drone_index = -1;                      ///< action
   int function_index = -1;                   ///< call / async_call of a block
   ControlKind control = ControlKind::none;   ///< call of a control structure
-  std::vector<int> branch_functions;         ///< control: functions named in the args, in order
+  SourceLocation loc;         ///< first token
+  SourceLocation callee_loc;  ///< the capability or function name
+  std::string_view drone;     ///< action only; a view into the SourceFile, as Expr's names
+  std::string_view callee;    ///< capability name, or block / control structure name
+  std::vector<Expr*> args;    ///< owned by Mission::expressions
+  std::vector<int> branch_functions;         ///< control, filled by the checker: functions named in the args, in order
 };
 
 enum class BlockKind { seq, par };
 
 struct Function {
   std::string name;
+  std::vector<Statement> body;
   SourceLocation loc;  ///< the name after `func`
   BlockKind block = BlockKind::seq;  ///< INIT and SEQ_* run in sequence, PAR_* in parallel
-  std::vector<Statement> body;
   bool called = false;  ///< filled by the checker
 };
 
@@ -87,6 +104,7 @@ struct Mission {
   std::string package;
   std::vector<DroneDecl> drones;
   std::vector<Function> functions;
+  ExprArena expressions;  ///< every expression of the statements, which point into it
   int init_function = -1;  ///< index of INIT, filled by the checker
 
   int find_drone(const std::string& name) const;

@@ -5,7 +5,7 @@
 #include <set>
 #include <string>
 #include <string_view>
-#include <unordered_map>
+#include <functional>
 
 #include "lang/altitude.h"
 #include "lang/arming.h"
@@ -15,7 +15,7 @@
 
 namespace eamos::lang {
 
-bool is_block_name(const std::string& name) {
+bool is_block_name(std::string_view name) {
   return (name.rfind("SEQ_", 0) == 0 || name.rfind("PAR_", 0) == 0) && name.size() > 4;
 }
 
@@ -98,6 +98,65 @@ const char* control_meaning(ControlKind kind) {
 
 namespace {
 
+/// Name → index of the first entry of that name: open addressing in one array of slots,
+/// each with the name's hash and a view of it. A large mission resolves a million calls
+/// among half a million functions; a node-based map missed the cache about four times per
+/// look-up, this about twice (the slot, then the name it holds when the hashes agree).
+class NameIndex {
+ public:
+  /// Adds `name` as entry `index` unless the name is there; returns its first entry's index.
+  int insert(std::string_view name, int index) {
+    if ((count_ + 1) * 2 > slots_.size()) resize(slots_.empty() ? 16 : slots_.size() * 2);
+    std::size_t h = std::hash<std::string_view>{}(name);
+    for (std::size_t i = h & mask_;; i = (i + 1) & mask_) {
+      Slot& s = slots_[i];
+      if (s.index < 0) {
+        s = {h, name, index};
+        ++count_;
+        return index;
+      }
+      if (s.hash == h && s.name == name) return s.index;
+    }
+  }
+
+  int find(std::string_view name) const {
+    if (slots_.empty()) return -1;
+    std::size_t h = std::hash<std::string_view>{}(name);
+    for (std::size_t i = h & mask_;; i = (i + 1) & mask_) {
+      const Slot& s = slots_[i];
+      if (s.index < 0) return -1;
+      if (s.hash == h && s.name == name) return s.index;
+    }
+  }
+
+  void reserve(std::size_t n) {
+    std::size_t size = 16;
+    while (size < 2 * n) size *= 2;
+    if (size > slots_.size()) resize(size);
+  }
+
+ private:
+  struct Slot {
+    std::size_t hash = 0;
+    std::string_view name;
+    int index = -1;
+  };
+
+  /// `size` is a power of two: a slot is the hash's low bits.
+  void resize(std::size_t size) {
+    std::vector<Slot> old = std::move(slots_);
+    slots_.assign(size, Slot{});
+    mask_ = slots_.size() - 1;
+    count_ = 0;
+    for (const Slot& s : old)
+      if (s.index >= 0) insert(s.name, s.index);
+  }
+
+  std::vector<Slot> slots_;
+  std::size_t mask_ = 0;
+  std::size_t count_ = 0;
+};
+
 const char* type_name(ValueType t) {
   switch (t) {
     case ValueType::number: return "number";
@@ -123,7 +182,7 @@ class Checker {
   int resolve_block(const Expr& e);
   ValueType type_of(Expr& e);
   /// `what` and `whose` name the value in a message: "argument of" "FlyTo".
-  void expect_type(Expr& e, ValueType want, const char* what, const std::string& whose);
+  void expect_type(Expr& e, ValueType want, const char* what, std::string_view whose);
   void check_call_graph();
   void check_unused();
   void error(SourceLocation loc, const std::string& msg) { diags_.error(file_, loc, msg); }
@@ -131,8 +190,8 @@ class Checker {
   std::vector<std::string> function_names() const;
   std::vector<std::string> drone_names() const;
   void index_names();
-  int find_function(const std::string& name) const;
-  int find_drone(const std::string& name) const;
+  int find_function(std::string_view name) const;
+  int find_drone(std::string_view name) const;
 
   Mission& m_;
   const fleet::Fleet& fleet_;
@@ -142,8 +201,8 @@ class Checker {
   CheckedMission out_;
   // Name → index of the first function and drone of that name. A large mission names
   // thousands of blocks, and Mission::find_* would compare against every one per call.
-  std::unordered_map<std::string_view, int> function_index_;
-  std::unordered_map<std::string_view, int> drone_index_;
+  NameIndex function_index_;
+  NameIndex drone_index_;
   std::vector<int> first_function_;  ///< per function: the first function of its name
   /// Per function, the blocks it calls (check_call_graph fills it, check_unused reads it).
   std::vector<std::vector<std::pair<int, SourceLocation>>> calls_;
@@ -172,20 +231,13 @@ void Checker::index_names() {
   drone_index_.reserve(m_.drones.size());
   first_function_.reserve(m_.functions.size());
   for (std::size_t i = 0; i < m_.functions.size(); ++i)
-    first_function_.push_back(function_index_.emplace(m_.functions[i].name, static_cast<int>(i)).first->second);
-  for (std::size_t i = 0; i < m_.drones.size(); ++i)
-    drone_index_.emplace(m_.drones[i].name, static_cast<int>(i));
+    first_function_.push_back(function_index_.insert(m_.functions[i].name, static_cast<int>(i)));
+  for (std::size_t i = 0; i < m_.drones.size(); ++i) drone_index_.insert(m_.drones[i].name, static_cast<int>(i));
 }
 
-int Checker::find_function(const std::string& name) const {
-  auto it = function_index_.find(name);
-  return it == function_index_.end() ? -1 : it->second;
-}
+int Checker::find_function(std::string_view name) const { return function_index_.find(name); }
 
-int Checker::find_drone(const std::string& name) const {
-  auto it = drone_index_.find(name);
-  return it == drone_index_.end() ? -1 : it->second;
-}
+int Checker::find_drone(std::string_view name) const { return drone_index_.find(name); }
 
 std::vector<std::string> Checker::function_names() const {
   std::vector<std::string> names;
@@ -268,11 +320,11 @@ void Checker::check_statement(Function& f, Statement& s) {
       int fi = find_function(s.callee);
       if (fi < 0) {
         std::string near = closest_match(s.callee, function_names());
-        error(s.callee_loc, "undefined block '" + s.callee + "' in async(...)" +
-                                (near.empty() ? "; define it with `func " + s.callee + "() { ... }`"
+        error(s.callee_loc, "undefined block '" + std::string(s.callee) + "' in async(...)" +
+                                (near.empty() ? "; define it with `func " + std::string(s.callee) + "() { ... }`"
                                               : "; did you mean '" + near + "'?"));
       } else if (!is_block_name(s.callee)) {
-        error(s.callee_loc, "async(...) needs a SEQ_ or PAR_ block, not '" + s.callee + "'");
+        error(s.callee_loc, "async(...) needs a SEQ_ or PAR_ block, not '" + std::string(s.callee) + "'");
       } else {
         s.function_index = fi;
       }
@@ -285,8 +337,8 @@ void Checker::check_action(Statement& s) {
   s.drone_index = find_drone(s.drone);
   if (s.drone_index < 0) {
     std::string near = closest_match(s.drone, drone_names());
-    error(s.loc, "unknown drone '" + s.drone + "'" +
-                     (near.empty() ? "; declare it with `var " + s.drone + " DroneType`"
+    error(s.loc, "unknown drone '" + std::string(s.drone) + "'" +
+                     (near.empty() ? "; declare it with `var " + std::string(s.drone) + " DroneType`"
                                    : "; did you mean '" + near + "'?"));
     for (auto& a : s.args) type_of(*a);
     return;
@@ -296,14 +348,14 @@ void Checker::check_action(Statement& s) {
   if (!spec) {
     const fleet::PropertySpec* prop = type.find_property(s.callee);
     if (prop) {
-      error(s.callee_loc, "'" + s.drone + "." + s.callee +
+      error(s.callee_loc, "'" + std::string(s.drone) + "." + std::string(s.callee) +
                               "()' is a property, not an action; read it inside a condition or argument");
     } else {
       std::vector<std::string> actions;
       for (const auto& spec_ : type.actions) actions.push_back(spec_.name);
       std::string near = closest_match(s.callee, actions);
-      error(s.callee_loc, "drone '" + s.drone + "' of type '" + type.name + "' has no capability '" +
-                              s.callee + "'" +
+      error(s.callee_loc, "drone '" + std::string(s.drone) + "' of type '" + type.name + "' has no capability '" +
+                              std::string(s.callee) + "'" +
                               (near.empty() ? "; see `eamos check --list-capabilities`"
                                             : "; did you mean '" + near + "'?"));
     }
@@ -315,8 +367,8 @@ void Checker::check_action(Statement& s) {
     std::string accepted;
     for (std::size_t i = 0; i < spec->arities.size(); ++i)
       accepted += (i ? " or " : "") + std::to_string(spec->arities[i]);
-    error(s.callee_loc, s.callee + " takes " + accepted + " argument(s), " + std::to_string(n) +
-                            " given; write " + s.drone + "." + s.callee + "(" + spec->params + ")");
+    error(s.callee_loc, std::string(s.callee) + " takes " + accepted + " argument(s), " + std::to_string(n) +
+                            " given; write " + std::string(s.drone) + "." + std::string(s.callee) + "(" + spec->params + ")");
   }
   for (auto& a : s.args) expect_type(*a, ValueType::number, "argument of", s.callee);
 }
@@ -330,18 +382,18 @@ void Checker::check_block_call(Statement& s) {
     bool is_action = false;
     for (const auto& a : fleet::standard_actions()) is_action |= a.name == s.callee;
     if (find_drone(s.callee) >= 0)
-      error(s.callee_loc, "'" + s.callee + "' is a drone; call one of its actions, e.g. " +
-                              s.callee + ".Takeoff(5)");
+      error(s.callee_loc, "'" + std::string(s.callee) + "' is a drone; call one of its actions, e.g. " +
+                              std::string(s.callee) + ".Takeoff(5)");
     else if (is_action)
-      error(s.callee_loc, "'" + s.callee + "' is an action; call it on a drone, e.g. " +
+      error(s.callee_loc, "'" + std::string(s.callee) + "' is an action; call it on a drone, e.g. " +
                               (m_.drones.empty() ? std::string("Drone1") : m_.drones.front().name) + "." +
-                              s.callee + "(...)");
+                              std::string(s.callee) + "(...)");
     else if (near.empty() && !is_block_name(s.callee))
-      error(s.callee_loc, "undefined function '" + s.callee +
+      error(s.callee_loc, "undefined function '" + std::string(s.callee) +
                               "'; blocks are named SEQ_... or PAR_..., control structures are If, WaitUntil, RepeatWhile, …");
     else
-      error(s.callee_loc, "undefined function '" + s.callee + "'" +
-                              (near.empty() ? "; define it with `func " + s.callee + "() { ... }`"
+      error(s.callee_loc, "undefined function '" + std::string(s.callee) + "'" +
+                              (near.empty() ? "; define it with `func " + std::string(s.callee) + "() { ... }`"
                                             : "; did you mean '" + near + "'?"));
     return;
   }
@@ -350,7 +402,7 @@ void Checker::check_block_call(Statement& s) {
     return;
   }
   if (!s.args.empty())
-    error(s.args.front()->loc, "blocks take no arguments; write " + s.callee + "()");
+    error(s.args.front()->loc, "blocks take no arguments; write " + std::string(s.callee) + "()");
   s.function_index = fi;
 }
 
@@ -362,13 +414,13 @@ int Checker::resolve_block(const Expr& e) {
   int fi = find_function(e.drone);
   if (fi < 0) {
     std::string near = closest_match(e.drone, function_names());
-    error(e.loc, "undefined block '" + e.drone + "'" +
-                     (near.empty() ? "; define it with `func " + e.drone + "() { ... }`"
+    error(e.loc, "undefined block '" + std::string(e.drone) + "'" +
+                     (near.empty() ? "; define it with `func " + std::string(e.drone) + "() { ... }`"
                                    : "; did you mean '" + near + "'?"));
     return -1;
   }
   if (!is_block_name(e.drone)) {
-    error(e.loc, "'" + e.drone + "' cannot be a branch; branches are SEQ_ or PAR_ blocks");
+    error(e.loc, "'" + std::string(e.drone) + "' cannot be a branch; branches are SEQ_ or PAR_ blocks");
     return -1;
   }
   return fi;
@@ -414,19 +466,19 @@ ValueType Checker::type_of(Expr& e) {
     case ExprKind::boolean: return e.type = ValueType::boolean;
     case ExprKind::name: {
       std::string hint = find_drone(e.drone) >= 0
-                             ? "; read a property, e.g. " + e.drone + ".X()"
+                             ? "; read a property, e.g. " + std::string(e.drone) + ".X()"
                              : find_function(e.drone) >= 0
                                    ? "; a block cannot be used as a value"
                                    : "; property reads are written Drone.Property()";
-      error(e.loc, "unknown name '" + e.drone + "' in expression" + hint);
+      error(e.loc, "unknown name '" + std::string(e.drone) + "' in expression" + hint);
       return e.type = ValueType::unknown;
     }
     case ExprKind::property: {
       e.drone_index = find_drone(e.drone);
       if (e.drone_index < 0) {
         std::string near = closest_match(e.drone, drone_names());
-        error(e.loc, "unknown drone '" + e.drone + "'" +
-                         (near.empty() ? "; declare it with `var " + e.drone + " DroneType`"
+        error(e.loc, "unknown drone '" + std::string(e.drone) + "'" +
+                         (near.empty() ? "; declare it with `var " + std::string(e.drone) + " DroneType`"
                                        : "; did you mean '" + near + "'?"));
         return e.type = ValueType::unknown;
       }
@@ -437,11 +489,11 @@ ValueType Checker::type_of(Expr& e) {
         for (const auto& q : type.properties) props.push_back(q.name);
         std::string near = closest_match(e.property, props);
         if (type.find_action(e.property))
-          error(e.loc, "'" + e.property + "' is an action, not a property; conditions read properties such as " +
-                           e.drone + ".Landed() or " + e.drone + ".Z()");
+          error(e.loc, "'" + std::string(e.property) + "' is an action, not a property; conditions read properties such as " +
+                           std::string(e.drone) + ".Landed() or " + std::string(e.drone) + ".Z()");
         else
-          error(e.loc, "drone '" + e.drone + "' of type '" + type.name + "' has no property '" +
-                           e.property + "'" +
+          error(e.loc, "drone '" + std::string(e.drone) + "' of type '" + type.name + "' has no property '" +
+                           std::string(e.property) + "'" +
                            (near.empty() ? "; see `eamos check --list-capabilities`" : "; did you mean '" + near + "'?"));
         return e.type = ValueType::unknown;
       }
@@ -487,11 +539,11 @@ ValueType Checker::type_of(Expr& e) {
   return ValueType::unknown;
 }
 
-void Checker::expect_type(Expr& e, ValueType want, const char* what_text, const std::string& whose) {
+void Checker::expect_type(Expr& e, ValueType want, const char* what_text, std::string_view whose) {
   ValueType t = type_of(e);
   if (t == ValueType::unknown || t == want) return;
   // Built only here: a large mission checks hundreds of thousands of values.
-  std::string what = std::string(what_text) + " " + whose;
+  std::string what = std::string(what_text) + " " + std::string(whose);
   if (want == ValueType::boolean)
     error(e.loc, what + " must be boolean, found " + type_name(t) + " '" + expr_text(e) +
                      "'; compare it, e.g. '" + expr_text(e) + " > 0'");

@@ -31,7 +31,7 @@ CheckedMission check_mission(Mission& mission, const fleet::Fleet& fleet, Diagno
                              const CheckLimits& limits = {});
 
 /// True for names the language reserves for blocks.
-bool is_block_name(const std::string& name);
+bool is_block_name(std::string_view name);
 
 /// A control structure's signature as docs/language.md §8 writes it, e.g.
 /// "If(condition, SEQ_then, SEQ_else)"; "" for ControlKind::none.

@@ -68,7 +68,7 @@ class LoopTime {
   int branch(const Statement& s, std::size_t i) const {
     return i < s.branch_functions.size() ? s.branch_functions[i] : -1;
   }
-  const Expr* condition(const Statement& s) const { return s.args.empty() ? nullptr : s.args[0].get(); }
+  const Expr* condition(const Statement& s) const { return s.args.empty() ? nullptr : s.args[0]; }
 
   bool control_waits(const Statement& s) {
     int c = literal(condition(s));
@@ -112,11 +112,11 @@ class LoopTime {
     std::string line = " (line " + std::to_string(s.loc.line) + ")";
     if (s.kind == StatementKind::async_call)
       return "async(" + name_of(s.function_index) + ")" + line + " continues at once";
-    if (s.kind == StatementKind::action) return s.drone + "." + s.callee + line + " waits";
+    if (s.kind == StatementKind::action) return std::string(s.drone) + "." + std::string(s.callee) + line + " waits";
     if (s.control == ControlKind::none) {
-      if (block_waits(s.function_index)) return s.callee + "()" + line + " waits";
+      if (block_waits(s.function_index)) return std::string(s.callee) + "()" + line + " waits";
       bool empty = m_.functions[s.function_index].body.empty();
-      return s.callee + "()" + line + (empty ? " is empty" : " does not wait either");
+      return std::string(s.callee) + "()" + line + (empty ? " is empty" : " does not wait either");
     }
     std::string name = control_name(s.control);
     if (control_waits(s)) return name + line + " waits";

@@ -96,6 +96,7 @@ Mission Parser::parse() {
       skip_to_declaration();
     }
   }
+  m.expressions = std::move(arena_);
   return m;
 }
 
@@ -220,10 +221,10 @@ bool Parser::parse_statement(Statement& s) {
       skip_to_statement_end();
       return false;
     }
-    s.callee = std::string(tok_.text);
+    s.callee = tok_.text;
     advance();
     if (tok_.kind == TokenKind::lparen) {
-      error_here("async takes the block name without '()'; write `async(" + s.callee + ")`");
+      error_here("async takes the block name without '()'; write `async(" + std::string(s.callee) + ")`");
       skip_to_statement_end();
       return false;
     }
@@ -237,7 +238,7 @@ bool Parser::parse_statement(Statement& s) {
     skip_to_statement_end();
     return false;
   }
-  std::string first(tok_.text);
+  std::string_view first = tok_.text;
   SourceLocation first_loc = tok_.loc;
   advance();
   if (accept(TokenKind::dot)) {
@@ -245,11 +246,11 @@ bool Parser::parse_statement(Statement& s) {
     s.drone = first;
     s.callee_loc = tok_.loc;
     if (tok_.kind != TokenKind::identifier) {
-      error_here("expected capability name after '" + first + ".', found " + describe(tok_));
+      error_here("expected capability name after '" + std::string(first) + ".', found " + describe(tok_));
       skip_to_statement_end();
       return false;
     }
-    s.callee = std::string(tok_.text);
+    s.callee = tok_.text;
     advance();
   } else {
     s.kind = StatementKind::call;
@@ -257,8 +258,8 @@ bool Parser::parse_statement(Statement& s) {
     s.callee_loc = first_loc;
   }
   if (tok_.kind != TokenKind::lparen) {
-    std::string call = (s.kind == StatementKind::action ? s.drone + "." : std::string()) + s.callee + "()";
-    error_here("expected '(' after '" + s.callee + "', found " + describe(tok_) +
+    std::string call = (s.kind == StatementKind::action ? std::string(s.drone) + "." : std::string()) + std::string(s.callee) + "()";
+    error_here("expected '(' after '" + std::string(s.callee) + "', found " + describe(tok_) +
                "; calls are written " + call);
     skip_to_statement_end();
     return false;
@@ -269,7 +270,7 @@ bool Parser::parse_statement(Statement& s) {
 // args = [ expr { "," expr } [ "," ] ]   (within parentheses)
 // Returns false after a syntax error: the statement is dropped, so the checker does not
 // add a follow-on "wrong number of arguments" for an argument list that was cut short.
-bool Parser::parse_arguments(std::vector<std::unique_ptr<Expr>>& args) {
+bool Parser::parse_arguments(std::vector<Expr*>& args) {
   ++paren_depth_;
   advance();  // '('
   while (tok_.kind != TokenKind::rparen) {
@@ -279,7 +280,7 @@ bool Parser::parse_arguments(std::vector<std::unique_ptr<Expr>>& args) {
       skip_to_statement_end();
       return false;
     }
-    args.push_back(std::move(e));
+    args.push_back(e);
     if (tok_.kind == TokenKind::comma) {
       advance();
       continue;
@@ -340,7 +341,7 @@ bool Parser::within_depth(int levels, SourceLocation at) {
 }
 
 // expr = unary { binary-op unary }   — precedence climbing over Go's five levels
-std::unique_ptr<Expr> Parser::parse_expression(int min_precedence) {
+Expr* Parser::parse_expression(int min_precedence) {
   auto lhs = parse_unary();
   if (!lhs) return nullptr;
   for (;;) {
@@ -349,31 +350,31 @@ std::unique_ptr<Expr> Parser::parse_expression(int min_precedence) {
     if (p == 0 || p < min_precedence) return lhs;
     SourceLocation loc = tok_.loc;
     advance();
-    std::unique_ptr<Expr> rhs;
+    Expr* rhs = nullptr;
     {
       DepthGuard below(depth_);  // the operator is a level above its right operand
       rhs = parse_expression(p + 1);
     }
     if (!rhs) return nullptr;
-    auto bin = std::make_unique<Expr>();
+    auto bin = arena_.make();
     bin->kind = ExprKind::binary;
     bin->loc = loc;
     bin->op = op;
     bin->levels = 1 + std::max(lhs->levels, rhs->levels);
     if (!within_depth(bin->levels, loc)) return nullptr;
-    bin->lhs = std::move(lhs);
-    bin->rhs = std::move(rhs);
-    lhs = std::move(bin);
+    bin->lhs = lhs;
+    bin->rhs = rhs;
+    lhs = bin;
   }
 }
 
 // unary = ( "-" | "!" ) unary | primary
-std::unique_ptr<Expr> Parser::parse_unary() {
+Expr* Parser::parse_unary() {
   // Every operand starts here: a value at this point is one level below depth_. Checked
   // before recursing, so no input can exhaust the stack.
   if (!within_depth(1, tok_.loc)) return nullptr;
   if (tok_.kind == TokenKind::minus || tok_.kind == TokenKind::bang) {
-    auto e = std::make_unique<Expr>();
+    auto e = arena_.make();
     e->kind = ExprKind::unary;
     e->loc = tok_.loc;
     e->op = tok_.kind == TokenKind::minus ? Op::neg : Op::not_;
@@ -392,8 +393,8 @@ std::unique_ptr<Expr> Parser::parse_unary() {
 // primary = int | decimal | "true" | "false" | drone "." property "(" ")"
 //         | identifier | "(" expr ")"
 // long: one case per kind of primary expression, the grammar rule read top to bottom.
-std::unique_ptr<Expr> Parser::parse_primary() {
-  auto e = std::make_unique<Expr>();
+Expr* Parser::parse_primary() {
+  auto e = arena_.make();
   e->loc = tok_.loc;
   switch (tok_.kind) {
     case TokenKind::integer:
@@ -419,7 +420,7 @@ std::unique_ptr<Expr> Parser::parse_primary() {
     case TokenKind::lparen: {
       ++paren_depth_;
       advance();
-      std::unique_ptr<Expr> inner;
+      Expr* inner = nullptr;
       {
         DepthGuard below(depth_);  // parentheses are a level, as the limit is documented
         inner = parse_expression();
@@ -435,7 +436,7 @@ std::unique_ptr<Expr> Parser::parse_primary() {
       return inner;
     }
     case TokenKind::identifier: {
-      std::string name(tok_.text);
+      std::string_view name = tok_.text;
       advance();
       if (tok_.kind != TokenKind::dot) {
         e->kind = ExprKind::name;
@@ -444,21 +445,21 @@ std::unique_ptr<Expr> Parser::parse_primary() {
       }
       advance();
       if (tok_.kind != TokenKind::identifier) {
-        error_here("expected property name after '" + name + ".', found " + describe(tok_));
+        error_here("expected property name after '" + std::string(name) + ".', found " + describe(tok_));
         return nullptr;
       }
       e->kind = ExprKind::property;
       e->drone = name;
-      e->property = std::string(tok_.text);
+      e->property = tok_.text;
       advance();
       if (tok_.kind != TokenKind::lparen) {
-        error_here("expected '()' after property '" + name + "." + e->property +
-                   "'; properties are read as " + name + "." + e->property + "()");
+        error_here("expected '()' after property '" + std::string(name) + "." + std::string(e->property) +
+                   "'; properties are read as " + std::string(name) + "." + std::string(e->property) + "()");
         return nullptr;
       }
       advance();
       if (tok_.kind != TokenKind::rparen) {
-        error_here("property reads take no arguments; write " + name + "." + e->property + "()");
+        error_here("property reads take no arguments; write " + std::string(name) + "." + std::string(e->property) + "()");
         return nullptr;
       }
       advance();

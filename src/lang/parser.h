@@ -36,10 +36,10 @@ class Parser {
   void parse_function(Mission& m);
   void parse_block(Function& f);
   bool parse_statement(Statement& s);
-  bool parse_arguments(std::vector<std::unique_ptr<Expr>>& args);
-  std::unique_ptr<Expr> parse_expression(int min_precedence = 1);
-  std::unique_ptr<Expr> parse_unary();
-  std::unique_ptr<Expr> parse_primary();
+  bool parse_arguments(std::vector<Expr*>& args);
+  Expr* parse_expression(int min_precedence = 1);
+  Expr* parse_unary();
+  Expr* parse_primary();
   /// False, with the error at `at`, when `levels` more below the enclosing ones (depth_)
   /// pass kMaxExpressionDepth.
   bool within_depth(int levels, SourceLocation at);
@@ -51,6 +51,7 @@ class Parser {
   Token prev_;
   int depth_ = 0;  ///< expression levels enclosing the parse point (operators, parentheses)
   int paren_depth_ = 0;
+  ExprArena arena_;  ///< moved into the Mission at the end
 };
 
 }  // namespace eamos::lang

@@ -63,11 +63,28 @@ TEST(DeploymentCompile, FreesTheStatementsButWritesTheSameMissionFiles) {
                              graph::Keep::deployment_graphs))
       << diags.format();
   for (const lang::Function& f : lean.mission.functions) EXPECT_TRUE(f.body.empty()) << f.name;
-  EXPECT_FALSE(lean.expressions.empty());
+  EXPECT_GT(lean.mission.expressions.size(), 0u);  // the MEG points into them
   std::string hash = deploy::mission_hash(*full);
   ASSERT_EQ(deploy::mission_hash(lean), hash);
   for (int d = 0; d < full->drone_count(); ++d)
     EXPECT_EQ(deploy::mission_text(lean, d, hash), deploy::mission_text(*full, d, hash)) << full->drone_name(d);
+}
+
+// The trace header borrows the source's text for its dump: the AST's names are views into
+// that buffer, so it must come back the same bytes at the same address.
+TEST_F(Deployment, WritingTheTraceHeaderLeavesTheSourceWhereTheNamesPointInto) {
+  auto c = test::compile_mission(test::listing2_text(), test::kListing2Fleet);
+  ASSERT_TRUE(c);
+  const char* where = c->source->text.data();
+  std::string text = c->source->text;
+  Diagnostics diags;
+  ASSERT_TRUE(deploy::write_deployment(*c, dir_.string(), diags)) << diags.format();
+  EXPECT_EQ(c->source->text.data(), where);
+  EXPECT_EQ(c->source->text, text);
+  std::string header = test::read_text((dir_ / "trace-header.json").string());
+  EXPECT_EQ(json::parse(header)["source"], text);
+  std::string_view name = c->mission.drones.empty() ? std::string_view() : c->mission.functions.front().body.front().callee;
+  EXPECT_TRUE(name.data() >= where && name.data() < where + text.size()) << "names are views into the source";
 }
 
 TEST_F(Deployment, ReportsAnOutputFolderThatCannotBeCreated) {

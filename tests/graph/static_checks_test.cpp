@@ -109,5 +109,29 @@ TEST(StaticChecks, BudgetSpentMeansNothingIsReportedRatherThanAGuess) {
   EXPECT_EQ(quiet.error_count(), 0u) << quiet.format();
 }
 
+// `eamos compile` frees every statement but the control structures before it builds the MEG:
+// a finding still names the branch block, as a compile that keeps everything does.
+TEST(StaticChecks, AFindingNamesItsBranchBlockWhenOnlyTheControlStatementsAreKept) {
+  std::string text =
+      "var Drone1 Quad\nvar Drone2 Quad\n"
+      "func INIT() { Drone1.Arm(); Drone1.Takeoff(5); RepeatWhile(Drone2.Landed(), SEQ_photo, SEQ_after); "
+      "Drone1.Land(); Drone1.Disarm() }\n"
+      "func SEQ_photo() { Drone1.TakePicture(); PauseFor(1) }\n"
+      "func SEQ_after() { Drone2.Arm(); Drone2.Takeoff(5); Drone2.Land(); Drone2.Disarm() }\n";
+  std::string reports[2];
+  graph::Keep keeps[2] = {graph::Keep::all_graphs, graph::Keep::deployment_graphs};
+  for (int k = 0; k < 2; ++k) {
+    graph::Compilation c;
+    Diagnostics diags;
+    EXPECT_FALSE(graph::compile(std::make_shared<SourceFile>("m.eamos", text), fleet::Fleet{}, diags, c, {}, keeps[k]));
+    reports[k] = diags.format();
+    if (keeps[k] != graph::Keep::deployment_graphs) continue;
+    for (const lang::Function& f : c.mission.functions)
+      for (const lang::Statement& s : f.body) EXPECT_NE(s.control, lang::ControlKind::none) << f.name << " " << s.callee;
+  }
+  EXPECT_NE(reports[1].find("whatever its body SEQ_photo does"), std::string::npos) << reports[1];
+  EXPECT_EQ(reports[1], reports[0]);
+}
+
 }  // namespace
 }  // namespace eamos
