@@ -397,15 +397,20 @@ void SimDrone::fill_state(mid::DroneState& s) const {
   }
   s.pictures = pictures_;
   s.heading = heading_;
-  s.mode = mode_name();
+  write_mode(s.mode);
 }
 
-std::string SimDrone::mode_name() const {
+void SimDrone::write_mode(std::string& mode) const {
   // The simulator has no autopilot modes: its mode is what its motors do, and whether a
-  // failsafe took over.
+  // failsafe took over. Written into the string the state already holds: no new string per step.
   static const char* const kinds[] = {"idle", "hold", "go", "land", "orbit"};
-  std::string kind = kinds[static_cast<int>(motion_.kind)];
-  return failsafe_reason_.empty() ? kind : "failsafe " + kind;
+  const char* kind = kinds[static_cast<int>(motion_.kind)];
+  if (failsafe_reason_.empty()) {
+    mode.assign(kind);
+    return;
+  }
+  mode.assign("failsafe ");
+  mode.append(kind);
 }
 
 mid::SubscriptionId SimDrone::subscribe(mid::StateCallback fn) {

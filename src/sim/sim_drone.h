@@ -77,7 +77,7 @@ class SimDrone final : public mid::AdapterDrone {
   void post_publish();   ///< publish from the loop (for changes made inside API calls)
   void update_timers();  ///< steps while moving, idle telemetry while armed and still
   double sensor_value(int k) const;
-  std::string mode_name() const;
+  void write_mode(std::string& mode) const;  ///< the state's mode: what the motors do
   double ground_z() const { return settings_.home.z; }
   /// The fleet file's `gust:` pushes the drone now (in the air, within its time window).
   bool gust_blows() const;
