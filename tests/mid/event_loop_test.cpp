@@ -88,6 +88,26 @@ TEST(EventLoop, CancelledTimersDoNotPileUpInTheQueue) {
   EXPECT_EQ(loop.run_until_idle(), 1u);
 }
 
+// Cancelling so many timers from inside a callback that the queue compacts, while the
+// callbacks of that instant are half run, leaves the rest of the instant (and one scheduled
+// for it afterwards) to run in scheduling order.
+TEST(EventLoop, CompactingInTheMiddleOfAnInstantKeepsTheRestInOrder) {
+  EventLoop loop;
+  std::vector<TimerId> doomed;
+  for (int i = 0; i < 3000; ++i) doomed.push_back(loop.at(2.0 + i, [] { ADD_FAILURE() << "cancelled"; }));
+  std::vector<int> ran;
+  for (int i = 0; i < 10; ++i)
+    loop.at(1.0, [&, i] {
+      ran.push_back(i);
+      if (i == 4)
+        for (TimerId t : doomed) loop.cancel(t);
+      if (i == 5) loop.at(1.0, [&] { ran.push_back(10); });
+    });
+  EXPECT_EQ(loop.run_until_idle(), 11u);
+  EXPECT_EQ(ran, (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10}));
+  EXPECT_EQ(loop.queued(), 0u);
+}
+
 // The schedule a callback builds depends only on what ran before it, so two loops fed the
 // same program produce the same trace: the basis of deterministic simulated missions.
 TEST(EventLoop, EventLoopRunsSameScheduleIdentically) {
