@@ -83,8 +83,8 @@ bool EventLoop::cancel(TimerId id) {
 }
 
 void EventLoop::push(double t, Entry e) {
-  auto [at, added] = bucket_at_.try_emplace(t, 0);
-  if (added) {
+  auto at = bucket_at_.find(t);
+  if (at == bucket_at_.end()) {
     std::uint32_t b;
     if (free_buckets_.empty()) {
       b = static_cast<std::uint32_t>(buckets_.size());
@@ -94,11 +94,25 @@ void EventLoop::push(double t, Entry e) {
       free_buckets_.pop_back();
     }
     buckets_[b].time = t;
-    at->second = b;
+    at = add_time(t, b);
     heap_push(b);
   }
   buckets_[at->second].entries.push_back(e);
   ++queued_;
+}
+
+std::unordered_map<double, std::uint32_t>::iterator EventLoop::add_time(double t, std::uint32_t bucket) {
+  if (spare_times_.empty()) return bucket_at_.emplace(t, bucket).first;
+  auto node = std::move(spare_times_.back());
+  spare_times_.pop_back();
+  node.key() = t;
+  node.mapped() = bucket;
+  return bucket_at_.insert(std::move(node)).position;
+}
+
+void EventLoop::drop_time(double t) {
+  auto node = bucket_at_.extract(t);
+  if (!node.empty()) spare_times_.push_back(std::move(node));
 }
 
 const EventLoop::Entry& EventLoop::front() const {
@@ -111,7 +125,7 @@ void EventLoop::pop() {
   Bucket& b = buckets_[top];
   --queued_;
   if (++b.head < b.entries.size()) return;
-  bucket_at_.erase(b.time);
+  drop_time(b.time);
   b.entries.clear();  // its capacity is kept for the next time it is used
   b.head = 0;
   free_buckets_.push_back(top);
@@ -164,7 +178,7 @@ void EventLoop::compact() {
     b.head = 0;
     b.entries = std::move(kept);
     if (b.entries.empty()) {
-      bucket_at_.erase(b.time);
+      drop_time(b.time);
       free_buckets_.push_back(index);
       continue;
     }

@@ -145,6 +145,10 @@ class EventLoop {
   std::function<void()> take(std::uint32_t slot);
   /// Appends to the bucket of time `t`, making one when none is queued.
   void push(double t, Entry e);
+  /// bucket_at_[t] = bucket, in a map node kept from an earlier time when there is one: most
+  /// timeouts have an instant of their own, and a node allocated for each is a malloc per timer.
+  std::unordered_map<double, std::uint32_t>::iterator add_time(double t, std::uint32_t bucket);
+  void drop_time(double t);  ///< t's bucket left the queue: its node is kept for add_time
   /// The first entry due; the queue must not be empty.
   const Entry& front() const;
   double front_time() const { return buckets_[heap_.front()].time; }
@@ -182,6 +186,7 @@ class EventLoop {
   std::vector<Bucket> buckets_;
   std::vector<std::uint32_t> free_buckets_;
   std::unordered_map<double, std::uint32_t> bucket_at_;  ///< time → its bucket, while queued
+  std::vector<std::unordered_map<double, std::uint32_t>::node_type> spare_times_;
   std::vector<std::uint32_t> heap_;  ///< the queued buckets, earliest on top
   std::size_t queued_ = 0;           ///< entries in the buckets, cancelled ones included
   std::vector<Slot> slots_;
