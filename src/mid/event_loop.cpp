@@ -11,6 +11,8 @@
 namespace eamos::mid {
 
 namespace {
+constexpr std::size_t kKeptBucketEntries = 64;
+
 class SteadyWallClock final : public WallClock {
  public:
   double now_s() override {
@@ -126,7 +128,11 @@ void EventLoop::pop() {
   --queued_;
   if (++b.head < b.entries.size()) return;
   drop_time(b.time);
-  b.entries.clear();  // its capacity is kept for the next time it is used
+  // A small bucket keeps its capacity for the next time it is used; a large one (a fleet's
+  // steps) gives it back: every bucket keeping the largest it ever held would hold memory
+  // growing with the square of the fleet (timers in flight times drones stepping at once).
+  if (b.entries.capacity() > kKeptBucketEntries) std::vector<Entry>().swap(b.entries);
+  else b.entries.clear();
   b.head = 0;
   free_buckets_.push_back(top);
   heap_pop();

@@ -112,6 +112,12 @@ class EventLoop {
   /// Entries the queue holds, cancelled ones included (they leave it when due, or all at
   /// once when they outnumber the live ones): what the loop's memory grows with.
   std::size_t queued() const { return queued_; }
+  /// Entries the buckets have room for, used or not: the queue's memory beside queued().
+  std::size_t queue_room() const {
+    std::size_t room = 0;
+    for (const Bucket& b : buckets_) room += b.entries.capacity();
+    return room;
+  }
 
  private:
   struct Entry {

@@ -108,6 +108,22 @@ TEST(EventLoop, CompactingInTheMiddleOfAnInstantKeepsTheRestInOrder) {
   EXPECT_EQ(loop.queued(), 0u);
 }
 
+// A thousand drones stepping at the same instants fill one bucket each instant; a bucket used
+// for such an instant and then for a timeout of its own must not keep the thousand entries'
+// room, or the queue's memory grows with the drones times the timers.
+TEST(EventLoop, ABucketThatHeldAThousandTimersDoesNotKeepTheirRoom) {
+  EventLoop loop;
+  for (int round = 0; round < 50; ++round) {
+    for (int d = 0; d < 1000; ++d) loop.at(round + 1.0, [] {});
+    for (int i = 0; i < 20; ++i) loop.at(round + 1.0 + 0.001 * (i + 1), [] {});  // timeouts
+  }
+  std::size_t most_queued = 0;
+  loop.at(0.5, [&] { most_queued = loop.queued(); });
+  loop.run_until_idle();
+  EXPECT_EQ(most_queued, 51000u);
+  EXPECT_LT(loop.queue_room(), 5000u) << "the 50 instants of 1,000 steps each kept their room";
+}
+
 // The schedule a callback builds depends only on what ran before it, so two loops fed the
 // same program produce the same trace: the basis of deterministic simulated missions.
 TEST(EventLoop, EventLoopRunsSameScheduleIdentically) {
