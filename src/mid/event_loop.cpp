@@ -126,7 +126,15 @@ void EventLoop::pop() {
   const std::uint32_t top = heap_.front();
   Bucket& b = buckets_[top];
   --queued_;
-  if (++b.head < b.entries.size()) return;
+  if (++b.head < b.entries.size()) {
+    // An instant whose callbacks keep scheduling more at it (a cascade of zero-delay events)
+    // drops what it has run now and then, so its bucket holds what is still to run.
+    if (b.head >= 1024 && 2 * b.head >= b.entries.size()) {
+      b.entries.erase(b.entries.begin(), b.entries.begin() + static_cast<std::ptrdiff_t>(b.head));
+      b.head = 0;
+    }
+    return;
+  }
   drop_time(b.time);
   // A small bucket keeps its capacity for the next time it is used; a large one (a fleet's
   // steps) gives it back: every bucket keeping the largest it ever held would hold memory

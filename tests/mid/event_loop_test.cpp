@@ -124,6 +124,24 @@ TEST(EventLoop, ABucketThatHeldAThousandTimersDoesNotKeepTheirRoom) {
   EXPECT_LT(loop.queue_room(), 5000u) << "the 50 instants of 1,000 steps each kept their room";
 }
 
+// Two cascades of zero-delay callbacks, each callback scheduling the next of its cascade at
+// the same instant (so the instant never runs out of callbacks until both end): the queue
+// holds what is still to run, not the million callbacks the instant has run.
+TEST(EventLoop, AnInstantThatKeepsSchedulingItselfHoldsOnlyWhatIsStillToRun) {
+  EventLoop loop;
+  int left = 1000000;
+  std::size_t most_room = 0;
+  std::function<void()> next = [&] {
+    most_room = std::max(most_room, loop.queue_room());
+    if (--left > 0) loop.after(0.0, next);
+  };
+  loop.at(1.0, next);
+  loop.at(1.0, next);
+  loop.run_until_idle();
+  EXPECT_LE(left, 0);
+  EXPECT_LT(most_room, 10000u);
+}
+
 // The schedule a callback builds depends only on what ran before it, so two loops fed the
 // same program produce the same trace: the basis of deterministic simulated missions.
 TEST(EventLoop, EventLoopRunsSameScheduleIdentically) {
