@@ -153,8 +153,13 @@ class DdsNode {
 /// Notes: a second node in one process joins the domain the first created, and the first
 /// one's destruction ends the domain for both: tests destroy them in reverse order.
 
+/// Fleets up to this many drones keep Cyclone DDS's heartbeat of 100 ms on loopback; larger
+/// ones send it every 500 ms (dds_node.cpp, large_fleet_config).
+inline constexpr int kQuickHeartbeatFleet = 20;
+
 /// The Cyclone DDS XML for `options` (loopback, an interface, or the user's file), with
 /// the DDS Security plugins and `options.security_folder`'s credentials when it is set.
-bool dds_config(const DdsOptions& options, std::string& xml, std::string& error);
+/// `fleet`: the mission's drones (0: not known), which sets the loopback heartbeat.
+bool dds_config(const DdsOptions& options, std::string& xml, std::string& error, int fleet = 0);
 
 }  // namespace eamos::transport

@@ -6,9 +6,16 @@
 
 #include <chrono>
 #include <condition_variable>
+#include <cstring>
 #include <mutex>
 #include <stdexcept>
 #include <tuple>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include "transport/dds_node.h"
 
@@ -288,6 +295,64 @@ TEST(DdsNode, DropsASampleWhoseSenderIsNotTheDroneWhosePartitionItsWriterIsIn) {
   }
   drone1.reset();
   ground.reset();
+}
+
+
+// A member of Cyclone's discovery group on lo, at the port of `domain`'s participant
+// announcements (DDSI: 7400 + 250 * domain). -1 when the host refuses.
+int join_discovery_group_on_loopback(int domain) {
+  int fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return -1;
+  int one = 1;
+  setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+  sockaddr_in at{};
+  at.sin_family = AF_INET;
+  at.sin_port = htons(static_cast<std::uint16_t>(7400 + 250 * domain));
+  at.sin_addr.s_addr = htonl(INADDR_ANY);
+  ip_mreq group{};
+  inet_pton(AF_INET, "239.255.0.1", &group.imr_multiaddr);
+  inet_pton(AF_INET, "127.0.0.1", &group.imr_interface);
+  if (bind(fd, reinterpret_cast<sockaddr*>(&at), sizeof at) != 0 ||
+      setsockopt(fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &group, sizeof group) != 0) {
+    close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// Sent once to the group rather than to a port per possible peer: what lets a hundred
+// participants start on one host (docs/performance.md, "Many DEX processes on one host").
+TEST(DdsNode, OnLoopbackAnnouncesItselfOnceToTheMulticastGroup) {
+  const int domain = 45;
+  int fd = join_discovery_group_on_loopback(domain);
+  ASSERT_GE(fd, 0) << "cannot join 239.255.0.1 on lo: " << std::strerror(errno);
+  std::string error;
+  DdsOptions options;  // no interface, no file: the loopback configuration compiled in
+  options.domain = domain;
+  auto node = DdsNode::open(options, {}, error);
+  ASSERT_TRUE(node) << error;
+  pollfd p{fd, POLLIN, 0};
+  // Cyclone announces a participant as it creates it; the bound only ends a failing test.
+  ASSERT_EQ(poll(&p, 1, 20000), 1) << "no participant announcement on the multicast group";
+  char datagram[2048];
+  ssize_t n = recv(fd, datagram, sizeof datagram, 0);
+  close(fd);
+  ASSERT_GE(n, 20);
+  EXPECT_EQ(std::string(datagram, 4), "RTPS");
+}
+
+// Cyclone's 100 ms heartbeats were most of a 50-drone start's messages (docs/performance.md);
+// a small fleet keeps them, as its start would only be slower, and a user's file is untouched.
+TEST(DdsNode, OnLoopbackAFleetOfMoreThanTwentyDronesGetsASlowerHeartbeat) {
+  std::string xml, error;
+  DdsOptions options;
+  ASSERT_TRUE(dds_config(options, xml, error, kQuickHeartbeatFleet + 1)) << error;
+  EXPECT_NE(xml.find(">500ms</HeartbeatInterval>"), std::string::npos) << xml;
+  ASSERT_TRUE(dds_config(options, xml, error, kQuickHeartbeatFleet)) << error;
+  EXPECT_EQ(xml.find("HeartbeatInterval"), std::string::npos) << xml;
+  options.interface = "eth0";
+  ASSERT_TRUE(dds_config(options, xml, error, 100)) << error;
+  EXPECT_EQ(xml.find("HeartbeatInterval"), std::string::npos) << xml;
 }
 
 }  // namespace
