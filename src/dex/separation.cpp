@@ -114,6 +114,10 @@ Box Box::with(const Box& o) const {
   return {std::min(x0, o.x0), std::max(x1, o.x1), std::min(y0, o.y0), std::max(y1, o.y1)};
 }
 
+Box Box::within(const Box& o) const {
+  return {std::max(x0, o.x0), std::min(x1, o.x1), std::max(y0, o.y0), std::min(y1, o.y1)};
+}
+
 Box sweep(const Course& c, double horizon_s) { return Box::of(c.at(0.0), c.at(horizon_s)); }
 
 Prediction predict_courses(const Course& a, const Course& b, const fleet::Separation& min, double horizon_s) {
@@ -182,12 +186,18 @@ bool SeparationGuard::outranks(int a, int b) const {
   return rank(a) != rank(b) ? rank(a) < rank(b) : a < b;
 }
 
+std::optional<Vec> SeparationGuard::goal_of(int d) const {
+  const Track& k = tracks_[d];
+  if (!k.drone || k.drone->motion_held()) return std::nullopt;
+  const std::optional<fleet::Vec3> goal = k.drone->motion_goal();
+  if (!goal) return std::nullopt;
+  return Vec{goal->x, goal->y, goal->z};
+}
+
 Course SeparationGuard::course_of(int d) const {
   const Track& k = tracks_[d];
   const Vec here = now_at(k);
-  if (k.drone && !k.drone->motion_held())
-    if (std::optional<fleet::Vec3> goal = k.drone->motion_goal())
-      return goal_course(here, k.v, Vec{goal->x, goal->y, goal->z}, k.limits);
+  if (std::optional<Vec> goal = goal_of(d)) return goal_course(here, k.v, *goal, k.limits);
   return Course{.p = here, .v = k.v};
 }
 
@@ -354,11 +364,20 @@ SeparationGuard::Mine SeparationGuard::mine(int a) const {
   return m;
 }
 
-Box SeparationGuard::reach_box(int b) const {
+bool SeparationGuard::clear_of(const Box& box, int b) const {
   const Track& B = tracks_[b];
   double speed = B.speed_h;
   if (B.drone) speed = std::isfinite(B.max_speed) ? std::max(speed, B.max_speed) : HUGE_VAL;
-  return Box::around(now_at(B), speed * kSeparationHorizonS);
+  const Vec here = now_at(B);
+  const Box reach = Box::around(here, speed * kSeparationHorizonS);
+  // Most neighbours of a look are let go here, from the track alone, before their drone is asked.
+  if (box.apart(reach, min_.horizontal_m)) return true;
+  // Its course (course_of) runs from here towards its goal, stopping there, or straight on
+  // along its samples: a drone on its own row of a show stays on that row, although its
+  // speed limit alone would let it reach the neighbouring rows.
+  const std::optional<Vec> goal = goal_of(b);
+  const Box line = goal ? Box::of(here, *goal) : Box::of(here, here + B.v * kSeparationHorizonS);
+  return box.apart(reach.within(line), min_.horizontal_m);
 }
 
 // From drone a's side (this process flies it): does it give way to b? `mine`, when given, is
@@ -374,9 +393,7 @@ void SeparationGuard::consider(int a, int b, Mine* given) {
   if (!m.ready) m = mine(a);
   if (!m.moving) return;
   ++pairs_;
-  const Prediction p = m.box.apart(reach_box(b), min_.horizontal_m)
-                           ? Prediction{}
-                           : foresee(a, m.course, m.left, b, kSeparationHorizonS);
+  const Prediction p = clear_of(m.box, b) ? Prediction{} : foresee(a, m.course, m.left, b, kSeparationHorizonS);
   if (!p.conflict) {
     if (A.unheld_with == b) A.unheld_with = -1;
     return;

@@ -80,6 +80,7 @@ struct Box {
   static Box of(Vec a, Vec b);
   static Box around(Vec c, double r) { return {c.x - r, c.x + r, c.y - r, c.y + r}; }  ///< c ± r east and north
   Box with(const Box& o) const;  ///< both
+  Box within(const Box& o) const;  ///< what lies in both (two boxes holding the same course)
   /// Whether every point of one is at least `horizontal_m` (and a margin) east, west, north or
   /// south of every point of the other: no two points of them come within horizontal_m.
   /// The margin keeps a pair whose rounding could put it on the boundary: only pairs clearly
@@ -125,21 +126,23 @@ class SeparationGuard {
 
  private:
   struct Track {
+    // What every look reads of each neighbour comes first, in one or two cache lines: a look
+    // at a thousand-drone show visits some thirty neighbours.
     bool known = false;
     bool airborne = false;
+    int waits_for = -1;      ///< giving way to this drone; -1 none
     double t = 0.0;
     Vec p, v;
     double speed_h = 0.0;  ///< m/s, horizontally: |v|
+    mid::Drone* drone = nullptr;  ///< set for the drones this process flies
+    double max_speed = 0.0;  ///< m/s, horizontally: its limits
     Vec v_p;          ///< the position and time the velocity was last measured from
     double v_t = 0.0;
     long long cell = 0;
     bool in_grid = false;
     double checked_at = -1e300;
     // drones this process flies
-    mid::Drone* drone = nullptr;
-    double max_speed = 0.0;  ///< m/s, horizontally: its limits
     fleet::Limits limits;
-    int waits_for = -1;      ///< giving way to this drone; -1 none
     int unheld_with = -1;    ///< a conflict it could not hold for, recorded once
     int blocked_by = -1;     ///< held: the drone its course was last found blocked by
     double held_since = 0.0;
@@ -175,9 +178,13 @@ class SeparationGuard {
     Box box;
   };
   Mine mine(int a) const;
-  /// Where drone b can be within the horizon, whatever course it takes: a box around it as
-  /// wide as it flies at most (its samples' speed, or its speed limit when it has a goal).
-  Box reach_box(int b) const;
+  /// Whether drone b stays the minimum (and a margin) away from `box` on any course foresee()
+  /// predicts for it: it stays within a box around it as wide as it flies at most (its
+  /// samples' speed, or its speed limit when it has a goal), and on the line of its course
+  /// (to its goal, or straight on along its samples).
+  bool clear_of(const Box& box, int b) const;
+  /// The goal drone `d` flies to when this process flies it, has one and is not held.
+  std::optional<Vec> goal_of(int d) const;
   Prediction foresee(int a, const Course& mine, double left, int b, double horizon_s) const;
   void consider(int a, int b, Mine* mine = nullptr);
   void give_way(int a, int b, const Prediction& p);

@@ -11,6 +11,8 @@
 namespace eamos::mid {
 
 namespace {
+constexpr std::size_t kKeptBucketEntries = 64;
+
 class SteadyWallClock final : public WallClock {
  public:
   double now_s() override {
@@ -51,7 +53,7 @@ TimerId EventLoop::at(double t, std::function<void()> fn) {
   s.live = true;
   ++s.gen;  // a TimerId of the slot's earlier callback no longer names it
   ++live_;
-  push({t, next_seq_++, slot, s.gen});
+  push(t, {slot, s.gen});
   return (static_cast<TimerId>(s.gen) << 32) | (static_cast<TimerId>(slot) + 1);
 }
 
@@ -78,27 +80,91 @@ TimerId EventLoop::defer(std::function<void()> fn) {
 bool EventLoop::cancel(TimerId id) {
   if (id == kNoTimer || !live(slot_of(id), gen_of(id))) return false;
   take(slot_of(id));  // its heap entry stays and is skipped when popped: cancel is O(1)
-  if (heap_.size() > 2 * live_ + 1024) compact();
+  if (queued_ > 2 * live_ + 1024) compact();
   return true;
 }
 
-void EventLoop::push(const Entry& e) {
-  std::size_t i = heap_.size();
-  heap_.push_back(e);
-  while (i > 0) {
-    const std::size_t parent = (i - 1) / 4;
-    if (!e.before(heap_[parent])) break;
-    heap_[i] = heap_[parent];
-    i = parent;
+void EventLoop::push(double t, Entry e) {
+  auto at = bucket_at_.find(t);
+  if (at == bucket_at_.end()) {
+    std::uint32_t b;
+    if (free_buckets_.empty()) {
+      b = static_cast<std::uint32_t>(buckets_.size());
+      buckets_.emplace_back();
+    } else {
+      b = free_buckets_.back();
+      free_buckets_.pop_back();
+    }
+    buckets_[b].time = t;
+    at = add_time(t, b);
+    heap_push(b);
   }
-  heap_[i] = e;
+  buckets_[at->second].entries.push_back(e);
+  ++queued_;
+}
+
+std::unordered_map<double, std::uint32_t>::iterator EventLoop::add_time(double t, std::uint32_t bucket) {
+  if (spare_times_.empty()) return bucket_at_.emplace(t, bucket).first;
+  auto node = std::move(spare_times_.back());
+  spare_times_.pop_back();
+  node.key() = t;
+  node.mapped() = bucket;
+  return bucket_at_.insert(std::move(node)).position;
+}
+
+void EventLoop::drop_time(double t) {
+  auto node = bucket_at_.extract(t);
+  if (!node.empty()) spare_times_.push_back(std::move(node));
+}
+
+const EventLoop::Entry& EventLoop::front() const {
+  const Bucket& b = buckets_[heap_.front()];
+  return b.entries[b.head];
 }
 
 void EventLoop::pop() {
-  const Entry last = heap_.back();
+  const std::uint32_t top = heap_.front();
+  Bucket& b = buckets_[top];
+  --queued_;
+  if (++b.head < b.entries.size()) {
+    // An instant whose callbacks keep scheduling more at it (a cascade of zero-delay events)
+    // drops what it has run now and then, so its bucket holds what is still to run.
+    if (b.head >= 1024 && 2 * b.head >= b.entries.size()) {
+      b.entries.erase(b.entries.begin(), b.entries.begin() + static_cast<std::ptrdiff_t>(b.head));
+      b.head = 0;
+    }
+    return;
+  }
+  drop_time(b.time);
+  // A small bucket keeps its capacity for the next time it is used; a large one (a fleet's
+  // steps) gives it back: every bucket keeping the largest it ever held would hold memory
+  // growing with the square of the fleet (timers in flight times drones stepping at once).
+  if (b.entries.capacity() > kKeptBucketEntries) std::vector<Entry>().swap(b.entries);
+  else b.entries.clear();
+  b.head = 0;
+  free_buckets_.push_back(top);
+  heap_pop();
+}
+
+void EventLoop::heap_push(std::uint32_t bucket) {
+  const double t = buckets_[bucket].time;
+  std::size_t i = heap_.size();
+  heap_.push_back(bucket);
+  while (i > 0) {
+    const std::size_t parent = (i - 1) / 4;
+    if (!(t < buckets_[heap_[parent]].time)) break;
+    heap_[i] = heap_[parent];
+    i = parent;
+  }
+  heap_[i] = bucket;
+}
+
+void EventLoop::heap_pop() {
+  const std::uint32_t last = heap_.back();
   heap_.pop_back();
   const std::size_t n = heap_.size();
   if (n == 0) return;
+  const double t = buckets_[last].time;
   std::size_t i = 0;
   for (;;) {
     const std::size_t first = 4 * i + 1;
@@ -106,8 +172,8 @@ void EventLoop::pop() {
     std::size_t best = first;
     const std::size_t end = std::min(first + 4, n);
     for (std::size_t c = first + 1; c < end; ++c)
-      if (heap_[c].before(heap_[best])) best = c;
-    if (!heap_[best].before(last)) break;
+      if (buckets_[heap_[c]].time < buckets_[heap_[best]].time) best = c;
+    if (!(buckets_[heap_[best]].time < t)) break;
     heap_[i] = heap_[best];
     i = best;
   }
@@ -115,12 +181,24 @@ void EventLoop::pop() {
 }
 
 void EventLoop::compact() {
-  std::vector<Entry> kept;
-  kept.reserve(live_);
-  for (const Entry& e : heap_)
-    if (live(e.slot, e.gen)) kept.push_back(e);
+  std::vector<std::uint32_t> queued = std::move(heap_);
   heap_.clear();
-  for (const Entry& e : kept) push(e);
+  queued_ = 0;
+  for (std::uint32_t index : queued) {
+    Bucket& b = buckets_[index];
+    std::vector<Entry> kept;
+    for (std::size_t i = b.head; i < b.entries.size(); ++i)
+      if (live(b.entries[i].slot, b.entries[i].gen)) kept.push_back(b.entries[i]);
+    b.head = 0;
+    b.entries = std::move(kept);
+    if (b.entries.empty()) {
+      drop_time(b.time);
+      free_buckets_.push_back(index);
+      continue;
+    }
+    queued_ += b.entries.size();
+    heap_push(index);
+  }
 }
 
 std::size_t EventLoop::run_until_idle() {
@@ -147,21 +225,22 @@ std::size_t EventLoop::run(double limit, bool bounded) {
   running_ = true;
   while (!stop_requested_) {
     take_posted();
-    while (!heap_.empty() && !live(heap_.front().slot, heap_.front().gen)) pop();  // cancelled
+    while (!heap_.empty() && !live(front().slot, front().gen)) pop();  // cancelled
     // A real-time run bounded by `limit` waits for posted input until then, even when no
     // timer is due: that is how a DEX idles between messages.
-    if (heap_.empty() || (bounded && heap_.front().time > limit)) {
+    if (heap_.empty() || (bounded && front_time() > limit)) {
       if (bounded && real && !wait_for(limit)) continue;
       break;
     }
-    Entry next = heap_.front();
-    if (!wait_for(next.time)) continue;
-    if (real && stalled_before(next.time)) continue;  // the handler may have cancelled it
+    const Entry next = front();
+    const double next_time = front_time();
+    if (!wait_for(next_time)) continue;
+    if (real && stalled_before(next_time)) continue;  // the handler may have cancelled it
     pop();
     if (!live(next.slot, next.gen)) continue;
     // Take the callback out first: it may schedule or cancel timers, growing the slots.
     std::function<void()> fn = take(next.slot);
-    now_ = std::max(now_, next.time);  // after a stall, overdue callbacks run at its end
+    now_ = std::max(now_, next_time);  // after a stall, overdue callbacks run at its end
     run_callback(fn);
     ++ran;
     ++events_run_;

@@ -111,15 +111,28 @@ class EventLoop {
   std::uint64_t events_run() const { return events_run_; }
   /// Entries the queue holds, cancelled ones included (they leave it when due, or all at
   /// once when they outnumber the live ones): what the loop's memory grows with.
-  std::size_t queued() const { return heap_.size(); }
+  std::size_t queued() const { return queued_; }
+  /// Entries the buckets have room for, used or not: the queue's memory beside queued().
+  std::size_t queue_room() const {
+    std::size_t room = 0;
+    for (const Bucket& b : buckets_) room += b.entries.capacity();
+    return room;
+  }
 
  private:
   struct Entry {
-    double time;
-    std::uint64_t seq;  ///< insertion order: breaks ties between equal times
     std::uint32_t slot;
     std::uint32_t gen;
-    bool before(const Entry& o) const { return time != o.time ? time < o.time : seq < o.seq; }
+  };
+  /// Every entry due at one time, in scheduling order (appending keeps it: later calls come
+  /// later). Callbacks with equal times run in the order scheduled, so the queue is ordered
+  /// by time across buckets and by position within one: a fleet whose drones step at the
+  /// same instants (every drone that passed a barrier together) pops its steps from one
+  /// bucket each, not each from the top of a heap of thousands.
+  struct Bucket {
+    double time = 0.0;
+    std::vector<Entry> entries;
+    std::size_t head = 0;  ///< entries before it have been popped
   };
   /// Where a scheduled callback waits. A TimerId names its slot and the slot's generation, so
   /// scheduling, cancelling and running one index an array instead of a hash map (a 1,000-drone
@@ -136,10 +149,21 @@ class EventLoop {
   }
   /// Takes the callback out of its slot and frees the slot.
   std::function<void()> take(std::uint32_t slot);
-  /// The queue is a 4-ary min-heap on (time, seq): half the depth of a binary heap, and a
-  /// node's children share a cache line or two (a 1,000-drone run pops tens of millions).
-  void push(const Entry& e);
+  /// Appends to the bucket of time `t`, making one when none is queued.
+  void push(double t, Entry e);
+  /// bucket_at_[t] = bucket, in a map node kept from an earlier time when there is one: most
+  /// timeouts have an instant of their own, and a node allocated for each is a malloc per timer.
+  std::unordered_map<double, std::uint32_t>::iterator add_time(double t, std::uint32_t bucket);
+  void drop_time(double t);  ///< t's bucket left the queue: its node is kept for add_time
+  /// The first entry due; the queue must not be empty.
+  const Entry& front() const;
+  double front_time() const { return buckets_[heap_.front()].time; }
+  /// Removes front(); an emptied bucket leaves the heap.
   void pop();
+  /// The heap of buckets is a 4-ary min-heap on their times: half the depth of a binary heap,
+  /// and a node's children share a cache line.
+  void heap_push(std::uint32_t bucket);
+  void heap_pop();
   /// Drops cancelled entries once they outnumber the live ones, so a run that schedules and
   /// cancels timeouts for hours holds what is pending, not everything ever cancelled.
   void compact();
@@ -161,12 +185,16 @@ class EventLoop {
 
   ClockOptions options_;
   double now_ = 0.0;
-  std::uint64_t next_seq_ = 1;
   std::uint64_t events_run_ = 0;
   bool stop_requested_ = false;
   bool running_ = false;  ///< inside run(): the wall anchor is valid
-  /// Cancelled timers stay in the heap and are skipped when popped: cancel is O(1).
-  std::vector<Entry> heap_;
+  /// Cancelled timers stay in their bucket and are skipped when popped: cancel is O(1).
+  std::vector<Bucket> buckets_;
+  std::vector<std::uint32_t> free_buckets_;
+  std::unordered_map<double, std::uint32_t> bucket_at_;  ///< time → its bucket, while queued
+  std::vector<std::unordered_map<double, std::uint32_t>::node_type> spare_times_;
+  std::vector<std::uint32_t> heap_;  ///< the queued buckets, earliest on top
+  std::size_t queued_ = 0;           ///< entries in the buckets, cancelled ones included
   std::vector<Slot> slots_;
   std::vector<std::uint32_t> free_slots_;
   std::size_t live_ = 0;

@@ -40,6 +40,7 @@ SimDrone::SimDrone(fleet::DroneSettings settings, fleet::DroneType type, mid::Ev
     auto it = settings_.sensors.find(name);
     sensor_names_models_.push_back(it == settings_.sensors.end() ? nullptr : &it->second);
   }
+  published_.sensors = sensor_names_;
 }
 
 SimDrone::~SimDrone() {
@@ -376,6 +377,12 @@ double SimDrone::sensor_value(int k) const {
 
 mid::DroneState SimDrone::state() const {
   mid::DroneState s;
+  s.sensors = sensor_names_;  // the names copied in one go, in order: none is compared or built
+  fill_state(s);
+  return s;
+}
+
+void SimDrone::fill_state(mid::DroneState& s) const {
   s.t = loop_.now();
   s.x = kin_.position.x;
   s.y = kin_.position.y;
@@ -383,8 +390,6 @@ mid::DroneState SimDrone::state() const {
   s.battery = battery_.at(loop_.now());
   s.armed = armed_;
   s.landed = landed_;
-  // The names copied in one go, in order, then the readings: no name is compared or built.
-  s.sensors = sensor_names_;
   auto model = sensor_names_models_.begin();
   for (auto& reading : s.sensors) {
     const fleet::SensorModel* m = *model++;
@@ -392,16 +397,20 @@ mid::DroneState SimDrone::state() const {
   }
   s.pictures = pictures_;
   s.heading = heading_;
-  s.mode = mode_name();
-  return s;
+  write_mode(s.mode);
 }
 
-std::string SimDrone::mode_name() const {
+void SimDrone::write_mode(std::string& mode) const {
   // The simulator has no autopilot modes: its mode is what its motors do, and whether a
-  // failsafe took over.
+  // failsafe took over. Written into the string the state already holds: no new string per step.
   static const char* const kinds[] = {"idle", "hold", "go", "land", "orbit"};
-  std::string kind = kinds[static_cast<int>(motion_.kind)];
-  return failsafe_reason_.empty() ? kind : "failsafe " + kind;
+  const char* kind = kinds[static_cast<int>(motion_.kind)];
+  if (failsafe_reason_.empty()) {
+    mode.assign(kind);
+    return;
+  }
+  mode.assign("failsafe ");
+  mode.append(kind);
 }
 
 mid::SubscriptionId SimDrone::subscribe(mid::StateCallback fn) {
@@ -417,9 +426,17 @@ void SimDrone::unsubscribe(mid::SubscriptionId id) {
 
 void SimDrone::publish() {
   if (broker_.empty() && !watches_site()) return;
-  mid::DroneState s = state();
-  watch_site(s);
-  if (!broker_.empty()) broker_.publish(s);
+  if (publishing_) {
+    const mid::DroneState s = state();
+    watch_site(s);
+    if (!broker_.empty()) broker_.publish(s);
+    return;
+  }
+  publishing_ = true;
+  fill_state(published_);
+  watch_site(published_);
+  if (!broker_.empty()) broker_.publish(published_);
+  publishing_ = false;
 }
 
 void SimDrone::post_publish() {

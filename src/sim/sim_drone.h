@@ -72,10 +72,12 @@ class SimDrone final : public mid::AdapterDrone {
   void phase_changed();  ///< battery rate and depletion timer follow armed/landed
   void battery_empty();
   void publish();
+  /// Everything of a state but its sensors' names, which `s` already holds in order.
+  void fill_state(mid::DroneState& s) const;
   void post_publish();   ///< publish from the loop (for changes made inside API calls)
   void update_timers();  ///< steps while moving, idle telemetry while armed and still
   double sensor_value(int k) const;
-  std::string mode_name() const;
+  void write_mode(std::string& mode) const;  ///< the state's mode: what the motors do
   double ground_z() const { return settings_.home.z; }
   /// The fleet file's `gust:` pushes the drone now (in the air, within its time window).
   bool gust_blows() const;
@@ -87,6 +89,11 @@ class SimDrone final : public mid::AdapterDrone {
   std::vector<std::pair<std::string, const fleet::SensorModel*>> sensor_models_;
   mid::SensorValues sensor_names_;  ///< the same names, each reading 0: what a state starts from
   std::vector<const fleet::SensorModel*> sensor_names_models_;  ///< each of sensor_names_'s model
+  /// The state publish() hands its subscribers, refilled in place at every step: a state
+  /// built anew costs an allocation and a copy of every sensor's name (20 a second per
+  /// moving drone). A publish from inside a subscriber builds its own.
+  mid::DroneState published_;
+  bool publishing_ = false;
   SimOptions options_;
 
   mid::Kinematics kin_;

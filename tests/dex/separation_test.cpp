@@ -394,23 +394,59 @@ TEST(SeparationGuard, AnAbsurdSpeedLooksThroughTheOccupiedCellsOnly) {
 }
 
 
-// Drones on rows of a show, each flying along its own: a neighbour whose row is farther than
-// both can fly within the horizon is let go before its course is worked out. B flies east
-// 40 m north of A, both at 10 m/s (3 s: 30 m each way at most, still 10 m apart); C, 20 m
-// north, could come near, and is foreseen.
+// Drones on rows of a show, each flying along its own: a neighbour whose course stays on its
+// row, 20 m north of A's, is let go before its course is worked out (its speed alone, 10 m/s
+// over the 3 s horizon, could reach A's row). One crossing A's row well ahead of A, 20 m/s
+// east and 10 m/s south, could come near, and is foreseen (and is no conflict).
 TEST(SeparationGuard, ADroneOnARowFartherThanEitherCanFlyIsNotForeseen) {
-  for (double north : {40.0, 20.0}) {
+  for (bool crossing : {false, true}) {
     Guarded g(2);
     for (int i = 0; i <= 4; ++i) {
       const double t = 0.1 * i;
       g.at(t);
-      g.sample(1, t, 10.0 * t, north);
+      if (crossing) g.sample(1, t, 20.0 * t, 20.0 - 10.0 * t);
+      else g.sample(1, t, 10.0 * t, 20.0);
       g.sample(0, t, 10.0 * t);
     }
-    EXPECT_GE(g.guard->pairs_predicted(), 1u) << north;
-    const std::uint64_t foreseen = north == 40.0 ? 0u : g.guard->pairs_predicted();
-    EXPECT_EQ(g.guard->pairs_foreseen(), foreseen) << north;
+    EXPECT_GE(g.guard->pairs_predicted(), 1u) << crossing;
+    const std::uint64_t foreseen = crossing ? g.guard->pairs_predicted() : 0u;
+    EXPECT_EQ(g.guard->pairs_foreseen(), foreseen) << crossing;
     EXPECT_EQ(g.conflicts(), 0);
+  }
+}
+
+// Drones of a show flown here, each along its own row to a goal on it: a neighbour's course
+// stays on its row, so B's row 5 m north of A's is let go before B's course is worked out,
+// although B's speed limit alone (10 m/s over the 3 s horizon) would reach A's row. B flying
+// across towards A's row is foreseen.
+TEST(SeparationGuard, ANeighbourFlyingAlongItsOwnRowIsNotForeseen) {
+  for (double b_goal_north : {5.0, 0.0}) {
+    Guarded g(2);
+    fleet::DroneSettings s;
+    s.name = "B";
+    s.adapter = "sim";
+    s.home = {0.0, 5.0, 0.0};
+    std::unique_ptr<mid::Drone> b = g.adapters.create("sim", s, fleet::generic_multirotor("Quad"), g.loop).drone;
+    g.guard->fly(1, *b, fleet::Limits{});
+    std::vector<mid::Drone*> both{g.a.get(), b.get()};
+    for (int d = 0; d < 2; ++d) both[d]->subscribe([&g, d](const mid::DroneState& st) { g.guard->update(d, st); });
+    auto fly_both = [&](const mid::ActionRequest& ra, const mid::ActionRequest& rb) {
+      int done = 0;
+      g.a->start(ra, [&](const mid::ActionEnd&) { ++done; });
+      b->start(rb, [&](const mid::ActionEnd&) { ++done; });
+      while (done < 2 && g.loop.now() < 60.0) g.at(g.loop.now() + 0.05);
+    };
+    fly_both({"Arm", {}}, {"Arm", {}});
+    fly_both({"Takeoff", {5}}, {"Takeoff", {5}});
+    const std::uint64_t before = g.guard->pairs_foreseen();
+    g.a->start({"FlyTo", {100, 0, 5}}, [](const mid::ActionEnd&) {});
+    b->start({"FlyTo", {100, b_goal_north, 5}}, [](const mid::ActionEnd&) {});
+    g.at(g.loop.now() + 1.0);
+    EXPECT_GE(g.guard->pairs_predicted(), 5u) << b_goal_north;
+    if (b_goal_north == 5.0)
+      EXPECT_EQ(g.guard->pairs_foreseen(), before) << "B flies along its own row";
+    else
+      EXPECT_GT(g.guard->pairs_foreseen(), before) << "B flies towards A's row";
   }
 }
 

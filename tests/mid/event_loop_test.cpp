@@ -88,6 +88,60 @@ TEST(EventLoop, CancelledTimersDoNotPileUpInTheQueue) {
   EXPECT_EQ(loop.run_until_idle(), 1u);
 }
 
+// Cancelling so many timers from inside a callback that the queue compacts, while the
+// callbacks of that instant are half run, leaves the rest of the instant (and one scheduled
+// for it afterwards) to run in scheduling order.
+TEST(EventLoop, CompactingInTheMiddleOfAnInstantKeepsTheRestInOrder) {
+  EventLoop loop;
+  std::vector<TimerId> doomed;
+  for (int i = 0; i < 3000; ++i) doomed.push_back(loop.at(2.0 + i, [] { ADD_FAILURE() << "cancelled"; }));
+  std::vector<int> ran;
+  for (int i = 0; i < 10; ++i)
+    loop.at(1.0, [&, i] {
+      ran.push_back(i);
+      if (i == 4)
+        for (TimerId t : doomed) loop.cancel(t);
+      if (i == 5) loop.at(1.0, [&] { ran.push_back(10); });
+    });
+  EXPECT_EQ(loop.run_until_idle(), 11u);
+  EXPECT_EQ(ran, (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10}));
+  EXPECT_EQ(loop.queued(), 0u);
+}
+
+// A thousand drones stepping at the same instants fill one bucket each instant; a bucket used
+// for such an instant and then for a timeout of its own must not keep the thousand entries'
+// room, or the queue's memory grows with the drones times the timers.
+TEST(EventLoop, ABucketThatHeldAThousandTimersDoesNotKeepTheirRoom) {
+  EventLoop loop;
+  for (int round = 0; round < 50; ++round) {
+    for (int d = 0; d < 1000; ++d) loop.at(round + 1.0, [] {});
+    for (int i = 0; i < 20; ++i) loop.at(round + 1.0 + 0.001 * (i + 1), [] {});  // timeouts
+  }
+  std::size_t most_queued = 0;
+  loop.at(0.5, [&] { most_queued = loop.queued(); });
+  loop.run_until_idle();
+  EXPECT_EQ(most_queued, 51000u);
+  EXPECT_LT(loop.queue_room(), 5000u) << "the 50 instants of 1,000 steps each kept their room";
+}
+
+// Two cascades of zero-delay callbacks, each callback scheduling the next of its cascade at
+// the same instant (so the instant never runs out of callbacks until both end): the queue
+// holds what is still to run, not the million callbacks the instant has run.
+TEST(EventLoop, AnInstantThatKeepsSchedulingItselfHoldsOnlyWhatIsStillToRun) {
+  EventLoop loop;
+  int left = 1000000;
+  std::size_t most_room = 0;
+  std::function<void()> next = [&] {
+    most_room = std::max(most_room, loop.queue_room());
+    if (--left > 0) loop.after(0.0, next);
+  };
+  loop.at(1.0, next);
+  loop.at(1.0, next);
+  loop.run_until_idle();
+  EXPECT_LE(left, 0);
+  EXPECT_LT(most_room, 10000u);
+}
+
 // The schedule a callback builds depends only on what ran before it, so two loops fed the
 // same program produce the same trace: the basis of deterministic simulated missions.
 TEST(EventLoop, EventLoopRunsSameScheduleIdentically) {
