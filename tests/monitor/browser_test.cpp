@@ -303,10 +303,10 @@ TEST(MonitorBrowser, LiveTwentyDronesAreDrawnWithin100msOfEachEvent) {
 // a test that fails once in a while is no test (docs/performance.md has the runs). A miss while the
 // host's load average is above 4 a core skips the case (with the figures) instead of failing
 // it: other work then delays Chromium's processes, not the page's script; the other checks
-// hold regardless. Before, such a page fell seconds
-// behind: it laid out all 27,000 lines of the mission text on every frame, drew every track
-// again, and handled one WebSocket message per event; the lanes canvas was drawn whole on
-// every frame.
+// hold regardless. What keeps a thousand-drone page within it (docs/monitor.md): the mission
+// text laid out only in view, tracks kept as layers, the server's events batched into one
+// message per 8 ms, and the lanes canvas kept in columns of which a frame redraws only those
+// that changed.
 TEST(MonitorBrowser, LiveThousandDronesAreDrawnWithin200msOfEachEvent) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
   fs::path dir = fs::temp_directory_path() / ("eamos-monitor-live1000-" + std::to_string(getpid()));
