@@ -13,6 +13,19 @@ namespace eamos::mid {
 namespace {
 constexpr std::size_t kKeptBucketEntries = 64;
 
+/// An index freed earlier when there is one, else a new element's at the end of `items`:
+/// slots and buckets are reused so the loop allocates only when more are in use than ever.
+template <class T>
+std::uint32_t reuse_or_append(std::vector<T>& items, std::vector<std::uint32_t>& freed) {
+  if (freed.empty()) {
+    items.emplace_back();
+    return static_cast<std::uint32_t>(items.size() - 1);
+  }
+  const std::uint32_t index = freed.back();
+  freed.pop_back();
+  return index;
+}
+
 class SteadyWallClock final : public WallClock {
  public:
   double now_s() override {
@@ -40,14 +53,7 @@ EventLoop::EventLoop(ClockOptions options) : options_(options) {
 TimerId EventLoop::at(double t, std::function<void()> fn) {
   if (!std::isfinite(t)) return kNoTimer;
   if (t < now_) t = now_;
-  std::uint32_t slot;
-  if (free_slots_.empty()) {
-    slot = static_cast<std::uint32_t>(slots_.size());
-    slots_.emplace_back();
-  } else {
-    slot = free_slots_.back();
-    free_slots_.pop_back();
-  }
+  const std::uint32_t slot = reuse_or_append(slots_, free_slots_);
   Slot& s = slots_[slot];
   s.fn = std::move(fn);
   s.live = true;
@@ -87,14 +93,7 @@ bool EventLoop::cancel(TimerId id) {
 void EventLoop::push(double t, Entry e) {
   auto at = bucket_at_.find(t);
   if (at == bucket_at_.end()) {
-    std::uint32_t b;
-    if (free_buckets_.empty()) {
-      b = static_cast<std::uint32_t>(buckets_.size());
-      buckets_.emplace_back();
-    } else {
-      b = free_buckets_.back();
-      free_buckets_.pop_back();
-    }
+    const std::uint32_t b = reuse_or_append(buckets_, free_buckets_);
     buckets_[b].time = t;
     at = add_time(t, b);
     heap_push(b);
