@@ -426,17 +426,16 @@ void SimDrone::unsubscribe(mid::SubscriptionId id) {
 
 void SimDrone::publish() {
   if (broker_.empty() && !watches_site()) return;
-  if (publishing_) {
-    const mid::DroneState s = state();
-    watch_site(s);
-    if (!broker_.empty()) broker_.publish(s);
-    return;
-  }
+  if (publishing_) return hand_out(state());  // from inside a subscriber: published_ is in use
   publishing_ = true;
   fill_state(published_);
-  watch_site(published_);
-  if (!broker_.empty()) broker_.publish(published_);
+  hand_out(published_);
   publishing_ = false;
+}
+
+void SimDrone::hand_out(const mid::DroneState& s) {
+  watch_site(s);
+  if (!broker_.empty()) broker_.publish(s);
 }
 
 void SimDrone::post_publish() {

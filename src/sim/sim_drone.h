@@ -72,6 +72,7 @@ class SimDrone final : public mid::AdapterDrone {
   void phase_changed();  ///< battery rate and depletion timer follow armed/landed
   void battery_empty();
   void publish();
+  void hand_out(const mid::DroneState& s);  ///< to the site-limits watch and the subscribers
   /// Everything of a state but its sensors' names, which `s` already holds in order.
   void fill_state(mid::DroneState& s) const;
   void post_publish();   ///< publish from the loop (for changes made inside API calls)
