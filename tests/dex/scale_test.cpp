@@ -170,8 +170,11 @@ TEST(Scale, FiveHundredDronesMissionsHoldTheFleetsNamesAndSetsOnce) {
   for (const dex::Mission& m : missions) {
     ASSERT_TRUE(m.fleet.same_as(missions[0].fleet)) << m.fleet[m.self];
     ASSERT_EQ(m.drone_sets.size(), missions[0].drone_sets.size());
-    for (std::size_t s = 0; s < m.drone_sets.size(); ++s)
-      if (m.drone_sets[s] == missions[0].drone_sets[s]) EXPECT_TRUE(m.drone_sets[s].same_as(missions[0].drone_sets[s]));
+    for (std::size_t s = 0; s < m.drone_sets.size(); ++s) {
+      if (m.drone_sets[s] == missions[0].drone_sets[s]) {
+        EXPECT_TRUE(m.drone_sets[s].same_as(missions[0].drone_sets[s]));
+      }
+    }
   }
   EXPECT_LT(per_drone, 20u * 1024) << "bytes held per drone";
 }
