@@ -5,6 +5,7 @@
 # Layout under the prefix (GNUInstallDirs):
 #   bin/eamos                                  the command
 #   libexec/eamos/eamos-fly                    its commands that fly or serve (run, launch, dex, ...)
+#   libexec/eamos/eamos-credentials            a compile's last step: the DDS Security credentials
 #   include/eamos/<component>/*.h              public headers, included as "dex/runner.h"
 #   lib/libeamos_*.a, lib/cmake/eamos/         the libraries and the package (eamos::dex, ...)
 #   lib/systemd/system/eamos-dex@.service      the DEX as a service (docs/deploy.md)
@@ -66,8 +67,9 @@ add_library(eamos::version ALIAS eamos_version)
 get_property(exported GLOBAL PROPERTY EAMOS_EXPORTED_TARGETS)
 
 install(TARGETS eamos RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
-# The commands that fly or serve, which `eamos` hands over to (src/cli/CMakeLists.txt).
-install(TARGETS eamos-fly RUNTIME DESTINATION ${CMAKE_INSTALL_LIBEXECDIR}/eamos COMPONENT runtime)
+# The commands that fly or serve, and a compile's credentials, which `eamos` hands over to
+# (src/cli/CMakeLists.txt, src/security/CMakeLists.txt).
+install(TARGETS eamos-fly eamos-credentials RUNTIME DESTINATION ${CMAKE_INSTALL_LIBEXECDIR}/eamos COMPONENT runtime)
 install(TARGETS ${exported} eamos_version EXPORT eamosTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev
         INCLUDES DESTINATION ${EAMOS_INCLUDE_DIR})

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include "cli/arguments.h"
 #include "diag/report.h"
@@ -15,7 +16,7 @@
 #include "deploy/synthesize.h"
 #include "graph/export.h"
 #include "graph/pipeline.h"
-#include "security/mission_keys.h"
+#include "security/mission_keys.h"  // remove_mission_keys only: no OpenSSL in `eamos`
 #include "stress/generator.h"
 
 namespace eamos::cli {
@@ -137,26 +138,6 @@ std::vector<std::string> drone_names(const graph::Compilation& c) {
   return drones;
 }
 
-bool make_credentials(const std::vector<std::string>& drones, const std::string& dir, const std::string& hash,
-                      const SecurityOptions& security) {
-  security::MissionKeysRequest r{dir, hash, drones, security.keys_dir, security.valid_days};
-  std::vector<std::string> notes;
-  std::string error;
-  if (!security::write_mission_keys(r, notes, error)) {
-    std::cerr << error_prefix() << "cannot make the mission's DDS Security credentials: " << error << "\n";
-    return false;
-  }
-  for (const std::string& n : notes) std::cout << n << "\n";
-  return true;
-}
-
-bool write_security(const graph::Compilation& c, const std::string& dir, const std::string& hash,
-                    const SecurityOptions& security) {
-  if (!security.insecure) return make_credentials(drone_names(c), dir, hash, security);
-  security::remove_mission_keys(dir, drone_names(c));
-  return true;
-}
-
 /// The deployment files and, with --package, each drone's package: everything that needs the
 /// compiled graphs.
 bool write_compiled_files(const graph::Compilation& c, const std::string& out_dir, const std::string& hash,
@@ -178,7 +159,7 @@ bool write_compiled_files(const graph::Compilation& c, const std::string& out_di
 }
 
 int cmd_compile(const CommonOptions& o, const std::string& out_dir, const SecurityOptions& security,
-                const deploy::PackageOptions* package) {
+                const deploy::PackageOptions* package, CompileFinisher finish) {
   if (security.insecure) warn_insecure("compile");
   // An option that cannot be packaged is refused before anything is written.
   if (package) {
@@ -189,23 +170,26 @@ int cmd_compile(const CommonOptions& o, const std::string& out_dir, const Securi
   }
   auto c = std::make_unique<graph::Compilation>();
   if (!compile_and_report(o, *c, graph::Keep::deployment_graphs)) return 1;
-  std::string hash = deploy::mission_hash(*c);
-  if (!write_compiled_files(*c, out_dir, hash, security, package)) return 1;
-  std::vector<std::string> drones = drone_names(*c);
-  std::size_t meg_nodes = c->meg.nodes.size();
+  CompileEnding end{out_dir, deploy::mission_hash(*c), drone_names(*c), security, ""};
+  if (!write_compiled_files(*c, out_dir, end.hash, security, package)) return 1;
+  std::ostringstream done;
+  done << "compiled " << o.mission << " → " << out_dir << "/ (" << count_of(end.drones.size(), "drone") << ", "
+       << count_of(c->meg.nodes.size(), "MEG node") << ")\n";
+  if (package)
+    done << "packaged each drone's DEX as a systemd service: " << out_dir << "/<drone>/DEPLOY.txt says what to "
+         << "copy where" << (package->interface.empty() ? "; set EAMOS_DDS_INTERFACE in each dex.env" : "")
+         << " (docs/deploy.md)\n";
+  end.done = done.str();
   // The credentials need only the hash and the drones' names. With the graphs freed first and
   // their pages handed back to the kernel (malloc_trim), the compile's peak memory is the larger
-  // of the two, not their sum: OpenSSL touches about 2.6 MB of its own pages.
+  // of the two, not their sum.
   c.reset();
   malloc_trim(0);
-  if (!security.insecure && !make_credentials(drones, out_dir, hash, security)) return 1;
-  std::cout << "compiled " << o.mission << " → " << out_dir << "/ (" << count_of(drones.size(), "drone")
-            << ", " << count_of(meg_nodes, "MEG node") << ")\n";
-  if (package)
-    std::cout << "packaged each drone's DEX as a systemd service: " << out_dir << "/<drone>/DEPLOY.txt says what to "
-              << "copy where" << (package->interface.empty() ? "; set EAMOS_DDS_INTERFACE in each dex.env" : "")
-              << " (docs/deploy.md)\n";
-  return 0;
+  if (security.insecure) {
+    std::cout << end.done;
+    return 0;
+  }
+  return finish(end);
 }
 
 bool render_svg(const std::string& dot, std::string& svg, std::string& error) {

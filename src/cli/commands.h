@@ -37,9 +37,23 @@ struct SecurityOptions {
 };
 
 int cmd_check(const CommonOptions& o, bool list_capabilities);
+/// What a compile has left to do once its mission files are written and its graphs freed.
+struct CompileEnding {
+  std::string out_dir;
+  std::string hash;                 ///< the mission hash
+  std::vector<std::string> drones;  ///< by index
+  SecurityOptions security;
+  std::string done;                 ///< the lines to print once everything is written
+};
+/// Makes the credentials of `end` and prints `end.done`; the exit status. `eamos` replaces
+/// itself with eamos-credentials for it (main.cpp): libcrypto is then never mapped beside the
+/// compile's data. eamos-fly makes them in-process (`finish_in_process`).
+using CompileFinisher = int (*)(const CompileEnding& end);
+int finish_in_process(const CompileEnding& end);
 /// With `package`: also each drone's service files (deploy/drone_package.h, docs/deploy.md).
 int cmd_compile(const CommonOptions& o, const std::string& out_dir, const SecurityOptions& security,
-                const deploy::PackageOptions* package = nullptr);
+                const deploy::PackageOptions* package, CompileFinisher finish);
+std::vector<std::string> drone_names(const graph::Compilation& c);
 /// Writes (or, insecure, removes) the credentials of the deployment in `dir`; false with
 /// the error printed.
 bool write_security(const graph::Compilation& c, const std::string& dir, const std::string& hash,

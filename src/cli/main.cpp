@@ -13,6 +13,7 @@
 #include "cli/arguments.h"
 #include "cli/commands.h"
 #include "lsp/server.h"
+#include "security/mission_keys.h"
 #include "version.h"
 
 namespace {
@@ -396,24 +397,46 @@ bool outputs_usable(const Commands& c, const std::vector<std::string>& args, con
 }
 
 #ifdef EAMOS_FLY_ELSEWHERE
-/// eamos-fly: next to this program (the build tree, or both in bin/), else in
-/// ../libexec/eamos/ (the install tree and the Debian package).
-std::string fly_program() {
+/// A helper program (eamos-fly, eamos-credentials): next to this program (the build tree, or
+/// all in bin/), else in ../libexec/eamos/ (the install tree and the Debian package).
+std::string helper_program(const char* name) {
   namespace fs = std::filesystem;
   std::error_code ec;
   fs::path self = fs::read_symlink("/proc/self/exe", ec);
   // Never a path relative to the working directory: that would run whatever lies there.
-  if (ec || !self.is_absolute()) return "/proc/self/exe/../eamos-fly";
-  fs::path beside = self.parent_path() / "eamos-fly";
+  if (ec || !self.is_absolute()) return std::string("/proc/self/exe/../") + name;
+  fs::path beside = self.parent_path() / name;
   if (fs::exists(beside, ec)) return beside.string();
-  return (self.parent_path().parent_path() / "libexec" / "eamos" / "eamos-fly").string();
+  return (self.parent_path().parent_path() / "libexec" / "eamos" / name).string();
 }
 
-/// The commands that fly or serve (run, verify, launch, dex, sim-vehicle, monitor) live in
-/// eamos-fly, which links Cyclone DDS, civetweb and the MAVLink stack. This `eamos` links none
-/// of them, so check, compile and the other commands start without loading them
-/// (docs/performance.md); a flying command replaces it with eamos-fly: the same pid, terminal
-/// and arguments.
+std::string fly_program() { return helper_program("eamos-fly"); }
+
+/// The compile's last step: this process becomes eamos-credentials (the same pid, so a
+/// caller waits for, and measures, one process), which makes the credentials and prints
+/// `end.done`. `eamos` itself never maps libcrypto.
+int exec_credentials(const eamos::cli::CompileEnding& end) {
+  std::string program = helper_program("eamos-credentials");
+  std::string days = std::to_string(end.security.valid_days);
+  const char* color = eamos::cli::output_style().color_stderr ? "always" : "never";
+  std::vector<const char*> argv = {program.c_str(), "--deploy-dir", end.out_dir.c_str(), "--mission-hash",
+                                   end.hash.c_str(), "--valid-days", days.c_str(), "--color", color,
+                                   "--done", end.done.c_str()};
+  if (!end.security.keys_dir.empty()) argv.insert(argv.end(), {"--keys", end.security.keys_dir.c_str()});
+  argv.push_back("--");
+  for (const std::string& d : end.drones) argv.push_back(d.c_str());
+  argv.push_back(nullptr);
+  std::cout.flush();
+  std::fflush(nullptr);
+  ::execv(program.c_str(), const_cast<char* const*>(argv.data()));
+  int why = errno;
+  // No other compilation's credentials may stay beside these mission files.
+  eamos::security::remove_mission_keys(end.out_dir, end.drones);
+  std::cerr << eamos::cli::error_prefix() << "cannot start " << program << " to make the DDS Security credentials: "
+            << std::strerror(why) << "; the installation is incomplete (reinstall eamos)\n";
+  return 1;
+}
+
 int fly(const Commands&, Options&, char** argv) {
   std::string program = fly_program();
   argv[0] = program.data();
@@ -422,6 +445,7 @@ int fly(const Commands&, Options&, char** argv) {
             << "; the installation is incomplete (reinstall eamos)\n";
   return 1;
 }
+constexpr eamos::cli::CompileFinisher kFinishCompile = exec_credentials;
 #else
 int fly(const Commands& c, Options& o, char**) {
   if (*c.run && o.distributed) {
@@ -437,12 +461,14 @@ int fly(const Commands& c, Options& o, char**) {
   if (*c.monitor) return eamos::cli::cmd_monitor(o.monitor);
   return 1;
 }
+constexpr eamos::cli::CompileFinisher kFinishCompile = eamos::cli::finish_in_process;
 #endif
 
 /// Runs the command the line chose; its exit status.
 int dispatch(const Commands& c, Options& o, char** argv) {
   if (*c.check) return eamos::cli::cmd_check(o.common, o.list_caps);
-  if (*c.compile) return eamos::cli::cmd_compile(o.common, o.out_dir, o.security, o.packaged ? &o.package : nullptr);
+  if (*c.compile)
+    return eamos::cli::cmd_compile(o.common, o.out_dir, o.security, o.packaged ? &o.package : nullptr, kFinishCompile);
   if (*c.graph) return eamos::cli::cmd_graph(o.common, o.kind, o.drone, o.format, o.graph_out);
   if (*c.stats) return eamos::cli::cmd_stats(o.common, o.stats_out);
   if (*c.gen) return eamos::cli::cmd_gen_stress(o.shape, o.nodes, o.drones, o.work_per_step, o.seed, o.gen_out);

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -113,17 +114,28 @@ bool keys_dir_authorities(const MissionKeysRequest& r, const Validity& v, Author
   return true;
 }
 
-/// One participant's folder: the public CA certificates and governance, its identity,
-/// its private key and its permissions.
-bool write_participant(const MissionKeysRequest& r, const Authorities& cas, const std::string& governance,
-                       const Validity& v, int who, const fs::path& folder, std::string& error) {
+/// What every participant's folder holds the same of, encoded once.
+struct SharedFiles {
+  std::string identity_ca, permissions_ca, governance;
+};
+
+/// `folder` made (or kept) readable by its owner only.
+bool make_private_folder(const fs::path& folder, std::string& error) {
+  // The drone's folder exists (write_deployment made it): one mkdir, no walk up the path.
+  if (::mkdir(folder.c_str(), 0700) == 0 || (errno == EEXIST && ::chmod(folder.c_str(), 0700) == 0)) return true;
   std::error_code ec;
   fs::create_directories(folder, ec);
   fs::permissions(folder, fs::perms::owner_all, ec);
-  if (ec) {
-    error = "cannot create '" + folder.string() + "': " + ec.message();
-    return false;
-  }
+  if (!ec) return true;
+  error = "cannot create '" + folder.string() + "': " + ec.message();
+  return false;
+}
+
+/// One participant's folder: the public CA certificates and governance, its identity,
+/// its private key and its permissions.
+bool write_participant(const MissionKeysRequest& r, const Authorities& cas, const SharedFiles& shared,
+                       const Validity& v, int who, const fs::path& folder, std::string& error) {
+  if (!make_private_folder(folder, error)) return false;
   std::string name = who == transport::kGroundParticipant ? std::string("ground") : r.drones[who];
   // No ',', '/', '|' or '=' in the values: DDS Security's access control splits subjects there.
   std::string subject = "CN=" + name + ",O=eamos-mission-" + r.mission_hash.substr(0, 16);
@@ -133,9 +145,9 @@ bool write_participant(const MissionKeysRequest& r, const Authorities& cas, cons
   std::string doc = permissions_xml(subject, r.mission_hash, who, xml_date(v.now - 3600),
                                     xml_date(v.now + static_cast<std::time_t>(v.days) * 86400));
   if (!smime_sign(cas.permissions, doc, permissions, error)) return false;
-  return write_file(folder / "identity_ca.pem", cert_pem(cas.identity.cert.get()), false, error) &&
-         write_file(folder / "permissions_ca.pem", cert_pem(cas.permissions.cert.get()), false, error) &&
-         write_file(folder / "governance.p7s", governance, false, error) &&
+  return write_file(folder / "identity_ca.pem", shared.identity_ca, false, error) &&
+         write_file(folder / "permissions_ca.pem", shared.permissions_ca, false, error) &&
+         write_file(folder / "governance.p7s", shared.governance, false, error) &&
          write_file(folder / "identity.pem", cert_pem(id.cert.get()), false, error) &&
          write_file(folder / "identity_key.pem", key_pem(id.key.get()), true, error) &&
          write_file(folder / "permissions.p7s", permissions, false, error);
@@ -155,20 +167,13 @@ bool write_mission_keys(const MissionKeysRequest& r, std::vector<std::string>& n
   } else if (!keys_dir_authorities(r, v, cas, notes, error)) {
     return false;
   }
-  std::string governance;
-  if (!smime_sign(cas.permissions, governance_xml(), governance, error)) return false;
+  SharedFiles shared{cert_pem(cas.identity.cert.get()), cert_pem(cas.permissions.cert.get()), ""};
+  if (!smime_sign(cas.permissions, governance_xml(), shared.governance, error)) return false;
   fs::path dir(r.deploy_dir);
   for (int d = 0; d < static_cast<int>(r.drones.size()); ++d)
-    if (!write_participant(r, cas, governance, v, d, dir / r.drones[d] / kSecuritySubfolder, error)) return false;
-  return write_participant(r, cas, governance, v, transport::kGroundParticipant,
-                           dir / kGroundFolder / kSecuritySubfolder, error);
-}
-
-void remove_mission_keys(const std::string& deploy_dir, const std::vector<std::string>& drones) {
-  std::error_code ec;
-  fs::path dir(deploy_dir);
-  for (const std::string& d : drones) fs::remove_all(dir / d / kSecuritySubfolder, ec);
-  fs::remove_all(dir / kGroundFolder, ec);
+    if (!write_participant(r, cas, shared, v, d, dir / r.drones[d] / kSecuritySubfolder, error)) return false;
+  return write_participant(r, cas, shared, v, transport::kGroundParticipant, dir / kGroundFolder / kSecuritySubfolder,
+                           error);
 }
 
 }  // namespace eamos::security

@@ -169,9 +169,12 @@ bool read_credential(const std::string& cert_text, const std::string& key_text, 
 }
 
 bool smime_sign(const Credential& signer, const std::string& text, std::string& out, std::string& error) {
-  // As `openssl smime -sign -text`: detached (multipart/signed), the content a text/plain
-  // MIME part, the signer's certificate included; streamed, so the content is read once.
-  const int flags = PKCS7_DETACHED | PKCS7_TEXT | PKCS7_STREAM;
+  // As `openssl smime -sign -text -nosmimecap`: detached (multipart/signed), the content a
+  // text/plain MIME part, the signer's certificate included; streamed, so the content is read
+  // once. No S/MIME capabilities attribute: it tells a mail client which ciphers to encrypt a
+  // reply with, which DDS Security never reads, and listing them looks up every cipher
+  // OpenSSL knows for each document signed.
+  const int flags = PKCS7_DETACHED | PKCS7_TEXT | PKCS7_STREAM | PKCS7_NOSMIMECAP;
   Bio in(BIO_new_mem_buf(text.data(), static_cast<int>(text.size())));
   PKCS7* p7 = PKCS7_sign(signer.cert.get(), signer.key.get(), nullptr, in.get(), flags);
   if (!p7) return failed(error, "cannot sign");
