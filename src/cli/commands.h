@@ -48,7 +48,10 @@ struct CompileEnding {
 /// Makes the credentials of `end` and prints `end.done`; the exit status. `eamos` replaces
 /// itself with eamos-credentials for it (main.cpp): libcrypto is then never mapped beside the
 /// compile's data. eamos-fly makes them in-process (`finish_in_process`).
-using CompileFinisher = int (*)(const CompileEnding& end);
+struct CompileFinisher {
+  int (*run)(const CompileEnding& end);
+  bool replaces_process;  ///< exec: the compile's memory goes with the process image
+};
 int finish_in_process(const CompileEnding& end);
 /// With `package`: also each drone's service files (deploy/drone_package.h, docs/deploy.md).
 int cmd_compile(const CommonOptions& o, const std::string& out_dir, const SecurityOptions& security,

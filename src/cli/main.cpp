@@ -445,7 +445,7 @@ int fly(const Commands&, Options&, char** argv) {
             << "; the installation is incomplete (reinstall eamos)\n";
   return 1;
 }
-constexpr eamos::cli::CompileFinisher kFinishCompile = exec_credentials;
+constexpr eamos::cli::CompileFinisher kFinishCompile{exec_credentials, true};
 #else
 int fly(const Commands& c, Options& o, char**) {
   if (*c.run && o.distributed) {
@@ -461,7 +461,7 @@ int fly(const Commands& c, Options& o, char**) {
   if (*c.monitor) return eamos::cli::cmd_monitor(o.monitor);
   return 1;
 }
-constexpr eamos::cli::CompileFinisher kFinishCompile = eamos::cli::finish_in_process;
+constexpr eamos::cli::CompileFinisher kFinishCompile{eamos::cli::finish_in_process, false};
 #endif
 
 /// Runs the command the line chose; its exit status.

@@ -79,6 +79,11 @@ TEST_F(DebianPackage, UnpackedCommandFliesAnInstalledExample) {
                            "usr/share/bash-completion/completions/eamos", "usr/share/zsh/vendor-completions/_eamos"})
     EXPECT_TRUE(fs::exists(root / file) || fs::exists(root / fs::path(file).replace_extension())) << file;
   EXPECT_TRUE(fs::exists(root / "usr/libexec/eamos/eamos-fly")) << "`eamos run` above ran it";
+  fs::path deploy = dir_ / "deploy";
+  eamos_test::Shell compile = sh(shell_quote(eamos) + " compile -q " + shell_quote((examples / "listing2.eamos").string()) +
+                                 " -o " + shell_quote(deploy.string()));
+  EXPECT_EQ(compile.status, 0) << compile.out;
+  EXPECT_TRUE(fs::exists(deploy / "Drone1/security/identity_key.pem")) << "made by usr/libexec/eamos/eamos-credentials";
   EXPECT_FALSE(fs::exists(root / "usr/include")) << "headers belong to eamos-dev";
 }
 

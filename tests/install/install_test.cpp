@@ -97,6 +97,13 @@ TEST_F(Install, ExamplesUnitConfigurationAndCompletionsAreInstalled) {
   eamos_test::Shell check = sh(shell_quote((prefix_ / "bin/eamos").string()) + " check -q " +
                                shell_quote((share / "eamos/examples/listing2.eamos").string()));
   EXPECT_EQ(check.status, 0) << check.out;
+  // The compile's credentials come from libexec/eamos/eamos-credentials, installed beside eamos-fly.
+  eamos_test::Shell compile = sh(shell_quote((prefix_ / "bin/eamos").string()) + " compile -q " +
+                                 shell_quote((share / "eamos/examples/listing2.eamos").string()) + " -o " +
+                                 shell_quote((dir_ / "deploy").string()));
+  EXPECT_EQ(compile.status, 0) << compile.out;
+  EXPECT_TRUE(fs::exists(prefix_ / "libexec/eamos/eamos-credentials"));
+  EXPECT_TRUE(fs::exists(dir_ / "deploy/ground-station/security/permissions.p7s"));
   EXPECT_TRUE(fs::exists(share / "eamos/examples/listing2-right.yaml"));
   EXPECT_EQ(eamos_test::read_file(prefix_ / "lib/systemd/system/eamos-dex@.service"),
             eamos_test::read_file(std::string(EAMOS_SOURCE_DIR) + "/config/eamos-dex@.service"));
