@@ -141,6 +141,24 @@ TEST(CompileCommand, ACompileWithoutEamosCredentialsInstalledSaysSoAndLeavesNoCr
   fs::remove_all(dir);
 }
 
+TEST(CompileCommand, ABadKeysFolderIsReportedThroughTheHandOverWithExitOne) {
+  // eamos-credentials reads the CAs; its errors are the compile's, in the compile's words.
+  fs::path dir = fs::temp_directory_path() / ("eamos-bad-keys-" + std::to_string(::getpid()));
+  fs::create_directories(dir / "keys");
+  std::fclose(std::fopen((dir / "keys" / "identity_ca.pem").c_str(), "w"));
+  std::string mission = std::string(EAMOS_SOURCE_DIR) + "/examples/listing2.eamos";
+  eamos_test::Output r = eamos_test::run_eamos("compile -q " + mission + " -o " + (dir / "out").string() +
+                                               " --keys " + (dir / "keys").string());
+  fs::remove_all(dir);
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("eamos: error: cannot make the mission's DDS Security credentials: --keys " +
+                       (dir / "keys").string() + " lacks identity_ca_key.pem, permissions_ca.pem, "
+                       "permissions_ca_key.pem"),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("compiled "), std::string::npos) << r.out;
+}
+
 TEST(CompileCommand, AFlyingCommandWithoutEamosFlyInstalledSaysSoAndFailsCleanly) {
   fs::path dir = fs::temp_directory_path() / ("eamos-alone-" + std::to_string(::getpid()));
   fs::create_directories(dir / "bin");
