@@ -37,7 +37,7 @@ struct SecurityOptions {
 };
 
 int cmd_check(const CommonOptions& o, bool list_capabilities);
-/// What a compile has left to do once its mission files are written and its graphs freed.
+/// What a compile has left to do once its mission files are written.
 struct CompileEnding {
   std::string out_dir;
   std::string hash;                 ///< the mission hash

@@ -437,6 +437,11 @@ int exec_credentials(const eamos::cli::CompileEnding& end) {
   return 1;
 }
 
+/// The commands that fly or serve (run, verify, launch, dex, sim-vehicle, monitor) live in
+/// eamos-fly, which links Cyclone DDS, civetweb and the MAVLink stack. This `eamos` links none
+/// of them, so check, compile and the other commands start without loading them
+/// (docs/performance.md); a flying command replaces it with eamos-fly: the same pid, terminal
+/// and arguments.
 int fly(const Commands&, Options&, char** argv) {
   std::string program = fly_program();
   argv[0] = program.data();

@@ -1,5 +1,5 @@
 // eamos-credentials: the last step of `eamos compile`, which replaces itself with this program
-// (exec) once the mission files are written and the graphs freed. The credentials need only
+// (exec) once the mission files are written. The credentials need only
 // the mission hash and the drones' names; made here, OpenSSL's libcrypto is never mapped
 // beside the compile's data, so the command's peak memory is the larger of the two steps, not
 // their sum (docs/performance.md). Not meant to be run by hand: the arguments are checked as
