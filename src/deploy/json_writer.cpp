@@ -36,16 +36,19 @@ std::size_t utf8_length(std::string_view s) {
 
 }  // namespace
 
-JsonWriter::JsonWriter(std::ostream& out, int wrap_depth) : out_(out), wrap_depth_(wrap_depth) {
+JsonWriter::JsonWriter(std::ostream& out, int wrap_depth) : out_(&out), buffer_(own_), wrap_depth_(wrap_depth) {
   buffer_.reserve(kFlushAt + 1024);
 }
+
+JsonWriter::JsonWriter(std::string& text, int wrap_depth) : buffer_(text), wrap_depth_(wrap_depth) {}
 
 JsonWriter::~JsonWriter() { flush(); }
 
 bool JsonWriter::flush() {
-  out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+  if (!out_) return true;
+  out_->write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
   buffer_.clear();
-  return static_cast<bool>(out_);
+  return static_cast<bool>(*out_);
 }
 
 void JsonWriter::line_break(std::size_t depth) {
@@ -54,7 +57,7 @@ void JsonWriter::line_break(std::size_t depth) {
 }
 
 void JsonWriter::begin_value() {
-  if (buffer_.size() >= kFlushAt) flush();
+  if (out_ && buffer_.size() >= kFlushAt) flush();
   if (after_key_) {
     after_key_ = false;
     return;

@@ -17,6 +17,9 @@ class JsonWriter {
   /// of their own, indented one space per level; deeper ones stay on their parent's line.
   /// 0 writes the whole document on one line: the canonical form the mission hash reads.
   explicit JsonWriter(std::ostream& out, int wrap_depth = 0);
+  /// Appends to `text` instead, all of it, with no stream between: a mission file is
+  /// made whole in one buffer, hashed there and written with one call.
+  explicit JsonWriter(std::string& text, int wrap_depth = 0);
   ~JsonWriter();  ///< flushes
 
   void begin_object();
@@ -42,7 +45,8 @@ class JsonWriter {
   void member(std::string_view name, long long v) { key(name); value(v); }
   void member(std::string_view name, bool v) { key(name); value(v); }
 
-  /// Hands what is buffered to the stream; false when the stream has failed.
+  /// Hands what is buffered to the stream; false when the stream has failed. Appending
+  /// to a string, it has nothing to do.
   bool flush();
 
  private:
@@ -52,8 +56,9 @@ class JsonWriter {
   void write_string(std::string_view s);
   void line_break(std::size_t depth);
 
-  std::ostream& out_;
-  std::string buffer_;          ///< written to out_ in large pieces
+  std::ostream* out_ = nullptr;  ///< null: the text appended to is the whole output
+  std::string own_;              ///< the buffer when writing to a stream
+  std::string& buffer_;          ///< written to out_ in large pieces
   int wrap_depth_;
   std::vector<char> has_items_;  ///< per open container: 1 once something is in it
   bool after_key_ = false;       ///< a key was written; the next value is its member's

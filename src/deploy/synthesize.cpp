@@ -74,7 +74,7 @@ bool cannot_write(const std::filesystem::path& path, Diagnostics& diags) {
 
 bool write_text(const std::filesystem::path& path, const std::string& text, Diagnostics& diags) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
+  out.write(text.data(), static_cast<std::streamsize>(text.size()));
   out.close();
   return out ? true : cannot_write(path, diags);
 }
@@ -125,6 +125,9 @@ bool write_deployment(const graph::Compilation& c, const std::string& dir, const
   }
   if (!write_text(fs::path(dir) / "manifest.json", manifest(c, hash).dump(2) + "\n", diags)) return false;
   if (!write_trace_header(c, fs::path(dir) / "trace-header.json", hash, diags)) return false;
+  // One drone's file at a time is made in one buffer, reused (its capacity kept) by the next,
+  // and written with one call: a large fleet's files are a third of the compile.
+  std::string text;
   for (int d = 0; d < c.drone_count(); ++d) {
     fs::path folder = fs::path(dir) / c.drone_name(d);
     fs::create_directories(folder, ec);
@@ -132,13 +135,11 @@ bool write_deployment(const graph::Compilation& c, const std::string& dir, const
       diags.error(nullptr, {}, "cannot create '" + folder.string() + "': " + ec.message());
       return false;
     }
-    // Streamed straight into the file: no drone's mission is ever held in memory.
+    text.clear();
+    append_drone_mission(text, c, d, hash);
+    text += '\n';
     fs::path file = folder / "mission.json";
-    std::ofstream out(file, std::ios::binary | std::ios::trunc);
-    bool written = out && write_drone_mission(out, c, d, hash);
-    out << "\n";
-    out.close();
-    if (!written || !out) return cannot_write(file, diags);
+    if (!write_text(file, text, diags)) return false;
   }
   return true;
 }
