@@ -1,5 +1,6 @@
 #include "deploy/json_writer.h"
 
+#include <array>
 #include <charconv>
 #include <cmath>
 
@@ -9,6 +10,13 @@ namespace {
 
 /// Buffered output reaches the stream in pieces of about this size.
 constexpr std::size_t kFlushAt = 64 * 1024;
+
+/// The bytes a JSON string holds as they are: printable ASCII but the quote and backslash.
+constexpr auto kPlain = [] {
+  std::array<bool, 256> plain{};
+  for (int c = 0x20; c < 0x80; ++c) plain[c] = c != '"' && c != '\\';
+  return plain;
+}();
 
 /// Length of the well-formed UTF-8 sequence at the start of `s` (1 to 4), or 0 when the
 /// bytes there are not one (a stray continuation byte, an overlong form, a surrogate, a
@@ -147,11 +155,11 @@ void JsonWriter::write_string(std::string_view s) {
   std::size_t copied = 0;  // s[0, copied) is in the buffer
   std::size_t i = 0;
   while (i < s.size()) {
+    // Names, keys and labels are plain ASCII: one table look-up per byte finds the end of
+    // such a run (a third of the time of writing a large fleet's files went to this loop).
+    while (i < s.size() && kPlain[static_cast<unsigned char>(s[i])]) ++i;
+    if (i == s.size()) break;
     unsigned char c = static_cast<unsigned char>(s[i]);
-    if (c >= 0x20 && c < 0x80 && c != '"' && c != '\\') {
-      ++i;
-      continue;
-    }
     if (c >= 0x80) {
       std::size_t n = utf8_length(s.substr(i));
       if (n > 0) {
