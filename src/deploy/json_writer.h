@@ -4,6 +4,7 @@
 // them (strings escaped the same way, doubles in their shortest form that reads back to the
 // same value, integral doubles with ".0"), so a file written here parses to exactly the
 // nlohmann::json the graph exporters build.
+#include <cstring>
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -56,9 +57,30 @@ class JsonWriter {
   void write_string(std::string_view s);
   void line_break(std::size_t depth);
 
+  /// Room for `n` more bytes at cur_. Bytes are written through a pointer into space the
+  /// string already holds, not appended one by one: each append checks and sets the
+  /// string's length, and a large fleet's files are written a few bytes at a time.
+  void reserve(std::size_t n) {
+    if (static_cast<std::size_t>(end_ - cur_) < n) grow(n);
+  }
+  void grow(std::size_t n);
+  void put(char c) {
+    reserve(1);
+    *cur_++ = c;
+  }
+  void put(std::string_view s) {
+    reserve(s.size());
+    std::memcpy(cur_, s.data(), s.size());
+    cur_ += s.size();
+  }
+  /// Gives the string the length of what is written (it holds spare room while writing).
+  void settle();
+
   std::ostream* out_ = nullptr;  ///< null: the text appended to is the whole output
   std::string own_;              ///< the buffer when writing to a stream
   std::string& buffer_;          ///< written to out_ in large pieces
+  char* cur_ = nullptr;          ///< where the next byte goes, inside buffer_
+  char* end_ = nullptr;          ///< the end of buffer_'s room
   int wrap_depth_;
   std::vector<char> has_items_;  ///< per open container: 1 once something is in it
   bool after_key_ = false;       ///< a key was written; the next value is its member's

@@ -398,6 +398,7 @@ void append_drone_mission(std::string& text, const Compilation& c, int drone, co
   write_drone_names(w, c, g.reads);
   write_separation(w, c, fleet_members);
   write_mdg(w, c, g);
+  w.flush();  // the text holds every byte written so far
   Sha256 sha;
   sha.update(text.data() + start, text.size() - start);
   w.member(kFileHashMember, sha.hex_digest());
