@@ -120,11 +120,9 @@ class Mentions {
       const std::vector<Statement>& body = m_.functions[fn].body;
       int pending = -1;  // a callee not indexed yet
       for (; next < body.size() && pending < 0; next += pending < 0 ? 1 : 0)
-        for (int callee : callees(body[next]))
-          if (callee >= 0 && state_[callee] == 0) {
-            pending = callee;
-            break;
-          }
+        for_each_callee(body[next], [&](int callee) {
+          if (pending < 0 && callee >= 0 && state_[callee] == 0) pending = callee;
+        });
       stack.back().second = next;
       if (pending >= 0) {
         stack.push_back({pending, 0});
@@ -135,11 +133,11 @@ class Mentions {
     }
   }
 
-  static std::vector<int> callees(const Statement& s) {
-    std::vector<int> out;
-    if (s.kind != StatementKind::action && s.function_index >= 0) out.push_back(s.function_index);
-    out.insert(out.end(), s.branch_functions.begin(), s.branch_functions.end());
-    return out;
+  /// The blocks a statement calls, without a vector per statement (a million of them).
+  template <class Each>
+  static void for_each_callee(const Statement& s, Each visit) {
+    if (s.kind != StatementKind::action && s.function_index >= 0) visit(s.function_index);
+    for (int fn : s.branch_functions) visit(fn);
   }
 
   void finish(int fn) {
@@ -149,9 +147,10 @@ class Mentions {
       const Statement& s = body[i];
       int at = static_cast<int>(i);
       if (s.kind == StatementKind::action && s.drone_index >= 0) pairs.push_back({s.drone_index, at});
-      for (int callee : callees(s))
+      for_each_callee(s, [&](int callee) {
         if (callee >= 0 && state_[callee] == 2)  // not a recursive call: the checker reports those
           for (int d : of_function_[callee]) pairs.push_back({d, at});
+      });
     }
     std::sort(pairs.begin(), pairs.end());
     pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
