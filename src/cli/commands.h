@@ -132,9 +132,10 @@ void print_diagnostics(const Diagnostics& diags, bool on_stdout = false);
 /// Compiles and prints every diagnostic; true when the graphs are usable.
 bool compile_and_report(const CommonOptions& o, graph::Compilation& c,
                         graph::Keep keep = graph::Keep::all_graphs);
-/// Every drone's mission as `eamos compile` would write it, read back through the one
-/// validating reader, so a run or a verification exercises the deployed format; false
-/// (errors printed) when the reader refuses one.
+/// Every drone's mission built from the compiled MDGs in memory (deploy::compiled_missions):
+/// the structure the validating reader makes of the files `eamos compile` writes, without
+/// writing and parsing them (tests/deploy/mission_memory_test.cpp holds the two equal);
+/// false (errors printed) when one cannot be built.
 bool load_compiled_missions(const graph::Compilation& c, std::vector<dex::Mission>& missions);
 
 /// Renders DOT to SVG with Graphviz `dot`; returns false with `error` set on failure.
