@@ -76,7 +76,7 @@ void print_diagnostics(const Diagnostics& diags, bool on_stdout) {
 
 bool load_compiled_missions(const graph::Compilation& c, std::vector<dex::Mission>& missions) {
   std::vector<std::string> errors;
-  if (deploy::read_compiled_missions(c, missions, errors)) return true;
+  if (deploy::compiled_missions(c, missions, errors)) return true;
   for (const std::string& e : errors) std::cerr << e << "\n";
   return false;
 }

@@ -1,6 +1,9 @@
 #pragma once
 // The `eamos` subcommands. Each returns the process exit status: 0 success, 1 when the
 // input had errors (all of them printed) or a file could not be read or written.
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <condition_variable>
 #include <mutex>
 #include <string>
@@ -78,6 +81,15 @@ struct RunCommandOptions {
   double telemetry_hz = 5.0;  ///< telemetry events per drone per mission second in the trace; 0 = none
 };
 int cmd_run(const CommonOptions& o, const RunCommandOptions& r);
+/// Whether `eamos run` (in one process) writes its log in blocks rather than line by line:
+/// on virtual time into a regular file, where nobody acts on a line the moment it is
+/// written and a write per line cost a tenth of a 1,000-drone run. A terminal, a pipe and
+/// a real-time run get each line as it happens. Inline: main() of the small `eamos` asks
+/// it too, and must not link run.cpp (CMakeLists.txt, `--as-needed`).
+inline bool run_log_in_blocks(const RunCommandOptions& r) {
+  struct stat st {};
+  return !r.realtime && r.speed <= 0 && fstat(STDOUT_FILENO, &st) == 0 && S_ISREG(st.st_mode);
+}
 /// Writes the summary and plot of a finished run as `eamos run` does; false when a file
 /// could not be written.
 bool report_run(const RunCommandOptions& r, const dex::RunResult& result, const std::vector<dex::TraceEvent>& events);
@@ -149,9 +161,10 @@ void print_diagnostics(const Diagnostics& diags, bool on_stdout = false);
 /// Compiles and prints every diagnostic; true when the graphs are usable.
 bool compile_and_report(const CommonOptions& o, graph::Compilation& c,
                         graph::Keep keep = graph::Keep::all_graphs);
-/// Every drone's mission as `eamos compile` would write it, read back through the one
-/// validating reader, so a run or a verification exercises the deployed format; false
-/// (errors printed) when the reader refuses one.
+/// Every drone's mission built from the compiled MDGs in memory (deploy::compiled_missions):
+/// the structure the validating reader makes of the files `eamos compile` writes, without
+/// writing and parsing them (tests/deploy/mission_memory_test.cpp holds the two equal);
+/// false (errors printed) when one cannot be built.
 bool load_compiled_missions(const graph::Compilation& c, std::vector<dex::Mission>& missions);
 
 /// Renders DOT to SVG with Graphviz `dot`; returns false with `error` set on failure.

@@ -516,7 +516,12 @@ int main(int argc, char** argv) {
 
   // A flight's live log goes out line by line also into a pipe (`| tee log`): what a person
   // watches is now, not a buffer later, and a killed process loses at most half a line.
-  if (*c.run || *c.launch || *c.dex || *c.sim_vehicle || *c.monitor) std::setvbuf(stdout, nullptr, _IOLBF, BUFSIZ);
+  // `eamos run` on virtual time into a file (run_log_in_blocks) is the exception: its
+  // whole flight takes seconds, and a Ctrl-C or SIGTERM lands the drones and flushes it
+  // (a second one, which exits at once, leaves the last block unwritten).
+  bool blocks = *c.run && !o.distributed && eamos::cli::run_log_in_blocks(o.run);
+  if ((*c.run || *c.launch || *c.dex || *c.sim_vehicle || *c.monitor) && !blocks)
+    std::setvbuf(stdout, nullptr, _IOLBF, BUFSIZ);
   try {
     return dispatch(c, o, argv);
   } catch (const std::exception& e) {

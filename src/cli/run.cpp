@@ -112,6 +112,7 @@ bool open_sinks(const RunCommandOptions& r, const graph::Compilation& c, const s
   if (r.log && stdout_is_terminal()) sinks.progress = std::make_unique<ProgressDisplay>(std::cout, missions);
   if (sinks.progress) sinks.tee.add(sinks.progress.get());
   else if (r.log) sinks.tee.add(&sinks.live);
+  sinks.live.set_flush_each_line(!run_log_in_blocks(r));
   if (!r.trace.empty()) {
     sinks.trace_file.open(r.trace, std::ios::trunc);
     if (!sinks.trace_file) {

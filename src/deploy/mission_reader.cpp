@@ -263,6 +263,7 @@ class Reader {
     nodes(file);
     arcs(file);
     node_references();
+    if (!d_.any()) dex::link_mission(m_);  // nodes() refused a repeated (meg, drone) already
   }
 
  private:
@@ -397,10 +398,6 @@ class Reader {
     if ((n.waits >= 0 || n.notify >= 0) && !graph::is_sync_point(n.kind))
       return d_.add(where, "only a sync point (init or fork) waits for or notifies drones"), false;
     if (n.waits >= 0 && !n.internal) return d_.add(at(where, "waits"), "an external node waits for nothing"), false;
-    if (n.waits >= 0) {
-      const std::vector<int>& set = m_.drone_sets[n.waits].get();
-      n.waits_count = static_cast<int>(set.size()) - (std::binary_search(set.begin(), set.end(), m_.self) ? 1 : 0);
-    }
     return true;
   }
 
@@ -742,8 +739,7 @@ class Reader {
     if (ok && n.control == lang::ControlKind::none)
       ok = false, d_.add(at(where, "control"), "a condition without a control structure");
     const json* c = f_.member(j, "condition", where);
-    if (c && expr(*c, at(where, "condition"), n.condition, 1)) dex::collect_drones(n.condition, n.condition_reads);
-    else ok = false;
+    if (!c || !expr(*c, at(where, "condition"), n.condition, 1)) ok = false;
     if (n.control == lang::ControlKind::RepeatFor)
       ok &= f_.integer(j, "count", where, n.count, 0, std::numeric_limits<long long>::max());
     if (const json* cancels = f_.member(j, "cancels", where, false);
@@ -779,9 +775,6 @@ class Reader {
       if (!ok) continue;
       a.kind = static_cast<graph::ArcKind>(kind);
       a.branch = static_cast<graph::Branch>(branch);
-      m_.nodes[a.from].out.push_back(static_cast<int>(m_.arcs.size()));
-      if (a.kind == graph::ArcKind::exec) ++m_.nodes[a.to].exec_in;
-      if (a.kind == graph::ArcKind::back) ++m_.nodes[a.to].back_in;
       m_.arcs.push_back(a);
     }
   }

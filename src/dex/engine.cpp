@@ -430,7 +430,7 @@ void Engine::activate_condition(int node, bool by_back_arc) {
     case ControlKind::PauseUntil:
     case ControlKind::PauseWhile:
       ++active_;
-      if (s.watchers++ == 0) watched_.push_back(node);
+      if (s.watchers++ == 0) watch(node);
       evaluate_watch(node);
       return;
     case ControlKind::RepeatUntil:
@@ -496,7 +496,22 @@ void Engine::stop_watching(int node) {
   active_ -= s.watchers;
   s.watchers = 0;
   s.last_value = -1;
+  unwatch(node);
+}
+
+void Engine::watch(int node) {
+  watched_.push_back(node);
+  if (hooks_.watching) *hooks_.watching = true;
+}
+
+void Engine::unwatch(int node) {
   watched_.erase(std::remove(watched_.begin(), watched_.end(), node), watched_.end());
+  if (hooks_.watching) *hooks_.watching = !watched_.empty();
+}
+
+void Engine::unwatch_all() {
+  watched_.clear();
+  if (hooks_.watching) *hooks_.watching = false;
 }
 
 void Engine::cancel_local(const std::vector<int>& nodes) {
@@ -594,7 +609,7 @@ void Engine::halt() {
     s.next_iteration = mid::kNoTimer;
     s.watchers = 0;
   }
-  watched_.clear();
+  unwatch_all();
 }
 
 }  // namespace eamos::dex

@@ -35,6 +35,10 @@ struct EngineHooks {
   std::function<void()> on_idle;
   /// `eamos verify` only: sees action starts and may decide conditions (dex/observer.h).
   RunObserver* observer = nullptr;
+  /// Kept true while a condition of this engine watches properties, false otherwise: a
+  /// runner of many engines reads it before calling properties_changed, whose first look
+  /// at a cold engine costs a cache miss per motion step of its drone.
+  bool* watching = nullptr;
 };
 
 /// Iterations in a row a Repeat may run without mission time passing before the engine
@@ -148,7 +152,10 @@ class Engine {
   int active_ = 0;
   std::uint64_t next_instance_ = 0;
   std::uint64_t activations_ = 0;
-  std::vector<int> watched_;  ///< condition nodes currently watching
+  std::vector<int> watched_;  ///< condition nodes currently watching (through watch and unwatch)
+  void watch(int node);
+  void unwatch(int node);
+  void unwatch_all();
   /// The newest telemetry of each drone this one reads (Mission::reads, in board_drones_'s
   /// order): sized by what the mission reads, not by the fleet, which at 10,000 drones would
   /// be 10⁸ pointers over one process.

@@ -26,7 +26,7 @@ void Engine::activate_do(int node) {
     s.watchers = 1;
     s.last_value = static_cast<int>(v);  // traced just now: log again only on a change
     ++active_;
-    watched_.push_back(node);
+    watch(node);
     epoch_[n.meg] = next_run(epoch_[n.meg]);  // a new run of the do-branch
     end(node, Branch::do_);
   } else {

@@ -109,4 +109,12 @@ struct Mission {
   std::unordered_map<std::uint64_t, int> index;  ///< key(meg, drone) → node index
 };
 
+/// The last step of making a Mission, shared by the two ways to make one (a mission file
+/// read by deploy::read_mission, and the compiled MDG in memory, deploy::compiled_missions),
+/// so that both give the engine the same structure: from `nodes`, `arcs` and `drone_sets`
+/// it fills each node's `out`, `exec_in`, `back_in`, `condition_reads` and `waits_count`,
+/// and `index`. Every arc, `waits` and `self` must be in range. Returns the nodes whose
+/// (meg, drone) an earlier node holds already, which `index` keeps for the earlier one.
+std::vector<int> link_mission(Mission& m);
+
 }  // namespace eamos::dex

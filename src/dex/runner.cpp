@@ -370,6 +370,9 @@ class InProcessRun {
   std::vector<std::unique_ptr<mid::Drone>> drones_;
   std::vector<std::vector<Sample>> tracks_;
   std::vector<std::unique_ptr<Engine>> engines_;
+  /// Whether each engine watches a condition (EngineHooks::watching): a drone's motion step
+  /// looks here, not at its cold engine, to learn that no condition waits on it.
+  std::unique_ptr<bool[]> watching_;
   InProcessTransport transport_;
   TelemetryRecorder telemetry_;
   bool end_reached_ = false;
@@ -429,6 +432,7 @@ bool InProcessRun::homes_agree() {
 }
 
 void InProcessRun::make_engines() {
+  watching_ = std::make_unique<bool[]>(static_cast<std::size_t>(n_));  // all false
   for (int d = 0; d < n_; ++d) {
     EngineHooks hooks;
     hooks.transport = &transport_;
@@ -437,6 +441,7 @@ void InProcessRun::make_engines() {
     hooks.on_end = [this] { end_reached_ = true; };  // the lead's engine settles next: check_done then
     hooks.on_idle = [this] { check_done(); };
     hooks.observer = options_.observer;
+    hooks.watching = &watching_[d];
     engines_.push_back(std::make_unique<Engine>(missions_[d], *drones_[d], loop_, hooks));
   }
 }
@@ -467,7 +472,7 @@ void InProcessRun::subscribe_drones() {
     drones_[d]->subscribe([this, d](const mid::DroneState& s) {
       if (options_.keep_tracks) record_sample(tracks_[d], s);
       if (separation_) separation_->update(d, s);
-      engines_[d]->properties_changed(d);
+      if (watching_[d]) engines_[d]->properties_changed(d);
       if (!transport_.readers_of(d).empty())
         transport_.publish(std::make_shared<const Telemetry>(Telemetry{missions_[d].hash, d, s}));
     });

@@ -120,7 +120,8 @@ void LiveLog::record(const TraceEvent& e) {
   if (e.line > 0) out_ << "   line " << e.line;
   // Live: a line is out when it happened, also through a pipe (`eamos run | tee`, a test
   // that acts on a line), not when a buffer fills.
-  out_ << '\n' << std::flush;
+  out_ << '\n';
+  if (flush_each_line_) out_ << std::flush;
 }
 
 }  // namespace eamos::dex

@@ -36,9 +36,15 @@ SimDrone::SimDrone(fleet::DroneSettings settings, fleet::DroneType type, mid::Ev
     sensor_names_.emplace_hint(sensor_names_.end(), name, 0.0);
   }
   // In the names' order (Sensor10 before Sensor2), as a state lists them.
-  for (const auto& [name, zero] : sensor_names_) {
+  for (auto& [name, reading] : sensor_names_) {
     auto it = settings_.sensors.find(name);
-    sensor_names_models_.push_back(it == settings_.sensors.end() ? nullptr : &it->second);
+    const fleet::SensorModel* m = it == settings_.sensors.end() ? nullptr : &it->second;
+    sensor_names_models_.push_back(m);
+    if (!m) continue;
+    reading = m->base;
+    // base + 0·position is base, except that -0 + 0 is +0: such a sensor is worked out per step.
+    const fleet::Vec3& g = m->gradient;
+    sensors_vary_ |= g.x != 0.0 || g.y != 0.0 || g.z != 0.0 || (m->base == 0.0 && std::signbit(m->base));
   }
   published_.sensors = sensor_names_;
 }
@@ -390,10 +396,14 @@ void SimDrone::fill_state(mid::DroneState& s) const {
   s.battery = battery_.at(loop_.now());
   s.armed = armed_;
   s.landed = landed_;
-  auto model = sensor_names_models_.begin();
-  for (auto& reading : s.sensors) {
-    const fleet::SensorModel* m = *model++;
-    reading.second = m ? m->base + dot(m->gradient, kin_.position) : 0.0;
+  // Constant readings are in every state from the start (sensor_names_): a motion step
+  // touches no sensor then.
+  if (sensors_vary_) {
+    auto model = sensor_names_models_.begin();
+    for (auto& reading : s.sensors) {
+      const fleet::SensorModel* m = *model++;
+      reading.second = m ? m->base + dot(m->gradient, kin_.position) : 0.0;
+    }
   }
   s.pictures = pictures_;
   s.heading = heading_;

@@ -88,8 +88,11 @@ class SimDrone final : public mid::AdapterDrone {
   /// "Sensor1" … "SensorN" of the type and the fleet file's model of each (null: reads 0),
   /// looked up once: a state is built on every step of every drone.
   std::vector<std::pair<std::string, const fleet::SensorModel*>> sensor_models_;
-  mid::SensorValues sensor_names_;  ///< the same names, each reading 0: what a state starts from
+  /// The same names, each with its reading when it never changes (its base, or 0 without a
+  /// model): what a state starts from.
+  mid::SensorValues sensor_names_;
   std::vector<const fleet::SensorModel*> sensor_names_models_;  ///< each of sensor_names_'s model
+  bool sensors_vary_ = false;  ///< a reading depends on the position: fill_state works them out
   /// The state publish() hands its subscribers, refilled in place at every step: a state
   /// built anew costs an allocation and a copy of every sensor's name (20 a second per
   /// moving drone). A publish from inside a subscriber builds its own.

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -48,6 +49,47 @@ TEST_F(Cli, CheckAcceptsListing2AndPrintsItsWarning) {
   EXPECT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("ok — 3 drones"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("warning: drone 'Drone2' may run two motion actions"), std::string::npos);
+}
+
+// On virtual time `eamos run > FILE` writes its log lines in a few writes, not one per line:
+// the file must still hold what a pipe shows, the error after the lines that led to it.
+TEST_F(Cli, ARunIntoAFileLogsWhatAPipeShowsInTheSameOrder) {
+  const std::string data = std::string(EAMOS_SOURCE_DIR) + "/tests/cli/data/failure/";
+  const std::string args = "run " + data + "far-flight.eamos --fleet " + data + "low-battery.yaml";
+  Output piped = eamos(args);
+  ASSERT_EQ(piped.status, 1) << piped.out;
+  ASSERT_NE(piped.out.find("eamos: mission failed"), std::string::npos) << piped.out;
+  Output filed = eamos(args + " > " + (dir_ / "log.txt").string());
+  EXPECT_EQ(filed.status, 1);
+  EXPECT_EQ(read_file(dir_ / "log.txt"), piped.out);
+}
+
+/// Write calls (syscw) of `eamos ARGS > FILE` and of the shell that ran it: a shell's
+/// /proc/PID/io includes the children it reaped.
+long long write_calls_into_file(const std::string& args, const fs::path& file) {
+  std::string cmd = "sh -c '" + std::string(EAMOS_BINARY) + " " + args + " > " + file.string() +
+                    " 2>&1; grep syscw /proc/$$/io'";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return -1;
+  long long calls = -1;
+  if (std::fscanf(p, "syscw: %lld", &calls) != 1) calls = -1;
+  pclose(p);
+  return calls;
+}
+
+// A run on virtual time into a regular file writes its log in blocks: a write per line
+// was a tenth of a 1,000-drone run's CPU. Through a pipe each line still goes out alone.
+TEST_F(Cli, ARunOnVirtualTimeIntoAFileWritesItsLogInBlocks) {
+  fs::path mission = dir_ / "show.eamos";
+  ASSERT_EQ(eamos("gen-stress --shape show --drones 20 --nodes 1000 -o " + mission.string()).status, 0);
+  long long calls = write_calls_into_file("run " + mission.string(), dir_ / "log.txt");
+  std::string log = read_file(dir_ / "log.txt");
+  long long lines = std::count(log.begin(), log.end(), '\n');
+  ASSERT_GT(lines, 500) << log;
+  EXPECT_GE(calls, 1);
+  EXPECT_LT(calls, lines / 10) << lines << " lines";
+  Output piped = eamos("run " + mission.string());
+  EXPECT_EQ(piped.out, log);
 }
 
 TEST_F(Cli, LogLevelTakesTheFourLevelsOnly) {

@@ -71,7 +71,7 @@ inline std::vector<dex::Mission> missions_of(const std::string& text, const flee
   std::vector<dex::Mission> missions;
   std::vector<std::string> errors;
   if (!edit) {  // as `eamos run` loads them
-    EXPECT_TRUE(deploy::read_compiled_missions(c, missions, errors)) << (errors.empty() ? "" : errors.front());
+    EXPECT_TRUE(deploy::compiled_missions(c, missions, errors)) << (errors.empty() ? "" : errors.front());
     return missions;
   }
   std::string hash = deploy::mission_hash(c);

@@ -11,6 +11,36 @@
 namespace eamos {
 namespace {
 
+/// Counts the flushes a stream asks of its buffer.
+class FlushCount : public std::stringbuf {
+ public:
+  int flushes = 0;
+
+ protected:
+  int sync() override {
+    ++flushes;
+    return std::stringbuf::sync();
+  }
+};
+
+// A live log flushes each line unless told it need not (a run on virtual time into a file).
+TEST(LiveLog, FlushesEachLineOnlyWhenToldTo) {
+  for (bool each : {true, false}) {
+    FlushCount buffer;
+    std::ostream out(&buffer);
+    dex::LiveLog log(out);
+    log.set_flush_each_line(each);
+    dex::TraceEvent e;
+    e.drone = "A";
+    e.event = "start";
+    e.text = "A.Arm()";
+    for (int i = 0; i < 3; ++i) log.record(e);
+    EXPECT_EQ(buffer.flushes, each ? 3 : 0);
+    std::string text = buffer.str();
+    EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 3);
+  }
+}
+
 using test::Flight;
 using test::example;
 using test::fly;

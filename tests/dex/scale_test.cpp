@@ -179,7 +179,8 @@ TEST(Scale, FiveHundredDronesMissionsHoldTheFleetsNamesAndSetsOnce) {
   EXPECT_LT(per_drone, 20u * 1024) << "bytes held per drone";
 }
 
-/// Bytes of mission text `eamos run` reads to load every drone of `text`.
+/// Bytes of mission text a process that loads the fleet from its texts (the Python module)
+/// reads to load every drone of `text`.
 std::size_t text_bytes_loaded(const std::string& text) {
   graph::Compilation c;
   Diagnostics diags;

@@ -2,6 +2,8 @@
 // sensors read base + gradient · position.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "helpers.h"
 
 namespace eamos::sim {
@@ -77,6 +79,33 @@ TEST_F(Payload, AStateWithTenOrMoreSensorsGivesEachItsOwnReading) {
   EXPECT_DOUBLE_EQ(s.sensors.at("Sensor12"), 12.0);
   EXPECT_DOUBLE_EQ(s.sensors.at("Sensor11"), 0.0);
   EXPECT_DOUBLE_EQ(*run("Sensor10").end.value, 13.0);
+}
+
+// A motion step refills the state it publishes in place and works out only the readings
+// that follow the position: every published state must still carry every sensor's reading.
+TEST_F(Payload, EveryPublishedStateCarriesEachSensorsReadingWhileTheDroneMoves) {
+  config.sensors["Sensor1"] = {120.0, {}};
+  config.sensors["Sensor2"] = {10.0, {0.5, 0, -1}};
+  int states = 0;
+  d().subscribe([&states](const mid::DroneState& s) {
+    ++states;
+    EXPECT_DOUBLE_EQ(s.sensors.at("Sensor1"), 120.0);
+    EXPECT_DOUBLE_EQ(s.sensors.at("Sensor2"), 10.0 + 0.5 * s.x - s.z);
+    EXPECT_DOUBLE_EQ(s.sensors.at("Sensor3"), 0.0);
+  });
+  airborne(4);
+  ASSERT_EQ(run("FlyByX", {6}).end.outcome, Outcome::succeeded);
+  EXPECT_GT(states, 40);  // a state per step of a climb and a flight of several seconds
+}
+
+// A reading is base + gradient · position: for a base of -0 that is +0 wherever the drone
+// stands, so such a sensor is no constant to copy (its -0 would show in a trace).
+TEST_F(Payload, ASensorOfBaseMinusZeroReadsPlusZeroAsItsFormulaGives) {
+  config.sensors["Sensor1"] = {-0.0, {}};
+  airborne(4);
+  ASSERT_EQ(run("FlyByX", {6}).end.outcome, Outcome::succeeded);
+  EXPECT_FALSE(std::signbit(d().state().sensors.at("Sensor1")));
+  EXPECT_FALSE(std::signbit(*run("Sensor1").end.value));
 }
 
 TEST_F(Payload, SensorReadIsShortAndNeedsNoArming) {
