@@ -55,6 +55,35 @@ TEST(StateRate, UpToTwentyDronesEveryChangeIsPublishedBeyondTheRateFallsWithTheS
   EXPECT_DOUBLE_EQ(state_rate_for(1000), 1.0);
 }
 
+// Every drone receives every other drone's arrival at a barrier: beyond twenty drones a
+// status whose only news is its trigger counters waits for a quarter of the lease, while a
+// change of busy, phase, end or wave still goes out at once.
+TEST(StatusRate, BeyondTwentyDronesAChangeOfCountersAloneIsCoalescedOtherChangesAreNot) {
+  using eamos::launch::counters_gap_for;
+  using eamos::launch::status_change;
+  using eamos::launch::StatusChange;
+  EXPECT_DOUBLE_EQ(counters_gap_for(20, 2.0), 0.0);
+  EXPECT_DOUBLE_EQ(counters_gap_for(21, 2.0), 0.5);
+  EXPECT_DOUBLE_EQ(counters_gap_for(100, 10.0), 2.5);
+  eamos::transport::StatusSample before;
+  before.sent = 3;
+  before.received = 7;
+  eamos::transport::StatusSample now = before;
+  EXPECT_EQ(status_change(before, now), StatusChange::none);
+  now.received = 8;
+  EXPECT_EQ(status_change(before, now), StatusChange::counters);
+  now.sent = 4;
+  EXPECT_EQ(status_change(before, now), StatusChange::counters);
+  now.busy = true;
+  EXPECT_EQ(status_change(before, now), StatusChange::other);
+  now = before;
+  now.wave = 1;
+  EXPECT_EQ(status_change(before, now), StatusChange::other);
+  now = before;
+  now.phase = eamos::transport::Phase::completed;
+  EXPECT_EQ(status_change(before, now), StatusChange::other);
+}
+
 }  // namespace
 
 namespace {
