@@ -39,7 +39,9 @@ std::string read_url(eamos_test::EamosProcess& p, const std::string& marker) {
 
 // Runs the browser script; its output, and whether every check passed.
 bool run_browser(const std::string& mode, const std::string& url, std::string& output) {
-  std::string cmd = "cd '" + std::string(EAMOS_BROWSER_DIR) + "' && '" + EAMOS_NODE + "' monitor_check.js " + mode +
+  // EAMOS_TEST_PID: the script tells this test's processes from other work on the host.
+  std::string cmd = "cd '" + std::string(EAMOS_BROWSER_DIR) + "' && EAMOS_TEST_PID=" + std::to_string(getpid()) + " '" +
+                    EAMOS_NODE + "' monitor_check.js " + mode +
                     " '" + url + "' '" + EAMOS_SCREENSHOT_DIR + "' '" + EAMOS_CHROMIUM + "' 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return false;
@@ -295,19 +297,17 @@ TEST(MonitorBrowser, LiveTwentyDronesAreDrawnWithin100msOfEachEvent) {
 }
 
 // Latency at a thousand drones: a show (every drone in every PAR, five fleet-wide barriers)
-// in real time, lanes on the canvas, each event drawn within 200 ms of eamos emitting it (p95
-// over 8,000 live events, telemetry included: about three seconds), the page's renders under
-// 8 ms (median); the run is then stopped. Not the 100 ms of twenty drones, and not faster
-// than real time: on this shared 2-core host the p95 passed 100 ms in one of thirteen
-// real-time runs at load average 3-8 (144 ms) and in two of fourteen at twice real time, and
-// a test that fails once in a while is no test (docs/performance.md has the runs). A miss while the
-// host's load average is above 4 a core skips the case (with the figures) instead of failing
-// it: other work then delays Chromium's processes, not the page's script; the other checks
-// hold regardless. What keeps a thousand-drone page within it (docs/monitor.md): the mission
-// text laid out only in view, tracks kept as layers, the server's events batched into one
-// message per 8 ms, and the lanes canvas kept in columns of which a frame redraws only those
-// that changed.
-TEST(MonitorBrowser, LiveThousandDronesAreDrawnWithin200msOfEachEvent) {
+// in real time, lanes on the canvas, each event drawn within the monitor's bound of 100 ms of
+// eamos emitting it (p95 over 8,000 live events, telemetry included: about three seconds),
+// the page's renders under 8 ms (median); the run is then stopped. Real time, as a live
+// flight is watched; faster replays miss now and then on a shared 2-core host
+// (docs/performance.md has the runs). A miss while processes other than this test's took more
+// than a quarter of the machine skips the case (with the figures) instead of failing it: other
+// work then delays Chromium's processes, not the page's script; the other checks hold regardless. What keeps a
+// thousand-drone page within it (docs/monitor.md): the mission text laid out only in view,
+// tracks kept as layers, the server's events batched into one message per 8 ms, and the
+// lanes canvas kept in columns of which a frame redraws only those that changed.
+TEST(MonitorBrowser, LiveThousandDronesAreDrawnWithin100msOfEachEvent) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
   fs::path dir = fs::temp_directory_path() / ("eamos-monitor-live1000-" + std::to_string(getpid()));
   fs::create_directories(dir);

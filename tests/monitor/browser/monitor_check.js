@@ -319,12 +319,47 @@ async function live20(browser) {
   await page.screenshot({ path: path.join(shots, 'live-20-drones.png') });
 }
 
+// CPU that processes outside this test used while it measured, as a share of the machine:
+// the jiffies /proc/stat counts busy, less those of the test's own processes (the gtest
+// binary EAMOS_TEST_PID names and everything under it: eamos, node, Chromium). A process of
+// the test that ends inside the window counts as other work, which errs toward skipping.
+function cpuTicks(root) {
+  const cpu = fs.readFileSync('/proc/stat', 'utf8').split('\n')[0].trim().split(/\s+/).slice(1).map(Number);
+  const total = cpu.slice(0, 8).reduce((a, b) => a + b, 0);
+  const busy = total - cpu[3] - cpu[4];  // less idle and iowait
+  const parent = new Map(), ticks = new Map();
+  for (const d of fs.readdirSync('/proc')) {
+    if (!/^\d+$/.test(d)) continue;
+    try {
+      const text = fs.readFileSync(`/proc/${d}/stat`, 'utf8');
+      const f = text.slice(text.lastIndexOf(')') + 2).split(' ');
+      parent.set(Number(d), Number(f[1]));
+      ticks.set(Number(d), Number(f[11]) + Number(f[12]));
+    } catch (e) { /* the process ended meanwhile */ }
+  }
+  let own = 0;
+  for (const [pid, t] of ticks) {
+    let p = pid;
+    for (let hops = 0; p > 1 && p !== root && hops < 64; ++hops) p = parent.get(p) || 0;
+    if (p === root) own += t;
+  }
+  return { total, busy, own };
+}
+
+function otherWork(before, after) {
+  const total = after.total - before.total;
+  return total > 0 ? Math.max(0, (after.busy - before.busy) - (after.own - before.own)) / total : 0;
+}
+
 // A large fleet live at high speed (lanes on a canvas; `drones` of them): p95 of
 // emitted-to-drawn below `bound` ms over the first `events` live events (telemetry included). Prints the
 // page's render times. The test stops the run after.
 async function liveScale(browser, drones, bound, events) {
+  const root = Number(process.env.EAMOS_TEST_PID) || process.ppid;
+  const ticksBefore = cpuTicks(root);
   const page = await open(browser, '');
   await page.waitForFunction(n => window.eamosMonitor.liveLatency().count >= n, { timeout: 90000, polling: 200 }, events);
+  const others = otherWork(ticksBefore, cpuTicks(root));
   const r = await page.evaluate(() => {
     const canvas = document.getElementById('lanes-canvas');
     return { drones: Number(canvas.dataset.drones), hidden: canvas.hidden, mode: document.getElementById('mode').dataset.mode,
@@ -343,13 +378,14 @@ async function liveScale(browser, drones, bound, events) {
               `to sent by the server: median ${ms(v.median)}, p95 ${ms(v.p95)}, max ${ms(v.max)}`);
   console.log(`info: renders: ${r.frames.count}, median ${ms(r.frames.median)}, p95 ${ms(r.frames.p95)}, max ${ms(r.frames.max)}`);
   console.log(`info: load average ${os.loadavg().map(x => x.toFixed(1)).join(' ')} on ${os.cpus().length} cores`);
-  // The bounds are the page's on a host with cores for it. Other work beside it (the load
-  // average counts what waits for a core) delays Chromium's processes more than the page's
-  // script: in real time at load 15-53 on 2 cores the p95 was 190-800 ms with renders of
-  // 2-5 ms. A miss on such a host is reported and skipped, not failed.
-  const load = os.loadavg()[0], cores = os.cpus().length;
+  console.log(`info: other work used ${(100 * others).toFixed(0)} % of the machine while the test measured`);
+  // The bounds are the page's on a host with cores for it. Other work beside it delays
+  // Chromium's processes more than the page's script: in real time at load 15-53 on 2 cores
+  // the p95 was 190-800 ms with renders of 2-5 ms. A miss while other processes took more
+  // than a quarter of the machine is reported and skipped, not failed; on a host left to the
+  // test it fails.
   const timed = (held, what) => {
-    if (!held && load > 4 * cores) console.log(`skip: ${what}, on a loaded host (load average ${load.toFixed(1)} on ${cores} cores)`);
+    if (!held && others > 0.25) console.log(`skip: ${what}, while other work used ${(100 * others).toFixed(0)} % of the machine`);
     else check(held, what);
   };
   timed(l.p95 !== null && l.p95 < bound, `p95 of emitted-to-drawn below ${bound} ms: ${ms(l.p95)}`);
@@ -521,7 +557,7 @@ async function waits(browser) {
     if (mode === 'replay') await replay(browser);
     else if (mode === 'live') await live(browser);
     else if (mode === 'live20') await live20(browser);
-    else if (mode === 'live1000') await liveScale(browser, 1000, 200, 8000);
+    else if (mode === 'live1000') await liveScale(browser, 1000, 100, 8000);
     else if (mode === 'launch') await launchLive(browser);
     else if (mode === 'v1') await v1(browser);
     else if (mode === 'scale') await scale(browser);
