@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <csignal>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -202,6 +203,7 @@ class Ground {
   enum class Stage { barrier, running, done } stage_ = Stage::barrier;
   double barrier_deadline_ = 0.0;  ///< the newest wave's: its start plus the barrier timeout
   double first_started_at_ = 0.0;  ///< wall time the first wave was started
+  double wave_started_at_ = 0.0;   ///< wall time the newest wave was started
   double wall_guard_ = 0.0;
   std::optional<double> finish_at_;
   std::optional<LifecycleSample> abort_;
@@ -336,7 +338,7 @@ bool Ground::fly() {
   std::signal(SIGCHLD, SIG_DFL);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  first_started_at_ = wall_s();
+  first_started_at_ = wave_started_at_ = wall_s();
   barrier_deadline_ = first_started_at_ + o_.barrier_timeout_s;
   watch_ = std::make_unique<ProcessWatch>([this] {
     loop_.post([this] {
@@ -446,7 +448,8 @@ bool Ground::start_next_wave() {
     // Each wave has the whole barrier timeout from its own start: a handshake begins only
     // when the later of its two DEXes starts, so no handshake stays pending longer than
     // that, however many waves the fleet needs (with DDS Security, kMaxSecureBarrierS).
-    barrier_deadline_ = wall_s() + o_.barrier_timeout_s;
+    wave_started_at_ = wall_s();
+    barrier_deadline_ = wave_started_at_ + o_.barrier_timeout_s;
     check_after(o_.barrier_timeout_s);
   }
   std::vector<DroneEntry*> wave, later;
@@ -568,9 +571,16 @@ void Ground::watch_barrier() {
     std::string missing;
     for (auto& d : drones_)
       if (!d.ready_nonce) missing += (missing.empty() ? "" : ", ") + d.name;
-    char secs[32];
-    std::snprintf(secs, sizeof secs, "%g", o_.barrier_timeout_s);
-    fail_barrier(std::string("start barrier timed out after ") + secs + " s; not ready: " + missing);
+    char secs[160];
+    std::snprintf(secs, sizeof secs, "%g s", o_.barrier_timeout_s);
+    if (wave_started_at_ > first_started_at_) {
+      auto is_started = [](const DroneEntry& d) { return d.started; };
+      int started = static_cast<int>(std::count_if(drones_.begin(), drones_.end(), is_started));
+      std::snprintf(secs + std::strlen(secs), sizeof secs - std::strlen(secs),
+                    " of the wave started %.1f s after the first DEX (%d DEX processes started)",
+                    wave_started_at_ - first_started_at_, started);
+    }
+    fail_barrier(std::string("start barrier timed out after ") + secs + "; not ready: " + missing);
   }
 }
 
@@ -877,7 +887,7 @@ int start_wave_for(int drones, bool secure) {
   // Each DEX that joins authenticates with every participant already there (and they with
   // it): a wave of w joining n costs w * n + w * (w - 1) / 2 handshakes at once. Twenty
   // secure DEXes at once were ready on this 2-core host, thirty were not.
-  int wave = secure ? kSecureStartWave : kInsecureStartWave;
+  int wave = !secure ? kInsecureStartWave : drones > kLargeSecureFleet ? kLargeSecureStartWave : kSecureStartWave;
   return drones <= wave ? std::max(1, drones) : wave;
 }
 

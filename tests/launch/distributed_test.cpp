@@ -345,6 +345,20 @@ TEST_F(Distributed, ASecureDexNotReadyWithinItsReadyTimeoutLeavesNamingTheDrones
   EXPECT_NE(longer.out.find("'95' is not a number from"), std::string::npos) << longer.out;
 }
 
+// Each wave has the whole start barrier from its own start (a handshake begins only when
+// the later of its two DEXes starts): the barrier that runs out is the last wave's, and the
+// ground says so. Drone3's DEX is started by no one here.
+TEST_F(Distributed, TheStartBarrierOfAFleetStartedInWavesCountsFromTheLastWave) {
+  fs::path deploy = deploy_listing2(dir_);
+  Output r = eamos("launch " + deploy.string() +
+                   " --drones Drone1,Drone2 --start-wave 1 --barrier-timeout 5 --insecure --domain 44");
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("the 1 DEX processes started so far have heard from each other"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("start barrier timed out after 5 s of the wave started "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("after the first DEX (2 DEX processes started); not ready: Drone1, Drone2, Drone3"),
+            std::string::npos) << r.out;
+}
+
 // `eamos launch` starts a large fleet in waves, and a DEX of an early wave may wait longer
 // than its ready timeout for the later ones: a handshake begins only when the later of its
 // two DEXes joins, whose own ready timeout bounds it. Drones it is told start later are not
