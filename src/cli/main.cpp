@@ -230,7 +230,8 @@ CLI::App* add_launch(CLI::App& app, Options& o) {
       ->check(eamos::cli::positive());
   launch->add_option("--start-wave", l.start_wave,
                      "Start this many DEX processes at once, the next ones when the ground has heard from them "
-                     "(default: the whole fleet up to 10 drones with DDS Security, 25 without; then waves of that size)")
+                     "(default: the whole fleet up to 10 drones with DDS Security, 25 without; then waves of that size, "
+                     "with DDS Security beyond 50 drones of 5)")
       ->check(eamos::cli::whole_number(1, 100000));
   launch->add_option("--state-rate", l.state_rate_hz,
                      "Each DEX publishes its drone's state to the others at most this many times a wall second "

@@ -38,7 +38,9 @@ TEST(StartWave, AFleetUpToTheWaveSizeStartsAtOnceALargerOneInWaves) {
   using eamos::launch::start_wave_for;
   EXPECT_EQ(start_wave_for(3, true), 3);
   EXPECT_EQ(start_wave_for(eamos::launch::kSecureStartWave, true), eamos::launch::kSecureStartWave);
-  EXPECT_EQ(start_wave_for(100, true), eamos::launch::kSecureStartWave);
+  EXPECT_EQ(start_wave_for(50, true), eamos::launch::kSecureStartWave);
+  EXPECT_EQ(start_wave_for(51, true), eamos::launch::kLargeSecureStartWave);
+  EXPECT_EQ(start_wave_for(100, true), eamos::launch::kLargeSecureStartWave);
   EXPECT_EQ(start_wave_for(100, false), eamos::launch::kInsecureStartWave);
   EXPECT_LT(eamos::launch::kSecureStartWave, eamos::launch::kInsecureStartWave);
   EXPECT_EQ(start_wave_for(0, true), 1);
