@@ -1,5 +1,8 @@
 #include "deploy/json_writer.h"
 
+#include <algorithm>
+#include <array>
+#include <cstring>
 #include <charconv>
 #include <cmath>
 
@@ -9,6 +12,13 @@ namespace {
 
 /// Buffered output reaches the stream in pieces of about this size.
 constexpr std::size_t kFlushAt = 64 * 1024;
+
+/// The bytes a JSON string holds as they are: printable ASCII but the quote and backslash.
+constexpr auto kPlain = [] {
+  std::array<bool, 256> plain{};
+  for (int c = 0x20; c < 0x80; ++c) plain[c] = c != '"' && c != '\\';
+  return plain;
+}();
 
 /// Length of the well-formed UTF-8 sequence at the start of `s` (1 to 4), or 0 when the
 /// bytes there are not one (a stray continuation byte, an overlong form, a surrogate, a
@@ -36,38 +46,62 @@ std::size_t utf8_length(std::string_view s) {
 
 }  // namespace
 
-JsonWriter::JsonWriter(std::ostream& out, int wrap_depth) : out_(out), wrap_depth_(wrap_depth) {
-  buffer_.reserve(kFlushAt + 1024);
+JsonWriter::JsonWriter(std::ostream& out, int wrap_depth) : out_(&out), buffer_(own_), wrap_depth_(wrap_depth) {
+  grow(kFlushAt + 1024);
+}
+
+JsonWriter::JsonWriter(std::string& text, int wrap_depth) : buffer_(text), wrap_depth_(wrap_depth) {
+  cur_ = end_ = buffer_.data() + buffer_.size();
 }
 
 JsonWriter::~JsonWriter() { flush(); }
 
+void JsonWriter::grow(std::size_t n) {
+  std::size_t used = cur_ ? static_cast<std::size_t>(cur_ - buffer_.data()) : buffer_.size();
+  // All the room already allocated, else double: a text written in small pieces is copied
+  // a bounded number of times, and a reused string is not allocated again.
+  buffer_.resize(std::max({buffer_.capacity(), buffer_.size() * 2, used + n, std::size_t{4096}}));
+  cur_ = buffer_.data() + used;
+  end_ = buffer_.data() + buffer_.size();
+}
+
+void JsonWriter::settle() {
+  buffer_.resize(static_cast<std::size_t>(cur_ - buffer_.data()));
+  cur_ = end_ = buffer_.data() + buffer_.size();
+}
+
 bool JsonWriter::flush() {
-  out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+  settle();
+  if (!out_) return true;
+  out_->write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
   buffer_.clear();
-  return static_cast<bool>(out_);
+  cur_ = end_ = buffer_.data();
+  grow(0);
+  return static_cast<bool>(*out_);
 }
 
 void JsonWriter::line_break(std::size_t depth) {
-  buffer_ += '\n';
-  buffer_.append(depth, ' ');
+  reserve(depth + 1);
+  *cur_++ = '\n';
+  std::memset(cur_, ' ', depth);
+  cur_ += depth;
 }
 
 void JsonWriter::begin_value() {
-  if (buffer_.size() >= kFlushAt) flush();
+  if (out_ && static_cast<std::size_t>(cur_ - buffer_.data()) >= kFlushAt) flush();
   if (after_key_) {
     after_key_ = false;
     return;
   }
   if (has_items_.empty()) return;  // the document's top-level value
-  if (has_items_.back()) buffer_ += ',';
+  if (has_items_.back()) put(',');
   has_items_.back() = 1;
   if (has_items_.size() <= static_cast<std::size_t>(wrap_depth_)) line_break(has_items_.size());
 }
 
 void JsonWriter::open(char bracket) {
   begin_value();
-  buffer_ += bracket;
+  put(bracket);
   has_items_.push_back(0);
 }
 
@@ -76,7 +110,7 @@ void JsonWriter::close(char bracket) {
   has_items_.pop_back();
   if (had_items && has_items_.size() < static_cast<std::size_t>(wrap_depth_))
     line_break(has_items_.size());
-  buffer_ += bracket;
+  put(bracket);
 }
 
 void JsonWriter::begin_object() { open('{'); }
@@ -87,7 +121,7 @@ void JsonWriter::end_array() { close(']'); }
 void JsonWriter::key(std::string_view name) {
   begin_value();
   write_string(name);
-  buffer_ += ':';
+  put(':');
   after_key_ = true;
 }
 
@@ -109,9 +143,9 @@ void JsonWriter::value(double v) {
   auto [end, ec] = std::to_chars(text, text + sizeof text, v);
   (void)ec;  // 64 characters always suffice for a double
   std::string_view written(text, static_cast<std::size_t>(end - text));
-  buffer_ += written;
+  put(written);
   // nlohmann::json marks integral doubles with ".0" so they read back as floating point.
-  if (written.find_first_of(".e") == std::string_view::npos) buffer_ += ".0";
+  if (written.find_first_of(".e") == std::string_view::npos) put(".0");
 }
 
 void JsonWriter::value(int v) { value(static_cast<long long>(v)); }
@@ -121,17 +155,17 @@ void JsonWriter::value(long long v) {
   char text[24];
   auto [end, ec] = std::to_chars(text, text + sizeof text, v);
   (void)ec;
-  buffer_.append(text, end);
+  put(std::string_view(text, static_cast<std::size_t>(end - text)));
 }
 
 void JsonWriter::value(bool v) {
   begin_value();
-  buffer_ += v ? "true" : "false";
+  put(v ? "true" : "false");
 }
 
 void JsonWriter::null() {
   begin_value();
-  buffer_ += "null";
+  put("null");
 }
 
 // The escapes nlohmann::json writes (without ensure_ascii): quote, backslash and control
@@ -140,15 +174,24 @@ void JsonWriter::null() {
 // need nothing are copied in one piece.
 void JsonWriter::write_string(std::string_view s) {
   static const char* hex = "0123456789abcdef";
-  buffer_ += '"';
+  put('"');
   std::size_t copied = 0;  // s[0, copied) is in the buffer
   std::size_t i = 0;
+  auto hand_over = [&] {  // to the stream, in pieces: a 35 MB source is never whole in memory
+    if (out_ && static_cast<std::size_t>(cur_ - buffer_.data()) >= kFlushAt) flush();
+  };
   while (i < s.size()) {
-    unsigned char c = static_cast<unsigned char>(s[i]);
-    if (c >= 0x20 && c < 0x80 && c != '"' && c != '\\') {
-      ++i;
+    // Names, keys and labels are plain ASCII: one table look-up per byte finds the end of
+    // such a run.
+    std::size_t stop = std::min(s.size(), copied + kFlushAt);
+    while (i < stop && kPlain[static_cast<unsigned char>(s[i])]) ++i;
+    if (i >= stop) {
+      put(s.substr(copied, i - copied));
+      copied = i;
+      hand_over();
       continue;
     }
+    unsigned char c = static_cast<unsigned char>(s[i]);
     if (c >= 0x80) {
       std::size_t n = utf8_length(s.substr(i));
       if (n > 0) {
@@ -156,29 +199,30 @@ void JsonWriter::write_string(std::string_view s) {
         continue;
       }
     }
-    buffer_.append(s.substr(copied, i - copied));
+    put(s.substr(copied, i - copied));
     switch (c) {
-      case '"': buffer_ += "\\\""; break;
-      case '\\': buffer_ += "\\\\"; break;
-      case '\b': buffer_ += "\\b"; break;
-      case '\f': buffer_ += "\\f"; break;
-      case '\n': buffer_ += "\\n"; break;
-      case '\r': buffer_ += "\\r"; break;
-      case '\t': buffer_ += "\\t"; break;
+      case '"': put("\\\""); break;
+      case '\\': put("\\\\"); break;
+      case '\b': put("\\b"); break;
+      case '\f': put("\\f"); break;
+      case '\n': put("\\n"); break;
+      case '\r': put("\\r"); break;
+      case '\t': put("\\t"); break;
       default:
         if (c >= 0x80) {
-          buffer_ += "\xEF\xBF\xBD";  // not UTF-8: U+FFFD
+          put("\xEF\xBF\xBD");  // not UTF-8: U+FFFD
         } else {
-          buffer_ += "\\u00";
-          buffer_ += hex[c >> 4];
-          buffer_ += hex[c & 15];
+          put("\\u00");
+          put(hex[c >> 4]);
+          put(hex[c & 15]);
         }
     }
     ++i;
     copied = i;
+    hand_over();
   }
-  buffer_.append(s.substr(copied));
-  buffer_ += '"';
+  put(s.substr(copied));
+  put('"');
 }
 
 }  // namespace eamos::deploy

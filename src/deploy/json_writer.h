@@ -4,6 +4,7 @@
 // them (strings escaped the same way, doubles in their shortest form that reads back to the
 // same value, integral doubles with ".0"), so a file written here parses to exactly the
 // nlohmann::json the graph exporters build.
+#include <cstring>
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -17,6 +18,9 @@ class JsonWriter {
   /// of their own, indented one space per level; deeper ones stay on their parent's line.
   /// 0 writes the whole document on one line: the canonical form the mission hash reads.
   explicit JsonWriter(std::ostream& out, int wrap_depth = 0);
+  /// Appends to `text` instead, all of it, with no stream between: a mission file is
+  /// made whole in one buffer, hashed there and written with one call.
+  explicit JsonWriter(std::string& text, int wrap_depth = 0);
   ~JsonWriter();  ///< flushes
 
   void begin_object();
@@ -42,7 +46,8 @@ class JsonWriter {
   void member(std::string_view name, long long v) { key(name); value(v); }
   void member(std::string_view name, bool v) { key(name); value(v); }
 
-  /// Hands what is buffered to the stream; false when the stream has failed.
+  /// Hands what is buffered to the stream; false when the stream has failed. Appending
+  /// to a string, it has nothing to do.
   bool flush();
 
  private:
@@ -52,8 +57,30 @@ class JsonWriter {
   void write_string(std::string_view s);
   void line_break(std::size_t depth);
 
-  std::ostream& out_;
-  std::string buffer_;          ///< written to out_ in large pieces
+  /// Room for `n` more bytes at cur_. Bytes are written through a pointer into space the
+  /// string already holds, not appended one by one: each append checks and sets the
+  /// string's length, and a large fleet's files are written a few bytes at a time.
+  void reserve(std::size_t n) {
+    if (static_cast<std::size_t>(end_ - cur_) < n) grow(n);
+  }
+  void grow(std::size_t n);
+  void put(char c) {
+    reserve(1);
+    *cur_++ = c;
+  }
+  void put(std::string_view s) {
+    reserve(s.size());
+    std::memcpy(cur_, s.data(), s.size());
+    cur_ += s.size();
+  }
+  /// Gives the string the length of what is written (it holds spare room while writing).
+  void settle();
+
+  std::ostream* out_ = nullptr;  ///< null: the text appended to is the whole output
+  std::string own_;              ///< the buffer when writing to a stream
+  std::string& buffer_;          ///< written to out_ in large pieces
+  char* cur_ = nullptr;          ///< where the next byte goes, inside buffer_
+  char* end_ = nullptr;          ///< the end of buffer_'s room
   int wrap_depth_;
   std::vector<char> has_items_;  ///< per open container: 1 once something is in it
   bool after_key_ = false;       ///< a key was written; the next value is its member's

@@ -49,6 +49,11 @@ bool write_drone_mission(std::ostream& out, const graph::Compilation& c, int dro
 std::string mission_text(const graph::Compilation& c, int drone, const std::string& hash,
                          FleetMembers fleet_members = FleetMembers::written);
 
+/// write_drone_mission appended to `text`: one buffer that a caller writing many files
+/// reuses, so each is made in memory already allocated, hashed there and written whole.
+void append_drone_mission(std::string& text, const graph::Compilation& c, int drone, const std::string& hash,
+                          FleetMembers fleet_members = FleetMembers::written);
+
 /// The most defects one read reports; a badly damaged file would otherwise print one
 /// line per node.
 inline constexpr std::size_t kMaxMissionDefects = 50;

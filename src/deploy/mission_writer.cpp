@@ -2,9 +2,8 @@
 // compiled graphs to the file (or the digest), never as a document in memory, in an order
 // a reader can use: format and version first, the file hash last. mission_reader.cpp is
 // the one reader of what is written here.
-#include <sstream>
+#include <algorithm>
 #include <streambuf>
-#include <unordered_map>
 
 #include "deploy/json_writer.h"
 #include "deploy/sha256.h"
@@ -231,7 +230,9 @@ void write_drone_names(JsonWriter& w, const Compilation& c, const std::vector<in
 /// what it is, where it came from, and what executing it needs. `labels`: also the
 /// human-readable `text` of actions and conditions, which follows from the rest (the
 /// mission hash leaves it out).
-void write_node_content(JsonWriter& w, const Compilation& c, const MegNode& n, bool labels) {
+/// `label`: a string the caller reuses for every node's text, so that labelling a node
+/// allocates nothing.
+void write_node_content(JsonWriter& w, const Compilation& c, const MegNode& n, bool labels, std::string& label) {
   w.member("kind", graph::meg_kind_name(n.kind));
   w.member("name", n.name);
   w.member("line", n.loc.line);
@@ -241,13 +242,21 @@ void write_node_content(JsonWriter& w, const Compilation& c, const MegNode& n, b
     w.begin_array();
     for (const lang::Expr* a : n.args) write_expr(w, *a);
     w.end_array();
-    if (labels) w.member("text", graph::meg_node_label(c, n));
+    if (labels) {
+      label.clear();
+      graph::append_meg_node_label(label, c, n);
+      w.member("text", label);
+    }
   }
   if (n.kind == MegKind::condition) {
     w.member("control", lang::control_name(n.control));
     w.key("condition");
     write_expr(w, *n.condition);
-    if (labels) w.member("text", lang::expr_text(*n.condition));
+    if (labels) {
+      label.clear();
+      lang::append_expr_text(label, *n.condition);
+      w.member("text", label);
+    }
     if (n.control == lang::ControlKind::RepeatFor) w.member("count", n.count);
   }
   if (!n.reads.empty()) {
@@ -288,13 +297,16 @@ void write_mdg(JsonWriter& w, const Compilation& c, const graph::Mdg& g) {
 
   // A terminal names its condition by index in this MDG. Conditions are never cloned, so
   // their MEG id finds them.
-  std::unordered_map<int, int> condition_index;
+  // A sorted array, not a hash map: one allocation per drone instead of one per condition.
+  std::vector<std::pair<int, int>> condition_index;  // (MEG id, index in this MDG)
   for (std::size_t i = 0; i < g.nodes.size(); ++i)
     if (c.meg.nodes[g.nodes[i].meg].kind == MegKind::condition)
-      condition_index.emplace(g.nodes[i].meg, static_cast<int>(i));
+      condition_index.emplace_back(g.nodes[i].meg, static_cast<int>(i));
+  std::sort(condition_index.begin(), condition_index.end());
 
   w.key("nodes");
   w.begin_array();
+  std::string label;
   for (std::size_t i = 0; i < g.nodes.size(); ++i) {
     const graph::MdgNode& mn = g.nodes[i];
     const MegNode& n = c.meg.nodes[mn.meg];
@@ -306,15 +318,15 @@ void write_mdg(JsonWriter& w, const Compilation& c, const graph::Mdg& g) {
     if (graph::is_sync_point(n.kind)) w.member("clone", true);
     if (mn.waits >= 0) w.member("waits", mn.waits);
     if (mn.notify >= 0) w.member("notify", mn.notify);
-    write_node_content(w, c, n, true);
+    write_node_content(w, c, n, true, label);
     if (n.kind == MegKind::condition) w.member("evaluated_by", c.drone_name(n.drone));
     if (!mn.cancels.empty()) {
       w.key("cancels");
       write_ints(w, mn.cancels);
     }
     if (n.kind == MegKind::terminal && n.owner_condition >= 0) {
-      auto it = condition_index.find(n.owner_condition);
-      if (it != condition_index.end()) w.member("condition", it->second);
+      auto it = std::lower_bound(condition_index.begin(), condition_index.end(), std::pair{n.owner_condition, -1});
+      if (it != condition_index.end() && it->first == n.owner_condition) w.member("condition", it->second);
     }
     w.end_object();
   }
@@ -331,18 +343,15 @@ void write_mdg(JsonWriter& w, const Compilation& c, const graph::Mdg& g) {
   w.end_array();
 }
 
-/// A stream whose bytes go into a SHA-256 digest and, when `copy` is set, on to `copy`
-/// too: the mission file is hashed as it is written, in one pass.
+/// A stream whose bytes go into a SHA-256 digest: the mission hash reads its canonical
+/// form as it is written.
 class DigestBuffer : public std::streambuf {
  public:
-  explicit DigestBuffer(Sha256& digest, std::ostream* copy = nullptr) : digest_(digest), copy_(copy) {}
-  /// Bytes written from now on go to `copy` only.
-  void stop_digest() { digesting_ = false; }
+  explicit DigestBuffer(Sha256& digest) : digest_(digest) {}
 
  protected:
   std::streamsize xsputn(const char* s, std::streamsize n) override {
-    if (digesting_) digest_.update(s, static_cast<std::size_t>(n));
-    if (copy_ && !copy_->write(s, n)) return 0;
+    digest_.update(s, static_cast<std::size_t>(n));
     return n;
   }
   int_type overflow(int_type ch) override {
@@ -353,8 +362,6 @@ class DigestBuffer : public std::streambuf {
 
  private:
   Sha256& digest_;
-  std::ostream* copy_;
-  bool digesting_ = true;
 };
 
 }  // namespace
@@ -362,12 +369,10 @@ class DigestBuffer : public std::streambuf {
 // The file hash is the last member, over every byte before it (docs/architecture.md,
 // "Mission file"): the reader checks it without a canonical form of its own, and any edit
 // of the file, even of white space, is caught.
-bool write_drone_mission(std::ostream& out, const Compilation& c, int drone, const std::string& hash,
-                         FleetMembers fleet_members) {
-  Sha256 sha;
-  DigestBuffer tee(sha, &out);
-  std::ostream both(&tee);
-  JsonWriter w(both, kMissionFileWrap);
+void append_drone_mission(std::string& text, const Compilation& c, int drone, const std::string& hash,
+                          FleetMembers fleet_members) {
+  std::size_t start = text.size();
+  JsonWriter w(text, kMissionFileWrap);
   w.begin_object();
   w.member("format", "eamos-mission");
   w.member("format_version", kMissionFormatVersion);
@@ -393,17 +398,25 @@ bool write_drone_mission(std::ostream& out, const Compilation& c, int drone, con
   write_drone_names(w, c, g.reads);
   write_separation(w, c, fleet_members);
   write_mdg(w, c, g);
-  if (!w.flush()) return false;
-  tee.stop_digest();
+  w.flush();  // the text holds every byte written so far
+  Sha256 sha;
+  sha.update(text.data() + start, text.size() - start);
   w.member(kFileHashMember, sha.hex_digest());
   w.end_object();
-  return w.flush() && static_cast<bool>(out);
+}
+
+bool write_drone_mission(std::ostream& out, const Compilation& c, int drone, const std::string& hash,
+                         FleetMembers fleet_members) {
+  std::string text;
+  append_drone_mission(text, c, drone, hash, fleet_members);
+  out.write(text.data(), static_cast<std::streamsize>(text.size()));
+  return static_cast<bool>(out);
 }
 
 std::string mission_text(const Compilation& c, int drone, const std::string& hash, FleetMembers fleet_members) {
-  std::ostringstream out;
-  write_drone_mission(out, c, drone, hash, fleet_members);
-  return out.str();
+  std::string text;
+  append_drone_mission(text, c, drone, hash, fleet_members);
+  return text;
 }
 
 // The canonical form hashed is one line of JSON: every drone's settings and type, then
@@ -433,11 +446,12 @@ std::string mission_hash(const Compilation& c) {
     w.member("end", c.meg.end);
     w.key("nodes");
     w.begin_array();
+    std::string unused;
     for (const MegNode& n : c.meg.nodes) {
       w.begin_object();
       w.member("id", n.id);
       if (n.drone >= 0) w.member("drone", c.drone_name(n.drone));
-      write_node_content(w, c, n, false);
+      write_node_content(w, c, n, false, unused);
       if (n.kind == MegKind::condition) {
         w.key("terminals");
         write_ints(w, n.terminals);

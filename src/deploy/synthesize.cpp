@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "deploy/json_writer.h"
 #include "graph/export.h"
 #include "version.h"
 
@@ -74,36 +75,32 @@ bool cannot_write(const std::filesystem::path& path, Diagnostics& diags) {
 
 bool write_text(const std::filesystem::path& path, const std::string& text, Diagnostics& diags) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
+  out.write(text.data(), static_cast<std::streamsize>(text.size()));
   out.close();
   return out ? true : cannot_write(path, diags);
 }
 
-/// The header holds the mission's whole source: serialised straight into the file, as
-/// dump(2) would print it, so that a large mission's text is not held twice more in memory
-/// (the dump and the dump with its newline). Mission and fleet text may hold any byte:
-/// replaced, not thrown, as in the trace itself.
-///
-/// Nor is the source copied into the header: its text is lent to it for the dump and
-/// given back, the same bytes in the same buffer, so the AST's names, which are views into
-/// it, stay valid (a copy would be 35 MB of the 520,000-statement show's peak).
+/// The header holds the mission's whole source: written as dump(2) would print it, but
+/// the source's text is escaped by JsonWriter straight into the file's text, not copied
+/// into the document and escaped by nlohmann's serializer (a tenth of a large show's
+/// files stage; a copy of the source would be 35 MB of its peak). The two escape alike: quote,
+/// backslash and control characters, as nlohmann does without ensure_ascii. A mission
+/// that compiled is valid UTF-8 (the lexer reports any other byte), so nlohmann's
+/// replacement of invalid bytes never applies to it; the fleet's text keeps nlohmann's.
 bool write_trace_header(const graph::Compilation& c, const std::filesystem::path& path, const std::string& hash,
                         Diagnostics& diags) {
+  std::string text = header_with(c, hash, 0, std::string()).dump(2, ' ', false, json::error_handler_t::replace);
+  // The first "source" member is the header's own: a string value has its quotes escaped.
+  const std::string_view empty_source = "\"source\": \"\"";
+  std::size_t at = text.find(empty_source) + empty_source.size() - 2;
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(text.data(), static_cast<std::streamsize>(at));
   {
-    // Swapped in once the header is whole: adding a member may copy the others.
-    nlohmann::ordered_json header = header_with(c, hash, 0, std::string());
-    struct Lent {
-      std::string& owner;
-      std::string& borrower;
-      ~Lent() { owner.swap(borrower); }
-    } lent{c.source->text, header["source"].get_ref<std::string&>()};
-    lent.owner.swap(lent.borrower);
-    nlohmann::detail::serializer<nlohmann::ordered_json> writer(nlohmann::detail::output_adapter<char>(out), ' ',
-                                                               json::error_handler_t::replace);
-    writer.dump(header, true, false, 2);
+    JsonWriter w(out);  // in pieces of 64 KB: the escaped source is never whole in memory
+    w.value(c.source->text);
   }
-  out << "\n";
+  out.write(text.data() + at + 2, static_cast<std::streamsize>(text.size() - at - 2));
+  out << '\n';
   out.close();
   return out ? true : cannot_write(path, diags);
 }
@@ -125,6 +122,9 @@ bool write_deployment(const graph::Compilation& c, const std::string& dir, const
   }
   if (!write_text(fs::path(dir) / "manifest.json", manifest(c, hash).dump(2) + "\n", diags)) return false;
   if (!write_trace_header(c, fs::path(dir) / "trace-header.json", hash, diags)) return false;
+  // One drone's file at a time is made in one buffer, reused (its capacity kept) by the next,
+  // and written with one call: a large fleet's files are a third of the compile.
+  std::string text;
   for (int d = 0; d < c.drone_count(); ++d) {
     fs::path folder = fs::path(dir) / c.drone_name(d);
     fs::create_directories(folder, ec);
@@ -132,13 +132,11 @@ bool write_deployment(const graph::Compilation& c, const std::string& dir, const
       diags.error(nullptr, {}, "cannot create '" + folder.string() + "': " + ec.message());
       return false;
     }
-    // Streamed straight into the file: no drone's mission is ever held in memory.
+    text.clear();
+    append_drone_mission(text, c, d, hash);
+    text += '\n';
     fs::path file = folder / "mission.json";
-    std::ofstream out(file, std::ios::binary | std::ios::trunc);
-    bool written = out && write_drone_mission(out, c, d, hash);
-    out << "\n";
-    out.close();
-    if (!written || !out) return cannot_write(file, diags);
+    if (!write_text(file, text, diags)) return false;
   }
   return true;
 }

@@ -25,5 +25,7 @@ nlohmann::json expr_json(const lang::Expr& e, const lang::Mission& m);
 nlohmann::json meg_node_json(const Compilation& c, const MegNode& n);
 /// Short human label: "Drone1.Takeoff(3)", "If Drone1.Sensor1() >= 100", "fork PAR_x".
 std::string meg_node_label(const Compilation& c, const MegNode& n);
+/// meg_node_label appended to `out`: a writer labelling every node reuses one string.
+void append_meg_node_label(std::string& out, const Compilation& c, const MegNode& n);
 
 }  // namespace eamos::graph

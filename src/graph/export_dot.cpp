@@ -107,25 +107,49 @@ void legend(std::ostringstream& out, const Compilation& c) {
 
 }  // namespace
 
-std::string meg_node_label(const Compilation& c, const MegNode& n) {
+void append_meg_node_label(std::string& out, const Compilation& c, const MegNode& n) {
   switch (n.kind) {
-    case MegKind::init: return "INIT";
-    case MegKind::end: return "end";
-    case MegKind::action: return c.drone_name(n.drone) + "." + std::string(n.name) + "(" + args_text(n.args) + ")";
-    case MegKind::fork: return "fork " + std::string(n.name);
-    case MegKind::condition: {
-      std::string s = std::string(n.name) + " " + lang::expr_text(*n.condition);
-      if (n.control == lang::ControlKind::RepeatFor) s += " ×" + std::to_string(n.count);
-      return s;
-    }
-    case MegKind::terminal: return "T " + std::string(n.name);
+    case MegKind::init: out += "INIT"; return;
+    case MegKind::end: out += "end"; return;
+    case MegKind::action:
+      out += c.drone_name(n.drone);
+      out += '.';
+      out.append(n.name);
+      out += '(';
+      for (std::size_t i = 0; i < n.args.size(); ++i) {
+        if (i) out += ", ";
+        lang::append_expr_text(out, *n.args[i]);
+      }
+      out += ')';
+      return;
+    case MegKind::fork:
+      out += "fork ";
+      out.append(n.name);
+      return;
+    case MegKind::condition:
+      out.append(n.name);
+      out += ' ';
+      lang::append_expr_text(out, *n.condition);
+      if (n.control == lang::ControlKind::RepeatFor) out += " ×" + std::to_string(n.count);
+      return;
+    case MegKind::terminal:
+      out += "T ";
+      out.append(n.name);
+      return;
     case MegKind::pause: {
       std::ostringstream s;
       s << "PauseFor(" << n.seconds << ")";
-      return s.str();
+      out += s.str();
+      return;
     }
   }
-  return n.name;
+  out.append(n.name);
+}
+
+std::string meg_node_label(const Compilation& c, const MegNode& n) {
+  std::string out;
+  append_meg_node_label(out, c, n);
+  return out;
 }
 
 std::string amt_dot(const Compilation& c) {

@@ -237,8 +237,15 @@ class LogicChecker {
   /// outcome other than `excluded` (a seed's arcs of those branches do not count).
   std::vector<char> after(const std::vector<int>& seeds, std::initializer_list<Branch> excluded = {}) {
     std::vector<char> seed(meg_.nodes.size(), 0), mark(meg_.nodes.size(), 0);
-    for (int s : seeds) seed[s] = 1;
-    for (int x : order_)
+    // A node's predecessors come before it in the order, so nothing before the first seed
+    // can be marked: the walk starts there (on average half the graph for each condition).
+    std::size_t first = order_.size();
+    for (int s : seeds) {
+      seed[s] = 1;
+      first = std::min(first, static_cast<std::size_t>(position_[s]));
+    }
+    for (std::size_t k = first; k < order_.size(); ++k) {
+      int x = order_[k];
       for (const Pred& p : preds_[x]) {
         bool counts = seed[p.node] && std::find(excluded.begin(), excluded.end(), p.via) == excluded.end();
         if (counts || mark[p.node]) {
@@ -246,6 +253,7 @@ class LogicChecker {
           break;
         }
       }
+    }
     return mark;
   }
 

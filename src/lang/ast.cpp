@@ -49,17 +49,20 @@ int Mission::find_function(const std::string& name) const {
 }
 
 namespace {
-std::string number_text(double v) {
+void append_number(std::string& out, double v) {
+  char buf[32];
   if (std::isfinite(v) && v == std::floor(v) && std::fabs(v) < 1e15) {
     // What "%.0f" prints, without printf's cost: labels print a number per argument.
-    if (v == 0 && std::signbit(v)) return "-0";
-    char buf[32];
+    if (v == 0 && std::signbit(v)) {
+      out += "-0";
+      return;
+    }
     auto end = std::to_chars(buf, buf + sizeof buf, static_cast<long long>(v)).ptr;
-    return std::string(buf, end);
+    out.append(buf, end);
+    return;
   }
-  char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
+  out += buf;
 }
 
 // Go's binary precedence, used to print parentheses only where needed.
@@ -74,23 +77,42 @@ int precedence(Op op) {
   }
 }
 
-std::string text_of(const Expr& e, int parent_precedence) {
+void append_text(std::string& out, const Expr& e, int parent_precedence) {
   switch (e.kind) {
-    case ExprKind::number: return number_text(e.number);
-    case ExprKind::boolean: return e.boolean ? "true" : "false";
-    case ExprKind::property: return std::string(e.drone) + "." + std::string(e.property) + "()";
-    case ExprKind::name: return std::string(e.drone);
-    case ExprKind::unary: return std::string(op_text(e.op)) + text_of(*e.lhs, 6);
+    case ExprKind::number: append_number(out, e.number); return;
+    case ExprKind::boolean: out += e.boolean ? "true" : "false"; return;
+    case ExprKind::property:
+      out.append(e.drone);
+      out += '.';
+      out.append(e.property);
+      out += "()";
+      return;
+    case ExprKind::name: out.append(e.drone); return;
+    case ExprKind::unary:
+      out += op_text(e.op);
+      append_text(out, *e.lhs, 6);
+      return;
     case ExprKind::binary: {
       int p = precedence(e.op);
-      std::string s = text_of(*e.lhs, p) + " " + op_text(e.op) + " " + text_of(*e.rhs, p + 1);
-      return p < parent_precedence ? "(" + s + ")" : s;
+      if (p < parent_precedence) out += '(';
+      append_text(out, *e.lhs, p);
+      out += ' ';
+      out += op_text(e.op);
+      out += ' ';
+      append_text(out, *e.rhs, p + 1);
+      if (p < parent_precedence) out += ')';
+      return;
     }
   }
-  return "";
 }
 }  // namespace
 
-std::string expr_text(const Expr& e) { return text_of(e, 0); }
+std::string expr_text(const Expr& e) {
+  std::string out;
+  append_text(out, e, 0);
+  return out;
+}
+
+void append_expr_text(std::string& out, const Expr& e) { append_text(out, e, 0); }
 
 }  // namespace eamos::lang

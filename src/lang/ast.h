@@ -113,5 +113,7 @@ struct Mission {
 
 /// Source text of an expression, normalised ("Drone1.X() >= 5"), for labels and logs.
 std::string expr_text(const Expr& e);
+/// expr_text appended to `out`: a writer labelling every node reuses one string.
+void append_expr_text(std::string& out, const Expr& e);
 
 }  // namespace eamos::lang

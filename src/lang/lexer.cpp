@@ -1,6 +1,6 @@
 #include "lang/lexer.h"
 
-#include <cctype>
+#include <array>
 #include <string>
 
 namespace eamos::lang {
@@ -42,10 +42,26 @@ const char* token_kind_name(TokenKind kind) {
   return "token";
 }
 
-char Lexer::peek(std::size_t ahead) const {
-  std::size_t at = pos_ + ahead;
-  return at < file_.text.size() ? file_.text[at] : '\0';
-}
+namespace {
+
+// The character classes of the ASCII the language is written in, by table: <cctype>'s
+// functions are calls into the C library per byte (and follow the locale), a tenth of
+// the parse of a large mission.
+enum : unsigned char { kDigit = 1, kLetter = 2, kSpace = 4 };
+constexpr auto kClass = [] {
+  std::array<unsigned char, 256> t{};
+  for (int c = '0'; c <= '9'; ++c) t[c] = kDigit;
+  for (int c = 'a'; c <= 'z'; ++c) t[c] = kLetter;
+  for (int c = 'A'; c <= 'Z'; ++c) t[c] = kLetter;
+  for (char c : {' ', '\t', '\n', '\v', '\f', '\r'}) t[static_cast<unsigned char>(c)] = kSpace;
+  return t;
+}();
+bool is_digit(char c) { return kClass[static_cast<unsigned char>(c)] & kDigit; }
+bool is_letter(char c) { return kClass[static_cast<unsigned char>(c)] & kLetter; }
+bool is_word(char c) { return (kClass[static_cast<unsigned char>(c)] & (kDigit | kLetter)) || c == '_'; }
+bool is_space(char c) { return kClass[static_cast<unsigned char>(c)] & kSpace; }
+
+}  // namespace
 
 Token Lexer::make(TokenKind kind, std::size_t begin, std::size_t end) {
   return {kind, std::string_view(file_.text).substr(begin, end - begin), location_of(begin)};
@@ -122,9 +138,9 @@ Token Lexer::next() {
   std::size_t begin = pos_;
   unsigned char c = static_cast<unsigned char>(peek());
   Token t;
-  if (std::isdigit(c) || (c == '.' && std::isdigit(static_cast<unsigned char>(peek(1)))))
+  if (is_digit(static_cast<char>(c)) || (c == '.' && is_digit(peek(1))))
     t = lex_number(begin);
-  else if (std::isalpha(c) || c == '_')
+  else if (is_letter(static_cast<char>(c)) || c == '_')
     t = lex_identifier(begin);
   else
     t = lex_operator(begin);
@@ -136,14 +152,14 @@ Token Lexer::next() {
 }
 
 Token Lexer::lex_number(std::size_t begin) {
-  auto digit = [&] { return std::isdigit(static_cast<unsigned char>(peek())) != 0; };
+  auto digit = [&] { return is_digit(peek()); };
   bool is_decimal = false;
   while (digit()) ++pos_;
-  if (peek() == '.' && std::isdigit(static_cast<unsigned char>(peek(1)))) {
+  if (peek() == '.' && is_digit(peek(1))) {
     is_decimal = true;
     ++pos_;
     while (digit()) ++pos_;
-  } else if (peek() == '.' && !std::isalpha(static_cast<unsigned char>(peek(1))) && peek(1) != '_') {
+  } else if (peek() == '.' && !is_letter(peek(1)) && peek(1) != '_') {
     // "5." is a decimal in Go; "Drone1.X" never starts with a digit, so no ambiguity.
     is_decimal = true;
     ++pos_;
@@ -159,8 +175,8 @@ Token Lexer::lex_number(std::size_t begin) {
       pos_ = save;
     }
   }
-  if (std::isalpha(static_cast<unsigned char>(peek())) || peek() == '_') {
-    while (std::isalnum(static_cast<unsigned char>(peek())) || peek() == '_') ++pos_;
+  if (is_letter(peek()) || peek() == '_') {
+    while (is_word(peek())) ++pos_;
     diags_.error(&file_, file_.location_of(begin),
                  "malformed number '" + std::string(file_.text.substr(begin, pos_ - begin)) +
                      "'; a number cannot be followed by letters (units are implied: metres, seconds)");
@@ -170,7 +186,7 @@ Token Lexer::lex_number(std::size_t begin) {
 }
 
 Token Lexer::lex_identifier(std::size_t begin) {
-  while (std::isalnum(static_cast<unsigned char>(peek())) || peek() == '_') ++pos_;
+  while (is_word(peek())) ++pos_;
   Token t = make(TokenKind::identifier, begin, pos_);
   if (t.text == "package") t.kind = TokenKind::kw_package;
   else if (t.text == "var") t.kind = TokenKind::kw_var;
@@ -221,7 +237,7 @@ Token Lexer::lex_unknown(std::size_t begin) {
   char c = peek();
   while (!at_end()) {
     unsigned char u = static_cast<unsigned char>(peek());
-    bool known = std::isalnum(u) || std::isspace(u) || std::string_view("(){},.;+-*/!<>_\"").find(char(u)) != std::string_view::npos;
+    bool known = is_word(static_cast<char>(u)) || is_space(static_cast<char>(u)) || std::string_view("(){},.;+-*/!<>_\"").find(char(u)) != std::string_view::npos;
     if (known && pos_ > begin) break;
     ++pos_;
     if (known) break;

@@ -28,7 +28,10 @@ class Lexer {
   Token lex_operator(std::size_t begin);
   Token lex_unknown(std::size_t begin);
   bool at_end() const { return pos_ >= file_.text.size(); }
-  char peek(std::size_t ahead = 0) const;
+  char peek(std::size_t ahead = 0) const {
+    std::size_t at = pos_ + ahead;
+    return at < file_.text.size() ? file_.text[at] : '\0';
+  }
 
   const SourceFile& file_;
   Diagnostics& diags_;

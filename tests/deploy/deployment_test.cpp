@@ -70,8 +70,22 @@ TEST(DeploymentCompile, FreesTheStatementsButWritesTheSameMissionFiles) {
     EXPECT_EQ(deploy::mission_text(lean, d, hash), deploy::mission_text(*full, d, hash)) << full->drone_name(d);
 }
 
-// The trace header borrows the source's text for its dump: the AST's names are views into
-// that buffer, so it must come back the same bytes at the same address.
+// The header's source is escaped by JsonWriter straight into the file: the file must be
+// what nlohmann's dump(2) of the same header prints, byte for byte, whatever the comments
+// hold (quotes, backslashes, tabs, carriage returns, control characters, DEL, UTF-8).
+TEST_F(Deployment, TheTraceHeaderIsTheDumpOfTheHeaderWhateverTheSourceHolds) {
+  std::string text = test::listing2_text() + "// \"quoted\" back\\slash\ttab\r\x01\x1f\x7f caf\xc3\xa9 \xf0\x9f\x9a\x81 \"source\": \"\"\n";
+  auto c = test::compile_mission(text, test::kListing2Fleet);
+  ASSERT_TRUE(c);
+  Diagnostics diags;
+  ASSERT_TRUE(deploy::write_deployment(*c, dir_.string(), diags)) << diags.format();
+  std::string expected = deploy::trace_header(*c, deploy::mission_hash(*c), 0)
+                             .dump(2, ' ', false, json::error_handler_t::replace) + "\n";
+  EXPECT_EQ(test::read_text((dir_ / "trace-header.json").string()), expected);
+}
+
+// The AST's names are views into the source's buffer: writing the header must leave it
+// the same bytes at the same address.
 TEST_F(Deployment, WritingTheTraceHeaderLeavesTheSourceWhereTheNamesPointInto) {
   auto c = test::compile_mission(test::listing2_text(), test::kListing2Fleet);
   ASSERT_TRUE(c);

@@ -129,3 +129,52 @@ TEST(JsonWriter, WrapDepthPutsEachNodeOnALineOfItsOwn) {
 
 }  // namespace
 }  // namespace eamos
+
+namespace eamos {
+namespace {
+
+/// A stream that keeps what it is given and the largest piece it was given at once.
+class Pieces : public std::streambuf {
+ public:
+  std::string text;
+  std::size_t largest = 0;
+
+ protected:
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    text.append(s, static_cast<std::size_t>(n));
+    largest = std::max(largest, static_cast<std::size_t>(n));
+    return n;
+  }
+  int_type overflow(int_type ch) override {
+    if (traits_type::eq_int_type(ch, traits_type::eof())) return traits_type::not_eof(ch);
+    char c = traits_type::to_char_type(ch);
+    return xsputn(&c, 1) == 1 ? ch : traits_type::eof();
+  }
+};
+
+// The trace header's source is one string of up to tens of megabytes: written to a stream
+// it goes in pieces of about 64 KB, escapes and all, and reads back as the same string;
+// appended to a string, the same bytes.
+TEST(JsonWriter, ALongStringGoesToAStreamInPiecesAndToAStringWhole) {
+  std::string source;
+  for (int i = 0; source.size() < 1000000; ++i)
+    source += "func SEQ_" + std::to_string(i) + "() {\n\tD1.FlyTo(1, 2, 3) // \"caf\xc3\xa9\" \\ \x01\n}\n";
+  Pieces pieces;
+  std::ostream out(&pieces);
+  {
+    JsonWriter w(out);
+    w.value(source);
+  }
+  EXPECT_EQ(json::parse(pieces.text).get<std::string>(), source);
+  EXPECT_EQ(pieces.text, json(source).dump());
+  EXPECT_LE(pieces.largest, 80u * 1024) << "the escaped string was held whole";
+  std::string appended = "[";
+  {
+    JsonWriter w(appended);
+    w.value(source);
+  }
+  EXPECT_EQ(appended, "[" + pieces.text);
+}
+
+}  // namespace
+}  // namespace eamos

@@ -37,6 +37,26 @@ void expect_streamed_files_equal_documents(const graph::Compilation& c) {
   }
 }
 
+// The compiler makes every drone's file in one reused buffer: a file appended after
+// another's text (left in the buffer) must be the same bytes, and carry the same file
+// hash, as the file made alone, so the hash covers only its own file.
+TEST(MissionFile, AFileMadeAfterAnotherInTheSameBufferIsTheFileMadeAlone) {
+  auto c = compile_mission(test::listing2_text());
+  ASSERT_TRUE(c);
+  std::string hash = deploy::mission_hash(*c);
+  std::string buffer = "text already in the buffer";
+  deploy::append_drone_mission(buffer, *c, 0, hash);
+  std::size_t first_end = buffer.size();
+  deploy::append_drone_mission(buffer, *c, 1, hash);
+  EXPECT_EQ(buffer.substr(0, 26), "text already in the buffer");
+  EXPECT_EQ(buffer.substr(26, first_end - 26), deploy::mission_text(*c, 0, hash));
+  std::string second = buffer.substr(first_end);
+  EXPECT_EQ(second, deploy::mission_text(*c, 1, hash));
+  dex::Mission m;
+  std::vector<std::string> errors;
+  EXPECT_TRUE(deploy::read_mission(second, c->drone_name(1), m, errors)) << (errors.empty() ? "" : errors.front());
+}
+
 TEST(MissionFile, StreamedFileEqualsDroneMissionForEveryDroneOfListing2) {
   auto c = compile_mission(test::listing2_text(), test::kListing2Fleet);
   ASSERT_TRUE(c);
