@@ -231,7 +231,8 @@ CLI::App* add_launch(CLI::App& app, Options& o) {
       ->check(eamos::cli::positive());
   launch->add_option("--start-wave", l.start_wave,
                      "Start this many DEX processes at once, the next ones when the ground has heard from them "
-                     "(default: the whole fleet up to 10 drones with DDS Security, 25 without; then waves of that size)")
+                     "(default: the whole fleet up to 10 drones with DDS Security, 25 without; then waves of that size, "
+                     "with DDS Security beyond 50 drones of 5)")
       ->check(eamos::cli::whole_number(1, 100000));
   launch->add_option("--state-rate", l.state_rate_hz,
                      "Each DEX publishes its drone's state to the others at most this many times a wall second "
@@ -267,6 +268,10 @@ CLI::App* add_dex(CLI::App& app, Options& o) {
                      "With DDS Security: leave (exit 1) when not every other drone was heard from within this many "
                      "seconds of joining DDS, before Cyclone DDS gives its handshakes up (default and most: 90)")
       ->check(eamos::cli::number_between(0.1, eamos::launch::kSecureUnreadyLimitS));
+  dexcmd->add_option("--later-drones", d.later_drones,
+                     "Drones whose DEX starts after this one (set by `eamos launch` for its later waves): "
+                     "--ready-timeout does not wait for them, their own DEX answers for those handshakes")
+      ->delimiter(',');
   dexcmd->add_option("--state-rate", d.state_rate_hz,
                      "Publish this drone's state to the other drones at most this many times a wall second, "
                      "20 or more: at every change (default: 20 up to 20 drones, then 20 * (20 / drones)^2, at least 1)")

@@ -51,7 +51,7 @@ void on_dex_signal(int signal) {
 
 int DexProcess::run(const mid::AdapterRegistry& adapters) {
   nonce_ = process_nonce();
-  if (!load(adapters) || !open_dds()) return 1;
+  if (!load(adapters) || !check_later_drones() || !open_dds()) return 1;
   std::signal(SIGINT, on_dex_signal);
   std::signal(SIGTERM, on_dex_signal);
   if (!wait_for_start() || !begin()) {
@@ -207,7 +207,7 @@ bool DexProcess::wait_for_start() {
     }
     publish_heard();
     if (!ready_sent) ready_sent = ready_when_all_seen();
-    if (!ready_sent && wall_s() > unready_deadline) return leave_unready();
+    if (!ready_sent && wall_s() > unready_deadline && !unheard_earlier().empty()) return leave_unready();
     for (const LifecycleSample& s : starts)
       if (std::optional<bool> taken = take_start(s, refused)) return *taken;
     if (wall_s() > deadline) {
@@ -232,11 +232,29 @@ void DexProcess::publish_heard() {
 // not complete; Cyclone would give it up at kHandshakeGiveUpS, where Debian's build can
 // crash. Leaving the domain first ends this DEX cleanly (nothing has flown); a service
 // restarts it and its handshakes begin again.
-bool DexProcess::leave_unready() {
+std::vector<std::string> DexProcess::unheard_earlier() {
   std::map<int, TelemetrySample> seen = inbox_.latest();
-  std::string missing;
+  std::vector<std::string> missing;
   for (int d = 0; d < static_cast<int>(mission_.fleet.size()); ++d)
-    if (d != mission_.self && !seen.count(d)) missing += (missing.empty() ? "" : ", ") + mission_.fleet[d];
+    if (d != mission_.self && !seen.count(d) &&
+        std::find(o_.later_drones.begin(), o_.later_drones.end(), mission_.fleet[d]) == o_.later_drones.end())
+      missing.push_back(mission_.fleet[d]);
+  return missing;
+}
+
+bool DexProcess::check_later_drones() {
+  for (const std::string& later : o_.later_drones)
+    if (std::find(mission_.fleet.begin(), mission_.fleet.end(), later) == mission_.fleet.end()) {
+      err_ << "eamos dex: error: --later-drones names '" << later << "', which is not a drone of this mission; "
+           << "give the names of the mission's fleet, separated by commas\n";
+      return false;
+    }
+  return true;
+}
+
+bool DexProcess::leave_unready() {
+  std::string missing;
+  for (const std::string& d : unheard_earlier()) missing += (missing.empty() ? "" : ", ") + d;
   err_ << "eamos dex: error: " << name() << ": not ready " << o_.unready_limit_s
        << " s after joining DDS: nothing heard from " << missing
        << " (their DEX is not running, or its DDS Security handshake with this one did not complete); "

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 #include "mid/adapter_registry.h"
 #include "transport/dds_node.h"
@@ -26,6 +27,19 @@ inline constexpr double kSecureUnreadyLimitS = transport::kHandshakeGiveUpS - 10
 inline constexpr int kFullRateDrones = 20;
 inline constexpr double kFullStateRateHz = 20.0;
 double state_rate_for(int drones);
+
+/// Wall seconds between two statuses of a DEX that differ only in their trigger counters:
+/// 0 (every change) up to kFullRateDrones drones; beyond, a quarter of the liveliness lease.
+/// Every drone receives every other drone's arrival at a barrier, and each received one
+/// changes its counters: published at every change, a barrier of k drones would send
+/// k(k - 1) statuses to k readers each. The lead's termination waves are answered at once
+/// whatever this says (launch/termination.h); the newest counters always go out at the end
+/// of the gap, so nothing the lead or a FINISHED waits for is lost, only coalesced.
+double counters_gap_for(int drones, double lease_s);
+
+/// How a status differs from the one published before it.
+enum class StatusChange { none, counters, other };
+StatusChange status_change(const transport::StatusSample& before, const transport::StatusSample& now);
 
 struct DexProcessOptions {
   std::string folder;             ///< the drone's deployment folder (holds mission.json)
@@ -47,6 +61,10 @@ struct DexProcessOptions {
   /// must have been heard from (all its handshakes done); otherwise the DEX leaves with an
   /// error before Cyclone's handshake timeout (transport::kHandshakeGiveUpS).
   double unready_limit_s = kSecureUnreadyLimitS;
+  /// Drones (by name) whose DEX starts after this one (`eamos launch`'s later waves): not
+  /// waited for within unready_limit_s. A handshake begins when the later of its two DEXes
+  /// joins, so that one's own limit bounds it, however long the fleet takes to start.
+  std::vector<std::string> later_drones;
   /// Times per wall second at most that this drone's state goes to the other drones (the
   /// newest state, never later than one period); 0: state_rate_for(the fleet's size).
   double state_rate_hz = 0.0;

@@ -8,6 +8,7 @@
 #include "dex/latency.h"
 #include "dex/runner.h"
 #include "launch/dex_state.h"
+#include "launch/wall_time.h"
 
 namespace eamos::launch {
 
@@ -199,12 +200,38 @@ StatusSample DexProcess::status_now(Phase phase) const {
 
 void DexProcess::publish_status(bool force) {
   StatusSample s = status_now(phase_);
-  if (!force && last_status_ && last_status_->phase == s.phase && last_status_->busy == s.busy &&
-      last_status_->end_reached == s.end_reached && last_status_->sent == s.sent &&
-      last_status_->received == s.received && last_status_->wave == s.wave)
-    return;
+  if (!force && last_status_) {
+    StatusChange change = status_change(*last_status_, s);
+    if (change == StatusChange::none) return;
+    if (change == StatusChange::counters && defer_counters()) return;
+  }
   node_->write(s);
   last_status_ = s;
+  status_published_at_ = wall_s();
+}
+
+bool DexProcess::defer_counters() {
+  double gap = counters_gap_for(static_cast<int>(mission_.fleet.size()), o_.dds.lease_s);
+  double due = status_published_at_ + gap;
+  if (gap <= 0 || wall_s() >= due || !loop_) return false;
+  if (!counters_due_) {
+    counters_due_ = true;
+    loop_->after((due - wall_s()) * o_.speed, [this] {
+      counters_due_ = false;
+      if (phase_ == Phase::running) publish_status();
+    });
+  }
+  return true;
+}
+
+double counters_gap_for(int drones, double lease_s) { return drones <= kFullRateDrones ? 0.0 : lease_s / 4; }
+
+StatusChange status_change(const StatusSample& before, const StatusSample& now) {
+  if (before.phase != now.phase || before.busy != now.busy || before.end_reached != now.end_reached ||
+      before.wave != now.wave)
+    return StatusChange::other;
+  if (before.sent != now.sent || before.received != now.received) return StatusChange::counters;
+  return StatusChange::none;
 }
 
 // Only the lead (it ran the end node) decides, by termination waves (launch/termination.h);

@@ -90,6 +90,11 @@ class DexProcess {
   void publish_heard();
   /// Gives up waiting for the other drones (DexProcessOptions::unready_limit_s); false.
   bool leave_unready();
+  /// The drones not heard from yet that this DEX's ready timeout waits for (all but itself
+  /// and DexProcessOptions::later_drones), by name.
+  std::vector<std::string> unheard_earlier();
+  /// Checks DexProcessOptions::later_drones against the fleet; false with a message.
+  bool check_later_drones();
   /// A START seen while waiting: true when it starts this process's run, false when this
   /// process must give up, nothing when it is not this process's (noted in `refused`).
   std::optional<bool> take_start(const LifecycleSample& s, std::set<std::uint64_t>& refused);
@@ -142,6 +147,9 @@ class DexProcess {
   void settle();
   void schedule_settle();
   void publish_status(bool force = false);
+  /// True when a change of counters alone waits for the end of its gap (counters_gap_for),
+  /// where a timer publishes the newest status.
+  bool defer_counters();
   void check_finished();
   /// Trigger counters of the whole fleet (this drone's own and every other drone's newest
   /// status), and the latest instant another drone went idle.
@@ -200,6 +208,8 @@ class DexProcess {
   std::uint64_t received_ = 0;
   std::map<int, StatusSample> statuses_;  ///< other drones' newest status of this run
   std::optional<StatusSample> last_status_;
+  double status_published_at_ = -1e300;  ///< wall time of last_status_
+  bool counters_due_ = false;            ///< a timer publishes the newest counters
   bool settle_scheduled_ = false;
   std::optional<TerminationDetector> termination_;  ///< the lead's waves (made at the start)
   std::uint64_t wave_answered_ = 0;                 ///< the newest wave this drone answered

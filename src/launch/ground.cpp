@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <csignal>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -152,7 +153,8 @@ class Ground {
   /// Starts the next wave of DEX processes once every DEX started so far has been heard
   /// from (its discovery, and with DDS Security its handshakes, done); false on a failed spawn.
   bool start_next_wave();
-  bool start_one(DroneEntry& d, const std::string& exe);
+  /// Starts `d`'s DEX; `later`: the drones this launch starts in later waves.
+  bool start_one(DroneEntry& d, const std::string& exe, const std::vector<DroneEntry*>& later);
   /// Looks at what may have changed: a signal, the barrier, the flight's end. After every
   /// input that can change them, after a DEX process ended (poll_children first) and at
   /// each deadline; never on a timer of its own (the ground idles while the drones fly).
@@ -199,7 +201,9 @@ class Ground {
   std::string hash_;
   std::vector<DroneEntry> drones_;
   enum class Stage { barrier, running, done } stage_ = Stage::barrier;
-  double barrier_deadline_ = 0.0;
+  double barrier_deadline_ = 0.0;  ///< the newest wave's: its start plus the barrier timeout
+  double first_started_at_ = 0.0;  ///< wall time the first wave was started
+  double wave_started_at_ = 0.0;   ///< wall time the newest wave was started
   double wall_guard_ = 0.0;
   std::optional<double> finish_at_;
   std::optional<LifecycleSample> abort_;
@@ -334,7 +338,8 @@ bool Ground::fly() {
   std::signal(SIGCHLD, SIG_DFL);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  barrier_deadline_ = wall_s() + o_.barrier_timeout_s;
+  first_started_at_ = wave_started_at_ = wall_s();
+  barrier_deadline_ = first_started_at_ + o_.barrier_timeout_s;
   watch_ = std::make_unique<ProcessWatch>([this] {
     loop_.post([this] {
       poll_children();
@@ -437,17 +442,23 @@ bool Ground::start_next_wave() {
     if (d.started && (!d.heard || (d.heard_drones < started - 1 && !d.ready_nonce))) return true;
   if (started > 0) {
     char took[64];
-    std::snprintf(took, sizeof took, "%.1f", wall_s() - (barrier_deadline_ - o_.barrier_timeout_s));
+    std::snprintf(took, sizeof took, "%.1f", wall_s() - first_started_at_);
     out_ << "ground: the " << started << " DEX processes started so far have heard from each other (" << took
          << " s after the first was started); starting " << std::min(waiting, wave_size_) << " more\n";
+    // Each wave has the whole barrier timeout from its own start: a handshake begins only
+    // when the later of its two DEXes starts, so no handshake stays pending longer than
+    // that, however many waves the fleet needs (with DDS Security, kMaxSecureBarrierS).
+    wave_started_at_ = wall_s();
+    barrier_deadline_ = wave_started_at_ + o_.barrier_timeout_s;
+    check_after(o_.barrier_timeout_s);
   }
+  std::vector<DroneEntry*> wave, later;
+  for (auto& d : drones_)
+    if (d.local && !d.started) (static_cast<int>(wave.size()) < wave_size_ ? wave : later).push_back(&d);
   std::string exe = o_.exe.empty() ? self_exe() : o_.exe;
-  int n = 0;
-  for (auto& d : drones_) {
-    if (!d.local || d.started) continue;
-    if (n++ == wave_size_) break;
-    if (!start_one(d, exe)) return false;
-    if (!watch_->watch(d.child.pid) && !polling_) {
+  for (DroneEntry* d : wave) {
+    if (!start_one(*d, exe, later)) return false;
+    if (!watch_->watch(d->child.pid) && !polling_) {
       polling_ = true;
       poll_on_timer();
     }
@@ -456,7 +467,7 @@ bool Ground::start_next_wave() {
   return true;
 }
 
-bool Ground::start_one(DroneEntry& d, const std::string& exe) {
+bool Ground::start_one(DroneEntry& d, const std::string& exe, const std::vector<DroneEntry*>& later) {
   char number[64];
   std::vector<std::string> argv = {exe, "dex", d.folder, "--domain", std::to_string(o_.dds.domain)};
   if (!o_.dds.interface.empty()) argv.insert(argv.end(), {"--interface", o_.dds.interface});
@@ -467,9 +478,17 @@ bool Ground::start_one(DroneEntry& d, const std::string& exe) {
   argv.insert(argv.end(), {"--liveliness-timeout", number});
   std::snprintf(number, sizeof number, "%.17g", o_.time_limit_s);
   argv.insert(argv.end(), {"--time-limit", number});
-  // The barrier's deadline counts from the first wave: a later DEX waits no longer.
-  std::snprintf(number, sizeof number, "%.17g", std::max(1.0, barrier_deadline_ - wall_s()) + 5.0);
+  // This wave and every later one may take the whole barrier timeout.
+  const int waves_left = 1 + (static_cast<int>(later.size()) + wave_size_ - 1) / wave_size_;
+  std::snprintf(number, sizeof number, "%.17g", waves_left * o_.barrier_timeout_s + 5.0);
   argv.insert(argv.end(), {"--start-timeout", number});
+  if (!later.empty()) {
+    // Not waited for within its ready timeout: each of them starts later and answers for
+    // its own handshakes (DexProcessOptions::later_drones).
+    std::string names;
+    for (const DroneEntry* l : later) names += (names.empty() ? "" : ",") + l->name;
+    argv.insert(argv.end(), {"--later-drones", names});
+  }
   if (o_.insecure) argv.push_back("--insecure");
   if (o_.state_rate_hz > 0) {
     std::snprintf(number, sizeof number, "%.17g", o_.state_rate_hz);
@@ -552,9 +571,16 @@ void Ground::watch_barrier() {
     std::string missing;
     for (auto& d : drones_)
       if (!d.ready_nonce) missing += (missing.empty() ? "" : ", ") + d.name;
-    char secs[32];
-    std::snprintf(secs, sizeof secs, "%g", o_.barrier_timeout_s);
-    fail_barrier(std::string("start barrier timed out after ") + secs + " s; not ready: " + missing);
+    char secs[160];
+    std::snprintf(secs, sizeof secs, "%g s", o_.barrier_timeout_s);
+    if (wave_started_at_ > first_started_at_) {
+      auto is_started = [](const DroneEntry& d) { return d.started; };
+      int started = static_cast<int>(std::count_if(drones_.begin(), drones_.end(), is_started));
+      std::snprintf(secs + std::strlen(secs), sizeof secs - std::strlen(secs),
+                    " of the wave started %.1f s after the first DEX (%d DEX processes started)",
+                    wave_started_at_ - first_started_at_, started);
+    }
+    fail_barrier(std::string("start barrier timed out after ") + secs + "; not ready: " + missing);
   }
 }
 
@@ -636,7 +662,7 @@ void Ground::send_start() {
   wall_guard_ = wall_s() + o_.start_delay_s + o_.time_limit_s / o_.speed + 700.0 / o_.speed + 30.0;
   check_after(wall_guard_ - wall_s());
   char took[64];
-  std::snprintf(took, sizeof took, "%.1f", wall_s() - (barrier_deadline_ - o_.barrier_timeout_s));
+  std::snprintf(took, sizeof took, "%.1f", wall_s() - first_started_at_);
   out_ << "ground: every drone is ready; starting run " << start.run_id << " (" << took
        << " s after the first DEX was started)\n" << std::flush;
 }
@@ -861,7 +887,7 @@ int start_wave_for(int drones, bool secure) {
   // Each DEX that joins authenticates with every participant already there (and they with
   // it): a wave of w joining n costs w * n + w * (w - 1) / 2 handshakes at once. Twenty
   // secure DEXes at once were ready on this 2-core host, thirty were not.
-  int wave = secure ? kSecureStartWave : kInsecureStartWave;
+  int wave = !secure ? kInsecureStartWave : drones > kLargeSecureFleet ? kLargeSecureStartWave : kSecureStartWave;
   return drones <= wave ? std::max(1, drones) : wave;
 }
 

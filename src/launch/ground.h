@@ -55,6 +55,12 @@ inline constexpr double kMaxSecureBarrierS = 85.0;
 /// DEX processes `eamos launch` starts at once by default, with and without DDS Security.
 inline constexpr int kSecureStartWave = 10;
 inline constexpr int kInsecureStartWave = 25;
+/// Beyond this many drones, DDS Security starts in waves of kLargeSecureStartWave: each wave
+/// joins a fleet that keeps all its pairs of participants in touch, and on a 2-core host the
+/// eighth wave of 10 joining 70 secure DEXes did not finish in 85 s, waves of 5 did
+/// (docs/performance.md, "Many DEX processes on one host").
+inline constexpr int kLargeSecureFleet = 50;
+inline constexpr int kLargeSecureStartWave = 5;
 
 /// The default wave of DEX processes started together: the whole fleet up to the default
 /// wave size, otherwise waves of that size.

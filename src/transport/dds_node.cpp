@@ -255,6 +255,7 @@ bool DdsNode::create(const DdsOptions& options, std::string& error) {
     return false;
   }
   mission_hash_ = options.mission_hash;
+  self_ = options.self;
   if (!create_endpoints(options, error)) return false;
   return true;
 }
@@ -358,33 +359,50 @@ bool DdsNode::create_endpoints(const DdsOptions& options, std::string& error) {
 }
 
 DdsNode::~DdsNode() {
+  if (!mission_hash_.empty())
+    diag::Logger{"transport", self_ == kGroundParticipant ? std::string("ground") : "drone " + std::to_string(self_)}
+        .debug("DDS samples: " + traffic());
   // Deleting the participant stops its listeners before anything they use goes away.
   if (participant_ > 0) dds_delete(participant_);
   if (domain_ > 0) dds_delete(domain_);
 }
 
+std::string DdsNode::traffic() const {
+  static const char* const names[kTopics] = {"trigger", "telemetry", "lifecycle", "status", "trace"};
+  std::string line;
+  for (int t = 0; t < kTopics; ++t)
+    line += std::string(t ? "; " : "") + names[t] + " " + std::to_string(written_[t]) + " written, " +
+            std::to_string(received_[t]) + " received";
+  return line;
+}
+
 bool DdsNode::write(const TriggerSample& s) {
+  ++written_[kTrigger];
   eamos_wire_Trigger w = to_wire(s);
   return dds_write(w_trigger_, &w) == DDS_RETCODE_OK;
 }
 
 bool DdsNode::write(const TelemetrySample& s) {
+  ++written_[kTelemetry];
   TelemetryOut out;
   to_wire(s, out);
   return dds_write(w_telemetry_, &out.c) == DDS_RETCODE_OK;
 }
 
 bool DdsNode::write(const LifecycleSample& s) {
+  ++written_[kLifecycle];
   eamos_wire_Lifecycle w = to_wire(s);
   return dds_write(w_lifecycle_, &w) == DDS_RETCODE_OK;
 }
 
 bool DdsNode::write(const StatusSample& s) {
+  ++written_[kStatus];
   eamos_wire_Status w = to_wire(s);
   return dds_write(w_status_, &w) == DDS_RETCODE_OK;
 }
 
 bool DdsNode::write(const TraceSample& s) {
+  ++written_[kTrace];
   eamos_wire_TraceRecord w = to_wire(s);
   return dds_write(w_trace_, &w) == DDS_RETCODE_OK;
 }
@@ -409,6 +427,7 @@ bool DdsNode::flush(double timeout_s) {
 void DdsNode::take_triggers(int reader) {
   take_all<eamos_wire_Trigger, TriggerSample>(
       reader, "trigger", *this, [](const TriggerSample& s) { return s.message.from; }, [this](TriggerSample s) {
+    count_received(kTrigger);
     if (handlers_.trigger) handlers_.trigger(std::move(s));
   });
 }
@@ -417,6 +436,7 @@ void DdsNode::take_telemetry(int reader) {
   take_all<eamos_wire_Telemetry, TelemetrySample>(
       reader, "telemetry", *this, [](const TelemetrySample& s) { return s.telemetry.from; },
       [this](TelemetrySample s) {
+    count_received(kTelemetry);
     if (handlers_.telemetry) handlers_.telemetry(std::move(s));
   });
 }
@@ -424,6 +444,7 @@ void DdsNode::take_telemetry(int reader) {
 void DdsNode::take_lifecycle(int reader) {
   take_all<eamos_wire_Lifecycle, LifecycleSample>(
       reader, "lifecycle", *this, [](const LifecycleSample& s) { return s.drone; }, [this](LifecycleSample s) {
+    count_received(kLifecycle);
     if (handlers_.lifecycle) handlers_.lifecycle(std::move(s));
   });
 }
@@ -437,6 +458,7 @@ void DdsNode::take_status(int reader) {
           std::lock_guard<std::mutex> lock(writers_mutex_);
           status_writers_[handle] = {s.mission_hash, s.drone, s.nonce};
         }
+        count_received(kStatus);
         if (handlers_.status) handlers_.status(std::move(s));
       },
       [&handle](std::uint64_t h) { handle = h; });
@@ -445,6 +467,7 @@ void DdsNode::take_status(int reader) {
 void DdsNode::take_trace(int reader) {
   take_all<eamos_wire_TraceRecord, TraceSample>(
       reader, "trace", *this, [](const TraceSample& s) { return s.drone; }, [this](TraceSample s) {
+    count_received(kTrace);
     if (handlers_.trace) handlers_.trace(std::move(s));
   });
 }

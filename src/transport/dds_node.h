@@ -125,6 +125,11 @@ class DdsNode {
   void dropped(const char* topic, const std::string& why);
   /// Samples dropped so far (for tests).
   std::uint64_t dropped_count() const { return dropped_; }
+  /// Samples written and received (accepted) so far per topic, one line: what a process
+  /// cost the others, for `--log-level=debug` and the measurements of docs/performance.md.
+  std::string traffic() const;
+  enum Topic { kTrigger, kTelemetry, kLifecycle, kStatus, kTrace, kTopics };
+  void count_received(Topic t) { ++received_[t]; }
 
  private:
   DdsNode() = default;
@@ -145,9 +150,11 @@ class DdsNode {
   std::mutex writers_mutex_;  ///< per status writer: whose it is, for liveliness reports
   std::map<std::uint64_t, Writer> status_writers_;
   std::string mission_hash_;  ///< "" = samples are not bound to their writers
+  int self_ = kGroundParticipant;
   std::mutex senders_mutex_;  ///< per remote writer: whose partition it writes in
   std::map<std::uint64_t, int> senders_;
   std::atomic<std::uint64_t> dropped_{0};
+  std::atomic<std::uint64_t> written_[kTopics] = {}, received_[kTopics] = {};
 };
 
 /// Notes: a second node in one process joins the domain the first created, and the first

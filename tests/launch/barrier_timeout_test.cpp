@@ -38,7 +38,9 @@ TEST(StartWave, AFleetUpToTheWaveSizeStartsAtOnceALargerOneInWaves) {
   using eamos::launch::start_wave_for;
   EXPECT_EQ(start_wave_for(3, true), 3);
   EXPECT_EQ(start_wave_for(eamos::launch::kSecureStartWave, true), eamos::launch::kSecureStartWave);
-  EXPECT_EQ(start_wave_for(100, true), eamos::launch::kSecureStartWave);
+  EXPECT_EQ(start_wave_for(50, true), eamos::launch::kSecureStartWave);
+  EXPECT_EQ(start_wave_for(51, true), eamos::launch::kLargeSecureStartWave);
+  EXPECT_EQ(start_wave_for(100, true), eamos::launch::kLargeSecureStartWave);
   EXPECT_EQ(start_wave_for(100, false), eamos::launch::kInsecureStartWave);
   EXPECT_LT(eamos::launch::kSecureStartWave, eamos::launch::kInsecureStartWave);
   EXPECT_EQ(start_wave_for(0, true), 1);
@@ -53,6 +55,35 @@ TEST(StateRate, UpToTwentyDronesEveryChangeIsPublishedBeyondTheRateFallsWithTheS
   EXPECT_DOUBLE_EQ(state_rate_for(40), 5.0);
   EXPECT_DOUBLE_EQ(state_rate_for(100), 1.0);   // 0.8 by the square, at least 1
   EXPECT_DOUBLE_EQ(state_rate_for(1000), 1.0);
+}
+
+// Every drone receives every other drone's arrival at a barrier: beyond twenty drones a
+// status whose only news is its trigger counters waits for a quarter of the lease, while a
+// change of busy, phase, end or wave still goes out at once.
+TEST(StatusRate, BeyondTwentyDronesAChangeOfCountersAloneIsCoalescedOtherChangesAreNot) {
+  using eamos::launch::counters_gap_for;
+  using eamos::launch::status_change;
+  using eamos::launch::StatusChange;
+  EXPECT_DOUBLE_EQ(counters_gap_for(20, 2.0), 0.0);
+  EXPECT_DOUBLE_EQ(counters_gap_for(21, 2.0), 0.5);
+  EXPECT_DOUBLE_EQ(counters_gap_for(100, 10.0), 2.5);
+  eamos::transport::StatusSample before;
+  before.sent = 3;
+  before.received = 7;
+  eamos::transport::StatusSample now = before;
+  EXPECT_EQ(status_change(before, now), StatusChange::none);
+  now.received = 8;
+  EXPECT_EQ(status_change(before, now), StatusChange::counters);
+  now.sent = 4;
+  EXPECT_EQ(status_change(before, now), StatusChange::counters);
+  now.busy = true;
+  EXPECT_EQ(status_change(before, now), StatusChange::other);
+  now = before;
+  now.wave = 1;
+  EXPECT_EQ(status_change(before, now), StatusChange::other);
+  now = before;
+  now.phase = eamos::transport::Phase::completed;
+  EXPECT_EQ(status_change(before, now), StatusChange::other);
 }
 
 }  // namespace

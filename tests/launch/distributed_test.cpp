@@ -345,6 +345,41 @@ TEST_F(Distributed, ASecureDexNotReadyWithinItsReadyTimeoutLeavesNamingTheDrones
   EXPECT_NE(longer.out.find("'95' is not a number from"), std::string::npos) << longer.out;
 }
 
+// Each wave has the whole start barrier from its own start (a handshake begins only when
+// the later of its two DEXes starts): the barrier that runs out is the last wave's, and the
+// ground says so. Drone3's DEX is started by no one here.
+TEST_F(Distributed, TheStartBarrierOfAFleetStartedInWavesCountsFromTheLastWave) {
+  fs::path deploy = deploy_listing2(dir_);
+  Output r = eamos("launch " + deploy.string() +
+                   " --drones Drone1,Drone2 --start-wave 1 --barrier-timeout 5 --insecure --domain 44");
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("the 1 DEX processes started so far have heard from each other"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("start barrier timed out after 5 s of the wave started "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("after the first DEX (2 DEX processes started); not ready: Drone1, Drone2, Drone3"),
+            std::string::npos) << r.out;
+}
+
+// `eamos launch` starts a large fleet in waves, and a DEX of an early wave may wait longer
+// than its ready timeout for the later ones: a handshake begins only when the later of its
+// two DEXes joins, whose own ready timeout bounds it. Drones it is told start later are not
+// waited for; the others still are.
+TEST_F(Distributed, ADexDoesNotLeaveUnreadyForDronesThatStartInALaterWave) {
+  fs::path deploy = deploy_listing2(dir_);
+  Output r = eamos("dex " + (deploy / "Drone1").string() + " --ready-timeout 1 --later-drones Drone3 --domain 37");
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("Drone1: not ready 1 s after joining DDS: nothing heard from Drone2 ("), std::string::npos)
+      << r.out;
+  Output later = eamos("dex " + (deploy / "Drone1").string() +
+                       " --ready-timeout 1 --later-drones Drone2,Drone3 --start-timeout 3 --domain 37");
+  EXPECT_EQ(later.status, 1) << later.out;
+  EXPECT_EQ(later.out.find("not ready"), std::string::npos) << later.out;
+  EXPECT_NE(later.out.find("Drone1: no start within 3 s"), std::string::npos) << later.out;
+  Output unknown = eamos("dex " + (deploy / "Drone1").string() + " --later-drones Drone9 --domain 37");
+  EXPECT_EQ(unknown.status, 1) << unknown.out;
+  EXPECT_NE(unknown.out.find("--later-drones names 'Drone9', which is not a drone of this mission"),
+            std::string::npos) << unknown.out;
+}
+
 TEST_F(Distributed, SecondMissionOnTheSameDomainChangesNothing) {
   // Listing 2 and patrol at the same time on one domain: both have a Drone1..Drone3.
   Output other;
