@@ -72,30 +72,7 @@ TEST(MissionFile, StreamedFileEqualsDroneMissionForEveryDroneOfAStressMission) {
 
 TEST(MissionFile, StreamedFileEqualsDroneMissionForEveryControlStructure) {
   // Do*, Pause*, async, RepeatFor counts, unary operators and property arguments.
-  auto c = compile_mission(
-      "var A Quad\nvar B Quad\n"
-      "func INIT() { SEQ_main() }\n"
-      "func SEQ_main() {\n"
-      "  PAR_up()\n"
-      "  async(SEQ_watch)\n"
-      "  DoWhileSync(A.Z() > 1 && !B.Landed(), SEQ_circle, SEQ_after)\n"
-      "  DoUntilAsync(-A.X() < 3, SEQ_circle2, SEQ_after2)\n"
-      "  PauseUntil(B.Z() >= 2)\n"
-      "  PauseFor(1.5)\n"
-      "  RepeatFor(A.Z() < 30, SEQ_climb, SEQ_after3, 4)\n"
-      "  B.FlyByX(A.X() * 2)\n"
-      "}\n"
-      "func PAR_up() { SEQ_a(); SEQ_b() }\n"
-      "func SEQ_a() { A.Arm(); A.Takeoff(3) }\n"
-      "func SEQ_b() { B.Arm(); B.Takeoff(4.5) }\n"
-      "func SEQ_watch() { WaitWhile(A.Z() < 2, SEQ_pic) }\n"
-      "func SEQ_pic() { B.TakePicture() }\n"
-      "func SEQ_circle() { A.FlyByX(1); A.FlyByX(-1) }\n"
-      "func SEQ_after() { A.Hover(1) }\n"
-      "func SEQ_circle2() { B.TakePicture() }\n"
-      "func SEQ_after2() { B.Hover(2) }\n"
-      "func SEQ_climb() { A.FlyByZ(1) }\n"
-      "func SEQ_after3() { A.Land(); B.Land() }\n");
+  auto c = compile_mission(test::read_text(std::string(EAMOS_SOURCE_DIR) + "/tests/deploy/missions/every_control_structure.eamos"));
   ASSERT_TRUE(c);
   expect_streamed_files_equal_documents(*c);
 }
