@@ -243,11 +243,12 @@ TEST(SimVehicle, ArduPilotAnswersDoOrbitAsUnsupported) {
 // QGroundControl listens on 14550) sees the vehicle the companion flies: its heartbeat and
 // its climb after the companion's takeoff.
 TEST(SimVehicle, AGroundStationSeesTheVehicleTheCompanionFlies) {
-  Companion companion(25344);
-  Companion ground_station(25345);
+  // Ports of its own: ctest runs the cases of this suite side by side.
+  Companion companion(25360);
+  Companion ground_station(25361);
   pid_t pid = fork();
   if (pid == 0) {
-    execl(EAMOS_BINARY, EAMOS_BINARY, "sim-vehicle", "--udp", "25344", "--gcs", "udpout://127.0.0.1:25345",
+    execl(EAMOS_BINARY, EAMOS_BINARY, "sim-vehicle", "--udp", "25360", "--gcs", "udpout://127.0.0.1:25361",
           "--speed", "4", "--duration", "40", static_cast<char*>(nullptr));
     _exit(127);
   }
