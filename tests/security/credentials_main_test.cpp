@@ -10,25 +10,15 @@
 #include <filesystem>
 #include <string>
 
+#include "support/run_eamos.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int status = -1;
-  std::string out;  ///< standard output and error together
-};
+using Result = eamos_test::Output;
 
-Result credentials(const std::string& args) {
-  Result r;
-  FILE* p = popen((std::string(EAMOS_CREDENTIALS) + " " + args + " 2>&1").c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, p)) r.out += buf;
-  int raw = pclose(p);
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return r;
-}
+Result credentials(const std::string& args) { return eamos_test::run_program(EAMOS_CREDENTIALS, args); }
 
 class EamosCredentials : public ::testing::Test {
  protected:
