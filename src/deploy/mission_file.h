@@ -87,7 +87,8 @@ bool read_mission(std::string_view text, const std::string& file, dex::Mission& 
                   std::vector<std::string>& errors, FleetTables& tables);
 
 /// Every drone's mission of `c`, checked by read_mission as its DEX checks its file, for
-/// the Python module and the tests (compiled_missions builds the same without the texts). The first drone's text is its whole
+/// the tests that compare it with compiled_missions, which builds the same without the
+/// texts. The first drone's text is its whole
 /// file; the others' leave the fleet-wide members to the tables their reads share, so
 /// loading k drones costs and holds what their own parts hold, not k² names. False with
 /// every defect in `errors`. `text_bytes`, when given, receives the bytes of text read.
@@ -95,7 +96,7 @@ bool read_compiled_missions(const graph::Compilation& c, std::vector<dex::Missio
                             std::vector<std::string>& errors, std::size_t* text_bytes = nullptr);
 
 /// Every drone's mission of `c` built from its MDG in memory, for a process that compiled
-/// the mission itself (`eamos run`, `eamos verify`): the structure read_compiled_missions
+/// the mission itself (`eamos run`, `eamos verify`, the Python module): the structure read_compiled_missions
 /// reads from the texts, without writing, hashing and parsing them (the shared tables too).
 /// Each carries mission_hash(c), as the files do. False, with what is wrong in `errors`,
 /// only for a compiled mission the file's reader would refuse too.

@@ -97,7 +97,7 @@ void check_args(const RunArgs& a) {
 std::vector<dex::Mission> load_missions(const graph::Compilation& c) {
   std::vector<dex::Mission> missions;
   std::vector<std::string> errors;
-  if (!deploy::read_compiled_missions(c, missions, errors)) {
+  if (!deploy::compiled_missions(c, missions, errors)) {
     std::string all;
     for (const std::string& e : errors) all += e + "\n";
     throw std::runtime_error(all);

@@ -98,8 +98,8 @@ TEST(VerifyJobs, FlyingTimingsSideBySideReportsWhatFlyingThemInTurnReports) {
   }
 }
 
-// `eamos verify` reads the missions into shared tables (deploy::read_compiled_missions), a library user
-// may not: the flights, and so the paths, must not depend on it. Listing 2's RepeatWhile
+// The missions of one process may share the fleet's tables (deploy::read_compiled_missions, and
+// `eamos verify` building them in memory), a library user's may not: the flights, and so the paths, must not depend on it. Listing 2's RepeatWhile
 // reads Drone3 while it takes off, so each outcome of its If is flown nominal and with Drone3
 // 25 % slower and faster: 6 paths (tests/verify/examples records the same through the CLI).
 TEST(VerifyLibrary, FliesTheSamePathsWhetherOrNotTheMissionsShareTheirTables) {
