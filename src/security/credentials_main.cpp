@@ -89,7 +89,8 @@ int main(int argc, char** argv) {
   // AES-256: both are SP 800-90A DRBGs of 256-bit strength, and SHA-256 is what every
   // signature here uses, while CTR-DRBG's first use builds OpenSSL's table of every cipher
   // (5 % of the work for 20 drones). Set before OpenSSL reads its configuration file, so a
-  // site's own choice there (its [random] section) still wins.
+  // site's own choice there (its [random] section) still wins. Should this fail, OpenSSL's
+  // default DRBG is used, as good a source.
   RAND_set_DRBG_type(nullptr, "HASH-DRBG", nullptr, nullptr, "SHA256");
   // The process ends right after the files are written: OpenSSL's clean-up at exit would only
   // free memory the kernel takes back anyway (a tenth of a millisecond).
