@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <openssl/crypto.h>
+#include <openssl/rand.h>
 
 #include "security/mission_keys.h"
 
@@ -84,6 +85,13 @@ std::string error_prefix(const char* who, bool color) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Random numbers from HASH-DRBG over SHA-256 rather than OpenSSL's default CTR-DRBG over
+  // AES-256: both are SP 800-90A DRBGs of 256-bit strength, and SHA-256 is what every
+  // signature here uses, while CTR-DRBG's first use builds OpenSSL's table of every cipher
+  // (5 % of the work for 20 drones). Set before OpenSSL reads its configuration file, so a
+  // site's own choice there (its [random] section) still wins. Should this fail, OpenSSL's
+  // default DRBG is used, as good a source.
+  RAND_set_DRBG_type(nullptr, "HASH-DRBG", nullptr, nullptr, "SHA256");
   // The process ends right after the files are written: OpenSSL's clean-up at exit would only
   // free memory the kernel takes back anyway (a tenth of a millisecond).
   OPENSSL_init_crypto(OPENSSL_INIT_NO_ATEXIT, nullptr);

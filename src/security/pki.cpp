@@ -46,14 +46,21 @@ std::string bio_text(BIO* b) {
   return n > 0 ? std::string(data, static_cast<std::size_t>(n)) : std::string();
 }
 
+/// P-256, made once and copied into each key: building the curve from its parameters for
+/// each key (EC_KEY_new_by_curve_name) cost more than generating the key.
+const EC_GROUP* p256() {
+  static const EC_GROUP* group = EC_GROUP_new_by_curve_name(NID_X9_62_prime256v1);
+  return group;
+}
+
 Key new_key() {
   // P-256: one of the two curves/key types Cyclone's authentication plugin accepts. Made as
   // an EC_KEY rather than with EVP_EC_gen: OpenSSL 3 encodes a provider key through its
   // encoder look-up on every certificate and PEM (about 0.3 ms per drone, most of a
   // 1,000-drone mission's credentials), a legacy key directly; the key and its PEM
   // (PKCS#8 "PRIVATE KEY") are the same either way.
-  EC_KEY* ec = EC_KEY_new_by_curve_name(NID_X9_62_prime256v1);
-  if (!ec || EC_KEY_generate_key(ec) != 1) {
+  EC_KEY* ec = EC_KEY_new();
+  if (!ec || !p256() || EC_KEY_set_group(ec, p256()) != 1 || EC_KEY_generate_key(ec) != 1) {
     EC_KEY_free(ec);
     return nullptr;
   }
