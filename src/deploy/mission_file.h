@@ -19,8 +19,15 @@ namespace eamos::deploy {
 
 /// Version of the mission file format; a DEX refuses files of another version.
 /// 2: every file ends with its `file_hash`. 3: sync points are barriers over `drone_sets`
-/// (`waits`, `notify`) instead of an external node and arc per peer.
-constexpr int kMissionFormatVersion = 3;
+/// (`waits`, `notify`) instead of an external node and arc per peer. 4: nodes leave out
+/// what the reader derives (`index`, `internal`, `clone`, `evaluated_by`, `drone` of the
+/// file's own nodes) and arcs are arrays.
+constexpr int kMissionFormatVersion = 4;
+
+/// Version of the canonical form the mission hash is taken over. It changes with that
+/// form, not with the files' layout: the hash names what the mission does, and the traces
+/// and credentials that carry it stay the same when only the files' layout changes.
+constexpr int kMissionHashFormVersion = 3;
 
 /// The last member of every mission file: SHA-256 (hex) of every byte before it.
 inline constexpr const char* kFileHashMember = "file_hash";
