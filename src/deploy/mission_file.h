@@ -73,7 +73,7 @@ inline constexpr std::size_t kMaxMissionDefects = 50;
 bool read_mission(std::string_view text, const std::string& file, dex::Mission& out,
                   std::vector<std::string>& errors);
 
-/// Bytes a mission file may hold: `eamos compile` writes about 0.3 MB a drone for 500,000
+/// Bytes a mission file may hold: `eamos compile` writes about 0.2 MB a drone for 500,000
 /// nodes over 1,000 drones; a larger file is refused unread.
 constexpr std::uint64_t kMaxMissionFileBytes = std::uint64_t{1} << 30;
 
