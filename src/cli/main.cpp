@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
@@ -474,11 +475,38 @@ int fly(const Commands& c, Options& o, char**) {
 constexpr eamos::cli::CompileFinisher kFinishCompile{eamos::cli::finish_in_process, false};
 #endif
 
+/// Sources from this size on (about 40,000 statements) are compiled on huge pages; below it
+/// the restart's cost and the 2 MiB pages' rounding are not worth it (5,000 statements:
+/// no CPU to take, up to 1 MB more peak memory).
+constexpr std::uintmax_t kHugePagesFrom = std::uintmax_t{1} << 20;
+
+/// A large compile first-touches hundreds of MB, and in 4 KiB pages each is a page fault:
+/// most of the kernel's share of the compile (docs/performance.md, "Fleets of a thousand").
+/// glibc's malloc asks the kernel for transparent huge pages only when GLIBC_TUNABLES says
+/// so as the process starts, so a compile of a large source starts this program again with
+/// `glibc.malloc.hugetlb=1`. A user who set that tunable keeps it. Returns only when the
+/// compile goes on in this process.
+void restart_on_huge_pages(const std::string& mission, char** argv) {
+  const char* set = std::getenv("GLIBC_TUNABLES");
+  std::string tunables = set ? set : "";
+  if (tunables.find("glibc.malloc.hugetlb") != std::string::npos) return;
+  std::error_code ec;
+  std::uintmax_t size = std::filesystem::file_size(mission, ec);
+  if (ec || size < kHugePagesFrom) return;
+  tunables += (tunables.empty() ? "" : ":") + std::string("glibc.malloc.hugetlb=1");
+  if (::setenv("GLIBC_TUNABLES", tunables.c_str(), 1) != 0) return;
+  std::cout.flush();
+  std::fflush(nullptr);
+  ::execv("/proc/self/exe", argv);  // on failure the compile goes on here, on small pages
+}
+
 /// Runs the command the line chose; its exit status.
 int dispatch(const Commands& c, Options& o, char** argv) {
   if (*c.check) return eamos::cli::cmd_check(o.common, o.list_caps);
-  if (*c.compile)
+  if (*c.compile) {
+    restart_on_huge_pages(o.common.mission, argv);
     return eamos::cli::cmd_compile(o.common, o.out_dir, o.security, o.packaged ? &o.package : nullptr, kFinishCompile);
+  }
   if (*c.graph) return eamos::cli::cmd_graph(o.common, o.kind, o.drone, o.format, o.graph_out);
   if (*c.stats) return eamos::cli::cmd_stats(o.common, o.stats_out);
   if (*c.gen) return eamos::cli::cmd_gen_stress(o.shape, o.nodes, o.drones, o.work_per_step, o.seed, o.gen_out);

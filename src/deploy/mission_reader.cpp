@@ -157,13 +157,18 @@ class Fields {
   bool one_of(const json& obj, const char* key, const std::string& where, const std::vector<std::string>& names,
               int& out, bool required = true) {
     if (!obj.contains(key) && !required) return true;
+    const json* j = member(obj, key, where, required);
+    return j && one_of_value(*j, Loc(where, key), names, out);
+  }
+
+  bool one_of_value(const json& j, const Loc& where, const std::vector<std::string>& names, int& out) {
     std::string s;
-    if (!string(obj, key, where, s, required)) return false;
+    if (!string_value(j, where, s)) return false;
     for (std::size_t i = 0; i < names.size(); ++i)
       if (names[i] == s) return out = static_cast<int>(i), true;
     std::string list;
     for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-    d_.add(Loc(where, key), "unknown value \"" + s + "\" (expected one of: " + list + ")");
+    d_.add(where, "unknown value \"" + s + "\" (expected one of: " + list + ")");
     return false;
   }
 
@@ -672,24 +677,15 @@ class Reader {
     for (std::size_t i = 0; i < list->size(); ++i) {
       std::string where = at("/nodes", i);
       dex::Node& n = m_.nodes[i];
-      if (!f_.object((*list)[i], where) || !node((*list)[i], where, i, n)) continue;
+      if (!f_.object((*list)[i], where) || !node((*list)[i], where, n)) continue;
       if (!m_.index.emplace(dex::Mission::key(n.meg, n.drone), static_cast<int>(i)).second)
         d_.add(where, "a second node with MEG id " + std::to_string(n.meg) + " held by " + m_.fleet[n.drone]);
     }
   }
 
-  bool node(const json& j, const std::string& where, std::size_t i, dex::Node& n) {
-    std::size_t index = 0;
-    if (f_.integer(j, "index", where, index, 0, std::numeric_limits<int>::max()) && index != i)
-      d_.add(at(where, "index"), "index " + std::to_string(index) + " is not the node's place in the list (" +
-                                     std::to_string(i) + ")");
+  bool node(const json& j, const std::string& where, dex::Node& n) {
     bool ok = f_.integer(j, "meg", where, n.meg, 0, std::numeric_limits<int>::max());
-    const json* drone = f_.member(j, "drone", where);
-    ok &= drone && (n.drone = drone_index(*drone, Loc(where, "drone"))) >= 0;
-    ok &= f_.boolean(j, "internal", where, n.internal);
-    if (ok && m_.self >= 0 && n.internal != (n.drone == m_.self))
-      ok = false, d_.add(at(where, "internal"), n.internal ? "an internal node held by another drone"
-                                                           : "an external node held by this drone");
+    ok &= holder(j, where, n);
     int kind = 0;
     ok &= f_.one_of(j, "kind", where, meg_kinds(), kind);
     n.kind = static_cast<graph::MegKind>(kind);
@@ -701,6 +697,19 @@ class Reader {
     ok &= f_.integer(j, "scope", where, n.scope, -1, std::numeric_limits<int>::max(), false);
     if (!ok || !barrier(j, where, n)) return false;
     return node_content(j, where, n);
+  }
+
+  /// `drone` names the holder of another drone's node (an external one); the drone's own
+  /// nodes leave it out.
+  bool holder(const json& j, const std::string& where, dex::Node& n) {
+    const json* drone = f_.member(j, "drone", where, false);
+    n.internal = drone == nullptr;
+    if (n.internal) return (n.drone = m_.self) >= 0;
+    n.drone = drone_index(*drone, Loc(where, "drone"));
+    if (n.drone < 0) return false;
+    if (n.drone != m_.self) return true;
+    d_.add(at(where, "drone"), "names this file's own drone, whose nodes leave \"drone\" out");
+    return false;
   }
 
   bool node_content(const json& j, const std::string& where, dex::Node& n) {
@@ -765,13 +774,15 @@ class Reader {
       std::string where = at("/arcs", i);
       dex::Arc a;
       int kind = 0, branch = 0;
-      if (!f_.object(j, where)) continue;
-      const json* from = f_.member(j, "from", where);
-      const json* to = f_.member(j, "to", where);
-      bool ok = from && node_index(*from, Loc(where, "from"), a.from);
-      ok &= to && node_index(*to, Loc(where, "to"), a.to);
-      ok &= f_.one_of(j, "kind", where, arc_kinds(), kind);
-      if (j.contains("branch")) ok &= f_.one_of(j, "branch", where, branches(), branch);
+      if (!f_.array(j, where)) continue;
+      if (j.size() != 3 && j.size() != 4) {
+        d_.add(where, "an arc is [from, to, kind] or [from, to, kind, branch]");
+        continue;
+      }
+      bool ok = node_index(j[0], at(where, 0), a.from);
+      ok &= node_index(j[1], at(where, 1), a.to);
+      ok &= f_.one_of_value(j[2], at(where, 2), arc_kinds(), kind);
+      if (j.size() == 4) ok &= f_.one_of_value(j[3], at(where, 3), branches(), branch);
       if (!ok) continue;
       a.kind = static_cast<graph::ArcKind>(kind);
       a.branch = static_cast<graph::Branch>(branch);

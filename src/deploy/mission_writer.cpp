@@ -269,13 +269,6 @@ void write_node_content(JsonWriter& w, const Compilation& c, const MegNode& n, b
   if (n.scope >= 0) w.member("scope", n.scope);
 }
 
-void write_arc(JsonWriter& w, int from, int to, graph::ArcKind kind, graph::Branch branch) {
-  w.member("from", from);
-  w.member("to", to);
-  w.member("kind", graph::arc_kind_name(kind));
-  if (branch != graph::Branch::any) w.member("branch", graph::branch_name(branch));
-}
-
 /// A sorted drone set as [first, last] ranges: a fleet-wide set is one pair.
 void write_drone_ranges(JsonWriter& w, const std::vector<int>& set) {
   w.begin_array();
@@ -288,7 +281,10 @@ void write_drone_ranges(JsonWriter& w, const std::vector<int>& set) {
   w.end_array();
 }
 
-/// The drone's MDG: graph::mdg_json's nodes and arcs, node by node.
+/// The drone's MDG, node by node: graph::mdg_json's nodes and arcs without what the
+/// reader derives (a node's place, whether it is internal, a condition's evaluator, an
+/// arc's ends being external), each arc as an array. The drone's own nodes leave `drone`
+/// out; a node that names one is another drone's.
 void write_mdg(JsonWriter& w, const Compilation& c, const graph::Mdg& g) {
   w.key("drone_sets");
   w.begin_array();
@@ -311,15 +307,11 @@ void write_mdg(JsonWriter& w, const Compilation& c, const graph::Mdg& g) {
     const graph::MdgNode& mn = g.nodes[i];
     const MegNode& n = c.meg.nodes[mn.meg];
     w.begin_object();
-    w.member("index", static_cast<long long>(i));
     w.member("meg", mn.meg);
-    w.member("drone", c.drone_name(mn.drone));
-    w.member("internal", mn.internal);
-    if (graph::is_sync_point(n.kind)) w.member("clone", true);
+    if (!mn.internal) w.member("drone", c.drone_name(mn.drone));
     if (mn.waits >= 0) w.member("waits", mn.waits);
     if (mn.notify >= 0) w.member("notify", mn.notify);
     write_node_content(w, c, n, true, label);
-    if (n.kind == MegKind::condition) w.member("evaluated_by", c.drone_name(n.drone));
     if (!mn.cancels.empty()) {
       w.key("cancels");
       write_ints(w, mn.cancels);
@@ -334,11 +326,13 @@ void write_mdg(JsonWriter& w, const Compilation& c, const graph::Mdg& g) {
 
   w.key("arcs");
   w.begin_array();
-  for (const graph::MdgArc& a : g.arcs) {
-    w.begin_object();
-    write_arc(w, a.from, a.to, a.kind, a.branch);
-    w.member("external", g.external(a));
-    w.end_object();
+  for (const graph::MdgArc& a : g.arcs) {  // [from, to, kind] or [from, to, kind, branch]
+    w.begin_array();
+    w.value(a.from);
+    w.value(a.to);
+    w.value(graph::arc_kind_name(a.kind));
+    if (a.branch != graph::Branch::any) w.value(graph::branch_name(a.branch));
+    w.end_array();
   }
   w.end_array();
 }
@@ -431,7 +425,7 @@ std::string mission_hash(const Compilation& c) {
     JsonWriter w(out);
     w.begin_object();
     w.member("format", "eamos-mission");
-    w.member("format_version", kMissionFormatVersion);
+    w.member("format_version", kMissionHashFormVersion);
     w.key("drones");
     w.begin_array();
     for (int d = 0; d < c.drone_count(); ++d) {

@@ -144,7 +144,7 @@ TEST_F(Cli, CompileWritesManifestAndOneMissionFilePerDrone) {
   for (const char* drone : {"Drone1", "Drone2", "Drone3"}) {
     auto m = nlohmann::json::parse(read_file(dir_ / "deploy" / drone / "mission.json"));
     EXPECT_EQ(m["format"], "eamos-mission");
-    EXPECT_EQ(m["format_version"], 3);
+    EXPECT_EQ(m["format_version"], 4);
     EXPECT_EQ(m["mission_hash"], hash);
     EXPECT_EQ(m["drone"]["name"], drone);
     EXPECT_FALSE(m["nodes"].empty());
@@ -453,11 +453,11 @@ TEST_F(CliDex, RefusesAMissionFileEditedAfterCompile) {
 TEST_F(CliDex, RefusesAnArcToANodeThatIsNotInTheFile) {
   auto doc = nlohmann::json::parse(text_);
   const auto& arc = doc["arcs"][0];
-  std::string was = "{\"from\":" + arc["from"].dump() + ",\"to\":" + arc["to"].dump() + ",";
-  std::string now = "{\"from\":" + arc["from"].dump() + ",\"to\":123456,";
+  std::string was = "\n  [" + arc[0].dump() + "," + arc[1].dump() + ",";  // the arc's own line
+  std::string now = "\n  [" + arc[0].dump() + ",123456,";
   Output r = dex_with(eamos_test::reseal(eamos_test::replace_once(text_, was, now)));
   EXPECT_EQ(r.status, 1);
-  EXPECT_EQ(r.out, file_.string() + ": error: /arcs/0/to: 123456 is out of range (0 to " +
+  EXPECT_EQ(r.out, file_.string() + ": error: /arcs/0/1: 123456 is out of range (0 to " +
                        std::to_string(doc["nodes"].size() - 1) + ")\n");
 }
 

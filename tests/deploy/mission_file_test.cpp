@@ -14,6 +14,28 @@ namespace {
 using nlohmann::json;
 using test::compile_mission;
 
+/// The graph exporter's MDG nodes as a mission file holds them: without the members the
+/// reader derives (docs/architecture.md, "Mission file"), `drone` only on other drones' nodes.
+json file_nodes(json nodes) {
+  for (json& n : nodes) {
+    bool internal = n["internal"];
+    for (const char* derived : {"index", "internal", "clone", "evaluated_by"}) n.erase(derived);
+    if (internal) n.erase("drone");
+  }
+  return nodes;
+}
+
+/// The exporter's arcs as a mission file holds them: [from, to, kind] or [from, to, kind, branch].
+json file_arcs(const json& arcs) {
+  json out = json::array();
+  for (const json& a : arcs) {
+    json row = json::array({a["from"], a["to"], a["kind"]});
+    if (a.contains("branch")) row.push_back(a["branch"]);
+    out.push_back(row);
+  }
+  return out;
+}
+
 /// Compares the streamed file of every drone with the MDG the graph exporter builds, and
 /// reads it back through the validating reader.
 void expect_streamed_files_equal_documents(const graph::Compilation& c) {
@@ -23,8 +45,8 @@ void expect_streamed_files_equal_documents(const graph::Compilation& c) {
     ASSERT_TRUE(deploy::write_drone_mission(out, c, d, hash));
     json streamed = json::parse(out.str());
     json mdg = graph::mdg_json(c, d);
-    EXPECT_EQ(streamed["nodes"], mdg["nodes"]) << "drone " << c.drone_name(d);
-    EXPECT_EQ(streamed["arcs"], mdg["arcs"]) << "drone " << c.drone_name(d);
+    EXPECT_EQ(streamed["nodes"], file_nodes(mdg["nodes"])) << "drone " << c.drone_name(d);
+    EXPECT_EQ(streamed["arcs"], file_arcs(mdg["arcs"])) << "drone " << c.drone_name(d);
     EXPECT_EQ(streamed["reads"], mdg["reads"]) << "drone " << c.drone_name(d);
     EXPECT_EQ(streamed["drone_sets"], mdg["drone_sets"]) << "drone " << c.drone_name(d);
     dex::Mission m;

@@ -37,10 +37,10 @@ class MissionReader : public ::testing::Test {
     return out;
   }
 
-  /// The exact text of arc `i` as written: `{"from":F,"to":T,`.
+  /// The exact text of arc `i` as written, on a line of its own: `[F,T,`.
   std::string arc_start(std::size_t i) {
     const json& a = doc_["arcs"][i];
-    return "{\"from\":" + a["from"].dump() + ",\"to\":" + a["to"].dump() + ",";
+    return "\n  [" + a[0].dump() + "," + a[1].dump() + ",";
   }
 
   std::unique_ptr<graph::Compilation> c_;
@@ -70,23 +70,36 @@ TEST_F(MissionReader, RefusesAFileWithoutItsFileHash) {
 
 TEST_F(MissionReader, RefusesAnArcToANodeThatIsNotInTheFile) {
   std::size_t nodes = doc_["nodes"].size();
-  std::string from = doc_["arcs"][0]["from"].dump();
-  std::string edited = reseal(replace_once(text_, arc_start(0), "{\"from\":" + from + ",\"to\":9999,"));
-  EXPECT_EQ(defects(edited), "Drone1/mission.json: error: /arcs/0/to: 9999 is out of range (0 to " +
+  std::string from = doc_["arcs"][0][0].dump();
+  std::string edited = reseal(replace_once(text_, arc_start(0), "\n  [" + from + ",9999,"));
+  EXPECT_EQ(defects(edited), "Drone1/mission.json: error: /arcs/0/1: 9999 is out of range (0 to " +
                                  std::to_string(nodes - 1) + ")\n");
 }
 
 TEST_F(MissionReader, RefusesANegativeNodeIndex) {
-  std::string to = doc_["arcs"][1]["to"].dump();
-  std::string edited = reseal(replace_once(text_, arc_start(1), "{\"from\":-1,\"to\":" + to + ","));
-  EXPECT_NE(defects(edited).find("error: /arcs/1/from: -1 is out of range (0 to "), std::string::npos);
+  std::string to = doc_["arcs"][1][1].dump();
+  std::string edited = reseal(replace_once(text_, arc_start(1), "\n  [-1," + to + ","));
+  EXPECT_NE(defects(edited).find("error: /arcs/1/0: -1 is out of range (0 to "), std::string::npos);
+}
+
+TEST_F(MissionReader, RefusesAnArcThatIsNotFromToAndKind) {
+  std::string edited = reseal(replace_once(text_, arc_start(0), arc_start(0) + "7,8,"));
+  EXPECT_NE(defects(edited).find("error: /arcs/0: an arc is [from, to, kind] or [from, to, kind, branch]"),
+            std::string::npos)
+      << defects(edited);
 }
 
 TEST_F(MissionReader, RefusesANodeHeldByADroneOutsideTheFleet) {
-  std::string edited = reseal(replace_once(text_, "{\"index\":0,\"meg\":0,\"drone\":\"Drone1\"",
-                                           "{\"index\":0,\"meg\":0,\"drone\":\"Ghost\""));
+  std::string edited = reseal(replace_once(text_, "{\"meg\":0,", "{\"meg\":0,\"drone\":\"Ghost\","));
   EXPECT_EQ(defects(edited),
             "Drone1/mission.json: error: /nodes/0/drone: drone \"Ghost\" is not in the mission's fleet\n");
+}
+
+// A node that names its holder is another drone's: the file's own drone never names itself.
+TEST_F(MissionReader, RefusesAnOwnNodeThatNamesItsDrone) {
+  std::string edited = reseal(replace_once(text_, "{\"meg\":0,", "{\"meg\":0,\"drone\":\"Drone1\","));
+  EXPECT_EQ(defects(edited), "Drone1/mission.json: error: /nodes/0/drone: names this file's own drone, whose nodes "
+                             "leave \"drone\" out\n");
 }
 
 TEST_F(MissionReader, RefusesUnknownEnumValues) {
@@ -138,7 +151,7 @@ TEST_F(MissionReader, ReadsTheSeparationAndPrioritiesAndRefusesAPriorityOutOfRan
 }
 
 TEST_F(MissionReader, RefusesAWholeNumberWrittenAsAFraction) {
-  std::string edited = reseal(replace_once(text_, "{\"index\":0,\"meg\":0,", "{\"index\":0,\"meg\":0.5,"));
+  std::string edited = reseal(replace_once(text_, "{\"meg\":0,", "{\"meg\":0.5,"));
   EXPECT_NE(defects(edited).find("error: /nodes/0/meg: expected a whole number, found number"), std::string::npos);
 }
 
@@ -179,9 +192,9 @@ TEST_F(MissionReader, RefusesANumberTooLargeForADouble) {
 }
 
 TEST_F(MissionReader, RefusesAFileOfAnotherFormatVersion) {
-  std::string edited = reseal(replace_once(text_, "\"format_version\":3", "\"format_version\":1"));
+  std::string edited = reseal(replace_once(text_, "\"format_version\":4", "\"format_version\":1"));
   EXPECT_EQ(defects(edited),
-            "Drone1/mission.json: error: /format_version: format version 1 is not supported by this DEX (knows 3); "
+            "Drone1/mission.json: error: /format_version: format version 1 is not supported by this DEX (knows 4); "
             "compile the mission with a matching eamos\n");
 }
 
@@ -199,8 +212,13 @@ TEST_F(MissionReader, StopsListingDefectsAfterFifty) {
   ASSERT_TRUE(stress);
   std::string edited = deploy::mission_text(*stress, 0, deploy::mission_hash(*stress));
   ASSERT_GT(json::parse(edited)["nodes"].size(), 60u);
-  for (std::size_t i = 0; i < 60; ++i)
-    edited = replace_once(edited, "{\"index\":" + std::to_string(i) + ",", "{\"index\":-" + std::to_string(i + 1) + ",");
+  std::size_t at = 0;
+  for (std::size_t i = 0; i < 60; ++i) {  // a negative MEG id in each of the first 60 nodes
+    at = edited.find("{\"meg\":", at);
+    ASSERT_NE(at, std::string::npos);
+    at += 7;
+    edited.insert(at, "-1");
+  }
   dex::Mission m;
   std::vector<std::string> errors;
   EXPECT_FALSE(deploy::read_mission(edited, "f", m, errors));
