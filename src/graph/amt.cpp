@@ -29,25 +29,30 @@ const char* role_name(Role r) {
   return "";
 }
 
-namespace {
-
-using lang::ControlKind;
-
-std::vector<Role> branch_roles(ControlKind k) {
+std::span<const Role> branch_roles(lang::ControlKind k) {
+  using lang::ControlKind;
+  static constexpr Role if_roles[] = {Role::then_, Role::else_};
+  static constexpr Role wait_roles[] = {Role::wait};
+  static constexpr Role repeat_roles[] = {Role::repeat, Role::after};
+  static constexpr Role do_roles[] = {Role::do_, Role::done};
   switch (k) {
-    case ControlKind::If: return {Role::then_, Role::else_};
+    case ControlKind::If: return if_roles;
     case ControlKind::WaitUntil:
-    case ControlKind::WaitWhile: return {Role::wait};
+    case ControlKind::WaitWhile: return wait_roles;
     case ControlKind::RepeatUntil:
     case ControlKind::RepeatWhile:
-    case ControlKind::RepeatFor: return {Role::repeat, Role::after};
+    case ControlKind::RepeatFor: return repeat_roles;
     case ControlKind::DoUntilAsync:
     case ControlKind::DoWhileAsync:
     case ControlKind::DoUntilSync:
-    case ControlKind::DoWhileSync: return {Role::do_, Role::done};
+    case ControlKind::DoWhileSync: return do_roles;
     default: return {};
   }
 }
+
+namespace {
+
+using lang::ControlKind;
 
 class AmtBuilder {
  public:
@@ -145,7 +150,7 @@ class AmtBuilder {
     amt_.nodes[id].condition = s.args[0];
     if (s.control == ControlKind::RepeatFor)
       amt_.nodes[id].count = static_cast<long long>(s.args[3]->number);
-    std::vector<Role> roles = branch_roles(s.control);
+    std::span<const Role> roles = branch_roles(s.control);
     // Branch arguments follow the condition: args[1], args[2].
     for (std::size_t b = 0; b < roles.size() && b < s.branch_functions.size(); ++b) {
       int child = expand_block(id, s.branch_functions[b], s.args[b + 1]->loc);

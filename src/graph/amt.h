@@ -2,6 +2,7 @@
 // The Abstract Mission Tree (paper, section IV.B): the static structure of a mission with
 // every block call expanded in place. Parents are sequential and parallel blocks and
 // control structures; leaves are drone actions and timed pauses.
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -25,6 +26,8 @@ const char* amt_kind_name(AmtKind k);
 /// What a branch of a control structure is for.
 enum class Role { none, then_, else_, wait, repeat, after, do_, done };
 const char* role_name(Role r);
+/// The roles of a control structure's branches, in the order of its block arguments.
+std::span<const Role> branch_roles(lang::ControlKind k);
 
 struct AmtNode {
   // Ordered so that no field pads another: a large mission has a million nodes.

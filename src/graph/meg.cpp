@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <map>
+#include <span>
+#include <string_view>
 
 namespace eamos::graph {
 
@@ -48,15 +50,29 @@ std::vector<int> unique_drones(const std::vector<int>& order) {
   return out;
 }
 
+/// One node of the AMT, read from the statements it expands: the MEG is built from the
+/// mission itself, so a compile that needs no AMT never holds one (it was as large as the
+/// MEG). `id` is the node's place in the AMT's preorder, as build_amt numbers it.
+struct Node {
+  AmtKind kind = AmtKind::seq;
+  int id = 0;
+  SourceLocation loc;
+  std::string_view name;
+  int function = -1;                           ///< init, seq, par: the block it expands
+  const lang::Statement* statement = nullptr;  ///< async, action, pause, control
+};
+
 class MegBuilder {
  public:
-  MegBuilder(const Amt& amt, const lang::Mission& m) : amt_(amt) {
+  explicit MegBuilder(const lang::Mission& m)
+      : m_(m), first_drone_(m.functions.size(), kNotFound), bounds_(m.functions.size(), -1) {
     meg_.drone_count = static_cast<int>(m.drones.size());
   }
 
   Meg build() {
+    const lang::Function& init = m_.functions[m_.init_function];
     meg_.nodes.reserve(node_bound());
-    const AmtNode& root = amt_.nodes[amt_.root()];
+    Node root{AmtKind::init, next_id_++, init.loc, init.name, m_.init_function};
     meg_.init = meg_.add_node(MegKind::init, root.loc, root.id);
     meg_.nodes[meg_.init].name = "INIT";
     Ends ends = build_children(root, {{meg_.init}});
@@ -70,30 +86,88 @@ class MegBuilder {
   }
 
  private:
-  /// At most the number of MEG nodes the AMT turns into: one per init, fork, async
+  static constexpr int kNotFound = -2;
+
+  /// At most the number of MEG nodes the mission turns into: one per init, fork, async
   /// terminal, action and pause, up to three per control structure (its condition and two
   /// terminals), plus the end. Reserving it keeps the node vector from being copied as it
   /// grows, which at 500,000 nodes costs time and a transient third of the MEG's memory.
-  std::size_t node_bound() const {
-    std::size_t bound = 1;
-    for (const AmtNode& n : amt_.nodes) bound += n.kind == AmtKind::seq ? 0 : n.kind == AmtKind::control ? 3 : 1;
+  std::size_t node_bound() {
+    std::size_t bound = 2;  // the init and the end
+    for (const lang::Statement& s : m_.functions[m_.init_function].body) bound += statement_bound(s);
     return bound;
+  }
+
+  std::size_t block_bound(int f) {
+    if (bounds_[f] >= 0) return static_cast<std::size_t>(bounds_[f]);
+    std::size_t bound = m_.functions[f].block == lang::BlockKind::par ? 1 : 0;
+    for (const lang::Statement& s : m_.functions[f].body) bound += statement_bound(s);
+    bounds_[f] = static_cast<long long>(bound);
+    return bound;
+  }
+
+  std::size_t statement_bound(const lang::Statement& s) {
+    switch (s.kind) {
+      case lang::StatementKind::action: return 1;
+      case lang::StatementKind::async_call: return 1 + block_bound(s.function_index);
+      case lang::StatementKind::call: break;
+    }
+    if (s.control == ControlKind::none) return block_bound(s.function_index);
+    if (s.control == ControlKind::PauseFor) return 1;
+    std::size_t bound = 3;
+    std::span<const Role> roles = branch_roles(s.control);
+    for (std::size_t b = 0; b < roles.size() && b < s.branch_functions.size(); ++b)
+      bound += block_bound(s.branch_functions[b]);
+    return bound;
+  }
+
+  /// The AMT node a statement expands into, numbered next.
+  Node child_of(const lang::Statement& s) {
+    switch (s.kind) {
+      case lang::StatementKind::action: return {AmtKind::action, next_id_++, s.loc, s.callee, -1, &s};
+      case lang::StatementKind::async_call: return {AmtKind::async, next_id_++, s.loc, "async", -1, &s};
+      case lang::StatementKind::call: break;
+    }
+    if (s.control == ControlKind::none) return block(s.function_index, s.loc);
+    if (s.control == ControlKind::PauseFor) return {AmtKind::pause, next_id_++, s.loc, "PauseFor", -1, &s};
+    return {AmtKind::control, next_id_++, s.loc, lang::control_name(s.control), -1, &s};
+  }
+
+  /// An instance of block `f` called at `loc`, numbered next.
+  Node block(int f, SourceLocation loc) {
+    const lang::Function& fn = m_.functions[f];
+    AmtKind kind = fn.block == lang::BlockKind::par ? AmtKind::par : AmtKind::seq;
+    return {kind, next_id_++, loc, fn.name, f};
   }
 
   void connect(const Ends& ends, int to) {
     for (const Pending& p : ends) meg_.add_arc(p.node, to, ArcKind::exec, p.branch);
   }
 
-  /// The drone of the first action in a subtree (depth first), or -1.
-  int first_action_drone(int amt_node) const {
-    std::vector<int> stack{amt_node};
-    while (!stack.empty()) {
-      const AmtNode& n = amt_.nodes[stack.back()];
-      stack.pop_back();
-      if (n.kind == AmtKind::action) return n.drone;
-      for (auto it = n.children.rbegin(); it != n.children.rend(); ++it) stack.push_back(*it);
+  /// The drone of the first action in block `f`'s expansion (depth first), or -1; the
+  /// same for every instance, so found once per block.
+  int first_action_drone(int f) {
+    if (first_drone_[f] != kNotFound) return first_drone_[f];
+    int drone = kNotFound;
+    for (const lang::Statement& s : m_.functions[f].body)
+      if ((drone = first_action_drone(s)) != kNotFound) break;
+    first_drone_[f] = drone == kNotFound ? -1 : drone;
+    return first_drone_[f];
+  }
+
+  /// kNotFound when the statement's expansion holds no action.
+  int first_action_drone(const lang::Statement& s) {
+    if (s.kind == lang::StatementKind::action) return s.drone_index;
+    if (s.kind == lang::StatementKind::async_call || s.control == ControlKind::none) {
+      int d = first_action_drone(s.function_index);
+      return d >= 0 ? d : kNotFound;
     }
-    return -1;
+    std::span<const Role> roles = branch_roles(s.control);
+    for (std::size_t b = 0; b < roles.size() && b < s.branch_functions.size(); ++b) {
+      int d = first_action_drone(s.branch_functions[b]);
+      if (d >= 0) return d;
+    }
+    return kNotFound;
   }
 
   /// The drone of the nearest open end that has one, or -1.
@@ -103,12 +177,12 @@ class MegBuilder {
     return -1;
   }
 
-  Ends build_children(const AmtNode& n, Ends ends) {
-    for (int c : n.children) ends = build(amt_.nodes[c], ends);
+  Ends build_children(const Node& n, Ends ends) {
+    for (const lang::Statement& s : m_.functions[n.function].body) ends = build(child_of(s), ends);
     return ends;
   }
 
-  Ends build(const AmtNode& n, const Ends& ends) {
+  Ends build(const Node& n, const Ends& ends) {
     switch (n.kind) {
       case AmtKind::init:
       case AmtKind::seq: return build_children(n, ends);
@@ -121,51 +195,54 @@ class MegBuilder {
     return ends;
   }
 
-  Ends build_par(const AmtNode& n, const Ends& ends) {
+  Ends build_par(const Node& n, const Ends& ends) {
     int fork = meg_.add_node(MegKind::fork, n.loc, n.id);
     meg_.nodes[fork].name = n.name;
     connect(ends, fork);
     Ends out;
-    for (int c : n.children) {
-      Ends child = build(amt_.nodes[c], {{fork}});
+    const std::vector<lang::Statement>& body = m_.functions[n.function].body;
+    for (const lang::Statement& s : body) {
+      Ends child = build(child_of(s), {{fork}});
       out.insert(out.end(), child.begin(), child.end());
     }
-    if (n.children.empty()) out.push_back({fork});
+    if (body.empty()) out.push_back({fork});
     return out;
   }
 
   // async(F): F starts where the call stands; the sequence goes on from the same point,
   // and F's end goes to a terminal of its own that nothing waits for.
-  Ends build_async(const AmtNode& n, const Ends& ends) {
-    const AmtNode& body = amt_.nodes[n.children.at(0)];
+  Ends build_async(const Node& n, const Ends& ends) {
+    const lang::Statement& s = *n.statement;
+    Node body = block(s.function_index, s.callee_loc);
     Ends body_ends = build(body, ends);
     int t = meg_.add_node(MegKind::terminal, n.loc, n.id);
     meg_.nodes[t].name = "async " + std::string(body.name);
-    int owner = first_action_drone(body.id);
+    int owner = first_action_drone(s.function_index);
     meg_.nodes[t].drone = owner >= 0 ? owner : std::max(0, drone_of(ends));
     connect(body_ends, t);
     return ends;
   }
 
-  Ends build_action(const AmtNode& n, const Ends& ends) {
+  Ends build_action(const Node& n, const Ends& ends) {
+    const lang::Statement& s = *n.statement;
     int a = meg_.add_node(MegKind::action, n.loc, n.id);
     MegNode& node = meg_.nodes[a];
-    node.drone = n.drone;
+    node.drone = s.drone_index;
     node.name = n.name;
-    node.args = n.args;
+    node.args.assign(s.args.begin(), s.args.end());
     std::vector<int> order;
-    for (const lang::Expr* e : n.args) collect_reads(e, order);
+    for (const lang::Expr* e : s.args) collect_reads(e, order);
     node.reads = unique_drones(order);
     connect(ends, a);
     return {{a}};
   }
 
-  Ends build_pause(const AmtNode& n, const Ends& ends) {
+  Ends build_pause(const Node& n, const Ends& ends) {
     int p = meg_.add_node(MegKind::pause, n.loc, n.id);
     int owner = drone_of(ends);
     meg_.nodes[p].drone = owner >= 0 ? owner : 0;
     meg_.nodes[p].name = n.name;
-    meg_.nodes[p].seconds = n.seconds;
+    meg_.nodes[p].seconds = n.statement->args[0]->number;
     connect(ends, p);
     return {{p}};
   }
@@ -173,7 +250,7 @@ class MegBuilder {
   // The evaluating drone: the one the condition reads most (ties: first read), so that
   // the freshest values are local; a condition on constants goes to the first drone of
   // its branches, then to the drone that ran just before it.
-  int condition_owner(const AmtNode& n, const Ends& ends, const std::vector<int>& order) const {
+  int condition_owner(const lang::Statement& s, const Ends& ends, const std::vector<int>& order) {
     std::map<int, int> count;
     for (int d : order) ++count[d];
     int best = -1, best_count = 0;
@@ -183,15 +260,16 @@ class MegBuilder {
         best_count = count[d];
       }
     if (best >= 0) return best;
-    for (int c : n.children) {
-      int d = first_action_drone(c);
+    std::span<const Role> roles = branch_roles(s.control);
+    for (std::size_t b = 0; b < roles.size() && b < s.branch_functions.size(); ++b) {
+      int d = first_action_drone(s.branch_functions[b]);
       if (d >= 0) return d;
     }
     int d = drone_of(ends);
     return d >= 0 ? d : 0;
   }
 
-  int add_terminal(const AmtNode& n, int condition, Role role) {
+  int add_terminal(const Node& n, int condition, Role role) {
     int t = meg_.add_node(MegKind::terminal, n.loc, n.id);
     MegNode& node = meg_.nodes[t];
     node.drone = meg_.nodes[condition].drone;
@@ -202,10 +280,14 @@ class MegBuilder {
     return t;
   }
 
-  const AmtNode* child_with_role(const AmtNode& n, Role role) const {
-    for (int c : n.children)
-      if (amt_.nodes[c].role == role) return &amt_.nodes[c];
-    return nullptr;
+  /// Builds the branch of control node `n` with `role` from `from`; `from` itself when the
+  /// structure has no such branch.
+  Ends build_role(const Node& n, Role role, Ends from) {
+    const lang::Statement& s = *n.statement;
+    std::span<const Role> roles = branch_roles(s.control);
+    for (std::size_t b = 0; b < roles.size() && b < s.branch_functions.size(); ++b)
+      if (roles[b] == role) return build(block(s.branch_functions[b], s.args[b + 1]->loc), from);
+    return from;
   }
 
   /// Nodes [first, last) belong to the body of condition `c` unless a body nested inside
@@ -216,29 +298,29 @@ class MegBuilder {
   }
 
   /// Builds a branch starting at (condition, branch) and ends it in a new terminal.
-  int build_branch(const AmtNode& n, int c, Role role, Branch branch) {
-    const AmtNode* body = child_with_role(n, role);
-    Ends body_ends = body ? build(*body, {{c, branch}}) : Ends{{c, branch}};
+  int build_branch(const Node& n, int c, Role role, Branch branch) {
+    Ends body_ends = build_role(n, role, {{c, branch}});
     int t = add_terminal(n, c, role);
     connect(body_ends, t);
     return t;
   }
 
-  Ends build_control(const AmtNode& n, const Ends& ends) {
+  Ends build_control(const Node& n, const Ends& ends) {
+    const lang::Statement& s = *n.statement;
     int c = meg_.add_node(MegKind::condition, n.loc, n.id);
     {
       MegNode& node = meg_.nodes[c];
       node.name = n.name;
-      node.control = n.control;
-      node.condition = n.condition;
-      node.count = n.count;
+      node.control = s.control;
+      node.condition = s.args[0];
+      if (s.control == ControlKind::RepeatFor) node.count = static_cast<long long>(s.args[3]->number);
       std::vector<int> order;
-      collect_reads(n.condition, order);
+      collect_reads(node.condition, order);
       node.reads = unique_drones(order);
-      node.drone = condition_owner(n, ends, order);
+      node.drone = condition_owner(s, ends, order);
     }
     connect(ends, c);
-    switch (n.control) {
+    switch (s.control) {
       case ControlKind::If: {
         int t1 = build_branch(n, c, Role::then_, Branch::true_);
         int t2 = build_branch(n, c, Role::else_, Branch::false_);
@@ -262,7 +344,7 @@ class MegBuilder {
       case ControlKind::DoUntilSync:
       case ControlKind::DoWhileSync:
       case ControlKind::DoUntilAsync:
-      case ControlKind::DoWhileAsync: return build_do(n, c, ends);
+      case ControlKind::DoWhileAsync: return build_do(n, c);
       default: return {{c}};
     }
   }
@@ -271,11 +353,11 @@ class MegBuilder {
   // built for it is in `cancels`) and starts the done-branch. The do-terminal tells the
   // condition to stop watching; the two terminals release each other so that the
   // statement after a Sync Do waits for exactly one of them.
-  Ends build_do(const AmtNode& n, int c, const Ends&) {
-    bool sync = n.control == ControlKind::DoUntilSync || n.control == ControlKind::DoWhileSync;
+  Ends build_do(const Node& n, int c) {
+    ControlKind k = n.statement->control;
+    bool sync = k == ControlKind::DoUntilSync || k == ControlKind::DoWhileSync;
     int first = static_cast<int>(meg_.nodes.size());
-    const AmtNode* body = child_with_role(n, Role::do_);
-    Ends body_ends = body ? build(*body, {{c, Branch::do_}}) : Ends{{c, Branch::do_}};
+    Ends body_ends = build_role(n, Role::do_, {{c, Branch::do_}});
     int last = static_cast<int>(meg_.nodes.size());
     for (int i = first; i < last; ++i) meg_.nodes[c].cancels.push_back(i);
     mark_scope(first, last, c);
@@ -291,14 +373,15 @@ class MegBuilder {
     return {{c, Branch::continue_}};
   }
 
-  const Amt& amt_;
+  const lang::Mission& m_;
   Meg meg_;
+  int next_id_ = 0;                  ///< the AMT preorder number of the next node
+  std::vector<int> first_drone_;     ///< per function: first_action_drone, kNotFound until known
+  std::vector<long long> bounds_;    ///< per function: block_bound, -1 until known
 };
 
 }  // namespace
 
-Meg build_meg(const Amt& amt, const lang::Mission& mission) {
-  return MegBuilder(amt, mission).build();
-}
+Meg build_meg(const lang::Mission& mission) { return MegBuilder(mission).build(); }
 
 }  // namespace eamos::graph

@@ -24,7 +24,7 @@ struct MegNode {
   int id = 0;
   MegKind kind = MegKind::action;
   SourceLocation loc;
-  int amt = -1;            ///< the AMT node it came from (-1 for init/end)
+  int amt = -1;            ///< the AMT node it came from, by build_amt's numbering (-1 for end)
   int drone = -1;          ///< owner; -1 for sync points
   std::string name;        ///< capability, control structure or block name
   std::vector<int> out;    ///< indices into Meg::arcs
@@ -61,8 +61,9 @@ struct Meg {
   int add_arc(int from, int to, ArcKind kind = ArcKind::exec, Branch branch = Branch::any);
 };
 
-/// Builds the MEG from the AMT. Conditions, terminals and pauses are assigned to the drone
-/// that evaluates them (see docs/architecture.md: "who evaluates a condition").
-Meg build_meg(const Amt& amt, const lang::Mission& mission);
+/// Builds the MEG of a checked mission (no errors), expanding INIT as build_amt does but
+/// without holding an AMT. Conditions, terminals and pauses are assigned to the drone that
+/// evaluates them (see docs/architecture.md: "who evaluates a condition").
+Meg build_meg(const lang::Mission& mission);
 
 }  // namespace eamos::graph

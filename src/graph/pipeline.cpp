@@ -9,11 +9,10 @@ namespace eamos::graph {
 
 namespace {
 
-/// Once the AMT exists, the MEG is built from it alone, and the logic checks read of the
-/// statements only the control structures (a finding names their branch blocks). The
-/// others, a fifth of a large mission's memory, are freed before the MEG is built: the
-/// AMT, the AST and the MEG together are the compile's peak. The MEG's arguments and
-/// conditions point into Mission::expressions, which stays.
+/// Once the MEG exists, the logic checks read of the statements only the control
+/// structures (a finding names their branch blocks). The others, a fifth of a large
+/// mission's memory, are freed before the checks' working sets are made. The MEG's
+/// arguments and conditions point into Mission::expressions, which stays.
 void keep_control_statements(Compilation& c) {
   for (lang::Function& f : c.mission.functions) {
     std::vector<lang::Statement> controls;
@@ -47,14 +46,12 @@ bool compile(std::shared_ptr<SourceFile> source, const fleet::Fleet& fleet, Diag
   for (int d = 0; d < out.drone_count(); ++d)
     out.settings.push_back(out.fleet.settings_for(out.mission.drones[d].name,
                                                   out.mission.drones[d].type, d));
-  out.amt = build_amt(out.mission);
+  out.meg = build_meg(out.mission);
+  if (keep == Keep::all_graphs) out.amt = build_amt(out.mission);
   if (keep == Keep::deployment_graphs) {
     keep_control_statements(out);
     release_freed_memory();
   }
-  out.meg = build_meg(out.amt, out.mission);
-  // The AMT is as large as the MEG; freed before the logic check and the MDGs reuse its memory.
-  if (keep == Keep::deployment_graphs) out.amt = Amt{};
   // Like the checker's warnings, only on a mission without errors: the MEG needs one.
   check_mission_logic({out.meg, out.mission, out.fleet, out.checked.drone_types, out.settings}, diags);
   if (diags.has_errors()) return false;

@@ -32,12 +32,12 @@ struct Compilation {
 };
 
 /// Which graphs a Compilation keeps. A deployment needs only the MEG and the MDGs; the
-/// AMT serves tools (graph export, stats), and dropping it as soon as the MEG is built
-/// lowers the peak memory of a compile by about a tenth.
+/// AMT serves tools (graph export, stats), and a compile that does not build it holds
+/// about a tenth less memory at its peak.
 enum class Keep {
   all_graphs,
-  /// The statements other than control structures are freed once the AMT is built, the AMT
-  /// once the MEG is built, the rest of the statements once the MEG is checked.
+  /// No AMT is built. The statements other than control structures are freed once the MEG
+  /// is built, the rest once the MEG is checked.
   deployment_graphs,
 };
 

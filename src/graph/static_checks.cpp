@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <span>
 #include <string>
 #include <string_view>
 #include <tuple>
@@ -193,35 +194,50 @@ class LogicChecker {
   /// of a loop's condition does not wait for the body.
   bool build_order() {
     std::size_t n = meg_.nodes.size();
-    preds_.assign(n, {});
+    // Every node's predecessors in one array, the nodes in order, and their successors
+    // likewise: a vector per node was a million allocations in a large mission.
+    pred_start_.assign(n + 1, 0);
+    pred_list_.clear();
     for (const MegNode& node : meg_.nodes) {
-      if (node.kind == MegKind::terminal && node.owner_condition >= 0) {
-        ControlKind k = meg_.nodes[node.owner_condition].control;
-        if (k == ControlKind::If || is_do(k)) {
-          preds_[node.id].push_back({node.owner_condition, Branch::any});
-          continue;
-        }
-      }
-      for (int a : node.in) {
-        const MegArc& arc = meg_.arcs[a];
-        if (arc.kind == ArcKind::exec) preds_[node.id].push_back({arc.from, arc.branch});
-      }
+      pred_start_[node.id] = static_cast<int>(pred_list_.size());
+      add_preds(node);
     }
-    std::vector<int> waiting(n, 0);
-    std::vector<std::vector<int>> succ(n);
+    pred_start_[n] = static_cast<int>(pred_list_.size());
+    std::vector<int> waiting(n, 0), succ_start(n + 1, 0), succ(pred_list_.size());
+    for (const Pred& p : pred_list_) ++succ_start[p.node + 1];
+    for (std::size_t i = 0; i < n; ++i) succ_start[i + 1] += succ_start[i];
+    std::vector<int> filled(succ_start.begin(), succ_start.end() - 1);
     for (std::size_t i = 0; i < n; ++i)
-      for (const Pred& p : preds_[i]) {
+      for (const Pred& p : preds(static_cast<int>(i))) {
         ++waiting[i];
-        succ[p.node].push_back(static_cast<int>(i));
+        succ[filled[p.node]++] = static_cast<int>(i);
       }
     for (std::size_t i = 0; i < n; ++i)
       if (waiting[i] == 0) order_.push_back(static_cast<int>(i));
     for (std::size_t k = 0; k < order_.size(); ++k)
-      for (int s : succ[order_[k]])
-        if (--waiting[s] == 0) order_.push_back(s);
+      for (int j = succ_start[order_[k]]; j < succ_start[order_[k] + 1]; ++j)
+        if (--waiting[succ[j]] == 0) order_.push_back(succ[j]);
     position_.assign(n, 0);
     for (std::size_t k = 0; k < order_.size(); ++k) position_[order_[k]] = static_cast<int>(k);
     return order_.size() == n;  // a cycle would be a builder bug: analyse nothing then
+  }
+
+  void add_preds(const MegNode& node) {
+    if (node.kind == MegKind::terminal && node.owner_condition >= 0) {
+      ControlKind k = meg_.nodes[node.owner_condition].control;
+      if (k == ControlKind::If || is_do(k)) {
+        pred_list_.push_back({node.owner_condition, Branch::any});
+        return;
+      }
+    }
+    for (int a : node.in) {
+      const MegArc& arc = meg_.arcs[a];
+      if (arc.kind == ArcKind::exec) pred_list_.push_back({arc.from, arc.branch});
+    }
+  }
+
+  std::span<const Pred> preds(int node) const {
+    return {pred_list_.data() + pred_start_[node], static_cast<std::size_t>(pred_start_[node + 1] - pred_start_[node])};
   }
 
   bool spend(long long visits) {
@@ -246,7 +262,7 @@ class LogicChecker {
     }
     for (std::size_t k = first; k < order_.size(); ++k) {
       int x = order_[k];
-      for (const Pred& p : preds_[x]) {
+      for (const Pred& p : preds(x)) {
         bool counts = seed[p.node] && std::find(excluded.begin(), excluded.end(), p.via) == excluded.end();
         if (counts || mark[p.node]) {
           mark[x] = 1;
@@ -268,7 +284,7 @@ class LogicChecker {
     while (!work.empty()) {
       int x = work.back();
       work.pop_back();
-      for (const Pred& p : preds_[x])
+      for (const Pred& p : preds(x))
         if (!mark[p.node]) {
           mark[p.node] = 1;
           work.push_back(p.node);
@@ -802,7 +818,8 @@ class LogicChecker {
   const Meg& meg_;
   Diagnostics& diags_;
   StaticCheckLimits limits_;
-  std::vector<std::vector<Pred>> preds_;
+  std::vector<int> pred_start_;  ///< per node (and one past the last): its first entry in pred_list_
+  std::vector<Pred> pred_list_;
   std::vector<int> order_;
   std::vector<int> position_;  ///< index of each node in order_
   mutable std::map<std::pair<int, int>, const lang::Statement*> statements_;

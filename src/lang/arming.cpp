@@ -255,6 +255,7 @@ class DroneArming {
   /// the drone neither change it nor see more than the others do.
   Flow par(int fn, Mine mine, States entry, bool record) {
     std::size_t n = mine.size();
+    if (n == 1) return par_alone(fn, mine[0], entry, record);
     // Most blocks hold one statement of a drone (a show's PAR: one FlyTo sequence per
     // drone): their scratch stays on the stack, not one allocation per PAR and drone.
     constexpr std::size_t kOnStack = 8;
@@ -300,6 +301,18 @@ class DroneArming {
       }
     }
     return {changed ? exit : entry, seen};
+  }
+
+  /// A PAR with one statement that mentions the drone (a show's or a squad's PAR: one
+  /// sequence per drone): no sibling changes the drone meanwhile, so the statement starts
+  /// from the entry, and one pass, recorded, is both its flow alone and the one recorded.
+  Flow par_alone(int fn, const Entry& e, States entry, bool record) {
+    States detached = 0;
+    ++visited_;
+    Flow flow = entered(fn, e, entry, record, detached);
+    States exit = flow.exit | detached, seen = flow.seen | detached;
+    bool changes = seen != entry || exit != entry;
+    return {changes ? exit : entry, static_cast<States>(entry | seen)};
   }
 
   /// The statement of an entry of block `fn`; plain calls and actions that only arm,

@@ -312,7 +312,9 @@ void Checker::check_statement(Function& f, Statement& s) {
   switch (s.kind) {
     case StatementKind::action: check_action(s); break;
     case StatementKind::call:
-      s.control = control_from_name(s.callee);
+      // No control structure is named like a block: most calls skip the comparison with
+      // every structure's name.
+      s.control = is_block_name(s.callee) ? ControlKind::none : control_from_name(s.callee);
       if (s.control != ControlKind::none) check_control(s);
       else check_block_call(s);
       break;

@@ -175,8 +175,19 @@ void Parser::parse_function(Mission& m) {
   m.functions.push_back(std::move(f));
 }
 
-// block = "{" { statement ";" } "}"
+// The statements are gathered in one vector the parser reuses and moved into the body at
+// its size: growing each body (and each argument list) by doubling cost an allocation per
+// doubling, a million of them in a large mission, and left up to half of each unused.
 void Parser::parse_block(Function& f) {
+  statements_.clear();
+  parse_body(f);
+  f.body.reserve(statements_.size());
+  for (Statement& s : statements_) f.body.push_back(std::move(s));
+  statements_.clear();
+}
+
+// block = "{" { statement ";" } "}"
+void Parser::parse_body(Function& f) {
   if (!expect(TokenKind::lbrace, "'{' to open the function body")) {
     skip_to_declaration();
     return;
@@ -190,7 +201,7 @@ void Parser::parse_block(Function& f) {
       return;
     }
     Statement s;
-    if (parse_statement(s)) f.body.push_back(std::move(s));
+    if (parse_statement(s)) statements_.push_back(std::move(s));
     if (tok_.kind != TokenKind::semicolon && tok_.kind != TokenKind::rbrace) {
       if (tok_.kind != TokenKind::end_of_file)
         error_here("expected newline or ';' after statement, found " + describe(tok_));
@@ -271,6 +282,13 @@ bool Parser::parse_statement(Statement& s) {
 // Returns false after a syntax error: the statement is dropped, so the checker does not
 // add a follow-on "wrong number of arguments" for an argument list that was cut short.
 bool Parser::parse_arguments(std::vector<Expr*>& args) {
+  arguments_.clear();
+  if (!parse_argument_list()) return false;
+  args.assign(arguments_.begin(), arguments_.end());
+  return true;
+}
+
+bool Parser::parse_argument_list() {
   ++paren_depth_;
   advance();  // '('
   while (tok_.kind != TokenKind::rparen) {
@@ -280,7 +298,7 @@ bool Parser::parse_arguments(std::vector<Expr*>& args) {
       skip_to_statement_end();
       return false;
     }
-    args.push_back(e);
+    arguments_.push_back(e);
     if (tok_.kind == TokenKind::comma) {
       advance();
       continue;
@@ -319,6 +337,23 @@ int binary_precedence(TokenKind k, Op& op) {
     case TokenKind::slash: op = Op::div; return 5;
     default: op = Op::none; return 0;
   }
+}
+
+/// The value of a number token; false when it is out of range. An integer of up to 15
+/// digits is exact in a double, so it is read digit by digit to the value strtod gives;
+/// most literals of a large mission are such, and strtod (with a copy of the text to
+/// terminate it) was a tenth of the parse.
+bool read_number(const Token& t, double& value) {
+  if (t.kind == TokenKind::integer && t.text.size() <= 15) {
+    long long v = 0;
+    for (char c : t.text) v = v * 10 + (c - '0');
+    value = static_cast<double>(v);
+    return true;
+  }
+  std::string text(t.text);
+  errno = 0;
+  value = std::strtod(text.c_str(), nullptr);
+  return errno != ERANGE;
 }
 
 /// One level more below the current parse point while it lives.
@@ -401,11 +436,8 @@ Expr* Parser::parse_primary() {
     case TokenKind::decimal: {
       e->kind = ExprKind::number;
       e->integer_literal = tok_.kind == TokenKind::integer;
-      std::string text(tok_.text);
-      errno = 0;
-      e->number = std::strtod(text.c_str(), nullptr);
-      if (errno == ERANGE) {
-        error_here("number '" + text.substr(0, 40) + "' is out of range");
+      if (!read_number(tok_, e->number)) {
+        error_here("number '" + std::string(tok_.text.substr(0, 40)) + "' is out of range");
         return nullptr;
       }
       advance();

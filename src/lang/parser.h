@@ -35,8 +35,10 @@ class Parser {
   void parse_drone(Mission& m);
   void parse_function(Mission& m);
   void parse_block(Function& f);
+  void parse_body(Function& f);
   bool parse_statement(Statement& s);
   bool parse_arguments(std::vector<Expr*>& args);
+  bool parse_argument_list();
   Expr* parse_expression(int min_precedence = 1);
   Expr* parse_unary();
   Expr* parse_primary();
@@ -52,6 +54,8 @@ class Parser {
   int depth_ = 0;  ///< expression levels enclosing the parse point (operators, parentheses)
   int paren_depth_ = 0;
   ExprArena arena_;  ///< moved into the Mission at the end
+  std::vector<Statement> statements_;  ///< the body being parsed, moved into its Function
+  std::vector<Expr*> arguments_;       ///< the argument list being parsed, copied into its Statement
 };
 
 }  // namespace eamos::lang
