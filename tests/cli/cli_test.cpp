@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -225,6 +226,36 @@ TEST_F(Cli, GenStressMissionCompilesWithoutWarningsAndIsDeterministic) {
   int nodes = stats["meg"]["nodes"];
   EXPECT_GE(nodes, 2000);
   EXPECT_LT(nodes, 2400);
+}
+
+// Every file under `dir`, by its path relative to it.
+std::map<std::string, std::string> files_under(const fs::path& dir) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.is_regular_file()) out[fs::relative(e.path(), dir).string()] = read_file(e.path());
+  return out;
+}
+
+// A source of 1 MiB or more restarts `eamos compile` once with glibc's malloc on huge pages
+// (src/cli/main.cpp); the restarted process must get the same arguments and write the same
+// files, whether the user's GLIBC_TUNABLES is unset, names other tunables (kept, the huge
+// pages added) or already chooses huge pages (no restart).
+TEST_F(Cli, ALargeCompileWritesTheSameFilesWhetherOrNotItRestartsOnHugePages) {
+  fs::path mission = dir_ / "large.eamos";
+  ASSERT_EQ(eamos("gen-stress --nodes 40000 --drones 40 -o " + mission.string()).status, 0);
+  ASSERT_GE(fs::file_size(mission), std::uintmax_t{1} << 20) << "too small to restart: raise --nodes";
+  std::vector<std::map<std::string, std::string>> outputs;
+  for (const char* tunables : {"", "glibc.malloc.mmap_threshold=65536", "glibc.malloc.hugetlb=0"}) {
+    if (*tunables) setenv("GLIBC_TUNABLES", tunables, 1);
+    fs::path out = dir_ / ("out" + std::to_string(outputs.size()));
+    Output r = eamos("compile --insecure -q " + mission.string() + " -o " + out.string());
+    unsetenv("GLIBC_TUNABLES");
+    ASSERT_EQ(r.status, 0) << tunables << ": " << r.out.substr(0, 2000);
+    outputs.push_back(files_under(out));
+  }
+  EXPECT_EQ(outputs[0].size(), 41u + 1u) << "a mission file per drone, one for the ground and the manifest";
+  EXPECT_EQ(outputs[0], outputs[1]);
+  EXPECT_EQ(outputs[0], outputs[2]);
 }
 
 TEST_F(Cli, HelpAndVersion) {
