@@ -388,9 +388,18 @@ void SeparationGuard::consider(int a, int b, Mine* given) {
   Track& A = tracks_[a];
   const Track& B = tracks_[b];
   if (!A.airborne || !B.airborne) return;
-  Mine local;
-  Mine& m = given ? *given : local;
-  if (!m.ready) m = mine(a);
+  // A Mine is some 160 bytes: made only for a pair looked at alone, not zeroed for every
+  // neighbour of a look that shares one.
+  if (!given) {
+    Mine local = mine(a);
+    return consider_with(a, b, local);
+  }
+  if (!given->ready) *given = mine(a);
+  consider_with(a, b, *given);
+}
+
+void SeparationGuard::consider_with(int a, int b, const Mine& m) {
+  Track& A = tracks_[a];
   if (!m.moving) return;
   ++pairs_;
   const Prediction p = clear_of(m.box, b) ? Prediction{} : foresee(a, m.course, m.left, b, kSeparationHorizonS);

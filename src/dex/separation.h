@@ -187,6 +187,7 @@ class SeparationGuard {
   std::optional<Vec> goal_of(int d) const;
   Prediction foresee(int a, const Course& mine, double left, int b, double horizon_s) const;
   void consider(int a, int b, Mine* mine = nullptr);
+  void consider_with(int a, int b, const Mine& mine);  ///< consider() once a's side is known
   void give_way(int a, int b, const Prediction& p);
   void try_resume(int h);
   void too_long(int h, double since);

@@ -105,22 +105,31 @@ void LiveLog::record(const TraceEvent& e) {
   if (e.event == "telemetry" || e.event == "message" || e.event == "node") return;
   char head[64];
   std::snprintf(head, sizeof head, "%9.2f s  %-8s %-9s ", e.t, e.drone.c_str(), e.event.c_str());
-  out_ << head << (e.text.empty() ? e.name : e.text);
-  if (!e.outcome.empty()) out_ << "  " << e.outcome;
-  if (!e.failure.empty()) out_ << " [" << e.failure << "]";
-  if (e.value) out_ << "  → " << (*e.value ? "true" : "false");
-  if (e.reading) out_ << "  = " << *e.reading;
-  if (!e.other.empty()) out_ << " " << e.other;
+  // The line is put together first and written once: into std::cout every << is a write
+  // of its own into stdio, and a 1,000-drone run logs some 150,000 lines.
+  std::string& line = line_;
+  line.assign(head);
+  line += e.text.empty() ? e.name : e.text;
+  if (!e.outcome.empty()) line.append("  ").append(e.outcome);
+  if (!e.failure.empty()) line.append(" [").append(e.failure).append("]");
+  if (e.value) line.append("  → ").append(*e.value ? "true" : "false");
+  if (e.reading) {
+    line += "  = ";
+    out_ << line << *e.reading;  // a reading as the stream writes numbers
+    line.clear();
+  }
+  if (!e.other.empty()) line.append(" ").append(e.other);
   if (e.distance) {
     char d[32];
     std::snprintf(d, sizeof d, " %.1f m apart", *e.distance);
-    out_ << d;
+    line += d;
   }
-  if (!e.reason.empty()) out_ << "  (" << e.reason << ")";
-  if (e.line > 0) out_ << "   line " << e.line;
+  if (!e.reason.empty()) line.append("  (").append(e.reason).append(")");
+  if (e.line > 0) line.append("   line ").append(std::to_string(e.line));
   // Live: a line is out when it happened, also through a pipe (`eamos run | tee`, a test
   // that acts on a line), not when a buffer fills.
-  out_ << '\n';
+  line += '\n';
+  out_ << line;
   if (flush_each_line_) out_ << std::flush;
 }
 

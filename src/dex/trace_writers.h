@@ -57,6 +57,7 @@ class LiveLog : public TraceSink {
  private:
   std::ostream& out_;
   bool flush_each_line_ = true;
+  std::string line_;  ///< the line being put together, its room kept from line to line
 };
 
 class TeeTrace : public TraceSink {

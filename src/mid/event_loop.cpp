@@ -292,15 +292,18 @@ void EventLoop::post(std::function<void()> fn) {
   {
     std::lock_guard<std::mutex> lock(post_mutex_);
     posted_.push_back(std::move(fn));
+    has_posted_.store(true, std::memory_order_release);
   }
   post_cv_.notify_one();
 }
 
 void EventLoop::take_posted() {
+  if (!has_posted_.load(std::memory_order_acquire)) return;
   std::vector<std::function<void()>> taken;
   {
     std::lock_guard<std::mutex> lock(post_mutex_);
     taken.swap(posted_);
+    has_posted_.store(false, std::memory_order_relaxed);
   }
   if (taken.empty()) return;
   double t = now_;

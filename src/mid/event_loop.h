@@ -4,6 +4,7 @@
 // PauseFor are all timers here. Virtual time (tests, default runs) jumps from event to
 // event, so a 60 s mission takes as long as its callbacks; real time (the CLI's
 // --realtime/--speed) sleeps until each event's wall time.
+#include <atomic>
 #include <cstdint>
 #include <condition_variable>
 #include <functional>
@@ -202,6 +203,9 @@ class EventLoop {
   std::mutex post_mutex_;
   std::condition_variable post_cv_;
   std::vector<std::function<void()>> posted_;  ///< guarded by post_mutex_
+  /// posted_ is not empty: looked at without the lock before every callback, so a loop that
+  /// nothing posts to (a run on virtual time) takes no lock per event.
+  std::atomic<bool> has_posted_{false};
   std::optional<double> wall_origin_;
   double wall_anchor_ = 0.0;     ///< real time: wall time at which mission time ...
   double mission_anchor_ = 0.0;  ///< ... was this

@@ -1,7 +1,5 @@
 #include "mid/state_broker.h"
 
-#include <vector>
-
 namespace eamos::mid {
 
 SubscriptionId StateBroker::subscribe(StateCallback fn) {
@@ -13,15 +11,15 @@ SubscriptionId StateBroker::subscribe(StateCallback fn) {
 void StateBroker::unsubscribe(SubscriptionId id) { subscribers_.erase(id); }
 
 void StateBroker::publish(const DroneState& state) {
-  // Walk a snapshot of the ids: a callback may change the map under us.
-  std::vector<SubscriptionId> ids;
-  ids.reserve(subscribers_.size());
-  for (const auto& [id, fn] : subscribers_) ids.push_back(id);
-  for (SubscriptionId id : ids) {
-    auto it = subscribers_.find(id);
-    if (it == subscribers_.end()) continue;
+  // A callback may change the map under us: the next one is looked up after each call, and
+  // one subscribed meanwhile (a later id) is not called this time. No copy of the ids: a
+  // simulated drone publishes twenty times a second.
+  const SubscriptionId last = next_id_ - 1;
+  for (auto it = subscribers_.begin(); it != subscribers_.end() && it->first <= last;) {
+    const SubscriptionId id = it->first;
     StateCallback fn = it->second;  // a copy: the callback may unsubscribe itself
     fn(state);
+    it = subscribers_.upper_bound(id);
   }
 }
 
