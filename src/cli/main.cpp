@@ -402,6 +402,20 @@ bool outputs_usable(const Commands& c, const std::vector<std::string>& args, con
   return true;
 }
 
+/// glibc's malloc backs its heap with transparent huge pages (where the kernel offers them on
+/// request, as Debian's `madvise` setting does) only when GLIBC_TUNABLES says so as a program
+/// starts: for a heap of hundreds of MB touched a page at a time, a tenth of the page faults
+/// and less CPU besides (docs/performance.md). Puts `glibc.malloc.hugetlb=1` in the
+/// environment for the program this one starts or becomes; false, and nothing changed, when
+/// the user's GLIBC_TUNABLES already chooses (theirs wins).
+bool ask_malloc_for_huge_pages() {
+  const char* user = std::getenv("GLIBC_TUNABLES");
+  std::string tunables = user ? user : "";
+  if (tunables.find("glibc.malloc.hugetlb") != std::string::npos) return false;
+  tunables += (tunables.empty() ? "" : ":") + std::string("glibc.malloc.hugetlb=1");
+  return ::setenv("GLIBC_TUNABLES", tunables.c_str(), 1) == 0;
+}
+
 #ifdef EAMOS_FLY_ELSEWHERE
 /// A helper program (eamos-fly, eamos-credentials): next to this program (the build tree, or
 /// all in bin/), else in ../libexec/eamos/ (the install tree and the Debian package).
@@ -443,18 +457,6 @@ int exec_credentials(const eamos::cli::CompileEnding& end) {
   return 1;
 }
 
-/// `eamos run` flies the whole fleet in one process: some 200 MB of heap for 1,000 drones,
-/// touched a page at a time. glibc backs its heap with transparent huge pages when asked
-/// (where the kernel offers them on request): a tenth of the page faults, and less CPU in
-/// the flight too (docs/performance.md). glibc reads the setting when a program starts,
-/// so it goes into eamos-fly's environment; a GLIBC_TUNABLES of the user's comes after it
-/// and wins. The processes of a distributed run are many and small: they keep the default.
-void heap_in_huge_pages() {
-  std::string tunables = "glibc.malloc.hugetlb=1";
-  if (const char* user = std::getenv("GLIBC_TUNABLES"); user && *user) tunables += std::string(":") + user;
-  ::setenv("GLIBC_TUNABLES", tunables.c_str(), 1);
-}
-
 /// The commands that fly or serve (run, verify, launch, dex, sim-vehicle, monitor) live in
 /// eamos-fly, which links Cyclone DDS, civetweb and the MAVLink stack. This `eamos` links none
 /// of them, so check, compile and the other commands start without loading them
@@ -463,7 +465,9 @@ void heap_in_huge_pages() {
 int fly(const Commands& c, Options& o, char** argv) {
   std::string program = fly_program();
   argv[0] = program.data();
-  if (*c.run && !o.distributed) heap_in_huge_pages();
+  // `run` in one process holds the whole fleet (some 200 MB for 1,000 drones); the
+  // processes of a distributed run are many and small, and keep the default.
+  if (*c.run && !o.distributed) ask_malloc_for_huge_pages();
   ::execv(program.c_str(), argv);
   std::cerr << eamos::cli::error_prefix() << "cannot start " << program << ": " << std::strerror(errno)
             << "; the installation is incomplete (reinstall eamos)\n";
@@ -495,19 +499,12 @@ constexpr std::uintmax_t kHugePagesFrom = std::uintmax_t{1} << 20;
 
 /// A large compile first-touches hundreds of MB, and in 4 KiB pages each is a page fault:
 /// most of the kernel's share of the compile (docs/performance.md, "Fleets of a thousand").
-/// glibc's malloc asks the kernel for transparent huge pages only when GLIBC_TUNABLES says
-/// so as the process starts, so a compile of a large source starts this program again with
-/// `glibc.malloc.hugetlb=1`. A user who set that tunable keeps it. Returns only when the
-/// compile goes on in this process.
+/// A compile of a large source therefore starts this program again on huge pages. Returns
+/// only when the compile goes on in this process.
 void restart_on_huge_pages(const std::string& mission, char** argv) {
-  const char* set = std::getenv("GLIBC_TUNABLES");
-  std::string tunables = set ? set : "";
-  if (tunables.find("glibc.malloc.hugetlb") != std::string::npos) return;
   std::error_code ec;
   std::uintmax_t size = std::filesystem::file_size(mission, ec);
-  if (ec || size < kHugePagesFrom) return;
-  tunables += (tunables.empty() ? "" : ":") + std::string("glibc.malloc.hugetlb=1");
-  if (::setenv("GLIBC_TUNABLES", tunables.c_str(), 1) != 0) return;
+  if (ec || size < kHugePagesFrom || !ask_malloc_for_huge_pages()) return;
   std::cout.flush();
   std::fflush(nullptr);
   ::execv("/proc/self/exe", argv);  // on failure the compile goes on here, on small pages
