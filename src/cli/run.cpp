@@ -170,7 +170,9 @@ int cmd_run(const CommonOptions& o, const RunCommandOptions& r) {
     hold.signal();
   });
   graph::Compilation c;
-  if (!compile_and_report(o, c)) return 1;
+  // Flying needs the MEG and the MDGs only; the live page also draws the AMT.
+  if (!compile_and_report(o, c, r.monitor.empty() ? graph::Keep::deployment_graphs : graph::Keep::all_graphs))
+    return 1;
   std::vector<dex::Mission> missions;
   if (!load_compiled_missions(c, missions)) return 1;
   nlohmann::json view;

@@ -122,7 +122,7 @@ bool write_verify_trace(const std::string& path, const graph::Compilation& c, co
 
 int cmd_verify(const CommonOptions& o, const VerifyCommandOptions& v) {
   graph::Compilation c;
-  if (!compile_and_report(o, c)) return 1;
+  if (!compile_and_report(o, c, graph::Keep::deployment_graphs)) return 1;
   std::vector<dex::Mission> missions;
   if (!load_compiled_missions(c, missions)) return 1;
   verify::VerifyOptions options;
