@@ -7,12 +7,11 @@
 
 namespace eamos::graph {
 
-int Meg::add_node(MegKind kind, SourceLocation loc, int amt) {
+int Meg::add_node(MegKind kind, SourceLocation loc) {
   MegNode n;
   n.id = static_cast<int>(nodes.size());
   n.kind = kind;
   n.loc = loc;
-  n.amt = amt;
   nodes.push_back(std::move(n));
   return nodes.back().id;
 }
@@ -52,10 +51,9 @@ std::vector<int> unique_drones(const std::vector<int>& order) {
 
 /// One node of the AMT, read from the statements it expands: the MEG is built from the
 /// mission itself, so a compile that needs no AMT never holds one (it was as large as the
-/// MEG). `id` is the node's place in the AMT's preorder, as build_amt numbers it.
+/// MEG).
 struct Node {
   AmtKind kind = AmtKind::seq;
-  int id = 0;
   SourceLocation loc;
   std::string_view name;
   int function = -1;                           ///< init, seq, par: the block it expands
@@ -72,8 +70,8 @@ class MegBuilder {
   Meg build() {
     const lang::Function& init = m_.functions[m_.init_function];
     meg_.nodes.reserve(node_bound());
-    Node root{AmtKind::init, next_id_++, init.loc, init.name, m_.init_function};
-    meg_.init = meg_.add_node(MegKind::init, root.loc, root.id);
+    Node root{AmtKind::init, init.loc, init.name, m_.init_function};
+    meg_.init = meg_.add_node(MegKind::init, root.loc);
     meg_.nodes[meg_.init].name = "INIT";
     Ends ends = build_children(root, {{meg_.init}});
     meg_.end = meg_.add_node(MegKind::end, root.loc);
@@ -121,23 +119,23 @@ class MegBuilder {
     return bound;
   }
 
-  /// The AMT node a statement expands into, numbered next.
+  /// The AMT node a statement expands into.
   Node child_of(const lang::Statement& s) {
     switch (s.kind) {
-      case lang::StatementKind::action: return {AmtKind::action, next_id_++, s.loc, s.callee, -1, &s};
-      case lang::StatementKind::async_call: return {AmtKind::async, next_id_++, s.loc, "async", -1, &s};
+      case lang::StatementKind::action: return {AmtKind::action, s.loc, s.callee, -1, &s};
+      case lang::StatementKind::async_call: return {AmtKind::async, s.loc, "async", -1, &s};
       case lang::StatementKind::call: break;
     }
     if (s.control == ControlKind::none) return block(s.function_index, s.loc);
-    if (s.control == ControlKind::PauseFor) return {AmtKind::pause, next_id_++, s.loc, "PauseFor", -1, &s};
-    return {AmtKind::control, next_id_++, s.loc, lang::control_name(s.control), -1, &s};
+    if (s.control == ControlKind::PauseFor) return {AmtKind::pause, s.loc, "PauseFor", -1, &s};
+    return {AmtKind::control, s.loc, lang::control_name(s.control), -1, &s};
   }
 
-  /// An instance of block `f` called at `loc`, numbered next.
+  /// An instance of block `f` called at `loc`.
   Node block(int f, SourceLocation loc) {
     const lang::Function& fn = m_.functions[f];
     AmtKind kind = fn.block == lang::BlockKind::par ? AmtKind::par : AmtKind::seq;
-    return {kind, next_id_++, loc, fn.name, f};
+    return {kind, loc, fn.name, f};
   }
 
   void connect(const Ends& ends, int to) {
@@ -196,7 +194,7 @@ class MegBuilder {
   }
 
   Ends build_par(const Node& n, const Ends& ends) {
-    int fork = meg_.add_node(MegKind::fork, n.loc, n.id);
+    int fork = meg_.add_node(MegKind::fork, n.loc);
     meg_.nodes[fork].name = n.name;
     connect(ends, fork);
     Ends out;
@@ -215,7 +213,7 @@ class MegBuilder {
     const lang::Statement& s = *n.statement;
     Node body = block(s.function_index, s.callee_loc);
     Ends body_ends = build(body, ends);
-    int t = meg_.add_node(MegKind::terminal, n.loc, n.id);
+    int t = meg_.add_node(MegKind::terminal, n.loc);
     meg_.nodes[t].name = "async " + std::string(body.name);
     int owner = first_action_drone(s.function_index);
     meg_.nodes[t].drone = owner >= 0 ? owner : std::max(0, drone_of(ends));
@@ -225,7 +223,7 @@ class MegBuilder {
 
   Ends build_action(const Node& n, const Ends& ends) {
     const lang::Statement& s = *n.statement;
-    int a = meg_.add_node(MegKind::action, n.loc, n.id);
+    int a = meg_.add_node(MegKind::action, n.loc);
     MegNode& node = meg_.nodes[a];
     node.drone = s.drone_index;
     node.name = n.name;
@@ -238,7 +236,7 @@ class MegBuilder {
   }
 
   Ends build_pause(const Node& n, const Ends& ends) {
-    int p = meg_.add_node(MegKind::pause, n.loc, n.id);
+    int p = meg_.add_node(MegKind::pause, n.loc);
     int owner = drone_of(ends);
     meg_.nodes[p].drone = owner >= 0 ? owner : 0;
     meg_.nodes[p].name = n.name;
@@ -270,7 +268,7 @@ class MegBuilder {
   }
 
   int add_terminal(const Node& n, int condition, Role role) {
-    int t = meg_.add_node(MegKind::terminal, n.loc, n.id);
+    int t = meg_.add_node(MegKind::terminal, n.loc);
     MegNode& node = meg_.nodes[t];
     node.drone = meg_.nodes[condition].drone;
     node.owner_condition = condition;
@@ -307,7 +305,7 @@ class MegBuilder {
 
   Ends build_control(const Node& n, const Ends& ends) {
     const lang::Statement& s = *n.statement;
-    int c = meg_.add_node(MegKind::condition, n.loc, n.id);
+    int c = meg_.add_node(MegKind::condition, n.loc);
     {
       MegNode& node = meg_.nodes[c];
       node.name = n.name;
@@ -375,7 +373,6 @@ class MegBuilder {
 
   const lang::Mission& m_;
   Meg meg_;
-  int next_id_ = 0;                  ///< the AMT preorder number of the next node
   std::vector<int> first_drone_;     ///< per function: first_action_drone, kNotFound until known
   std::vector<long long> bounds_;    ///< per function: block_bound, -1 until known
 };

@@ -24,7 +24,6 @@ struct MegNode {
   int id = 0;
   MegKind kind = MegKind::action;
   SourceLocation loc;
-  int amt = -1;            ///< the AMT node it came from, by build_amt's numbering (-1 for end)
   int drone = -1;          ///< owner; -1 for sync points
   std::string name;        ///< capability, control structure or block name
   std::vector<int> out;    ///< indices into Meg::arcs
@@ -57,7 +56,7 @@ struct Meg {
   int end = -1;
   int drone_count = 0;
 
-  int add_node(MegKind kind, SourceLocation loc, int amt = -1);
+  int add_node(MegKind kind, SourceLocation loc);
   int add_arc(int from, int to, ArcKind kind = ArcKind::exec, Branch branch = Branch::any);
 };
 
