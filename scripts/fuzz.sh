@@ -8,7 +8,7 @@ SECONDS_PER_TARGET=${2:-20}
 cd "$(dirname "$0")/.."
 
 if [ ! -f "$BUILD/build.ninja" ]; then
-  CC=clang CXX=clang++ cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  CC=clang CXX=clang++ cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_UNITY_BUILD=ON \
     -DEAMOS_FUZZ=ON -DEAMOS_TESTS=OFF -DEAMOS_BENCH=OFF >/dev/null
 fi
 targets=(fuzz_frontend fuzz_fleet fuzz_mavlink fuzz_mission fuzz_wire)

@@ -42,7 +42,7 @@ TSAN_REALTIME='^(Monitor|Interrupt|Distributed\.(Listing2Right|FailedActionOnOne
 # Every time, so a tree configured before keeps the options this script needs (no Python
 # module, benchmarks or fuzzers); on an existing tree it takes seconds.
 configure() {  # tree, sanitizer
-  CC=clang CXX=clang++ cmake -S . -B "$1" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  CC=clang CXX=clang++ cmake -S . -B "$1" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_UNITY_BUILD=ON \
     -DEAMOS_SANITIZE="$2" -DEAMOS_BENCH=OFF -DEAMOS_FUZZ=OFF -DEAMOS_PYTHON=OFF >/dev/null
 }
 

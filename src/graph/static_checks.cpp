@@ -112,9 +112,6 @@ bool is_wait(ControlKind k) {
   return k == ControlKind::WaitUntil || k == ControlKind::WaitWhile || k == ControlKind::PauseUntil ||
          k == ControlKind::PauseWhile;
 }
-bool is_repeat(ControlKind k) {
-  return k == ControlKind::RepeatUntil || k == ControlKind::RepeatWhile || k == ControlKind::RepeatFor;
-}
 bool is_do(ControlKind k) {
   return k == ControlKind::DoUntilSync || k == ControlKind::DoWhileSync || k == ControlKind::DoUntilAsync ||
          k == ControlKind::DoWhileAsync;

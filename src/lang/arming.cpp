@@ -38,9 +38,6 @@ struct Visit {
   const Statement* statement = nullptr;
 };
 
-bool is_repeat(ControlKind k) {
-  return k == ControlKind::RepeatUntil || k == ControlKind::RepeatWhile || k == ControlKind::RepeatFor;
-}
 bool is_do_sync(ControlKind k) { return k == ControlKind::DoUntilSync || k == ControlKind::DoWhileSync; }
 bool is_do_async(ControlKind k) { return k == ControlKind::DoUntilAsync || k == ControlKind::DoWhileAsync; }
 

@@ -6,12 +6,9 @@
 namespace eamos::lang {
 namespace {
 
-bool is_repeat(ControlKind k) {
-  return k == ControlKind::RepeatUntil || k == ControlKind::RepeatWhile || k == ControlKind::RepeatFor;
-}
 
 /// 1 for the literal `true`, 0 for `false`, -1 for anything else (decided at run time).
-int literal(const Expr* e) {
+int literal_truth(const Expr* e) {
   if (!e || e->kind != ExprKind::boolean) return -1;
   return e->boolean ? 1 : 0;
 }
@@ -71,7 +68,7 @@ class LoopTime {
   const Expr* condition(const Statement& s) const { return s.args.empty() ? nullptr : s.args[0]; }
 
   bool control_waits(const Statement& s) {
-    int c = literal(condition(s));
+    int c = literal_truth(condition(s));
     switch (s.control) {
       case ControlKind::If:
         if (c == 1) return block_waits(branch(s, 0));

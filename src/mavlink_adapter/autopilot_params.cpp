@@ -12,7 +12,7 @@ namespace {
 // ArduCopter (its parameter docs): waypoint speeds in cm/s; LAND_SPEED is the last 10 m
 // (LAND_ALT_LOW) of a landing, LAND_SPEED_HIGH above it (0: WPNAV_SPEED_DN). The whole
 // descent is counted at the slower one: a deadline must not be too short.
-const std::vector<LimitParam> kArduPilot = {
+const std::vector<LimitParam> kArduPilotLimits = {
     {"WPNAV_SPEED", LimitKind::speed, 0.01},     {"WPNAV_SPEED_UP", LimitKind::climb, 0.01},
     {"WPNAV_SPEED_DN", LimitKind::descent, 0.01}, {"LAND_SPEED", LimitKind::land, 0.01},
     {"LAND_SPEED_HIGH", LimitKind::land, 0.01},
@@ -26,7 +26,7 @@ const std::vector<LimitParam> kArduPilot = {
 };
 // PX4 (multicopter position control): m/s. A takeoff climbs at MPC_TKO_SPEED, a landing
 // ends at MPC_LAND_SPEED.
-const std::vector<LimitParam> kPx4 = {
+const std::vector<LimitParam> kPx4Limits = {
     {"MPC_XY_CRUISE", LimitKind::speed, 1.0},    {"MPC_Z_VEL_MAX_UP", LimitKind::climb, 1.0},
     {"MPC_TKO_SPEED", LimitKind::climb, 1.0},    {"MPC_Z_VEL_MAX_DN", LimitKind::descent, 1.0},
     {"MPC_LAND_SPEED", LimitKind::land, 1.0},
@@ -112,7 +112,7 @@ void read_return_profile(const Autopilot& a, const std::vector<LimitParam>& para
 }  // namespace
 
 std::vector<LimitParam> limit_params(const Autopilot& a) {
-  return a.mav_autopilot == mavlink::autopilot::PX4 ? kPx4 : kArduPilot;
+  return a.mav_autopilot == mavlink::autopilot::PX4 ? kPx4Limits : kArduPilotLimits;
 }
 
 FlightLimits combine_limits(const Autopilot& a, const fleet::Limits& fleet,

@@ -38,6 +38,11 @@ inline constexpr ControlEntry kControls[] = {
 };
 }  // namespace detail
 
+/// A loop: RepeatUntil, RepeatWhile or RepeatFor.
+inline bool is_repeat(ControlKind k) {
+  return k == ControlKind::RepeatUntil || k == ControlKind::RepeatWhile || k == ControlKind::RepeatFor;
+}
+
 /// The structure's name as written in a mission ("If"); "" for none.
 inline const char* control_name(ControlKind kind) {
   for (const auto& e : detail::kControls)

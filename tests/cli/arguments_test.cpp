@@ -17,7 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 
 using eamos_test::Output;
-Output eamos(const std::string& args) { return eamos_test::run_eamos(args, {}, EAMOS_SOURCE_DIR); }
+Output eamos_in_source_dir(const std::string& args) { return eamos_test::run_eamos(args, {}, EAMOS_SOURCE_DIR); }
 
 class Arguments : public ::testing::Test {
  protected:
@@ -31,7 +31,7 @@ class Arguments : public ::testing::Test {
 };
 
 TEST_F(Arguments, AMisspelledCommandGetsTheClosestWithACaretUnderIt) {
-  Output r = eamos("chek examples/listing2.eamos");
+  Output r = eamos_in_source_dir("chek examples/listing2.eamos");
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(r.out,
             "eamos: error: unknown command 'chek'; did you mean 'check'?\n"
@@ -40,7 +40,7 @@ TEST_F(Arguments, AMisspelledCommandGetsTheClosestWithACaretUnderIt) {
 }
 
 TEST_F(Arguments, NoCommandListsTheCommands) {
-  Output r = eamos("");
+  Output r = eamos_in_source_dir("");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("eamos: error: no command given; say what to do: eamos COMMAND …, where COMMAND is one of "
                        "check, compile, graph"),
@@ -49,7 +49,7 @@ TEST_F(Arguments, NoCommandListsTheCommands) {
 }
 
 TEST_F(Arguments, AMisspelledOptionGetsTheClosestOfItsCommand) {
-  Output r = eamos("run examples/listing2.eamos --trce t.jsonl");
+  Output r = eamos_in_source_dir("run examples/listing2.eamos --trce t.jsonl");
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(r.out,
             "eamos: error: unknown option '--trce' of `eamos run`; did you mean '--trace'?\n"
@@ -58,7 +58,7 @@ TEST_F(Arguments, AMisspelledOptionGetsTheClosestOfItsCommand) {
 }
 
 TEST_F(Arguments, AnOptionOfAnotherCommandSaysWhoseItIs) {
-  Output r = eamos("check examples/listing2.eamos --summary s.json");
+  Output r = eamos_in_source_dir("check examples/listing2.eamos --summary s.json");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("eamos: error: '--summary' is an option of `eamos run`, `eamos launch`, not of `eamos check`"),
             std::string::npos)
@@ -66,23 +66,23 @@ TEST_F(Arguments, AnOptionOfAnotherCommandSaysWhoseItIs) {
 }
 
 TEST_F(Arguments, ANumberOutOfRangeIsStatedInWordsUnderItsValue) {
-  Output r = eamos("run examples/listing2.eamos --speed 0");
+  Output r = eamos_in_source_dir("run examples/listing2.eamos --speed 0");
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(r.out,
             "eamos: error: --speed: '0' is not a number greater than 0\n"
             " eamos run examples/listing2.eamos --speed 0\n"
             "                                           ^\n");
-  r = eamos("run examples/listing2.eamos --domain=300 --distributed");
+  r = eamos_in_source_dir("run examples/listing2.eamos --domain=300 --distributed");
   EXPECT_NE(r.out.find("--domain: '300' is not a whole number from 0 to 230\n"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("                                   ^~~\n"), std::string::npos) << r.out;
-  r = eamos("run examples/listing2.eamos --telemetry-hz 101");
+  r = eamos_in_source_dir("run examples/listing2.eamos --telemetry-hz 101");
   EXPECT_NE(r.out.find("--telemetry-hz: '101' is not a number from 0 to 100"), std::string::npos) << r.out;
-  r = eamos("graph examples/listing2.eamos --kind megg");
+  r = eamos_in_source_dir("graph examples/listing2.eamos --kind megg");
   EXPECT_NE(r.out.find("--kind: 'megg' is not one of amt, meg, mdg; did you mean 'meg'?"), std::string::npos) << r.out;
 }
 
 TEST_F(Arguments, AMissingFileGetsTheCloseNameBesideIt) {
-  Output r = eamos("check examples/listing3.eamos");
+  Output r = eamos_in_source_dir("check examples/listing3.eamos");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("eamos: error: no file 'examples/listing3.eamos'; did you mean 'examples/listing2.eamos'?"),
             std::string::npos)
@@ -91,17 +91,17 @@ TEST_F(Arguments, AMissingFileGetsTheCloseNameBesideIt) {
 }
 
 TEST_F(Arguments, AMissingValueAndAMissingArgumentAreNamed) {
-  Output r = eamos("run examples/listing2.eamos --speed");
+  Output r = eamos_in_source_dir("run examples/listing2.eamos --speed");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("eamos: error: --speed needs a value"), std::string::npos) << r.out;
-  r = eamos("compile examples/listing2.eamos");
+  r = eamos_in_source_dir("compile examples/listing2.eamos");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("eamos: error: `eamos compile` needs --output (Output folder)"), std::string::npos) << r.out;
 }
 
 TEST_F(Arguments, EveryOutputPathIsCheckedBeforeAnythingFlies) {
   std::string nowhere = (dir_ / "no" / "such" / "folder").string();
-  Output r = eamos("run examples/listing2.eamos --plot " + nowhere + "/plot.svg --trace " + dir_.string() +
+  Output r = eamos_in_source_dir("run examples/listing2.eamos --plot " + nowhere + "/plot.svg --trace " + dir_.string() +
                    " --summary " + (dir_ / "s.json").string());
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("eamos: error: --plot: the folder '" + nowhere + "' does not exist; create it (mkdir -p " +
@@ -117,26 +117,26 @@ TEST_F(Arguments, EveryOutputPathIsCheckedBeforeAnythingFlies) {
 
 TEST_F(Arguments, TwoOutputsToOneFileAndAnOutputOverTheMissionAreRefused) {
   std::string same = (dir_ / "out.json").string();
-  Output r = eamos("run examples/listing2.eamos --trace " + same + " --summary " + same);
+  Output r = eamos_in_source_dir("run examples/listing2.eamos --trace " + same + " --summary " + same);
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("eamos: error: --summary: --trace writes '" + same + "' too; give each its own file"),
             std::string::npos)
       << r.out;
   fs::copy_file(fs::path(EAMOS_SOURCE_DIR) / "examples/listing2.eamos", dir_ / "m.eamos");
-  r = eamos("run " + (dir_ / "m.eamos").string() + " --plot " + (dir_ / "m.eamos").string());
+  r = eamos_in_source_dir("run " + (dir_ / "m.eamos").string() + " --plot " + (dir_ / "m.eamos").string());
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("is an input of this command; writing it would destroy it"), std::string::npos) << r.out;
   EXPECT_GT(fs::file_size(dir_ / "m.eamos"), 1000u);
 }
 
 TEST_F(Arguments, AMissionWhereATraceOrADeploymentIsExpectedIsRecognised) {
-  Output r = eamos("monitor examples/listing2.eamos --port 0");
+  Output r = eamos_in_source_dir("monitor examples/listing2.eamos --port 0");
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(r.out,
             "eamos: error: 'examples/listing2.eamos' is a mission, not a trace; watch it fly with `eamos run "
             "examples/listing2.eamos --monitor 8080`, or record a trace with `eamos run examples/listing2.eamos "
             "--trace run.jsonl` and replay that\n");
-  r = eamos("launch examples/listing2.eamos");
+  r = eamos_in_source_dir("launch examples/listing2.eamos");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("'examples/listing2.eamos' is a mission, not a deployment folder; compile it first"),
             std::string::npos)
@@ -146,12 +146,12 @@ TEST_F(Arguments, AMissionWhereATraceOrADeploymentIsExpectedIsRecognised) {
 TEST_F(Arguments, ColourOnlyWhenAskedOrOnATerminal) {
   fs::path m = dir_ / "bad.eamos";
   std::ofstream(m) << "var A Quad\nfunc INIT() { A.Tkeoff(3) }\n";
-  Output plain = eamos("check " + m.string());
+  Output plain = eamos_in_source_dir("check " + m.string());
   EXPECT_EQ(plain.out.find("\x1b["), std::string::npos) << plain.out;  // a pipe: no colour
-  Output coloured = eamos("check " + m.string() + " --color=always");
+  Output coloured = eamos_in_source_dir("check " + m.string() + " --color=always");
   EXPECT_NE(coloured.out.find("\x1b[1;31merror:\x1b[0m"), std::string::npos) << coloured.out;
   EXPECT_NE(coloured.out.find("\x1b[1;32m^~~~~~\x1b[0m"), std::string::npos) << coloured.out;
-  Output bad = eamos("check " + m.string() + " --color=sometimes");
+  Output bad = eamos_in_source_dir("check " + m.string() + " --color=sometimes");
   EXPECT_NE(bad.out.find("--color: 'sometimes' is not one of auto, always, never"), std::string::npos) << bad.out;
 }
 
@@ -185,10 +185,10 @@ TEST_F(Arguments, SarifLogHasTheResultsTheirRangesAndTheirNotes) {
 TEST_F(Arguments, CountsArePluralOnlyAboveOne) {
   fs::path m = dir_ / "one.eamos";
   std::ofstream(m) << "var Drone1 Quad\nfunc INIT() { Drone1.Arm(); Drone1.Tkeoff(3) }\n";
-  Output r = eamos("check " + m.string());
+  Output r = eamos_in_source_dir("check " + m.string());
   EXPECT_NE(r.out.find("\n1 error, 0 warnings\n"), std::string::npos) << r.out;
   std::ofstream(m) << "var Drone1 Quad\nfunc INIT() { Drone1.Arm(); Drone1.Takeoff(3); Drone1.Land(); Drone1.Disarm() }\n";
-  r = eamos("check " + m.string());
+  r = eamos_in_source_dir("check " + m.string());
   EXPECT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find(": ok — 1 drone, "), std::string::npos) << r.out;
 }

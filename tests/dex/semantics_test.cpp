@@ -14,10 +14,10 @@ namespace {
 using test::Flight;
 using test::fly;
 
-const std::string kTwo = "var A Quad\nvar B Quad\n";
+const std::string kTwoQuads = "var A Quad\nvar B Quad\n";
 
 TEST(Semantics, AsyncStartsBlockAndSequenceGoesOnAtOnceButMissionWaitsForIt) {
-  Flight f = fly(kTwo + "func INIT() { A.Arm(); async(SEQ_side); A.TakePicture() }\n"
+  Flight f = fly(kTwoQuads + "func INIT() { A.Arm(); async(SEQ_side); A.TakePicture() }\n"
                         "func SEQ_side() { B.Arm(); B.Takeoff(10); B.Land(); B.Disarm() }\n");
   ASSERT_TRUE(f.result.completed) << f.result.error;
   EXPECT_EQ(f.time_of("start", "A.TakePicture()"), f.time_of("start", "B.Arm()"));
@@ -26,14 +26,14 @@ TEST(Semantics, AsyncStartsBlockAndSequenceGoesOnAtOnceButMissionWaitsForIt) {
 }
 
 TEST(Semantics, PauseForHaltsTheSequenceForMissionSeconds) {
-  Flight f = fly(kTwo + "func INIT() { A.Arm(); PauseFor(7.5); A.Disarm() }\n");
+  Flight f = fly(kTwoQuads + "func INIT() { A.Arm(); PauseFor(7.5); A.Disarm() }\n");
   ASSERT_TRUE(f.result.completed) << f.result.error;
   EXPECT_NEAR(f.time_of("start", "A.Disarm()") - f.time_of("end", "A.Arm()"), 7.5, 1e-9);
 }
 
 TEST(Semantics, PauseUntilAndPauseWhileHaltUntilTheAwaitedState) {
   for (const char* pause : {"PauseUntil(B.Z() >= 4)", "PauseWhile(B.Z() < 4)"}) {
-    Flight f = fly(kTwo + "func INIT() { PAR_x() }\nfunc PAR_x() { SEQ_a(); SEQ_b() }\n"
+    Flight f = fly(kTwoQuads + "func INIT() { PAR_x() }\nfunc PAR_x() { SEQ_a(); SEQ_b() }\n"
                           "func SEQ_a() { A.Arm(); " + pause + "; A.Takeoff(2) }\n"
                           "func SEQ_b() { B.Arm(); B.Takeoff(8) }\n");
     ASSERT_TRUE(f.result.completed) << pause << ": " << f.result.error;
@@ -44,7 +44,7 @@ TEST(Semantics, PauseUntilAndPauseWhileHaltUntilTheAwaitedState) {
 }
 
 TEST(Semantics, WaitWhileRunsBranchOnceConditionTurnsFalse) {
-  Flight f = fly(kTwo + "func INIT() { PAR_x() }\nfunc PAR_x() { SEQ_a(); WaitWhile(A.Z() < 4, SEQ_b) }\n"
+  Flight f = fly(kTwoQuads + "func INIT() { PAR_x() }\nfunc PAR_x() { SEQ_a(); WaitWhile(A.Z() < 4, SEQ_b) }\n"
                         "func SEQ_a() { A.Arm(); A.Takeoff(8) }\nfunc SEQ_b() { B.Arm() }\n");
   ASSERT_TRUE(f.result.completed) << f.result.error;
   EXPECT_GT(f.time_of("start", "B.Arm()"), f.time_of("start", "A.Takeoff(8)"));
@@ -52,7 +52,7 @@ TEST(Semantics, WaitWhileRunsBranchOnceConditionTurnsFalse) {
 }
 
 TEST(Semantics, RepeatUntilRepeatsWhileFalseThenRunsAfterBranchOnce) {
-  Flight f = fly(kTwo + "func INIT() { A.Arm(); A.Takeoff(2); RepeatUntil(A.Z() >= 5, SEQ_up, SEQ_done) }\n"
+  Flight f = fly(kTwoQuads + "func INIT() { A.Arm(); A.Takeoff(2); RepeatUntil(A.Z() >= 5, SEQ_up, SEQ_done) }\n"
                         "func SEQ_up() { A.FlyByZ(1) }\nfunc SEQ_done() { A.Land(); A.Disarm() }\n");
   ASSERT_TRUE(f.result.completed) << f.result.error;
   int climbs = 0;
@@ -63,7 +63,7 @@ TEST(Semantics, RepeatUntilRepeatsWhileFalseThenRunsAfterBranchOnce) {
 
 TEST(Semantics, RepeatWhileAndRepeatForRunNoIterationWhenConditionFailsFirst) {
   for (const char* repeat : {"RepeatWhile(A.Z() > 100, SEQ_r, SEQ_n)", "RepeatFor(false, SEQ_r, SEQ_n, 5)"}) {
-    Flight f = fly(kTwo + "func INIT() { A.Arm(); " + repeat + " }\n"
+    Flight f = fly(kTwoQuads + "func INIT() { A.Arm(); " + repeat + " }\n"
                           "func SEQ_r() { A.TakePicture() }\nfunc SEQ_n() { A.Disarm() }\n");
     ASSERT_TRUE(f.result.completed) << repeat << ": " << f.result.error;
     EXPECT_EQ(f.result.drones[0].state.pictures, 0) << repeat;
@@ -72,7 +72,7 @@ TEST(Semantics, RepeatWhileAndRepeatForRunNoIterationWhenConditionFailsFirst) {
 }
 
 TEST(Semantics, DoSyncThatSaysDontContinuesAtOnceWithoutDoneBranch) {
-  Flight f = fly(kTwo + "func INIT() { A.Arm(); DoUntilSync(A.Armed(), SEQ_do, SEQ_done); A.Disarm() }\n"
+  Flight f = fly(kTwoQuads + "func INIT() { A.Arm(); DoUntilSync(A.Armed(), SEQ_do, SEQ_done); A.Disarm() }\n"
                         "func SEQ_do() { A.Takeoff(3) }\nfunc SEQ_done() { A.TakePicture() }\n");
   ASSERT_TRUE(f.result.completed) << f.result.error;
   EXPECT_LT(f.find("start", "A.Takeoff(3)"), 0);
@@ -81,7 +81,7 @@ TEST(Semantics, DoSyncThatSaysDontContinuesAtOnceWithoutDoneBranch) {
 }
 
 TEST(Semantics, DoSyncWhoseDoBranchEndsByItselfSkipsTheDoneBranch) {
-  Flight f = fly(kTwo + "func INIT() { A.Arm(); DoWhileSync(A.Battery() > 10, SEQ_do, SEQ_done); A.Disarm() }\n"
+  Flight f = fly(kTwoQuads + "func INIT() { A.Arm(); DoWhileSync(A.Battery() > 10, SEQ_do, SEQ_done); A.Disarm() }\n"
                         "func SEQ_do() { A.Takeoff(3); A.Land() }\nfunc SEQ_done() { A.TakePicture() }\n");
   ASSERT_TRUE(f.result.completed) << f.result.error;
   EXPECT_LT(f.find("start", "A.TakePicture()"), 0);
@@ -89,7 +89,7 @@ TEST(Semantics, DoSyncWhoseDoBranchEndsByItselfSkipsTheDoneBranch) {
 }
 
 TEST(Semantics, DoAsyncDetachesDoBranchAndFlipCancelsItOnEveryDrone) {
-  Flight f = fly(kTwo +
+  Flight f = fly(kTwoQuads +
                  "func INIT() { PAR_up(); DoWhileAsync(A.Z() < 6, PAR_circle, SEQ_home); A.FlyByZ(5) }\n"
                  "func PAR_up() { SEQ_a(); SEQ_b() }\n"
                  "func SEQ_a() { A.Arm(); A.Takeoff(3) }\nfunc SEQ_b() { B.Arm(); B.Takeoff(3) }\n"
@@ -107,7 +107,7 @@ TEST(Semantics, DoAsyncDetachesDoBranchAndFlipCancelsItOnEveryDrone) {
 }
 
 TEST(Semantics, DoUntilAsyncRunsDoBranchUntilConditionTurnsTrueThenDoneBranch) {
-  Flight f = fly(kTwo + "func INIT() { PAR_up(); PAR_main() }\n"
+  Flight f = fly(kTwoQuads + "func INIT() { PAR_up(); PAR_main() }\n"
                         "func PAR_up() { SEQ_a(); B.Arm() }\nfunc SEQ_a() { A.Arm(); A.Takeoff(3) }\n"
                         "func PAR_main() { SEQ_watch(); SEQ_b() }\n"
                         "func SEQ_watch() { DoUntilAsync(B.Z() > 4, SEQ_do, SEQ_done); A.TakePicture() }\n"
@@ -126,7 +126,7 @@ TEST(Semantics, DoUntilAsyncRunsDoBranchUntilConditionTurnsTrueThenDoneBranch) {
 // A do-branch spanning two drones, cancelled in every iteration of a loop: each run starts
 // afresh on both drones (epochs), nothing of a cancelled run leaks into the next.
 TEST(Semantics, DoInsideRepeatIsCancelledAndRestartedOnEveryDroneEachIteration) {
-  Flight f = fly(kTwo + "func INIT() { PAR_up(); RepeatFor(true, SEQ_iter, SEQ_end, 3) }\n"
+  Flight f = fly(kTwoQuads + "func INIT() { PAR_up(); RepeatFor(true, SEQ_iter, SEQ_end, 3) }\n"
                         "func PAR_up() { SEQ_a(); SEQ_b() }\n"
                         "func SEQ_a() { A.Arm(); A.Takeoff(3) }\nfunc SEQ_b() { B.Arm(); B.Takeoff(3) }\n"
                         "func SEQ_iter() { DoWhileSync(A.Z() < 6, PAR_work, SEQ_reset); PauseFor(0.5) }\n"
@@ -152,14 +152,14 @@ TEST(Semantics, DoInsideRepeatIsCancelledAndRestartedOnEveryDroneEachIteration) 
 
 TEST(Semantics, ConditionReadsOtherDronesTelemetryFromTheFirstInstant) {
   // B evaluates (it is read twice); A's position comes from A's telemetry, known at t = 0.
-  Flight f = fly(kTwo + "func INIT() { If(A.Y() == 0 && B.Y() == 5 && B.X() == 0, SEQ_t, SEQ_f) }\n"
+  Flight f = fly(kTwoQuads + "func INIT() { If(A.Y() == 0 && B.Y() == 5 && B.X() == 0, SEQ_t, SEQ_f) }\n"
                         "func SEQ_t() { A.Arm() }\nfunc SEQ_f() { A.TakePicture() }\n");
   ASSERT_TRUE(f.result.completed) << f.result.error;
   EXPECT_GE(f.find("end", "A.Arm()", "succeeded"), 0);
 }
 
 TEST(Semantics, ConditionEvaluatedByOneDroneDecidesForTheOthers) {
-  Flight f = fly(kTwo + "func INIT() { A.Arm(); B.Arm(); If(A.Armed(), PAR_yes, PAR_no) }\n"
+  Flight f = fly(kTwoQuads + "func INIT() { A.Arm(); B.Arm(); If(A.Armed(), PAR_yes, PAR_no) }\n"
                         "func PAR_yes() { B.TakePicture() }\nfunc PAR_no() { B.Disarm() }\n");
   ASSERT_TRUE(f.result.completed) << f.result.error;
   int evaluations = 0;
@@ -170,7 +170,7 @@ TEST(Semantics, ConditionEvaluatedByOneDroneDecidesForTheOthers) {
 }
 
 TEST(Semantics, NewMotionPreemptsTheRunningOneWhichEndsPreempted) {
-  Flight f = fly(kTwo + "func INIT() { A.Arm(); A.Takeoff(3); PAR_x() }\n"
+  Flight f = fly(kTwoQuads + "func INIT() { A.Arm(); A.Takeoff(3); PAR_x() }\n"
                         "func PAR_x() { A.Orbit(); SEQ_later() }\nfunc SEQ_later() { PauseFor(4); A.Land() }\n");
   ASSERT_TRUE(f.result.completed) << f.result.error;
   EXPECT_GE(f.find("end", "A.Orbit()", "preempted"), 0);
@@ -178,7 +178,7 @@ TEST(Semantics, NewMotionPreemptsTheRunningOneWhichEndsPreempted) {
 }
 
 TEST(Semantics, PayloadActionRunsBesideMotion) {
-  Flight f = fly(kTwo + "func INIT() { A.Arm(); A.Takeoff(3); PAR_x() }\n"
+  Flight f = fly(kTwoQuads + "func INIT() { A.Arm(); A.Takeoff(3); PAR_x() }\n"
                         "func PAR_x() { A.FlyTo(30, 0, 3); A.TakePicture() }\n");
   ASSERT_TRUE(f.result.completed) << f.result.error;
   EXPECT_GE(f.find("end", "A.FlyTo(30, 0, 3)", "succeeded"), 0);
@@ -196,7 +196,7 @@ TEST(Semantics, EveryStartedActionEndsExactlyOnce) {
 }
 
 TEST(Semantics, DisarmInTheAirFailsTheMissionAndAirborneDronesRunTheirFailsafe) {
-  Flight f = fly(kTwo + "func INIT() { PAR_up() }\n"
+  Flight f = fly(kTwoQuads + "func INIT() { PAR_up() }\n"
                         "func PAR_up() { SEQ_a(); SEQ_b() }\n"
                         "func SEQ_a() { A.Arm(); A.Takeoff(3); A.Disarm() }\n"
                         "func SEQ_b() { B.Arm(); B.Takeoff(5); B.Orbit() }\n");
@@ -242,7 +242,7 @@ TEST(Semantics, ActionExceedingItsFleetTimeoutFails) {
   ASSERT_TRUE(fleet::parse_fleet(std::make_shared<SourceFile>("f.yaml", "drones:\n  A:\n    timeouts: {FlyTo: 2}\n"),
                                  fleet, diags))
       << diags.format();
-  Flight f = fly(kTwo + "func INIT() { A.Arm(); A.Takeoff(3); A.FlyTo(100, 0, 3) }\n", fleet);
+  Flight f = fly(kTwoQuads + "func INIT() { A.Arm(); A.Takeoff(3); A.FlyTo(100, 0, 3) }\n", fleet);
   EXPECT_FALSE(f.result.completed);
   ASSERT_TRUE(f.result.failure.has_value());
   EXPECT_EQ(f.result.failure->action, "FlyTo");
@@ -302,7 +302,7 @@ TEST(Semantics, LoopThatTakesNoTimeFailsTheMissionAndRunsTheFailsafeInsteadOfSpi
 // B's Arm, a trigger through the transport) gets its turn while the loop spins.
 TEST(Semantics, LoopThatTakesNoTimeYieldsToTheEventLoopAtEveryIteration) {
   Flight f = test::fly_missions(test::missions_of(
-      kTwo + "func INIT() { PAR_x() }\nfunc PAR_x() { SEQ_loop(); SEQ_b() }\n"
+      kTwoQuads + "func INIT() { PAR_x() }\nfunc PAR_x() { SEQ_loop(); SEQ_b() }\n"
              "func SEQ_loop() { RepeatFor(A.Battery() > 0, SEQ_r, SEQ_n, 1000000000) }\n"
              "func SEQ_r() { A.TakePicture() }\nfunc SEQ_n() { A.Disarm() }\n"
              "func SEQ_b() { B.Arm(); B.TakePicture() }\n",
@@ -402,7 +402,7 @@ TEST(Semantics, AsyncWorkAcrossDronesKeepsItsTriggersWhileTheNextIterationRuns) 
 }
 
 TEST(Semantics, DoAsyncStartedAgainWhileItsDoBranchRunsCancelsThatRunFirst) {
-  Flight f = fly(kTwo + "func INIT() { PAR_up(); RepeatFor(true, SEQ_r, SEQ_n, 2) }\n"
+  Flight f = fly(kTwoQuads + "func INIT() { PAR_up(); RepeatFor(true, SEQ_r, SEQ_n, 2) }\n"
                         "func PAR_up() { SEQ_a(); SEQ_b() }\n"
                         "func SEQ_a() { A.Arm(); A.Takeoff(3) }\nfunc SEQ_b() { B.Arm(); B.Takeoff(3) }\n"
                         "func SEQ_r() { DoWhileAsync(A.Z() < 100, SEQ_do, SEQ_done); PauseFor(1) }\n"
@@ -452,7 +452,7 @@ TEST(Semantics, DoAsyncDoneBranchThatEndsLastCompletesTheMissionWhenItEnds) {
 // in flight, it would keep the run waiting for the time limit although every drone had
 // reached the end.
 TEST(Semantics, MissionCompletesWhenItsLastWorkEndsWithTelemetryStillOnItsWay) {
-  Flight f = fly(kTwo + "func INIT() { PAR_x() }\nfunc PAR_x() { A.Arm(); SEQ_b() }\n"
+  Flight f = fly(kTwoQuads + "func INIT() { PAR_x() }\nfunc PAR_x() { A.Arm(); SEQ_b() }\n"
                         "func SEQ_b() { B.Arm(); PauseFor(1.5); If(A.Armed() && B.Armed(), SEQ_p, SEQ_p) }\n"
                         "func SEQ_p() { PauseFor(0.5) }\n");
   ASSERT_TRUE(f.result.completed) << f.result.error;

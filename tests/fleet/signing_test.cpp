@@ -19,7 +19,7 @@ using test::parse;
 
 const std::string kKey = "0f1e2d3c4b5a69788796a5b4c3d2e1f000112233445566778899aabbccddeeff";
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+bool mentions(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 struct KeyDir {
   fs::path dir = fs::temp_directory_path() / ("eamos-signing-" + std::to_string(::getpid()));
@@ -57,21 +57,21 @@ TEST(Signing, AKeyFileOthersMayReadIsRefusedWithTheFix) {
   Diagnostic e = first_error(p.diags);
   EXPECT_EQ(e.loc.line, 3);
   EXPECT_EQ(e.loc.col, 25) << "at the key_file's value";
-  EXPECT_TRUE(contains(e.message, "may be read or written by others (mode 0644)")) << e.message;
-  EXPECT_TRUE(contains(e.message, "chmod 600")) << e.message;
+  EXPECT_TRUE(mentions(e.message, "may be read or written by others (mode 0644)")) << e.message;
+  EXPECT_TRUE(mentions(e.message, "chmod 600")) << e.message;
 }
 
 TEST(Signing, BadKeysAndMissingFilesAreErrors) {
-  EXPECT_TRUE(contains(first_error(parse("drones:\n  D1: {signing: {key: abc}}\n").diags).message, "64 hexadecimal digits"));
-  EXPECT_TRUE(contains(first_error(parse("drones:\n  D1: {signing: {key: " + std::string(64, '0') + "}}\n").diags).message,
+  EXPECT_TRUE(mentions(first_error(parse("drones:\n  D1: {signing: {key: abc}}\n").diags).message, "64 hexadecimal digits"));
+  EXPECT_TRUE(mentions(first_error(parse("drones:\n  D1: {signing: {key: " + std::string(64, '0') + "}}\n").diags).message,
                        "all-zero"));
-  EXPECT_TRUE(contains(first_error(parse("drones:\n  D1: {signing: {key_file: /no/such/key}}\n").diags).message,
+  EXPECT_TRUE(mentions(first_error(parse("drones:\n  D1: {signing: {key_file: /no/such/key}}\n").diags).message,
                        "cannot read signing key file '/no/such/key'"));
-  EXPECT_TRUE(contains(first_error(parse("drones:\n  D1: {signing: {setup: true}}\n").diags).message,
+  EXPECT_TRUE(mentions(first_error(parse("drones:\n  D1: {signing: {setup: true}}\n").diags).message,
                        "exactly one of `key_file: PATH` and `key: HEX`"));
-  EXPECT_TRUE(contains(first_error(parse("drones:\n  D1: {signing: {key: " + kKey + ", setup: maybe}}\n").diags).message,
+  EXPECT_TRUE(mentions(first_error(parse("drones:\n  D1: {signing: {key: " + kKey + ", setup: maybe}}\n").diags).message,
                        "must be true or false"));
-  EXPECT_TRUE(contains(first_error(parse("drones:\n  D1: {signing: {kye: x}}\n").diags).message, "unknown key 'kye'"));
+  EXPECT_TRUE(mentions(first_error(parse("drones:\n  D1: {signing: {kye: x}}\n").diags).message, "unknown key 'kye'"));
 }
 
 }  // namespace
