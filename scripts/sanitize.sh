@@ -12,7 +12,7 @@
 # Every process the tests start (eamos, its DEXes, sim-vehicles) is instrumented too. A report
 # from any of them fails the run, whatever its exit status did to the test: the sanitizers
 # write each report to a file in the tree's sanitizer-logs/, which must stay empty.
-# Usage: scripts/sanitize.sh [address|thread|all] [BUILD_PREFIX]   (default: all build)
+# Usage: scripts/sanitize.sh [address|thread|all|prebuild] [BUILD_PREFIX]   (default: all build)
 set -uo pipefail
 WHICH=${1:-all}
 PREFIX=${2:-build}
@@ -138,12 +138,19 @@ run_all() {
   return $rc
 }
 
+# Only the two trees' builds, no test: what scripts/test.sh runs beside make test's real-time
+# cases for .ci/run (EAMOS_PREBUILD_SANITIZERS), stopped when they end.
+prebuild() {
+  build "$PREFIX-asan" address "${ASAN_TESTS[@]}" && build "$PREFIX-tsan" thread "${TSAN_TESTS[@]}"
+}
+
 rc=0
 case "$WHICH" in
+  prebuild) prebuild; exit $? ;;
   address) run_address || rc=1 ;;
   thread) run_thread || rc=1 ;;
   all) run_all || rc=1 ;;
-  *) echo "usage: scripts/sanitize.sh [address|thread|all] [BUILD_PREFIX]" >&2; exit 2 ;;
+  *) echo "usage: scripts/sanitize.sh [address|thread|all|prebuild] [BUILD_PREFIX]" >&2; exit 2 ;;
 esac
 [ "$rc" -eq 0 ] && echo "sanitize: $WHICH passed, no sanitizer report" || echo "sanitize: $WHICH FAILED (above)"
 exit $rc

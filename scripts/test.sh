@@ -20,17 +20,47 @@ CTEST=(ctest --test-dir "$BUILD" --output-on-failure -j "$JOBS")
 # Every other test fails the run the first time it fails, so a flaky one shows.
 RETRY=(--repeat until-pass:2)
 BESIDE_LOG="$BUILD/Testing/beside-realtime.log"
-FLYING_LOG="$BUILD/Testing/flying-beside-sitl.log"
-# Test names: the autopilot firmware's cases (tests/mavlink_adapter/sitl*_test.cpp) and the
-# cases that fly a sim-vehicle (the same set scripts/sanitize.sh calls FLYING).
+BESIDE_SITL_LOG="$BUILD/Testing/beside-sitl.log"
+# Test names: the autopilot firmware's cases (tests/mavlink_adapter/sitl*_test.cpp; every
+# case without a PX4 parameter flies ArduCopter), the suites that take a RESOURCE_LOCK, and
+# the cases that fly a sim-vehicle (the set scripts/sanitize.sh calls FLYING).
 SITL='Sitl'
+SITL_PX4='Sitl[^ ]*[/_]PX4( |$)'
+SITL_ARDUPILOT='^(Autopilots/Sitl.*ArduCopter|Examples/SitlExample.*ArduCopter|SitlSeparation|SitlSigning)'
+LOCKED='^(MultiHost|Netns|NetnsAttack|PackagedFleet|Faults|Monitor[A-Za-z]*|Security|SiteLimits)\.'
 FLYING='^(Mavlink|HostileVehicle|SimVehicle)'
 mkdir -p "$BUILD/Testing"
 
 "${CTEST[@]}" "${RETRY[@]}" -L alone
 alone_rc=$?
 
-# Its own process group, so that an interrupted run stops it too (fuzzers, test processes).
+# The cases on autopilot firmware run one at a time (RUN_SERIAL, fixed ports) and use about
+# one core, so another real-time case runs beside each, one at a time: beside ArduCopter's,
+# whose simulation steps with the firmware, the suites that take a RESOURCE_LOCK (DDS
+# processes, network namespaces); beside PX4's, whose SIH runs on the wall clock, only the
+# light cases that fly a sim-vehicle. Then every other real-time case, the RUN_SERIAL ones
+# alone.
+beside_sitl() {  # what, SITL cases' regex, regex of the cases beside them
+  "${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -R "$3" -j 1 >"$BESIDE_SITL_LOG" 2>&1 &
+  local other=$! rc=0
+  "${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -R "$2" || rc=1
+  wait "$other" || rc=1
+  echo
+  echo "test: the real-time cases that ran beside the SITL cases on $1:"
+  cat "$BESIDE_SITL_LOG"
+  return $rc
+}
+realtime_phase() {
+  set +m  # its ctest runs stay in the phase's process group
+  local rc=0
+  beside_sitl ArduCopter "$SITL_ARDUPILOT" "$LOCKED" || rc=1
+  beside_sitl PX4 "$SITL_PX4" "$FLYING" || rc=1
+  "${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -E "$SITL|$LOCKED|$FLYING" || rc=1
+  return $rc
+}
+
+# Each in its own process group, so that an interrupted run stops them too (fuzzers, test
+# processes, compilers).
 set -m
 nice -n 19 bash -c '
   rc=0
@@ -39,24 +69,31 @@ nice -n 19 bash -c '
   "$@" -LE "realtime|alone" || rc=1
   exit $rc' beside "$FUZZ_BUILD" "$FUZZ_SECONDS" "${CTEST[@]}" >"$BESIDE_LOG" 2>&1 &
 beside=$!
-set +m
-trap 'kill -TERM -- -"$beside" 2>/dev/null; kill -TERM "${flying:-}" 2>/dev/null; exit 130' INT TERM
-
 echo "test: the fuzzers and the tests not labelled realtime run beside these, at low priority ($BESIDE_LOG)"
-# The cases on autopilot firmware run one at a time (RUN_SERIAL, fixed ports) and use about
-# one core; the cases that fly a sim-vehicle, light and on ports of their own, run one at a
-# time beside them. Then every other real-time case.
-"${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -R "$FLYING" -j 1 >"$FLYING_LOG" 2>&1 &
-flying=$!
-"${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -R "$SITL"
-realtime_rc=$?
-wait "$flying" || realtime_rc=1
-echo
-echo "test: the real-time cases that fly a sim-vehicle, as they ran beside the SITL cases:"
-cat "$FLYING_LOG"
-"${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -E "$SITL|$FLYING" || realtime_rc=1
+realtime_phase &
+realtime=$!
+set +m
+prebuild=
+trap 'for g in "$beside" "$realtime" $prebuild; do kill -TERM -- -"$g" 2>/dev/null; done; exit 130' INT TERM
+
 wait "$beside"
 beside_rc=$?
+# With EAMOS_PREBUILD_SANITIZERS=1 (.ci/run), the core the real-time cases leave idle once the
+# low-priority work is done builds make sanitize's trees, at the lowest priority, until the
+# real-time cases end; make sanitize goes on from where it stopped (scripts/sanitize.sh prebuild).
+if [ -n "${EAMOS_PREBUILD_SANITIZERS:-}" ] && kill -0 "$realtime" 2>/dev/null; then
+  set -m
+  nice -n 19 bash scripts/sanitize.sh prebuild "$BUILD" >"$BUILD/Testing/sanitizer-prebuild.log" 2>&1 &
+  prebuild=$!
+  set +m
+fi
+wait "$realtime"
+realtime_rc=$?
+if [ -n "$prebuild" ]; then
+  kill -TERM -- -"$prebuild" 2>/dev/null
+  wait "$prebuild"
+  echo "test: the sanitizer trees built beside the real-time cases until they ended: $(tail -1 "$BUILD/Testing/sanitizer-prebuild.log")"
+fi
 trap - INT TERM
 
 echo
