@@ -6,7 +6,6 @@
 namespace eamos::lang {
 namespace {
 
-
 /// 1 for the literal `true`, 0 for `false`, -1 for anything else (decided at run time).
 int literal_truth(const Expr* e) {
   if (!e || e->kind != ExprKind::boolean) return -1;
