@@ -2,9 +2,10 @@
 # Runs every test of a built tree. First the cases labelled `alone` with nothing beside them:
 # the browser's, which hold a latency bound, and Listing 2 on SITL, which holds each position
 # report of an orbit to 5 %. Then the real-time suites (label `realtime`: SITL firmware, DDS
-# processes, signals) at normal priority: the SITL cases one at a time, each with one other
-# real-time case beside it, then the others. Beside all of those, at the lowest
-# priority (nice 19), the fuzzers' build and smoke run, then every other test. The real-time
+# processes, signals) at normal priority: ArduCopter's SITL cases one at a time with the
+# RESOURCE_LOCK suites beside them, PX4's with nothing beside them, then the others. Beside
+# all of those, at the lowest priority (nice 19), the fuzzers' build and smoke run, then every
+# other test. The real-time
 # suites leave part of the two cores idle (a SITL case uses about one); the low-priority work
 # fills it without taking CPU the real-time ones ask for.
 # Usage: scripts/test.sh BUILD_DIR FUZZ_BUILD_DIR FUZZ_SECONDS_PER_TARGET
@@ -22,41 +23,34 @@ RETRY=(--repeat until-pass:2)
 BESIDE_LOG="$BUILD/Testing/beside-realtime.log"
 BESIDE_SITL_LOG="$BUILD/Testing/beside-sitl.log"
 # Test names: the autopilot firmware's cases (tests/mavlink_adapter/sitl*_test.cpp) and of
-# them those that fly PX4 (every other one flies ArduCopter), the suites that take a
-# RESOURCE_LOCK, and the cases that fly a sim-vehicle (the set scripts/sanitize.sh calls FLYING).
+# them those that fly PX4 (every other one flies ArduCopter), and the suites that take a
+# RESOURCE_LOCK.
 SITL='Sitl'
 SITL_PX4='Sitl[^ ]*[/_]PX4( |$)'
 LOCKED='^(MultiHost|Netns|NetnsAttack|PackagedFleet|Faults|Monitor[A-Za-z]*|Security|SiteLimits)\.'
-FLYING='^(Mavlink|HostileVehicle|SimVehicle)'
 mkdir -p "$BUILD/Testing"
 
 "${CTEST[@]}" "${RETRY[@]}" -L alone
 alone_rc=$?
 
 # The cases on autopilot firmware run one at a time (RUN_SERIAL, fixed ports) and use about
-# one core, so another real-time case runs beside each, one at a time: beside ArduCopter's,
-# whose simulation steps with the firmware, the suites that take a RESOURCE_LOCK (DDS
-# processes, network namespaces); beside PX4's, whose SIH runs on the wall clock, only the
-# light cases that fly a sim-vehicle. Then every other real-time case, the RUN_SERIAL ones
-# alone.
-beside_sitl() {  # autopilot, regex of the cases beside, ctest options choosing the SITL cases...
-  local autopilot=$1 beside=$2
-  shift 2
-  "${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -R "$beside" -j 1 >"$BESIDE_SITL_LOG" 2>&1 &
-  local other=$! rc=0
-  "${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone "$@" || rc=1
-  wait "$other" || rc=1
-  echo
-  echo "test: the real-time cases that ran beside the SITL cases on $autopilot:"
-  cat "$BESIDE_SITL_LOG"
-  return $rc
-}
+# one core. ArduCopter's simulation steps with its firmware, so beside its cases the suites
+# that take a RESOURCE_LOCK (DDS processes, network namespaces) run, one at a time. PX4's SIH
+# runs on the wall clock, and a neighbour at normal priority, even a light sim-vehicle case,
+# slows that clock (to 0.77 of mission time) until a case fails: nothing else at normal
+# priority runs beside PX4's cases. Then every other real-time case, the RUN_SERIAL ones alone.
 realtime_phase() {
   set +m  # its ctest runs stay in the phase's process group
   local rc=0
-  beside_sitl ArduCopter "$LOCKED" -R "$SITL" -E "$SITL_PX4" || rc=1
-  beside_sitl PX4 "$FLYING" -R "$SITL_PX4" || rc=1
-  "${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -E "$SITL|$LOCKED|$FLYING" || rc=1
+  "${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -R "$LOCKED" -j 1 >"$BESIDE_SITL_LOG" 2>&1 &
+  local locked=$!
+  "${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -R "$SITL" -E "$SITL_PX4" || rc=1
+  wait "$locked" || rc=1
+  echo
+  echo "test: the real-time cases that ran beside ArduCopter's SITL cases:"
+  cat "$BESIDE_SITL_LOG"
+  "${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -R "$SITL_PX4" || rc=1
+  "${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -E "$SITL|$LOCKED" || rc=1
   return $rc
 }
 
