@@ -27,7 +27,7 @@ constexpr int kMissionFormatVersion = 4;
 /// Version of the canonical form the mission hash is taken over. It changes with that
 /// form, not with the files' layout: the hash names what the mission does, and the traces
 /// and credentials that carry it stay the same when only the files' layout changes.
-constexpr int kMissionHashFormVersion = 3;
+constexpr int kMissionHashFormVersion = 4;
 
 /// The last member of every mission file: SHA-256 (hex) of every byte before it.
 inline constexpr const char* kFileHashMember = "file_hash";
