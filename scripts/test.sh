@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # Runs every test of a built tree. First the cases labelled `alone` with nothing beside them:
 # the browser's, which hold a latency bound, and Listing 2 on SITL, which holds each position
-# report of an orbit to 5 %. Then the real-time suites (label `realtime`: SITL firmware, DDS
-# processes, signals) at normal priority: ArduCopter's SITL cases one at a time with the
-# RESOURCE_LOCK suites beside them, PX4's with nothing beside them, then the others. Beside
-# all of those, at the lowest priority (nice 19), the fuzzers' build and smoke run, then every
-# other test. The real-time
-# suites leave part of the two cores idle (a SITL case uses about one); the low-priority work
-# fills it without taking CPU the real-time ones ask for.
+# report of an orbit to 5 %. Then the real-time suites (labels `realtime` and
+# `realtime_serial`: SITL firmware, DDS processes, sim-vehicles, signals) at normal priority:
+# ArduCopter's SITL cases one at a time with the other real-time cases that need not run alone
+# beside them, two at a time; PX4's with nothing beside them; then the ones that run alone
+# (RUN_SERIAL). Beside all of those, at the lowest priority (nice 19), the fuzzers' build and
+# smoke run, then every other test. The real-time suites leave part of the two cores idle (a
+# SITL case uses about one); the low-priority work fills it without taking CPU the real-time
+# ones ask for.
 # Usage: scripts/test.sh BUILD_DIR FUZZ_BUILD_DIR FUZZ_SECONDS_PER_TARGET
 set -uo pipefail
 BUILD=${1:-build}
@@ -23,34 +24,33 @@ RETRY=(--repeat until-pass:2)
 BESIDE_LOG="$BUILD/Testing/beside-realtime.log"
 BESIDE_SITL_LOG="$BUILD/Testing/beside-sitl.log"
 # Test names: the autopilot firmware's cases (tests/mavlink_adapter/sitl*_test.cpp) and of
-# them those that fly PX4 (every other one flies ArduCopter), and the suites that take a
-# RESOURCE_LOCK.
+# them those that fly PX4 (every other one flies ArduCopter).
 SITL='Sitl'
 SITL_PX4='Sitl[^ ]*[/_]PX4( |$)'
-LOCKED='^(MultiHost|Netns|NetnsAttack|PackagedFleet|Faults|Monitor[A-Za-z]*|Security|SiteLimits)\.'
 mkdir -p "$BUILD/Testing"
 
 "${CTEST[@]}" "${RETRY[@]}" -L alone
 alone_rc=$?
 
 # The cases on autopilot firmware run one at a time (RUN_SERIAL, fixed ports) and use about
-# one core. ArduCopter's simulation steps with its firmware, so beside its cases the suites
-# that take a RESOURCE_LOCK (DDS processes, network namespaces) run, one at a time. PX4's SIH
-# runs on the wall clock, and a neighbour at normal priority, even a light sim-vehicle case,
-# slows that clock (to 0.77 of mission time) until a case fails: nothing else at normal
-# priority runs beside PX4's cases. Then every other real-time case, the RUN_SERIAL ones alone.
+# one core. ArduCopter's simulation steps with its firmware, so beside its cases the real-time
+# cases that need not run alone (the RESOURCE_LOCK suites: DDS processes, network namespaces;
+# the sim-vehicle cases) run, two at a time. PX4's SIH runs on the wall clock, and a neighbour
+# at normal priority, even a light sim-vehicle case, slows that clock (to 0.77 of mission time)
+# until a case fails: nothing else at normal priority runs beside PX4's cases. Then the
+# real-time suites that run alone (label `realtime_serial`).
 realtime_phase() {
   set +m  # its ctest runs stay in the phase's process group
   local rc=0
-  "${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -R "$LOCKED" -j 1 >"$BESIDE_SITL_LOG" 2>&1 &
-  local locked=$!
+  "${CTEST[@]}" "${RETRY[@]}" -L realtime -LE 'alone|realtime_serial' -E "$SITL" >"$BESIDE_SITL_LOG" 2>&1 &
+  local beside_sitl=$!
   "${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -R "$SITL" -E "$SITL_PX4" || rc=1
-  wait "$locked" || rc=1
+  wait "$beside_sitl" || rc=1
   echo
   echo "test: the real-time cases that ran beside ArduCopter's SITL cases:"
   cat "$BESIDE_SITL_LOG"
   "${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -R "$SITL_PX4" || rc=1
-  "${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -E "$SITL|$LOCKED" || rc=1
+  "${CTEST[@]}" "${RETRY[@]}" -L realtime_serial -LE alone -E "$SITL" || rc=1
   return $rc
 }
 
