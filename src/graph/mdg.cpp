@@ -27,9 +27,9 @@ std::vector<std::vector<int>> sync_clones(const Meg& meg) {
     state[root] = 1;
     while (!stack.empty()) {
       auto& [v, next] = stack.back();
-      const MegNode& n = meg.nodes[v];
-      if (next < n.out.size()) {
-        int to = meg.arcs[n.out[next++]].to;
+      std::span<const int> out = meg.out(v);
+      if (next < out.size()) {
+        int to = meg.arcs[out[next++]].to;
         if (is_sync_point(meg.nodes[to].kind) && state[to] == 0) {
           state[to] = 1;
           stack.push_back({to, 0});
@@ -37,7 +37,7 @@ std::vector<std::vector<int>> sync_clones(const Meg& meg) {
         continue;
       }
       std::vector<int>& mine = clones[v];
-      for (int arc : n.out) {
+      for (int arc : out) {
         int to = meg.arcs[arc].to;
         if (is_sync_point(meg.nodes[to].kind))
           mine.insert(mine.end(), clones[to].begin(), clones[to].end());

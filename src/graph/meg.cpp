@@ -19,9 +19,27 @@ int Meg::add_node(MegKind kind, SourceLocation loc) {
 int Meg::add_arc(int from, int to, ArcKind kind, Branch branch) {
   int id = static_cast<int>(arcs.size());
   arcs.push_back({from, to, kind, branch});
-  nodes[from].out.push_back(id);
-  nodes[to].in.push_back(id);
   return id;
+}
+
+namespace {
+
+/// A counting sort of the arcs by one end: start[n] is where node n's arcs begin in list.
+void index_by(const std::vector<MegArc>& arcs, std::size_t node_count, int MegArc::*end, std::vector<int>& start,
+              std::vector<int>& list) {
+  start.assign(node_count + 1, 0);
+  for (const MegArc& a : arcs) ++start[a.*end + 1];
+  for (std::size_t n = 0; n < node_count; ++n) start[n + 1] += start[n];
+  list.resize(arcs.size());
+  std::vector<int> next(start.begin(), start.end() - 1);
+  for (std::size_t a = 0; a < arcs.size(); ++a) list[next[arcs[a].*end]++] = static_cast<int>(a);
+}
+
+}  // namespace
+
+void Meg::index_arcs() {
+  index_by(arcs, nodes.size(), &MegArc::from, out_start, out_arcs);
+  index_by(arcs, nodes.size(), &MegArc::to, in_start, in_arcs);
 }
 
 namespace {
@@ -80,6 +98,7 @@ class MegBuilder {
     // last node to each drone, quadratic in fleet size, for no decision anyone needs.
     meg_.nodes[meg_.end].drone = 0;
     connect(ends, meg_.end);
+    meg_.index_arcs();
     return std::move(meg_);
   }
 

@@ -3,6 +3,7 @@
 // runs once all of its predecessors over execution arcs have ended, then triggers its
 // successors; control structures are nodes that choose which successors to trigger
 // (Taskflow's condition tasks), loops are back arcs, and every branch ends in a terminal.
+#include <span>
 #include <string>
 #include <vector>
 
@@ -26,8 +27,6 @@ struct MegNode {
   SourceLocation loc;
   int drone = -1;          ///< owner; -1 for sync points
   std::string name;        ///< capability, control structure or block name
-  std::vector<int> out;    ///< indices into Meg::arcs
-  std::vector<int> in;
   // action:
   std::vector<const lang::Expr*> args;
   // condition:
@@ -58,6 +57,22 @@ struct Meg {
 
   int add_node(MegKind kind, SourceLocation loc);
   int add_arc(int from, int to, ArcKind kind = ArcKind::exec, Branch branch = Branch::any);
+
+  /// The arcs out of and into `node` (indices into `arcs`, in the order they were added),
+  /// once index_arcs() has run; build_meg runs it.
+  std::span<const int> out(int node) const { return arcs_of(out_start, out_arcs, node); }
+  std::span<const int> in(int node) const { return arcs_of(in_start, in_arcs, node); }
+  /// Lists every node's arcs in two flat arrays: a list per node was two allocations per
+  /// node, a sixth of a large MEG's memory.
+  void index_arcs();
+
+  std::vector<int> out_start, out_arcs;  ///< node n's arcs out: out_arcs[out_start[n], out_start[n + 1])
+  std::vector<int> in_start, in_arcs;
+
+ private:
+  static std::span<const int> arcs_of(const std::vector<int>& start, const std::vector<int>& list, int node) {
+    return {list.data() + start[node], static_cast<std::size_t>(start[node + 1] - start[node])};
+  }
 };
 
 /// Builds the MEG of a checked mission (no errors), expanding INIT as build_amt does but

@@ -227,7 +227,7 @@ class LogicChecker {
         return;
       }
     }
-    for (int a : node.in) {
+    for (int a : meg_.in(node.id)) {
       const MegArc& arc = meg_.arcs[a];
       if (arc.kind == ArcKind::exec) pred_list_.push_back({arc.from, arc.branch});
     }
@@ -655,7 +655,7 @@ class LogicChecker {
       int x = work.front();
       work.erase(work.begin());
       if (x != w && meg_.nodes[x].kind == MegKind::action) return meg_.nodes[x].drone;
-      for (int a : meg_.nodes[x].out) {
+      for (int a : meg_.out(x)) {
         const MegArc& arc = meg_.arcs[a];
         if (arc.kind == ArcKind::exec && seen.insert(arc.to).second && seen.size() < 10000) work.push_back(arc.to);
       }

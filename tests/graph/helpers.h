@@ -44,7 +44,7 @@ inline bool has_arc(const graph::Compilation& c, int from, int to,
 
 inline int in_degree(const graph::Compilation& c, int node, graph::ArcKind kind = graph::ArcKind::exec) {
   int n = 0;
-  for (int a : c.meg.nodes[node].in) n += c.meg.arcs[a].kind == kind ? 1 : 0;
+  for (int a : c.meg.in(node)) n += c.meg.arcs[a].kind == kind ? 1 : 0;
   return n;
 }
 

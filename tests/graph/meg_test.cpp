@@ -164,7 +164,7 @@ TEST(Meg, DoAsyncLetsTheSequenceContinueAtOnce) {
     EXPECT_TRUE(has_arc(*c, cond, next, ArcKind::exec, Branch::continue_));
     EXPECT_EQ(test::in_degree(*c, next), 1);
     int tdo = node(*c, std::string("T do ") + kind);
-    EXPECT_TRUE(c->meg.nodes[tdo].out.size() == 2u);  // stop + partner, no execution successor
+    EXPECT_TRUE(c->meg.out(tdo).size() == 2u);  // stop + partner, no execution successor
   }
 }
 
@@ -177,7 +177,7 @@ TEST(Meg, AsyncBlockStartsFromCallPointAndEndsInItsOwnTerminal) {
   EXPECT_TRUE(has_arc(*c, arm, side));
   EXPECT_TRUE(has_arc(*c, arm, takeoff));
   EXPECT_TRUE(has_arc(*c, side, t));
-  EXPECT_TRUE(c->meg.nodes[t].out.empty());
+  EXPECT_TRUE(c->meg.out(t).empty());
   EXPECT_EQ(test::in_degree(*c, c->meg.end), 1);
 }
 
