@@ -125,6 +125,17 @@ void JsonWriter::key(std::string_view name) {
   after_key_ = true;
 }
 
+void JsonWriter::key_plain(std::string_view name) {
+  begin_value();
+  reserve(name.size() + 3);
+  *cur_++ = '"';
+  std::memcpy(cur_, name.data(), name.size());
+  cur_ += name.size();
+  *cur_++ = '"';
+  *cur_++ = ':';
+  after_key_ = true;
+}
+
 void JsonWriter::value(std::string_view s) {
   begin_value();
   write_string(s);
