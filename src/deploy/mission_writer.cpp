@@ -284,6 +284,16 @@ void write_drone_ranges(JsonWriter& w, const std::vector<int>& set) {
   w.end_array();
 }
 
+/// A drone's nodes lie far apart in the MEG (a fleet-wide show holds one in a thousand of
+/// them), and so do their arguments: asking for them a few nodes ahead lets the writer
+/// find them in the cache instead of waiting for each in turn.
+void prefetch_ahead(const Compilation& c, const graph::Mdg& g, std::size_t i) {
+  constexpr std::size_t kNodeAhead = 8, kArgsAhead = 4;
+  if (i + kNodeAhead < g.nodes.size()) __builtin_prefetch(&c.meg.nodes[g.nodes[i + kNodeAhead].meg]);
+  if (i + kArgsAhead < g.nodes.size())
+    for (const lang::Expr* a : c.meg.nodes[g.nodes[i + kArgsAhead].meg].args) __builtin_prefetch(a);
+}
+
 /// The drone's MDG, node by node: graph::mdg_json's nodes and arcs without what the
 /// reader derives (a node's place, whether it is internal, a condition's evaluator, an
 /// arc's ends being external), each arc as an array. The drone's own nodes leave `drone`
@@ -307,6 +317,7 @@ void write_mdg(JsonWriter& w, const Compilation& c, const graph::Mdg& g) {
   w.begin_array();
   std::string label;
   for (std::size_t i = 0; i < g.nodes.size(); ++i) {
+    prefetch_ahead(c, g, i);
     const graph::MdgNode& mn = g.nodes[i];
     const MegNode& n = c.meg.nodes[mn.meg];
     w.begin_object();
