@@ -179,11 +179,25 @@ void JsonWriter::null() {
   put("null");
 }
 
+void JsonWriter::write_string(std::string_view s) {
+  // Most strings are short names with nothing to escape (a drone's, a capability's): one
+  // look at their bytes, then one copy with the quotes.
+  if (s.size() <= 64 && std::all_of(s.begin(), s.end(), [](char c) { return kPlain[static_cast<unsigned char>(c)]; })) {
+    reserve(s.size() + 2);
+    *cur_++ = '"';
+    std::memcpy(cur_, s.data(), s.size());
+    cur_ += s.size();
+    *cur_++ = '"';
+    return;
+  }
+  write_escaped(s);
+}
+
 // The escapes nlohmann::json writes (without ensure_ascii): quote, backslash and control
 // characters; other UTF-8 passes through. Bytes that are not UTF-8 become U+FFFD, so the
 // output is always valid JSON whatever a fleet file or path contained. Runs of bytes that
 // need nothing are copied in one piece.
-void JsonWriter::write_string(std::string_view s) {
+void JsonWriter::write_escaped(std::string_view s) {
   static const char* hex = "0123456789abcdef";
   put('"');
   std::size_t copied = 0;  // s[0, copied) is in the buffer

@@ -67,6 +67,7 @@ class JsonWriter {
   void open(char bracket);
   void close(char bracket);
   void write_string(std::string_view s);
+  void write_escaped(std::string_view s);  ///< any string, escaped as nlohmann::json does
   void line_break(std::size_t depth);
 
   /// Room for `n` more bytes at cur_. Bytes are written through a pointer into space the
