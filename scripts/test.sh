@@ -3,12 +3,12 @@
 # the browser's, which hold a latency bound, and Listing 2 on SITL, which holds each position
 # report of an orbit to 5 %. Then the real-time suites (labels `realtime` and
 # `realtime_serial`: SITL firmware, DDS processes, sim-vehicles, signals) at normal priority:
+# PX4's SITL cases, also with nothing beside them (SIH runs on the wall clock); then
 # ArduCopter's SITL cases one at a time with the other real-time cases that need not run alone
-# beside them, two at a time; PX4's with nothing beside them; then the ones that run alone
-# (RUN_SERIAL). Beside all of those, at the lowest priority (nice 19), the fuzzers' build and
-# smoke run, then every other test. The real-time suites leave part of the two cores idle (a
-# SITL case uses about one); the low-priority work fills it without taking CPU the real-time
-# ones ask for.
+# beside them, two at a time; then the ones that run alone (RUN_SERIAL). Beside the last two,
+# at the lowest priority (nice 19), the fuzzers' build and smoke run, then every other test.
+# The real-time suites leave part of the two cores idle (a SITL case uses about one); the
+# low-priority work fills it without taking CPU the real-time ones ask for.
 # Usage: scripts/test.sh BUILD_DIR FUZZ_BUILD_DIR FUZZ_SECONDS_PER_TARGET
 set -uo pipefail
 BUILD=${1:-build}
@@ -31,14 +31,18 @@ mkdir -p "$BUILD/Testing"
 
 "${CTEST[@]}" "${RETRY[@]}" -L alone
 alone_rc=$?
+# PX4's SIH runs on the wall clock, and any neighbour slows that clock until a case fails: a
+# light sim-vehicle case at normal priority (to 0.77 of mission time), and the other tests'
+# processes at nice 19 (to 0.48). PX4's SITL cases therefore run next, also with nothing
+# beside them, before the low-priority work starts.
+"${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -R "$SITL_PX4"
+px4_rc=$?
 
 # The cases on autopilot firmware run one at a time (RUN_SERIAL, fixed ports) and use about
 # one core. ArduCopter's simulation steps with its firmware, so beside its cases the real-time
 # cases that need not run alone (the RESOURCE_LOCK suites: DDS processes, network namespaces;
-# the sim-vehicle cases) run, two at a time. PX4's SIH runs on the wall clock, and a neighbour
-# at normal priority, even a light sim-vehicle case, slows that clock (to 0.77 of mission time)
-# until a case fails: nothing else at normal priority runs beside PX4's cases. Then the
-# real-time suites that run alone (label `realtime_serial`).
+# the sim-vehicle cases) run, two at a time. Then the real-time suites that run alone (label
+# `realtime_serial`).
 realtime_phase() {
   set +m  # its ctest runs stay in the phase's process group
   local rc=0
@@ -49,7 +53,6 @@ realtime_phase() {
   echo
   echo "test: the real-time cases that ran beside ArduCopter's SITL cases:"
   cat "$BESIDE_SITL_LOG"
-  "${CTEST[@]}" "${RETRY[@]}" -L realtime -LE alone -R "$SITL_PX4" || rc=1
   "${CTEST[@]}" "${RETRY[@]}" -L realtime_serial -LE alone -E "$SITL" || rc=1
   return $rc
 }
@@ -97,6 +100,7 @@ cat "$BESIDE_LOG"
 echo
 verdict() { [ "$1" -eq 0 ] && echo "test: $2 passed" || echo "test: $2 FAILED (above)"; }
 verdict "$alone_rc" "tests run alone"
-verdict "$realtime_rc" "real-time tests"
+verdict "$px4_rc" "PX4's SITL tests"
+verdict "$realtime_rc" "other real-time tests"
 verdict "$beside_rc" "fuzzers and other tests"
-[ "$alone_rc" -eq 0 ] && [ "$realtime_rc" -eq 0 ] && [ "$beside_rc" -eq 0 ]
+[ "$alone_rc" -eq 0 ] && [ "$px4_rc" -eq 0 ] && [ "$realtime_rc" -eq 0 ] && [ "$beside_rc" -eq 0 ]
