@@ -402,30 +402,32 @@ class HashFeed {
   std::size_t used_ = 0;
 };
 
-/// An expression, each kind tagged by a letter of its own (not by the enum's value, which a
-/// reordering of lang::ExprKind would change).
+/// The letter an expression kind is tagged by in the canonical form: not the enum's value,
+/// which a reordering of lang::ExprKind would change.
+char expr_tag(lang::ExprKind kind) {
+  switch (kind) {
+    case lang::ExprKind::number: return 'n';
+    case lang::ExprKind::boolean: return 'b';
+    case lang::ExprKind::property: return 'p';
+    case lang::ExprKind::name: return 'i';
+    case lang::ExprKind::unary: return 'u';
+    case lang::ExprKind::binary: return 'x';
+  }
+  return '?';
+}
+
 void feed_expr(HashFeed& h, const lang::Expr& e) {
+  h.integer(expr_tag(e.kind));
   switch (e.kind) {
-    case lang::ExprKind::number:
-      h.integer('n');
-      h.number(e.number);
-      break;
-    case lang::ExprKind::boolean:
-      h.integer('b');
-      h.integer(e.boolean);
-      break;
+    case lang::ExprKind::number: h.number(e.number); break;
+    case lang::ExprKind::boolean: h.integer(e.boolean); break;
     case lang::ExprKind::property:
-      h.integer('p');
       h.text(e.property);
       h.text(e.drone);
       break;
-    case lang::ExprKind::name:
-      h.integer('i');
-      h.text(e.drone);
-      break;
+    case lang::ExprKind::name: h.text(e.drone); break;
     case lang::ExprKind::unary:
     case lang::ExprKind::binary:
-      h.integer(e.kind == lang::ExprKind::binary ? 'x' : 'u');
       h.text(lang::op_text(e.op));
       feed_expr(h, *e.lhs);
       if (e.kind == lang::ExprKind::binary) feed_expr(h, *e.rhs);
