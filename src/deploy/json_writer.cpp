@@ -127,14 +127,11 @@ void JsonWriter::key(std::string_view name) {
 
 void JsonWriter::key_plain(std::string_view name) {
   begin_value();
-  reserve(name.size() + 3);
-  *cur_++ = '"';
-  std::memcpy(cur_, name.data(), name.size());
-  cur_ += name.size();
-  *cur_++ = '"';
-  *cur_++ = ':';
+  put_quoted(name);
+  put(':');
   after_key_ = true;
 }
+
 
 void JsonWriter::value(std::string_view s) {
   begin_value();
@@ -182,15 +179,10 @@ void JsonWriter::null() {
 void JsonWriter::write_string(std::string_view s) {
   // Most strings are short names with nothing to escape (a drone's, a capability's): one
   // look at their bytes, then one copy with the quotes.
-  if (s.size() <= 64 && std::all_of(s.begin(), s.end(), [](char c) { return kPlain[static_cast<unsigned char>(c)]; })) {
-    reserve(s.size() + 2);
-    *cur_++ = '"';
-    std::memcpy(cur_, s.data(), s.size());
-    cur_ += s.size();
-    *cur_++ = '"';
-    return;
-  }
-  write_escaped(s);
+  if (s.size() <= 64 && std::all_of(s.begin(), s.end(), [](char c) { return kPlain[static_cast<unsigned char>(c)]; }))
+    put_quoted(s);
+  else
+    write_escaped(s);
 }
 
 // The escapes nlohmann::json writes (without ensure_ascii): quote, backslash and control

@@ -86,6 +86,14 @@ class JsonWriter {
     std::memcpy(cur_, s.data(), s.size());
     cur_ += s.size();
   }
+  /// Bytes that need no escape, in quotes.
+  void put_quoted(std::string_view plain) {
+    reserve(plain.size() + 2);
+    *cur_++ = '"';
+    std::memcpy(cur_, plain.data(), plain.size());
+    cur_ += plain.size();
+    *cur_++ = '"';
+  }
   /// Gives the string the length of what is written (it holds spare room while writing).
   void settle();
 
