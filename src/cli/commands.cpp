@@ -1,7 +1,5 @@
 #include "cli/commands.h"
 
-#include <malloc.h>
-
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -183,10 +181,9 @@ int cmd_compile(const CommonOptions& o, const std::string& out_dir, const Securi
   }
   auto c = std::make_unique<graph::Compilation>();
   if (!compile_and_report(o, *c, graph::Keep::deployment_graphs)) return 1;
-  // The checks and the graph builders leave freed blocks among live ones; given back before
-  // the writing touches its code and buffers, they keep the peak 0.1-0.15 MB lower (5,000
-  // statements, 20 drones; docs/performance.md).
-  malloc_trim(0);
+  // The checks and the graph builders leave freed blocks among live ones: given back before
+  // the writing touches its buffers.
+  graph::release_freed_memory();
   CompileEnding end{out_dir, deploy::mission_hash(*c), drone_names(*c), security, ""};
   if (!write_compiled_files(*c, out_dir, end.hash, security, package)) return 1;
   end.done = compiled_message(o.mission, out_dir, end.drones.size(), c->meg.nodes.size(), package);
@@ -200,7 +197,7 @@ int cmd_compile(const CommonOptions& o, const std::string& out_dir, const Securi
   // back first, so the compile's peak memory is the larger of the two steps, not their sum.
   if (!finish.replaces_process) {
     c.reset();
-    malloc_trim(0);
+    graph::release_freed_memory();
   }
   return finish.run(end);
 }

@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <new>
 
 namespace eamos::lang {
 
@@ -29,11 +30,12 @@ const char* op_text(Op op) {
 
 Expr* ExprArena::make() {
   if (used_ == kChunk) {
-    chunks_.push_back(std::make_unique<Expr[]>(kChunk));
+    // Default-initialised bytes: nothing written, so the kernel maps no page until used.
+    chunks_.push_back(std::unique_ptr<std::byte[]>(new std::byte[kChunk * sizeof(Expr)]));
     used_ = 0;
   }
   ++size_;
-  return &chunks_.back()[used_++];
+  return new (chunks_.back().get() + used_++ * sizeof(Expr)) Expr;
 }
 
 int Mission::find_drone(const std::string& name) const {
