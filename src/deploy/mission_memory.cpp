@@ -69,7 +69,7 @@ class Builder {
     for (const std::vector<int>& set : g.drone_sets) m.drone_sets.push_back(shared_set(set));
     m.nodes.resize(g.nodes.size());
     bool ok = true;
-    for (std::size_t i = 0; i < g.nodes.size(); ++i) ok &= node(g.nodes[i], m.nodes[i]);
+    for (std::size_t i = 0; i < g.nodes.size(); ++i) ok &= node(g.nodes[i], g.cancels(static_cast<int>(i)), m.nodes[i]);
     m.arcs.reserve(g.arcs.size());
     for (const graph::MdgArc& a : g.arcs) m.arcs.push_back({a.from, a.to, a.kind, a.branch});
     if (ok && dex::link_mission(m).empty()) return true;
@@ -86,7 +86,7 @@ class Builder {
     return it->second;
   }
 
-  bool node(const graph::MdgNode& mn, dex::Node& n) {
+  bool node(const graph::MdgNode& mn, std::span<const int> cancels, dex::Node& n) {
     const graph::MegNode& meg = c_.meg.nodes[mn.meg];
     n.meg = mn.meg;
     n.drone = mn.drone;
@@ -108,7 +108,7 @@ class Builder {
       n.text = lang::expr_text(*meg.condition);
       n.control = meg.control;
       if (meg.control == lang::ControlKind::RepeatFor) n.count = meg.count;
-      n.cancels = mn.cancels;
+      n.cancels.assign(cancels.begin(), cancels.end());
       ok &= expr(*meg.condition, n.condition);
     } else if (meg.kind == graph::MegKind::pause) {
       n.seconds = meg.seconds;

@@ -217,7 +217,7 @@ void write_expr(JsonWriter& w, const lang::Expr& e) {
   w.end_object();
 }
 
-void write_ints(JsonWriter& w, const std::vector<int>& values) {
+void write_ints(JsonWriter& w, std::span<const int> values) {
   w.begin_array();
   for (int v : values) w.value(v);
   w.end_array();
@@ -326,9 +326,9 @@ void write_mdg(JsonWriter& w, const Compilation& c, const graph::Mdg& g) {
     if (mn.waits >= 0) w.member("waits", mn.waits);
     if (mn.notify >= 0) w.member("notify", mn.notify);
     write_node_content(w, c, n, true, label);
-    if (!mn.cancels.empty()) {
+    if (std::span<const int> cancels = g.cancels(static_cast<int>(i)); !cancels.empty()) {
       w.key("cancels");
-      write_ints(w, mn.cancels);
+      write_ints(w, cancels);
     }
     if (n.kind == MegKind::terminal && n.owner_condition >= 0) {
       auto it = std::lower_bound(condition_index.begin(), condition_index.end(), std::pair{n.owner_condition, -1});

@@ -130,7 +130,8 @@ json mdg_json(const Compilation& c, int drone) {
     if (n.kind == MegKind::condition) j["evaluated_by"] = c.drone_name(n.drone);
     j.erase("terminals");
     j.erase("cancels");
-    if (!mn.cancels.empty()) j["cancels"] = mn.cancels;
+    if (std::span<const int> cancels = g.cancels(static_cast<int>(i)); !cancels.empty())
+      j["cancels"] = std::vector<int>(cancels.begin(), cancels.end());
     if (n.kind == MegKind::terminal) {
       int ci = n.owner_condition >= 0 ? g.find(n.owner_condition, c.meg.nodes[n.owner_condition].drone) : -1;
       if (ci >= 0) j["condition"] = ci;

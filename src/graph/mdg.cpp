@@ -11,6 +11,12 @@ int Mdg::find(int meg, int drone) const {
   return -1;
 }
 
+std::span<const int> Mdg::cancels(int node) const {
+  int list = nodes[node].cancels;
+  if (list < 0) return {};
+  return cancel_lists[list];
+}
+
 std::size_t Mdg::internal_count() const {
   return static_cast<std::size_t>(
       std::count_if(nodes.begin(), nodes.end(), [](const MdgNode& n) { return n.internal; }));
@@ -183,7 +189,7 @@ class MdgBuilder {
     }
     if (*index < 0) {
       *index = static_cast<int>(mdgs_[d].nodes.size());
-      mdgs_[d].nodes.push_back({i.meg, i.drone, i.drone == d, {}});
+      mdgs_[d].nodes.push_back({.meg = i.meg, .drone = i.drone, .internal = i.drone == d});
     }
     return *index;
   }
@@ -267,7 +273,12 @@ class MdgBuilder {
         for (int d : holders) {
           int cn = node(d, {c.id, c.drone});
           int tn = node(d, {t.id, d});
-          mdgs_[d].nodes[cn].cancels.push_back(tn);
+          Mdg& g = mdgs_[d];
+          if (g.nodes[cn].cancels < 0) {
+            g.nodes[cn].cancels = static_cast<int>(g.cancel_lists.size());
+            g.cancel_lists.emplace_back();
+          }
+          g.cancel_lists[g.nodes[cn].cancels].push_back(tn);
         }
       }
     }

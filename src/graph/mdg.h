@@ -11,6 +11,7 @@
 // holder (`notify`); each clone counts the arrivals it needs (`waits`). Both name a set of
 // drones in the MDG's table `drone_sets`, shared by every sync point with the same set.
 #include <cstdint>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -22,7 +23,6 @@ struct MdgNode {
   int meg = 0;            ///< the MEG node this is (a clone, for sync points)
   int drone = 0;          ///< the drone that holds it: owner, or clone holder
   bool internal = false;  ///< true when `drone` is the MDG's drone
-  std::vector<int> cancels;  ///< Do conditions: indices of this MDG's nodes it cancels
   /// Internal sync-point clones: the drones whose arrival it waits for (an index into
   /// Mdg::drone_sets; -1 none). The set may hold this drone, whose arrival is its own arcs.
   int waits = -1;
@@ -31,6 +31,9 @@ struct MdgNode {
   /// none). On a drone without a clone of its own the node is external (a copy of the
   /// first holder's clone) and only counts and announces.
   int notify = -1;
+  /// Do conditions: the nodes of this MDG it cancels (an index into Mdg::cancel_lists; -1
+  /// none). Kept out of the node, which a large mission has a million of.
+  int cancels = -1;
 };
 
 struct MdgArc {
@@ -46,6 +49,10 @@ struct Mdg {
   std::vector<MdgArc> arcs;
   std::vector<int> reads;  ///< drones whose telemetry this drone's conditions and arguments need
   std::vector<std::vector<int>> drone_sets;  ///< sorted drone lists named by `waits` and `notify`
+  std::vector<std::vector<int>> cancel_lists;  ///< indices into `nodes`, named by MdgNode::cancels
+
+  /// The nodes that node `node` cancels (empty for all but Do conditions).
+  std::span<const int> cancels(int node) const;
 
   int find(int meg, int drone) const;  ///< index of the node, or -1
   bool external(const MdgArc& a) const { return !nodes[a.from].internal || !nodes[a.to].internal; }

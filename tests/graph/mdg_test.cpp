@@ -147,7 +147,7 @@ TEST(Mdg, DoConditionListsTheNodesItCancelsOnEachDrone) {
   const graph::Mdg& b = c->mdgs[1];
   int cond_in_b = b.find(cond, 0);
   ASSERT_GE(cond_in_b, 0);
-  const auto& cancels = b.nodes[cond_in_b].cancels;
+  std::span<const int> cancels = b.cancels(cond_in_b);
   EXPECT_NE(std::find(cancels.begin(), cancels.end(), b.find(b_orbit, 1)), cancels.end());
 }
 
