@@ -181,9 +181,6 @@ int cmd_compile(const CommonOptions& o, const std::string& out_dir, const Securi
   }
   auto c = std::make_unique<graph::Compilation>();
   if (!compile_and_report(o, *c, graph::Keep::deployment_graphs)) return 1;
-  // The checks and the graph builders leave freed blocks among live ones: given back before
-  // the writing touches its buffers.
-  graph::release_freed_memory();
   CompileEnding end{out_dir, deploy::mission_hash(*c), drone_names(*c), security, ""};
   if (!write_compiled_files(*c, out_dir, end.hash, security, package)) return 1;
   end.done = compiled_message(o.mission, out_dir, end.drones.size(), c->meg.nodes.size(), package);
@@ -193,12 +190,9 @@ int cmd_compile(const CommonOptions& o, const std::string& out_dir, const Securi
   }
   // The credentials need only the hash and the drones' names. A finisher that replaces this
   // process takes the graphs' memory with it (freeing them would cost a millisecond of the
-  // 5,000-statement compile); one in this process gets them freed and their pages handed
-  // back first, so the compile's peak memory is the larger of the two steps, not their sum.
-  if (!finish.replaces_process) {
-    c.reset();
-    graph::release_freed_memory();
-  }
+  // 5,000-statement compile); one in this process gets them freed first, for the credentials
+  // to reuse, so the compile's peak memory is the larger of the two steps, not their sum.
+  if (!finish.replaces_process) c.reset();
   return finish.run(end);
 }
 

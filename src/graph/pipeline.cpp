@@ -1,7 +1,5 @@
 #include "graph/pipeline.h"
 
-#include <malloc.h>
-
 #include "graph/static_checks.h"
 #include "lang/parser.h"
 
@@ -29,15 +27,6 @@ void drop_statements(Compilation& c) {
 
 }  // namespace
 
-void release_freed_memory() {
-  // Every page handed back costs a page fault when the heap grows into it again (4-16 us
-  // each on the 2-core host, docs/performance.md), so a few MB are kept rather than
-  // returned and faulted in again: for 5,000 statements, trimming saved 0.13 MB of peak
-  // and cost 160 faults.
-  constexpr std::size_t kWorthReturning = std::size_t{8} << 20;
-  if (mallinfo2().fordblks >= kWorthReturning) malloc_trim(0);
-}
-
 bool compile(std::shared_ptr<SourceFile> source, const fleet::Fleet& fleet, Diagnostics& diags,
              Compilation& out, const lang::CheckLimits& limits, Keep keep) {
   out.source = std::move(source);
@@ -45,16 +34,12 @@ bool compile(std::shared_ptr<SourceFile> source, const fleet::Fleet& fleet, Diag
   out.mission = lang::parse_mission(*out.source, diags);
   out.checked = lang::check_mission(out.mission, out.fleet, diags, limits);
   if (diags.has_errors()) return false;
-  if (keep == Keep::deployment_graphs) release_freed_memory();
   for (int d = 0; d < out.drone_count(); ++d)
     out.settings.push_back(out.fleet.settings_for(out.mission.drones[d].name,
                                                   out.mission.drones[d].type, d));
   out.meg = build_meg(out.mission);
   if (keep == Keep::all_graphs) out.amt = build_amt(out.mission);
-  if (keep == Keep::deployment_graphs) {
-    keep_control_statements(out);
-    release_freed_memory();
-  }
+  if (keep == Keep::deployment_graphs) keep_control_statements(out);
   // Like the checker's warnings, only on a mission without errors: the MEG needs one.
   check_mission_logic({out.meg, out.mission, out.fleet, out.checked.drone_types, out.settings}, diags);
   if (diags.has_errors()) return false;

@@ -34,12 +34,6 @@ struct Compilation {
 /// Which graphs a Compilation keeps. A deployment needs only the MEG and the MDGs; the
 /// AMT serves tools (graph export, stats), and a compile that does not build it holds
 /// about a tenth less memory at its peak.
-/// Gives the pages of memory freed in the middle of the heap back to the system once
-/// there are enough of them to matter. A large compile frees the checker's working sets and
-/// the statements in many small blocks among live ones; kept resident, they were about 180 MB
-/// of the peak at 1,000 drones while the MEG and the MDGs took new pages.
-void release_freed_memory();
-
 enum class Keep {
   all_graphs,
   /// No AMT is built. The statements other than control structures are freed once the MEG
