@@ -385,7 +385,7 @@ class HashFeed {
     std::memcpy(buffer_.data() + used_, s.data(), s.size());
     used_ += s.size();
   }
-  void integers(const std::vector<int>& values) {
+  void integers(std::span<const int> values) {
     integer(static_cast<long long>(values.size()));
     for (int v : values) integer(v);
   }
@@ -437,7 +437,7 @@ void feed_expr(HashFeed& h, const lang::Expr& e) {
 
 /// A MEG node as its canonical form holds it: every member a mission file's copy of it
 /// has (write_node_content) and the condition's terminals and cancelled nodes.
-void feed_node(HashFeed& h, const MegNode& n) {
+void feed_node(HashFeed& h, const graph::Meg& meg, const MegNode& n) {
   h.integer(n.id);
   h.integer(n.drone);
   h.text(graph::meg_kind_name(n.kind));
@@ -452,8 +452,8 @@ void feed_node(HashFeed& h, const MegNode& n) {
     h.text(lang::control_name(n.control));
     feed_expr(h, *n.condition);
     h.integer(n.count);
-    h.integers(n.terminals);
-    h.integers(n.cancels);
+    h.integers(meg.terminals(n.id));
+    h.integers(meg.cancels(n.id));
   }
   h.integers(n.reads);
   if (n.kind == MegKind::terminal) {
@@ -552,7 +552,7 @@ std::string mission_hash(const Compilation& c) {
     h.integer(c.meg.init);
     h.integer(c.meg.end);
     h.integer(static_cast<long long>(c.meg.nodes.size()));
-    for (const MegNode& n : c.meg.nodes) feed_node(h, n);
+    for (const MegNode& n : c.meg.nodes) feed_node(h, c.meg, n);
     h.integer(static_cast<long long>(c.meg.arcs.size()));
     for (const graph::MegArc& a : c.meg.arcs) {
       h.integer(a.from);

@@ -46,8 +46,9 @@ json meg_node_json(const Compilation& c, const MegNode& n) {
     j["condition"] = expr_json(*n.condition, c.mission);
     j["text"] = lang::expr_text(*n.condition);
     if (n.control == lang::ControlKind::RepeatFor) j["count"] = n.count;
-    j["terminals"] = n.terminals;
-    if (!n.cancels.empty()) j["cancels"] = n.cancels;
+    std::span<const int> terminals = c.meg.terminals(n.id), cancels = c.meg.cancels(n.id);
+    j["terminals"] = std::vector<int>(terminals.begin(), terminals.end());
+    if (!cancels.empty()) j["cancels"] = std::vector<int>(cancels.begin(), cancels.end());
   }
   if (!n.reads.empty()) j["reads"] = drone_list(c, n.reads);
   if (n.kind == MegKind::terminal) {

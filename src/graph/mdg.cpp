@@ -266,8 +266,7 @@ class MdgBuilder {
 
   void add_cancel_scopes() {
     for (const MegNode& c : meg_.nodes) {
-      if (c.cancels.empty()) continue;
-      for (int target : c.cancels) {
+      for (int target : meg_.cancels(c.id)) {
         const MegNode& t = meg_.nodes[target];
         std::vector<int> holders = is_sync_point(t.kind) ? clones_[t.id] : std::vector<int>{t.drone};
         for (int d : holders) {

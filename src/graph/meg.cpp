@@ -22,6 +22,27 @@ int Meg::add_arc(int from, int to, ArcKind kind, Branch branch) {
   return id;
 }
 
+ConditionLists& Meg::lists_of(int condition) {
+  int& index = nodes[condition].lists;
+  if (index < 0) {
+    index = static_cast<int>(condition_lists.size());
+    condition_lists.emplace_back();
+  }
+  return condition_lists[index];
+}
+
+std::span<const int> Meg::terminals(int node) const {
+  int index = nodes[node].lists;
+  if (index < 0) return {};
+  return condition_lists[index].terminals;
+}
+
+std::span<const int> Meg::cancels(int node) const {
+  int index = nodes[node].lists;
+  if (index < 0) return {};
+  return condition_lists[index].cancels;
+}
+
 namespace {
 
 /// A counting sort of the arcs by one end: start[n] is where node n's arcs begin in list.
@@ -293,7 +314,7 @@ class MegBuilder {
     node.owner_condition = condition;
     node.role = role;
     node.name = std::string(role_name(role)) + " " + std::string(n.name);
-    meg_.nodes[condition].terminals.push_back(t);
+    meg_.lists_of(condition).terminals.push_back(t);
     return t;
   }
 
@@ -376,7 +397,8 @@ class MegBuilder {
     int first = static_cast<int>(meg_.nodes.size());
     Ends body_ends = build_role(n, Role::do_, {{c, Branch::do_}});
     int last = static_cast<int>(meg_.nodes.size());
-    for (int i = first; i < last; ++i) meg_.nodes[c].cancels.push_back(i);
+    std::vector<int>& cancels = meg_.lists_of(c).cancels;
+    for (int i = first; i < last; ++i) cancels.push_back(i);
     mark_scope(first, last, c);
     int t_do = add_terminal(n, c, Role::do_);
     connect(body_ends, t_do);

@@ -26,6 +26,9 @@ struct MegNode {
   MegKind kind = MegKind::action;
   SourceLocation loc;
   int drone = -1;          ///< owner; -1 for sync points
+  /// Condition: its terminals and the nodes it cancels (an index into Meg::condition_lists;
+  /// -1 none). Kept out of the node, which a large mission has a million of.
+  int lists = -1;
   std::string name;        ///< capability, control structure or block name
   // action:
   std::vector<const lang::Expr*> args;
@@ -39,8 +42,6 @@ struct MegNode {
   const lang::Expr* condition = nullptr;
   std::vector<int> reads;  ///< drones whose properties the condition/arguments read
   long long count = 0;     ///< RepeatFor's iteration limit
-  std::vector<int> terminals;  ///< condition: its terminals (then/else, repeat/after, do/done)
-  std::vector<int> cancels;    ///< Do* condition: nodes of the do-branch, cancelled on a flip
   // terminal:
   int owner_condition = -1;    ///< the condition whose branch it ends (-1: async branch end)
   Role role = Role::none;      ///< which branch it ends
@@ -48,15 +49,25 @@ struct MegNode {
   double seconds = 0.0;
 };
 
+struct ConditionLists {
+  std::vector<int> terminals;  ///< its terminals (then/else, repeat/after, do/done)
+  std::vector<int> cancels;    ///< Do* condition: nodes of the do-branch, cancelled on a flip
+};
+
 struct Meg {
   std::vector<MegNode> nodes;
   std::vector<MegArc> arcs;
+  std::vector<ConditionLists> condition_lists;  ///< named by MegNode::lists
   int init = -1;
   int end = -1;
   int drone_count = 0;
 
   int add_node(MegKind kind, SourceLocation loc);
   int add_arc(int from, int to, ArcKind kind = ArcKind::exec, Branch branch = Branch::any);
+  /// A condition's lists, made when first asked for.
+  ConditionLists& lists_of(int condition);
+  std::span<const int> terminals(int node) const;
+  std::span<const int> cancels(int node) const;
 
   /// The arcs out of and into `node` (indices into `arcs`, in the order they were added),
   /// once index_arcs() has run; build_meg runs it.

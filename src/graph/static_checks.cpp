@@ -334,8 +334,8 @@ class LogicChecker {
   /// Nodes a Do may cancel: a wait among them can end by cancellation, never for ever.
   void mark_cancellable() {
     cancellable_.assign(meg_.nodes.size(), 0);
-    for (const MegNode& n : meg_.nodes)
-      for (int c : n.cancels) cancellable_[c] = 1;
+    for (const ConditionLists& lists : meg_.condition_lists)
+      for (int c : lists.cancels) cancellable_[c] = 1;
   }
 
   std::string action_text(int node) const {

@@ -114,7 +114,7 @@ TEST(Meg, PauseUntilAndPauseWhileContinueOnGoWithoutTerminal) {
     EXPECT_EQ(c->meg.nodes[cond].drone, 1) << kind;  // B's property: B evaluates
     EXPECT_TRUE(has_arc(*c, node(*c, "A.Arm()"), cond)) << kind;
     EXPECT_TRUE(has_arc(*c, cond, node(*c, "A.Takeoff(3)"), ArcKind::exec, Branch::go)) << kind;
-    EXPECT_TRUE(c->meg.nodes[cond].terminals.empty()) << kind;
+    EXPECT_TRUE(c->meg.terminals(cond).empty()) << kind;
   }
 }
 
@@ -146,7 +146,7 @@ TEST(Meg, DoSyncCancelsDoBranchAndWaitsForOneOfItsTerminals) {
     EXPECT_TRUE(has_arc(*c, tdone, tdo, ArcKind::partner));
     EXPECT_TRUE(has_arc(*c, tdo, next));
     EXPECT_TRUE(has_arc(*c, tdone, next));
-    const auto& cancels = c->meg.nodes[cond].cancels;
+    std::span<const int> cancels = c->meg.cancels(cond);
     EXPECT_NE(std::find(cancels.begin(), cancels.end(), orbit), cancels.end());
     EXPECT_NE(std::find(cancels.begin(), cancels.end(), hover), cancels.end());
     EXPECT_EQ(std::find(cancels.begin(), cancels.end(), home), cancels.end());
