@@ -13,6 +13,7 @@
 
 #include "cli/arguments.h"
 #include "cli/commands.h"
+#include "cli/heap_tunables.h"
 #include "lsp/server.h"
 #include "security/mission_keys.h"
 #include "version.h"
@@ -402,26 +403,13 @@ bool outputs_usable(const Commands& c, const std::vector<std::string>& args, con
   return true;
 }
 
-/// glibc's malloc backs its heap with transparent huge pages (where the kernel offers them on
-/// request, as Debian's `madvise` setting does) only when GLIBC_TUNABLES says so as a program
-/// starts: for a heap of hundreds of MB touched a page at a time, a tenth of the page faults
-/// and less CPU besides (docs/performance.md). Blocks under 32 MiB come from that heap too
-/// rather than from mappings of their own on 4 KiB pages (glibc's threshold starts at 128 KiB):
-/// a third fewer page faults for the 500,000-statement compiles. And the heap keeps what is
-/// freed (trimmed only past 4 GiB free): verify's threads fly path after path, and each
-/// arena handed its pages back after every flight only to fault them in again (216,000
-/// page faults for the 100-drone squads' 64 paths, 8,500 without). Puts them in the
-/// environment for the program this one starts or becomes, in front of the user's
-/// GLIBC_TUNABLES (a later setting wins, so theirs do); false, and nothing changed, when
-/// theirs already choose huge pages or not.
+/// Puts the heap tunables (cli/heap_tunables.h) in the environment for the program this one
+/// starts or becomes; false, and nothing changed, when the user's GLIBC_TUNABLES already
+/// chooses huge pages or not.
 bool ask_malloc_for_huge_pages() {
   const char* user = std::getenv("GLIBC_TUNABLES");
-  std::string theirs = user ? user : "";
-  if (theirs.find("glibc.malloc.hugetlb") != std::string::npos) return false;
-  std::string tunables =
-      "glibc.malloc.hugetlb=1:glibc.malloc.mmap_threshold=33554432:glibc.malloc.trim_threshold=4294967296";
-  if (!theirs.empty()) tunables += ":" + theirs;
-  return ::setenv("GLIBC_TUNABLES", tunables.c_str(), 1) == 0;
+  std::optional<std::string> tunables = eamos::cli::heap_tunables(user ? user : "");
+  return tunables && ::setenv("GLIBC_TUNABLES", tunables->c_str(), 1) == 0;
 }
 
 #ifdef EAMOS_FLY_ELSEWHERE

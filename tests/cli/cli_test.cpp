@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli/heap_tunables.h"
 #include "support/mission_edit.h"
 #include "support/run_eamos.h"
 
@@ -256,6 +257,21 @@ TEST_F(Cli, ALargeCompileWritesTheSameFilesWhetherOrNotItRestartsOnHugePages) {
   EXPECT_EQ(outputs[0].size(), 41u + 1u) << "a mission file per drone, one for the ground and the manifest";
   EXPECT_EQ(outputs[0], outputs[1]);
   EXPECT_EQ(outputs[0], outputs[2]);
+}
+
+// What `eamos` puts in GLIBC_TUNABLES for run, verify and a large compile: its heap tunables
+// in front of the user's, whose later settings win; nothing when theirs choose huge pages.
+// (The running process cannot show it: glibc cuts the environment /proc shows at the first
+// tunable it reads.)
+TEST(HeapTunables, OursComeFirstAndAUsersChoiceOfHugePagesIsLeftAlone) {
+  const std::string ours(eamos::cli::kHeapTunables);
+  EXPECT_EQ(eamos::cli::heap_tunables(""), ours);
+  EXPECT_EQ(eamos::cli::heap_tunables("glibc.malloc.arena_max=2"), ours + ":glibc.malloc.arena_max=2");
+  EXPECT_EQ(eamos::cli::heap_tunables("glibc.malloc.trim_threshold=0"), ours + ":glibc.malloc.trim_threshold=0");
+  EXPECT_EQ(eamos::cli::heap_tunables("glibc.malloc.hugetlb=0"), std::nullopt);
+  EXPECT_EQ(eamos::cli::heap_tunables("glibc.malloc.arena_max=2:glibc.malloc.hugetlb=1"), std::nullopt);
+  // The string docs/performance.md and src/cli/README.md give.
+  EXPECT_EQ(ours, "glibc.malloc.hugetlb=1:glibc.malloc.mmap_threshold=33554432:glibc.malloc.trim_threshold=4294967296");
 }
 
 TEST_F(Cli, HelpAndVersion) {
