@@ -132,7 +132,6 @@ void JsonWriter::key_plain(std::string_view name) {
   after_key_ = true;
 }
 
-
 void JsonWriter::value(std::string_view s) {
   begin_value();
   write_string(s);

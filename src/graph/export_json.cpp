@@ -46,9 +46,8 @@ json meg_node_json(const Compilation& c, const MegNode& n) {
     j["condition"] = expr_json(*n.condition, c.mission);
     j["text"] = lang::expr_text(*n.condition);
     if (n.control == lang::ControlKind::RepeatFor) j["count"] = n.count;
-    std::span<const int> terminals = c.meg.terminals(n.id), cancels = c.meg.cancels(n.id);
-    j["terminals"] = std::vector<int>(terminals.begin(), terminals.end());
-    if (!cancels.empty()) j["cancels"] = std::vector<int>(cancels.begin(), cancels.end());
+    j["terminals"] = c.meg.terminals(n.id);
+    if (std::span<const int> cancels = c.meg.cancels(n.id); !cancels.empty()) j["cancels"] = cancels;
   }
   if (!n.reads.empty()) j["reads"] = drone_list(c, n.reads);
   if (n.kind == MegKind::terminal) {
@@ -131,8 +130,7 @@ json mdg_json(const Compilation& c, int drone) {
     if (n.kind == MegKind::condition) j["evaluated_by"] = c.drone_name(n.drone);
     j.erase("terminals");
     j.erase("cancels");
-    if (std::span<const int> cancels = g.cancels(static_cast<int>(i)); !cancels.empty())
-      j["cancels"] = std::vector<int>(cancels.begin(), cancels.end());
+    if (std::span<const int> cancels = g.cancels(static_cast<int>(i)); !cancels.empty()) j["cancels"] = cancels;
     if (n.kind == MegKind::terminal) {
       int ci = n.owner_condition >= 0 ? g.find(n.owner_condition, c.meg.nodes[n.owner_condition].drone) : -1;
       if (ci >= 0) j["condition"] = ci;

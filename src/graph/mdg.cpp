@@ -17,6 +17,15 @@ std::span<const int> Mdg::cancels(int node) const {
   return cancel_lists[list];
 }
 
+std::vector<int>& Mdg::cancel_list(int node) {
+  int& list = nodes[node].cancels;
+  if (list < 0) {
+    list = static_cast<int>(cancel_lists.size());
+    cancel_lists.emplace_back();
+  }
+  return cancel_lists[list];
+}
+
 std::size_t Mdg::internal_count() const {
   return static_cast<std::size_t>(
       std::count_if(nodes.begin(), nodes.end(), [](const MdgNode& n) { return n.internal; }));
@@ -272,12 +281,7 @@ class MdgBuilder {
         for (int d : holders) {
           int cn = node(d, {c.id, c.drone});
           int tn = node(d, {t.id, d});
-          Mdg& g = mdgs_[d];
-          if (g.nodes[cn].cancels < 0) {
-            g.nodes[cn].cancels = static_cast<int>(g.cancel_lists.size());
-            g.cancel_lists.emplace_back();
-          }
-          g.cancel_lists[g.nodes[cn].cancels].push_back(tn);
+          mdgs_[d].cancel_list(cn).push_back(tn);
         }
       }
     }

@@ -53,6 +53,8 @@ struct Mdg {
 
   /// The nodes that node `node` cancels (empty for all but Do conditions).
   std::span<const int> cancels(int node) const;
+  /// Node `node`'s list of cancelled nodes, made when first asked for (as Meg::lists_of).
+  std::vector<int>& cancel_list(int node);
 
   int find(int meg, int drone) const;  ///< index of the node, or -1
   bool external(const MdgArc& a) const { return !nodes[a.from].internal || !nodes[a.to].internal; }
