@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <tuple>
 #include <unordered_map>
 
 #include "sim/sim_drone.h"
@@ -56,12 +55,26 @@ std::vector<double> candidates(const fleet::SensorRange& r, const std::vector<do
   return v;
 }
 
+/// What the observer keeps about one node of one drone's mission over a flight.
+struct NodeWatch {
+  std::vector<std::size_t> open;        ///< an action's runs still running (in Flight::actions), oldest first
+  std::vector<const dex::Expr*> reads;  ///< a condition's property reads
+  ConditionSeen seen;                   ///< a condition's last evaluation (seen.node set once evaluated)
+  signed char free = -1;                ///< a condition explored both ways: 1 yes, 0 no, -1 not yet known
+  bool started = false;                 ///< an action that ran at least once
+  bool motion = false;                  ///< an action of the motion class
+  bool reads_known = false;
+  bool timing_noted = false;            ///< a condition already in Flight::timing_conditions
+};
+
 class Observer : public dex::RunObserver, public dex::TraceSink {
  public:
   Observer(const Setup& setup, const Assignment& forced, Flight& f, bool whole_trace)
-      : setup_(setup), forced_(forced), f_(f), whole_trace_(whole_trace) {
+      : setup_(setup), forced_(forced), f_(f), whole_trace_(whole_trace), watch_(setup.missions.size()) {
     const auto& names = setup_.missions[0].fleet;
     for (std::size_t d = names.size(); d-- > 0;) index_of_[names[d]] = static_cast<int>(d);  // the first of equal names
+    for (std::size_t d = 0; d < watch_.size(); ++d) watch_[d].resize(setup_.missions[d].nodes.size());
+    f_.actions_of.resize(setup_.missions.size());
   }
 
   // Every arrival delivered, on every flight: the runner's counted barriers (taken when no
@@ -71,38 +84,35 @@ class Observer : public dex::RunObserver, public dex::TraceSink {
 
   void action_started(double t, int drone, const dex::Node& node, const mid::ActionRequest& request,
                       const mid::DroneState& state) override {
-    ActionRun a;
+    NodeWatch& w = watch(drone, node);
+    if (!w.started) {  // the first run of this node: what it is
+      const fleet::ActionSpec* spec = setup_.missions[drone].type.find_action(node.name);
+      w.motion = spec && spec->action_class == fleet::ActionClass::motion;
+      w.started = true;
+    }
+    ActionRun& a = f_.actions.emplace_back();
     a.drone = drone;
     a.node = &node;
     a.request = request;
     a.state = state;
     a.start = t;
-    auto [open, added] = open_.try_emplace({drone, node.meg});
-    if (added) {  // the first run of this node: what it is, and where its ends will say they are
-      const fleet::ActionSpec* spec = setup_.missions[drone].type.find_action(node.name);
-      motion_[{drone, node.meg}] = spec && spec->action_class == fleet::ActionClass::motion;
-      std::vector<int>& megs = megs_at_[{drone, node.line, node.col}];
-      megs.insert(std::upper_bound(megs.begin(), megs.end(), node.meg), node.meg);
-    }
-    a.motion = motion_.at({drone, node.meg});
-    open->second.push_back(f_.actions.size());
-    if (f_.actions_of.size() <= static_cast<std::size_t>(drone)) f_.actions_of.resize(drone + 1);
-    f_.actions_of[drone].push_back(f_.actions.size());
-    f_.actions.push_back(std::move(a));
+    a.motion = w.motion;
+    w.open.push_back(f_.actions.size() - 1);
+    f_.actions_of[drone].push_back(f_.actions.size() - 1);
   }
 
   bool condition(double t, int drone, const dex::Node& node, bool computed, const dex::PropertyReader& read) override {
-    ConditionSeen& seen = f_.conditions[{drone, node.meg}];
+    NodeWatch& w = watch(drone, node);
+    if (!w.reads_known) collect_reads(node.condition, w.reads);
+    w.reads_known = true;
+    ConditionSeen& seen = w.seen;
     seen.node = &node;
     seen.t = t;
     seen.reads.clear();
-    auto [known, added] = reads_.try_emplace(&node);
-    if (added) collect_reads(node.condition, known->second);
-    const std::vector<const dex::Expr*>& reads = known->second;
-    for (const dex::Expr* r : reads) seen.reads.emplace_back(r, read(r->drone, r->property));
-    bool value = decide(drone, node, computed, read);
+    for (const dex::Expr* r : w.reads) seen.reads.emplace_back(r, read(r->drone, r->property));
+    bool value = decide(drone, node, w, computed, read);
     seen.value = value;
-    note_timing(t, drone, node, value, reads);
+    note_timing(t, drone, node, w, value);
     return value;
   }
 
@@ -110,24 +120,39 @@ class Observer : public dex::RunObserver, public dex::TraceSink {
     if (whole_trace_) f_.events.push_back(e);
     if (e.event == "failsafe" && f_.abandoned_at < 0) f_.abandoned_at = e.t;
     if (e.event != "end") return;
+    // Each end closes the oldest open run of its node on that drone (instances end in order).
     int drone = drone_index(e.drone);
-    // Each end closes the oldest open run of that node on that drone (instances end in order);
-    // the node is the first, in MEG order, at the event's place with a run open.
-    auto megs = megs_at_.find({drone, e.line, e.col});
-    if (megs == megs_at_.end()) return;
-    for (int meg : megs->second) {
-      std::vector<std::size_t>& open = open_.at({drone, meg});
-      if (open.empty()) continue;
-      ActionRun& a = f_.actions[open.front()];
-      if (a.node->text != e.text) continue;
-      a.end = e.t;
-      a.outcome = e.outcome;
-      open.erase(open.begin());
-      return;
-    }
+    if (drone >= static_cast<int>(watch_.size())) return;
+    int index = setup_.missions[drone].find(e.node, drone);
+    if (index < 0) return;
+    std::vector<std::size_t>& open = watch_[drone][index].open;
+    if (open.empty()) return;
+    ActionRun& a = f_.actions[open.front()];
+    a.end = e.t;
+    a.outcome = e.outcome;
+    open.erase(open.begin());
+  }
+
+  /// The flight is over: each condition's last evaluation goes into the flight.
+  void finish() {
+    for (std::size_t d = 0; d < watch_.size(); ++d)
+      for (NodeWatch& w : watch_[d]) {
+        if (!w.seen.node) continue;
+        ConditionSeen& kept = f_.conditions[{static_cast<int>(d), w.seen.node->meg}];
+        if (!kept.node || kept.t <= w.seen.t) kept = std::move(w.seen);
+      }
   }
 
  private:
+  /// The watch of `node`, which drone `drone` runs: nodes are ids into the drone's mission.
+  NodeWatch& watch(int drone, const dex::Node& node) {
+    const std::vector<dex::Node>& nodes = setup_.missions[drone].nodes;
+    std::ptrdiff_t index = &node - nodes.data();
+    if (index < 0 || index >= static_cast<std::ptrdiff_t>(nodes.size()))
+      index = setup_.missions[drone].find(node.meg, node.drone);
+    return watch_[drone].at(static_cast<std::size_t>(index));
+  }
+
   int drone_index(const std::string& name) const {
     auto it = index_of_.find(name);
     return it == index_of_.end() ? static_cast<int>(setup_.missions[0].fleet.size()) : it->second;
@@ -176,38 +201,38 @@ class Observer : public dex::RunObserver, public dex::TraceSink {
 
   /// An If, Repeat or Do whose first evaluation read a drone while it was moving: its
   /// outcome may differ when that drone is slower or faster (explore.cpp flies both).
-  void note_timing(double t, int drone, const dex::Node& node, bool value, const std::vector<const dex::Expr*>& reads) {
+  void note_timing(double t, int drone, const dex::Node& node, NodeWatch& w, bool value) {
     using lang::ControlKind;
     ControlKind k = node.control;
     if (k == ControlKind::WaitUntil || k == ControlKind::WaitWhile || k == ControlKind::PauseUntil ||
         k == ControlKind::PauseWhile || k == ControlKind::none)
       return;  // a wait ends either way; timing moves only when
-    std::pair<int, int> key{drone, node.meg};
-    if (f_.timing_conditions.count(key) || (free_.count(key) && free_.at(key))) return;
+    if (w.timing_noted || w.free == 1) return;
     std::vector<int> moving;
-    for (const dex::Expr* r : reads) {
+    for (const dex::Expr* r : w.reads) {
       if (r->drone < 0 || r->drone >= static_cast<int>(setup_.missions.size())) continue;
       if (r->property.rfind("Sensor", 0) == 0 || r->property == "Battery") continue;
       if (std::find(moving.begin(), moving.end(), r->drone) != moving.end()) continue;
       const ActionRun* a = running_at(f_, r->drone, t);
       if (a && a->motion) moving.push_back(r->drone);
     }
-    if (!moving.empty()) f_.timing_conditions[key] = {value, moving};
+    if (moving.empty()) return;
+    w.timing_noted = true;
+    f_.timing_conditions.try_emplace({drone, node.meg}, value, std::move(moving));
   }
 
-  bool decide(int drone, const dex::Node& node, bool computed, const dex::PropertyReader& read) {
-    std::pair<int, int> key{drone, node.meg};
-    auto known = free_.find(key);
-    if (known == free_.end()) {
+  bool decide(int drone, const dex::Node& node, NodeWatch& w, bool computed, const dex::PropertyReader& read) {
+    if (w.free < 0) {
       std::vector<RangedRead> ranged = ranged_reads(node);
       bool is_free = false;
       if (!ranged.empty()) {
         auto [can_false, can_true] = possible(node, ranged, read);
         is_free = can_false && can_true;
       }
-      known = free_.emplace(key, is_free).first;
+      w.free = is_free ? 1 : 0;
     }
-    if (!known->second) return computed;
+    if (w.free == 0) return computed;
+    std::pair<int, int> key{drone, node.meg};
     auto forced = forced_.find(key);
     bool value = forced == forced_.end() ? computed : forced->second;
     if (std::find(f_.decision_keys.begin(), f_.decision_keys.end(), key) == f_.decision_keys.end()) {
@@ -222,12 +247,8 @@ class Observer : public dex::RunObserver, public dex::TraceSink {
   const Assignment& forced_;
   Flight& f_;
   bool whole_trace_;
-  std::map<std::pair<int, int>, bool> free_;                    ///< condition → explored both ways
-  std::map<std::pair<int, int>, std::vector<std::size_t>> open_;  ///< (drone, meg) → running runs
-  std::map<std::tuple<int, int, int>, std::vector<int>> megs_at_;  ///< (drone, line, col) → its MEG ids, sorted
-  std::unordered_map<std::string, int> index_of_;                 ///< drone name → fleet index
-  std::map<std::pair<int, int>, bool> motion_;                     ///< (drone, meg) → a motion action
-  std::unordered_map<const dex::Node*, std::vector<const dex::Expr*>> reads_;  ///< condition → its property reads
+  std::unordered_map<std::string, int> index_of_;  ///< drone name → fleet index
+  std::vector<std::vector<NodeWatch>> watch_;      ///< per drone, per node of its mission
 };
 
 /// Every drone flies in the built-in simulator, whatever adapter the fleet names: verify
@@ -273,6 +294,7 @@ Flight fly(const Setup& setup, const Assignment& forced, const std::vector<doubl
   // not what the give-way in flight would make of it.
   options.keep_separation = false;
   f.result = dex::run_in_process(setup.missions, adapters, &observer, options);
+  observer.finish();
   return f;
 }
 

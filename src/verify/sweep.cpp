@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace eamos::verify {
 
@@ -13,7 +14,6 @@ namespace {
 // Cells a little wider than asked: a pair nearer than the separation then lies in neighbouring
 // cells even when the division rounds.
 constexpr double kCellMargin = 1.001;
-constexpr double kMaxCellIndex = 1 << 30;
 
 using Step = Timeline::Step;
 
@@ -24,7 +24,7 @@ class SeparationSweep {
  public:
   SeparationSweep(const Timeline& flight, const fleet::Separation& sep)
       : tracks_(flight.tracks), steps_(flight.steps), sep_(sep),
-        grid_(sep.horizontal_m * kCellMargin, static_cast<int>(tracks_.size())), now_(tracks_.size(), nullptr),
+        grid_(sep.horizontal_m * kCellMargin, area_of(flight), static_cast<int>(tracks_.size())), now_(tracks_.size(), nullptr),
         near_(tracks_.size()), moved_at_(tracks_.size(), -1), seen_(tracks_.size(), -1) {}
 
   std::vector<Approach> run() {
@@ -106,6 +106,9 @@ Timeline timeline(std::vector<const std::vector<dex::Sample>*> tracks) {
   Timeline out;
   out.tracks = std::move(tracks);
   std::vector<std::size_t> runs = {0};  // each track is a sorted run: merge them pairwise
+  std::size_t samples = 0;
+  for (const std::vector<dex::Sample>* track : out.tracks) samples += track->size();
+  out.steps.reserve(samples);
   for (std::size_t d = 0; d < out.tracks.size(); ++d) {
     for (std::size_t i = 0; i < out.tracks[d]->size(); ++i)
       out.steps.push_back({(*out.tracks[d])[i].t, static_cast<int>(d), static_cast<int>(i)});
@@ -128,20 +131,44 @@ Timeline timeline(std::vector<const std::vector<dex::Sample>*> tracks) {
   return out;
 }
 
-Grid::Grid(double cell, int drones) : cell_(cell), where_(drones, 0), placed_(drones, false) {}
+Area area_of(const Timeline& flight) {
+  Area a{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+         -std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+  for (const std::vector<dex::Sample>* track : flight.tracks)
+    for (const dex::Sample& s : *track)
+      if (finite(s)) {
+        a.x0 = std::min(a.x0, s.x), a.y0 = std::min(a.y0, s.y);
+        a.x1 = std::max(a.x1, s.x), a.y1 = std::max(a.y1, s.y);
+      }
+  return a.x0 <= a.x1 ? a : Area{};
+}
 
-std::uint64_t Grid::index(double v) const {
-  double i = std::clamp(std::floor(v / cell_), -kMaxCellIndex, kMaxCellIndex);
-  return static_cast<std::uint64_t>(static_cast<std::int64_t>(i) + (std::int64_t{1} << 31));
+Grid::Grid(double cell, const Area& area, int drones)
+    : cell_(cell), area_(area), next_(drones, -1), prev_(drones, -1), where_(drones, -1) {
+  auto cells_across = [this](double extent) {
+    double n = std::floor(extent / cell_) + 1;
+    return std::isfinite(n) ? n : 1.0;  // an extent past the doubles' range: one column
+  };
+  double width = area.x1 - area.x0, height = area.y1 - area.y0;
+  while (cells_across(width) * cells_across(height) > kMaxCells) cell_ *= 2;
+  columns_ = static_cast<int>(cells_across(width));
+  rows_ = static_cast<int>(cells_across(height));
+  first_.assign(static_cast<std::size_t>(columns_) * rows_, -1);
+}
+
+int Grid::index(double offset, int count) const {
+  double i = std::floor(offset / cell_);
+  if (i >= count) return count - 1;
+  return i >= 0 ? static_cast<int>(i) : 0;  // below the area, or not a number (inf / inf)
 }
 
 void Grid::remove(int drone) {
-  if (!placed_[drone]) return;
-  auto cell = cells_.find(where_[drone]);
-  auto& members = cell->second;
-  members.erase(std::find(members.begin(), members.end(), drone));
-  if (members.empty()) cells_.erase(cell);
-  placed_[drone] = false;
+  int cell = where_[drone];
+  if (cell < 0) return;
+  if (prev_[drone] >= 0) next_[prev_[drone]] = next_[drone];
+  else first_[cell] = next_[drone];
+  if (next_[drone] >= 0) prev_[next_[drone]] = prev_[drone];
+  where_[drone] = -1;
 }
 
 void Grid::place(int drone, double x, double y) {
@@ -149,22 +176,22 @@ void Grid::place(int drone, double x, double y) {
     remove(drone);
     return;
   }
-  std::uint64_t k = index(x) << 32 | index(y);
-  if (placed_[drone] && where_[drone] == k) return;
+  int cell = index(y - area_.y0, rows_) * columns_ + index(x - area_.x0, columns_);
+  if (where_[drone] == cell) return;
   remove(drone);
-  cells_[k].push_back(drone);
-  where_[drone] = k;
-  placed_[drone] = true;
+  prev_[drone] = -1;
+  next_[drone] = first_[cell];
+  if (first_[cell] >= 0) prev_[first_[cell]] = drone;
+  first_[cell] = drone;
+  where_[drone] = cell;
 }
 
 void Grid::around(double x, double y, std::vector<int>& out) const {
   if (!std::isfinite(x) || !std::isfinite(y)) return;
-  std::uint64_t ix = index(x), iy = index(y);
-  for (std::uint64_t cx = ix - 1; cx <= ix + 1; ++cx)
-    for (std::uint64_t cy = iy - 1; cy <= iy + 1; ++cy) {
-      auto cell = cells_.find(cx << 32 | cy);
-      if (cell != cells_.end()) out.insert(out.end(), cell->second.begin(), cell->second.end());
-    }
+  int cx = index(x - area_.x0, columns_), cy = index(y - area_.y0, rows_);
+  for (int r = std::max(cy - 1, 0); r <= std::min(cy + 1, rows_ - 1); ++r)
+    for (int c = std::max(cx - 1, 0); c <= std::min(cx + 1, columns_ - 1); ++c)
+      for (int d = first_[static_cast<std::size_t>(r) * columns_ + c]; d >= 0; d = next_[d]) out.push_back(d);
 }
 
 std::vector<Approach> approaches(const Timeline& flight, const fleet::Separation& separation) {
@@ -182,7 +209,7 @@ std::vector<int> standing_near(const Timeline& flight, const std::vector<SpotQue
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return queries[a].t < queries[b].t; });
   std::vector<const dex::Sample*> now(tracks.size(), nullptr);
-  Grid grounded(radius * kCellMargin, static_cast<int>(tracks.size()));
+  Grid grounded(radius * kCellMargin, area_of(flight), static_cast<int>(tracks.size()));
   std::vector<int> around;
   std::size_t next = 0;
   for (std::size_t q : order) {

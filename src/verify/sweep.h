@@ -3,8 +3,6 @@
 // one sweep over every drone's track in time order, with the drones bucketed in a grid of
 // cells at least the horizontal separation wide, so a drone is compared only with the drones
 // in its cell and the eight around it (no nearer pair can be farther apart than one cell).
-#include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 #include "dex/runner.h"
@@ -12,10 +10,20 @@
 
 namespace eamos::verify {
 
-/// Drones bucketed by horizontal position in square cells.
+/// The horizontal extent of a flight's finite positions.
+struct Area {
+  double x0 = 0.0, y0 = 0.0, x1 = 0.0, y1 = 0.0;
+};
+
+/// Drones bucketed by horizontal position in square cells over an area, each cell a list
+/// threaded through per-drone links: placing, moving and finding a drone cost no allocation
+/// and no hashing. A position outside the area counts in the nearest cell at its edge (a
+/// nearer pair still lies in neighbouring cells, as clamping never moves two cells apart).
 class Grid {
  public:
-  explicit Grid(double cell, int drones);
+  /// Cells at least `cell` wide over `area`; wider when the area would need more than
+  /// kMaxCells of them (a drone far from the rest), which costs more comparisons, never a miss.
+  Grid(double cell, const Area& area, int drones);
   /// Puts `drone` at (x, y); a drone at a position that is not finite is left out (it is near
   /// no one). Moving it again takes it out of its old cell.
   void place(int drone, double x, double y);
@@ -24,12 +32,18 @@ class Grid {
   /// it is there), in no particular order.
   void around(double x, double y, std::vector<int>& out) const;
 
+  static constexpr long kMaxCells = 1L << 18;
+
  private:
-  std::uint64_t index(double v) const;  ///< the cell's column (or row), offset to be positive
+  /// The column (or row) of a position `offset` from the area's edge, clamped to the grid.
+  int index(double offset, int count) const;
   double cell_;
-  std::unordered_map<std::uint64_t, std::vector<int>> cells_;
-  std::vector<std::uint64_t> where_;  ///< per drone: its cell's key
-  std::vector<bool> placed_;
+  Area area_;
+  int columns_ = 1, rows_ = 1;
+  std::vector<int> first_;  ///< per cell: its first drone, -1 none
+  std::vector<int> next_;   ///< per drone: the next drone in its cell, -1 none
+  std::vector<int> prev_;   ///< per drone: the one before it, -1 when it is the first
+  std::vector<int> where_;  ///< per drone: its cell, -1 when not placed
 };
 
 /// Every sample of every track (index = drone) in time order: one drone's samples in track
@@ -44,6 +58,8 @@ struct Timeline {
   std::vector<Step> steps;
 };
 Timeline timeline(std::vector<const std::vector<dex::Sample>*> tracks);
+/// The extent of every finite position in `flight`.
+Area area_of(const Timeline& flight);
 
 /// Two drones, both airborne, coming nearer than the separation (horizontally and
 /// vertically) at `t`, after having been apart (or not both seen) just before: a and b

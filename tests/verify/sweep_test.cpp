@@ -137,6 +137,47 @@ TEST(SeparationSweep, TheGridFindsWhatComparingEveryPairFinds) {
   }
 }
 
+// A drone 1,000 km from the rest would need more cells than the grid keeps: the cells widen,
+// and the approaches stay those comparing every pair finds, out there as well as at home.
+TEST(SeparationSweep, DronesFarFromTheRestWidenTheCellsAndNothingIsMissed) {
+  fleet::Separation sep;
+  std::vector<Track> tracks = hundredInALine(41);
+  tracks.push_back({at(0.0, 1e6, 0.0, 5.0), at(1.0, 1e6, 3.0, 5.0)});
+  tracks.push_back({at(0.0, 1e6 + 1.0, 0.5, 5.0)});
+  Area area = area_of(timelineOf(tracks));
+  ASSERT_GT((area.x1 - area.x0) / (sep.horizontal_m * 1.001) * (area.y1 - area.y0) / (sep.horizontal_m * 1.001),
+            Grid::kMaxCells);
+  std::vector<std::tuple<int, int, double>> expected = {{41, 42, 3.05}, {100, 101, 0.0}};
+  std::vector<std::tuple<int, int, double>> found = withTheGrid(tracks, sep);
+  ASSERT_EQ(found.size(), 2u);
+  EXPECT_EQ(std::get<0>(found[0]), 41);
+  EXPECT_NEAR(std::get<2>(found[0]), 3.05, 1e-9);
+  EXPECT_EQ(found[1], (std::tuple<int, int, double>{100, 101, 0.0}));
+  EXPECT_EQ(found, everyPair(tracks, sep));
+}
+
+// Positions and queries outside the area the grid was made for count at its edge.
+TEST(Grid, APositionOutsideItsAreaIsFoundFromNearby) {
+  Grid grid(2.0, Area{0.0, 0.0, 10.0, 10.0}, 3);
+  grid.place(0, -50.0, 5.0);
+  grid.place(1, 5.0, 5.0);
+  grid.place(2, std::nan(""), 5.0);  // nowhere: near no one
+  std::vector<int> out;
+  grid.around(-49.0, 5.0, out);
+  EXPECT_EQ(out, std::vector<int>{0});
+  out.clear();
+  grid.around(5.0, 5.0, out);
+  EXPECT_EQ(out, std::vector<int>{1});
+  grid.place(1, 1e300, -1e300);
+  out.clear();
+  grid.around(20.0, -3.0, out);
+  EXPECT_EQ(out, std::vector<int>{1});
+  grid.remove(1);
+  out.clear();
+  grid.around(20.0, -3.0, out);
+  EXPECT_TRUE(out.empty());
+}
+
 TEST(SpotSweep, FindsTheLowestNumberedDroneStandingNearATakeoffOrLanding) {
   std::vector<Track> tracks = {
       {at(0.0, -0.5, 0.0, 0.0, true)},                              // stands just across x = 0
