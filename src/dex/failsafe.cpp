@@ -20,8 +20,9 @@ void record_failsafe(const fleet::DroneSettings& settings, double t, const std::
   trace->record(e);
 }
 
-bool failsafe_over(const mid::DroneState& s, fleet::Failsafe failsafe, double waited_s) {
+bool failsafe_over(const mid::DroneState& s, fleet::Failsafe failsafe, double waited_s, double disarmed_s) {
   if (down_and_disarmed(s) || s.link_lost || waited_s >= kFailsafeWaitLimitS) return true;
+  if (!s.armed && disarmed_s >= kDisarmedSettleS) return true;
   // On the ground every failsafe disarms: that is still to come for an armed drone there.
   return failsafe == fleet::Failsafe::hover && !s.landed;
 }
@@ -43,13 +44,16 @@ void abandon_drones(const std::vector<FailsafeDrone>& drones, double t, const st
 }
 
 FailsafeWait::FailsafeWait(mid::EventLoop& loop, std::vector<FailsafeDrone> drones, double period_s,
-                           std::function<void()> on_over)
-    : loop_(loop), drones_(std::move(drones)), period_s_(period_s), on_over_(std::move(on_over)) {}
+                           std::function<void()> on_over, TraceSink* trace)
+    : loop_(loop), drones_(std::move(drones)), period_s_(period_s), on_over_(std::move(on_over)), trace_(trace) {}
 
 FailsafeWait::~FailsafeWait() { loop_.cancel(next_); }
 
 void FailsafeWait::start() {
   since_ = loop_.now();
+  disarmed_since_.assign(drones_.size(), -1.0);
+  commanded_.assign(drones_.size(), false);
+  for (std::size_t i = 0; i < drones_.size(); ++i) commanded_[i] = !down_and_disarmed(drones_[i].drone->state());
   loop_.cancel(next_);
   next_ = loop_.after(0.0, [this] { look(); });
 }
@@ -59,12 +63,33 @@ void FailsafeWait::start() {
 // drone's heartbeats never leave it idle.
 void FailsafeWait::look() {
   next_ = mid::kNoTimer;
-  for (const FailsafeDrone& d : drones_)
-    if (!failsafe_over(d.drone->state(), d.settings->failsafe, loop_.now() - since_)) {
+  const double now = loop_.now();
+  fail_over_armed(now);
+  for (std::size_t i = 0; i < drones_.size(); ++i) {
+    bool armed = drones_[i].drone->state().armed;
+    if (armed) disarmed_since_[i] = -1.0;
+    else if (disarmed_since_[i] < 0) disarmed_since_[i] = now;
+  }
+  for (std::size_t i = 0; i < drones_.size(); ++i) {
+    const FailsafeDrone& d = drones_[i];
+    double disarmed_s = disarmed_since_[i] < 0 ? 0.0 : now - disarmed_since_[i];
+    if (!failsafe_over(d.drone->state(), d.settings->failsafe, now - since_, disarmed_s)) {
       next_ = loop_.after(period_s_, [this] { look(); });
       return;
     }
+  }
   on_over_();
+}
+
+void FailsafeWait::fail_over_armed(double now) {
+  std::vector<std::size_t> armed;
+  for (std::size_t i = 0; i < drones_.size(); ++i)
+    if (!commanded_[i] && drones_[i].drone->state().armed && command_failsafe(*drones_[i].drone, *drones_[i].settings)) {
+      commanded_[i] = true;
+      armed.push_back(i);
+    }
+  for (std::size_t i : armed)  // every command out before anything is recorded
+    record_failsafe(*drones_[i].settings, now, "armed after the mission was abandoned", trace_);
 }
 
 }  // namespace eamos::dex

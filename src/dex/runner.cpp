@@ -496,7 +496,7 @@ void InProcessRun::fly() {
   if (abandoned_) {
     std::vector<FailsafeDrone> fleet;
     for (int d = 0; d < n_; ++d) fleet.push_back({engines_[d].get(), drones_[d].get(), &missions_[d].settings});
-    FailsafeWait wait(loop_, std::move(fleet), 0.1, [this] { loop_.stop(); });
+    FailsafeWait wait(loop_, std::move(fleet), 0.1, [this] { loop_.stop(); }, trace_);
     wait.start();
     loop_.run_until(loop_.now() + kFailsafeWaitLimitS);
   }

@@ -308,7 +308,7 @@ void DexProcess::abandon(const std::string& reason, const std::optional<dex::Fai
   // says, the rule `eamos run` follows too. Down alone is not over: a DEX that ended at the
   // touchdown left its vehicle armed on the ground (seen on PX4 SITL) and reported it so.
   failsafe_wait_ = std::make_unique<dex::FailsafeWait>(*loop_, std::move(self), 0.1 * o_.speed,
-                                                       [this] { on_failsafe_over(); });
+                                                       [this] { on_failsafe_over(); }, &tee_);
   failsafe_wait_->start();
 }
 

@@ -111,5 +111,103 @@ TEST(AbandonedMission, AWaitDestroyedBeforeTheEndLooksNoMore) {
   EXPECT_TRUE(dex::down_and_disarmed(f.drones[0]->state()));
 }
 
+// A vehicle as an autopilot reports it, state set by the test: PX4 SITL disarmed vehicles on
+// the ground during a takeoff and went on reporting them not landed (its land detector).
+class ReportedDrone final : public mid::Drone {
+ public:
+  const std::string& name() const override { return name_; }
+  mid::ActionId start(const mid::ActionRequest&, mid::EndCallback) override { return 1; }
+  bool cancel(mid::ActionId) override { return false; }
+  mid::DroneState state() const override { return state_; }
+  mid::SubscriptionId subscribe(mid::StateCallback) override { return 1; }
+  void unsubscribe(mid::SubscriptionId) override {}
+  void failsafe(fleet::Failsafe what) override { failsafes.push_back(what); }
+
+  std::string name_ = "Drone1";
+  mid::DroneState state_;
+  std::vector<fleet::Failsafe> failsafes;  ///< every failsafe commanded
+};
+
+TEST(AbandonedMission, ADisarmedDroneItsAutopilotCallsNotLandedEndsTheWaitAfterItsSettleTime) {
+  Fleet f;
+  ReportedDrone reported;
+  reported.state_.armed = true;
+  reported.state_.landed = false;
+  std::vector<dex::FailsafeDrone> drones = {{f.engines[2].get(), &reported, &f.missions[2].settings}};
+  double abandoned_at = f.loop.now(), over_at = -1;
+  dex::FailsafeWait wait(f.loop, drones, 0.1, [&] {
+    over_at = f.loop.now();
+    f.loop.stop();
+  });
+  wait.start();
+  f.loop.run_until(abandoned_at + 20.0);  // armed in the air: its failsafe still flies
+  EXPECT_LT(over_at, 0);
+  reported.state_.armed = false;  // disarmed, not landed by its autopilot's word
+  f.loop.run_until(abandoned_at + 22.0);
+  reported.state_.armed = true;  // a disarm that does not last does not count
+  f.loop.run_until(abandoned_at + 30.0);
+  EXPECT_LT(over_at, 0);
+  reported.state_.armed = false;
+  double disarmed_at = f.loop.now();
+  f.loop.run_until(abandoned_at + dex::kFailsafeWaitLimitS);
+  EXPECT_GE(over_at, disarmed_at + dex::kDisarmedSettleS);
+  EXPECT_LT(over_at, disarmed_at + dex::kDisarmedSettleS + 0.5);
+  EXPECT_FALSE(reported.state().landed);
+}
+
+// A drone down and disarmed when the mission was abandoned needs no failsafe; armed later
+// (an ARM sent for the mission that took effect late), it gets one then, recorded.
+TEST(AbandonedMission, ADroneArmedAfterTheAbandonmentGetsItsFailsafeThen) {
+  Fleet f;
+  ReportedDrone late;
+  late.name_ = "C";
+  std::vector<dex::FailsafeDrone> drones = f.all();
+  drones[2].drone = &late;  // C: on the ground, disarmed
+  dex::MemoryTrace trace;
+  dex::abandon_drones(drones, f.loop.now(), "a test", &trace);
+  ASSERT_EQ(trace.events.size(), 2u);  // A and B, flying
+  EXPECT_TRUE(late.failsafes.empty());
+  double abandoned_at = f.loop.now();
+  int over = 0;
+  dex::FailsafeWait wait(f.loop, drones, 0.1, [&] {
+    ++over;
+    f.loop.stop();
+  }, &trace);
+  wait.start();
+  f.loop.run_until(abandoned_at + 0.5);  // A and B still coming down
+  EXPECT_TRUE(late.failsafes.empty());
+  late.state_.armed = true;
+  f.loop.run_until(abandoned_at + 0.65);
+  ASSERT_EQ(late.failsafes.size(), 1u);
+  EXPECT_EQ(late.failsafes[0], fleet::Failsafe::land);
+  ASSERT_EQ(trace.events.size(), 3u);
+  EXPECT_EQ(trace.events[2].event, "failsafe");
+  EXPECT_EQ(trace.events[2].drone, "C");
+  EXPECT_EQ(trace.events[2].reason, "armed after the mission was abandoned");
+  late.state_.armed = false;  // its failsafe disarmed it where it stood
+  f.loop.run_until(abandoned_at + dex::kFailsafeWaitLimitS);
+  EXPECT_EQ(over, 1);
+  EXPECT_EQ(late.failsafes.size(), 1u) << "commanded once";
+}
+
+TEST(AbandonedMission, TheRuleForAFailsafeThatIsOver) {
+  mid::DroneState s;
+  s.armed = false;
+  s.landed = true;
+  EXPECT_TRUE(dex::failsafe_over(s, fleet::Failsafe::land, 0.0, 0.0)) << "down and disarmed";
+  s.landed = false;
+  EXPECT_FALSE(dex::failsafe_over(s, fleet::Failsafe::land, 0.0, 0.0));
+  EXPECT_FALSE(dex::failsafe_over(s, fleet::Failsafe::land, 100.0, dex::kDisarmedSettleS - 0.1));
+  EXPECT_TRUE(dex::failsafe_over(s, fleet::Failsafe::land, 100.0, dex::kDisarmedSettleS)) << "disarmed for its settle time";
+  s.armed = true;
+  EXPECT_FALSE(dex::failsafe_over(s, fleet::Failsafe::land, 100.0, 0.0)) << "armed in the air, landing";
+  EXPECT_TRUE(dex::failsafe_over(s, fleet::Failsafe::hover, 0.0, 0.0)) << "hovering as told";
+  s.landed = true;
+  EXPECT_FALSE(dex::failsafe_over(s, fleet::Failsafe::hover, 0.0, 0.0)) << "armed on the ground: its disarm is to come";
+  EXPECT_TRUE(dex::failsafe_over(s, fleet::Failsafe::land, dex::kFailsafeWaitLimitS, 0.0)) << "waited its limit";
+  s.link_lost = true;
+  EXPECT_TRUE(dex::failsafe_over(s, fleet::Failsafe::land, 0.0, 0.0)) << "its link lost";
+}
+
 }  // namespace
 }  // namespace eamos

@@ -576,6 +576,39 @@ void Sitl::fly_link_loss(const std::string& extra) {
 
 TEST_P(Sitl, LinkLossFailsTheMissionAndEveryOtherDroneRunsItsFailsafe) { fly_link_loss(""); }
 
+// PX4 set to disarm a vehicle that has not taken off 0.5 s after arming (COM_DISARM_PRFLT;
+// its default 10 s has struck within a takeoff's spool-up on a loaded SITL too): Drone1 is
+// disarmed during its Takeoff, armed again, disarmed again, and the Takeoff fails; the
+// others run their failsafe. The run ends with every vehicle's motors off, and soon: a
+// vehicle armed after the abandonment gets its failsafe then, and one that PX4 reports
+// disarmed but not landed ends the wait after dex::kDisarmedSettleS (docs/faults.md), not
+// after the 600 s failsafe limit.
+TEST_P(Sitl, AVehicleDisarmedTwiceDuringItsTakeoffFailsTheMissionAndTheRunEndsWithEveryMotorOff) {
+  if (GetParam() != Autopilot::px4) GTEST_SKIP() << "run on PX4 SITL only (COM_DISARM_PRFLT)";
+  auto sitl = start_fleet(kHomes, false, kSpeed);
+  if (HasFailure()) return;
+  std::string error;
+  ASSERT_TRUE(sitl->set_param(0, "COM_DISARM_PRFLT", 0.5f, eamos::mavlink::param_type::REAL32, 30, error, false))
+      << error;
+  auto began = std::chrono::steady_clock::now();
+  Flight f = fly(mission_path("three_hops.eamos"), fleet_file(*sitl, kHomes), dir_,
+                 {.extra = "--summary " + (dir_ / "summary.json").string(), .speed = kSpeed});
+  double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+  EXPECT_NE(f.run.status, 0) << f.run.out;
+  EXPECT_NE(f.run.out.find("Drone1.Takeoff(4)  failed [vehicle_fault]  (PX4 disarmed the vehicle again before it took off)"),
+            std::string::npos)
+      << f.run.out;
+  EXPECT_LT(wall_s, 60.0) << f.run.out;
+  std::ifstream in(dir_ / "summary.json");
+  nlohmann::json summary = nlohmann::json::parse(in, nullptr, false);
+  ASSERT_TRUE(summary.is_object() && summary["drones"].is_object()) << f.run.out;
+  for (int d = 1; d <= 3; ++d) {
+    const nlohmann::json& drone = summary["drones"]["Drone" + std::to_string(d)];
+    EXPECT_EQ(drone.value("armed", true), false) << "Drone" << d << "\n" << f.run.out;
+    std::cout << "[sitl] Drone" << d << " ends landed: " << drone.value("landed", false) << "\n";
+  }
+}
+
 TEST_P(Sitl, LinkLossWithOneDexPerDroneFailsTheMissionAndEveryOtherDroneRunsItsFailsafe) {
   fly_link_loss("--distributed");
 }
