@@ -1,5 +1,6 @@
 #include "lang/ast.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -36,6 +37,23 @@ Expr* ExprArena::make() {
   }
   ++size_;
   return new (chunks_.back().get() + used_++ * sizeof(Expr)) Expr;
+}
+
+std::span<Expr* const> ExprArena::keep(std::span<Expr* const> list) {
+  if (list.empty()) return {};
+  if (list.size() > kListChunk) {  // longer than a chunk: an allocation of its own
+    long_lists_.push_back(std::unique_ptr<Expr*[]>(new Expr*[list.size()]));
+    std::copy(list.begin(), list.end(), long_lists_.back().get());
+    return {long_lists_.back().get(), list.size()};
+  }
+  if (lists_used_ + list.size() > kListChunk) {
+    lists_.push_back(std::unique_ptr<Expr*[]>(new Expr*[kListChunk]));  // uninitialised: untouched until used
+    lists_used_ = 0;
+  }
+  Expr** at = lists_.back().get() + lists_used_;
+  std::copy(list.begin(), list.end(), at);
+  lists_used_ += list.size();
+  return {at, list.size()};
 }
 
 int Mission::find_drone(const std::string& name) const {

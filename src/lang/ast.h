@@ -4,6 +4,7 @@
 // structs owned by a Mission; later stages point into it and never copy expressions.
 #include <cstddef>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -57,13 +58,20 @@ class ExprArena {
  public:
   Expr* make();
   std::size_t size() const { return size_; }
+  /// A copy of `list` that lives as long as the arena: a statement's arguments, kept in chunks
+  /// as the expressions are rather than in an allocation of their own each.
+  std::span<Expr* const> keep(std::span<Expr* const> list);
 
  private:
   static_assert(std::is_trivially_destructible_v<Expr>, "a chunk is freed without destroying its expressions");
   static constexpr std::size_t kChunk = 4096;
+  static constexpr std::size_t kListChunk = 8192;  ///< argument pointers per chunk
   std::vector<std::unique_ptr<std::byte[]>> chunks_;
   std::size_t used_ = kChunk;  ///< in the last chunk
   std::size_t size_ = 0;
+  std::vector<std::unique_ptr<Expr*[]>> lists_;  ///< the last one is filled from lists_used_ on
+  std::size_t lists_used_ = kListChunk;
+  std::vector<std::unique_ptr<Expr*[]>> long_lists_;
 };
 
 enum class StatementKind {
@@ -83,7 +91,7 @@ struct Statement {
   SourceLocation callee_loc;  ///< the capability or function name
   std::string_view drone;     ///< action only; a view into the SourceFile, as Expr's names
   std::string_view callee;    ///< capability name, or block / control structure name
-  std::vector<Expr*> args;    ///< owned by Mission::expressions
+  std::span<Expr* const> args;  ///< the list and its expressions owned by Mission::expressions
   std::vector<int> branch_functions;         ///< control, filled by the checker: functions named in the args, in order
 };
 

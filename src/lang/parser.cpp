@@ -281,10 +281,10 @@ bool Parser::parse_statement(Statement& s) {
 // args = [ expr { "," expr } [ "," ] ]   (within parentheses)
 // Returns false after a syntax error: the statement is dropped, so the checker does not
 // add a follow-on "wrong number of arguments" for an argument list that was cut short.
-bool Parser::parse_arguments(std::vector<Expr*>& args) {
+bool Parser::parse_arguments(std::span<Expr* const>& args) {
   arguments_.clear();
   if (!parse_argument_list()) return false;
-  args.assign(arguments_.begin(), arguments_.end());
+  args = arena_.keep(arguments_);
   return true;
 }
 

@@ -37,7 +37,7 @@ class Parser {
   void parse_block(Function& f);
   void parse_body(Function& f);
   bool parse_statement(Statement& s);
-  bool parse_arguments(std::vector<Expr*>& args);
+  bool parse_arguments(std::span<Expr* const>& args);
   bool parse_argument_list();
   Expr* parse_expression(int min_precedence = 1);
   Expr* parse_unary();
