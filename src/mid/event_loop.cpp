@@ -102,7 +102,7 @@ void EventLoop::push(double t, Entry e) {
   ++queued_;
 }
 
-std::unordered_map<double, std::uint32_t>::iterator EventLoop::add_time(double t, std::uint32_t bucket) {
+EventLoop::TimeBuckets::iterator EventLoop::add_time(double t, std::uint32_t bucket) {
   if (spare_times_.empty()) return bucket_at_.emplace(t, bucket).first;
   auto node = std::move(spare_times_.back());
   spare_times_.pop_back();

@@ -5,6 +5,7 @@
 // event, so a 60 s mission takes as long as its callbacks; real time (the CLI's
 // --realtime/--speed) sleeps until each event's wall time.
 #include <atomic>
+#include <bit>
 #include <cstdint>
 #include <condition_variable>
 #include <functional>
@@ -152,9 +153,19 @@ class EventLoop {
   std::function<void()> take(std::uint32_t slot);
   /// Appends to the bucket of time `t`, making one when none is queued.
   void push(double t, Entry e);
+  /// A time's hash from its bits, mixed: std::hash<double> runs a byte hash, and the map
+  /// computes it again for each node it passes in a bucket (4 % of a verify's flights).
+  struct TimeHash {
+    std::size_t operator()(double t) const noexcept {
+      std::uint64_t bits = t == 0.0 ? 0 : std::bit_cast<std::uint64_t>(t);  // -0.0 == 0.0
+      bits *= 0x9E3779B97F4A7C15ull;
+      return static_cast<std::size_t>(bits ^ (bits >> 32));
+    }
+  };
+  using TimeBuckets = std::unordered_map<double, std::uint32_t, TimeHash>;
   /// bucket_at_[t] = bucket, in a map node kept from an earlier time when there is one: most
   /// timeouts have an instant of their own, and a node allocated for each is a malloc per timer.
-  std::unordered_map<double, std::uint32_t>::iterator add_time(double t, std::uint32_t bucket);
+  TimeBuckets::iterator add_time(double t, std::uint32_t bucket);
   void drop_time(double t);  ///< t's bucket left the queue: its node is kept for add_time
   /// The first entry due; the queue must not be empty.
   const Entry& front() const;
@@ -192,8 +203,8 @@ class EventLoop {
   /// Cancelled timers stay in their bucket and are skipped when popped: cancel is O(1).
   std::vector<Bucket> buckets_;
   std::vector<std::uint32_t> free_buckets_;
-  std::unordered_map<double, std::uint32_t> bucket_at_;  ///< time → its bucket, while queued
-  std::vector<std::unordered_map<double, std::uint32_t>::node_type> spare_times_;
+  TimeBuckets bucket_at_;  ///< time → its bucket, while queued
+  std::vector<TimeBuckets::node_type> spare_times_;
   std::vector<std::uint32_t> heap_;  ///< the queued buckets, earliest on top
   std::size_t queued_ = 0;           ///< entries in the buckets, cancelled ones included
   std::vector<Slot> slots_;
