@@ -1,6 +1,8 @@
 #include "mavlink_adapter/command_sender.h"
 
 #include <cstdio>
+#include <utility>
+#include <vector>
 
 #include "mavlink/enums.h"
 
@@ -75,12 +77,21 @@ void CommandSender::on_ack(const ml::CommandAck& ack) {
 
 void CommandSender::finish(uint16_t id, CommandResult result) {
   auto& queue = queues_[id];
-  CommandDone done = std::move(queue.front().done);
+  std::vector<std::pair<CommandDone, CommandResult>> ended;
+  ended.emplace_back(std::move(queue.front().done), std::move(result));
   loop_.cancel(queue.front().timer);
   queue.pop_front();
+  // A command that waited behind this one and is no longer wanted is not sent at all: an
+  // ARM for an action that has ended since must not reach a vehicle in its failsafe.
+  while (!queue.empty() && queue.front().resend_while && !queue.front().resend_while()) {
+    ended.emplace_back(std::move(queue.front().done),
+                       CommandResult{false, ml::command_name(id) + ": not sent: no longer wanted"});
+    queue.pop_front();
+  }
   if (!queue.empty()) transmit_head(id);
   else queues_.erase(id);
-  if (done) done(result);
+  for (auto& [done, r] : ended)
+    if (done) done(r);
 }
 
 void CommandSender::fail_all(const std::string& error) {

@@ -38,8 +38,9 @@ class CommandSender {
   CommandSender& operator=(const CommandSender&) = delete;
 
   /// Queues `command` (confirmation is set here); `done` runs once with the outcome. With
-  /// `resend_while`, a command whose ACK is late is sent again only while it returns true:
-  /// a command that is no longer wanted must not reach the vehicle after the ones that
+  /// `resend_while`, a command whose ACK is late is sent again only while it returns true,
+  /// and one that waited behind another of its id is sent at all only if it returns true
+  /// then: a command that is no longer wanted must not reach the vehicle after the ones that
   /// replaced it (it then ends unanswered at once).
   void send(mavlink::CommandLong command, CommandDone done, std::function<bool()> resend_while = nullptr);
   /// The same for a COMMAND_INT (a command with a position in degE7, exact where a float is

@@ -45,16 +45,21 @@ void MavlinkDrone::arm(ActionId id, std::function<void()> armed) {
                     });
 }
 
+// The ARM is sent (again) only while the action that wants it runs: once it has ended (failed,
+// cancelled by the failsafe), a resend after a late ACK would arm a vehicle that was left
+// down and disarmed.
 void MavlinkDrone::send_arm(ActionId id, std::function<void()> armed) {
   disarm_commanded_ = false;
-  commands_.send(link_.command(ml::cmd::COMPONENT_ARM_DISARM, {1.0f}),
-                 [this, id, armed = std::move(armed)](const CommandResult& result) {
-                   if (!tracker_.running(id)) return;
-                   if (!result.accepted) return end_refused(id, result);
-                   vehicle_.armed = true;  // the next HEARTBEAT (20 Hz) confirms it
-                   publish();
-                   armed();
-                 });
+  commands_.send(
+      link_.command(ml::cmd::COMPONENT_ARM_DISARM, {1.0f}),
+      [this, id, armed = std::move(armed)](const CommandResult& result) {
+        if (!tracker_.running(id)) return;
+        if (!result.accepted) return end_refused(id, result);
+        vehicle_.armed = true;  // the next HEARTBEAT (20 Hz) confirms it
+        publish();
+        armed();
+      },
+      [this, id] { return tracker_.running(id); });
 }
 
 void MavlinkDrone::start_takeoff(ActionId id, double altitude) {

@@ -197,6 +197,8 @@ void SimVehicle::on_command(const ml::CommandLong& c) {
   // A resend means our ACK was lost: answer again, but do not arm or take off twice.
   if (c.confirmation > 0 && has_last_ && last_command_ == c.command) return ack(c.command, last_result_);
   ++received_[c.command];
+  bool arm = c.command == ml::cmd::COMPONENT_ARM_DISARM && c.param[0] > 0.5f;
+  if (arm && arms_seen_++ < options_.arms_lost) return;
   if (c.command == dialect_.picture_command)
     return start_then_ack(c.command, "TakePicture", [this] {
       if (options_.camera_confirms)

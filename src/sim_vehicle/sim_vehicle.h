@@ -129,6 +129,9 @@ struct VehicleOptions {
   int fence_capacity = 100;
   /// Ignores the first this many MISSION_COUNTs of a fence upload, as a link losing them would.
   int fence_counts_ignored = 0;
+  /// Ignores the first this many ARMs (no ACK, no arming), as a link losing them would; a
+  /// resend after the adapter's ACK timeout then arms it.
+  int arms_lost = 0;
   /// Its read back reports each corner this far north of where it was given (degE7): a
   /// vehicle that stored something else than it acknowledged.
   int32_t fence_read_back_shift_e7 = 0;
@@ -266,6 +269,7 @@ class SimVehicle {
   mid::TimerId offboard_timer_ = mid::kNoTimer;
   mid::TimerId disarm_timer_ = mid::kNoTimer;
   std::map<uint16_t, int> received_;
+  int arms_seen_ = 0;  ///< ARMs received (arms_lost)
   std::map<uint32_t, int> intervals_asked_;
   std::set<uint8_t> heartbeat_types_;  ///< see heard_heartbeat_of_type
   std::vector<mavlink::CommandLong> orbit_commands_;

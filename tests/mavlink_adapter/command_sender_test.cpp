@@ -101,6 +101,30 @@ TEST(CommandSender, ACommandNoLongerWantedIsNotSentAgain) {
   EXPECT_EQ(next_done, 1);
 }
 
+// An ARM queued behind another of its id whose action ended meanwhile is never sent: it
+// would arm a vehicle left down and disarmed in its failsafe.
+TEST(CommandSender, AQueuedCommandNoLongerWantedIsNotSentAtAll) {
+  Fixture f;
+  bool wanted = true;
+  std::vector<std::string> results;
+  ml::CommandLong disarm = arm();
+  disarm.param[0] = 0;
+  f.sender.send(disarm, [&](const CommandResult& r) { results.push_back(r.error); });
+  f.sender.send(arm(), [&](const CommandResult& r) { results.push_back(r.error); }, [&] { return wanted; });
+  f.sender.send(disarm, [&](const CommandResult& r) { results.push_back(r.error); });
+  ASSERT_EQ(f.sent.size(), 1u);
+  wanted = false;
+  f.sender.on_ack({ml::cmd::COMPONENT_ARM_DISARM, ml::result::ACCEPTED});
+  ASSERT_EQ(f.sent.size(), 2u);  // the second DISARM, not the ARM
+  EXPECT_EQ(f.sent[1].param[0], 0.0f);
+  ASSERT_EQ(results.size(), 2u);
+  EXPECT_EQ(results[0], "");
+  EXPECT_EQ(results[1], "MAV_CMD_COMPONENT_ARM_DISARM: not sent: no longer wanted");
+  f.sender.on_ack({ml::cmd::COMPONENT_ARM_DISARM, ml::result::ACCEPTED});
+  EXPECT_EQ(results.size(), 3u);
+  EXPECT_EQ(f.sender.pending(), 0u);
+}
+
 TEST(CommandSender, FailAllEndsEveryQueuedCommand) {
   Fixture f;
   std::vector<std::string> errors;

@@ -209,6 +209,31 @@ TEST(MavlinkFlight, ArmRefusedByTheAutopilotFailsWithItsResultInWords) {
   EXPECT_FALSE(f.drone->state().armed);
 }
 
+// An ARM lost on its way (no ACK) for an Arm that is cancelled meanwhile (the mission was
+// abandoned) is not sent again after the ACK timeout: the resend would arm a vehicle the
+// mission had left on the ground, disarmed, with no failsafe to come for it.
+TEST(MavlinkFlight, AnArmWhoseActionEndedIsNotSentAgain) {
+  sim_vehicle::VehicleOptions o = test::VehicleThread::options(sim_vehicle::px4_dialect(), 1, 100.0, true);
+  o.arms_lost = 1;
+  test::VehicleThread vehicle(25324, kSpeed, o);
+  Flight f(25324);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  auto arms = [&] { return vehicle.inspect([](sim_vehicle::SimVehicle& v) { return v.received(mavlink::cmd::COMPONENT_ARM_DISARM); }); };
+  std::optional<mid::ActionEnd> end;
+  mid::ActionId id = f.drone->start({"Arm", {}}, [&](const mid::ActionEnd& e) { end = e; });
+  // The Arm may switch the mode first: wait for its ARM to reach the vehicle.
+  for (double until = f.loop.now() + 5.0; arms() == 0 && f.loop.now() < until;) f.loop.run_until(f.loop.now() + 0.05);
+  ASSERT_EQ(arms(), 1);
+  ASSERT_FALSE(end);
+  EXPECT_TRUE(f.drone->cancel(id));
+  f.loop.run_until(f.loop.now() + 5.0);  // past the ARM's ACK timeout (1 s) and its three resends
+  EXPECT_EQ(arms(), 1) << "the ARM was sent again after its Arm ended";
+  EXPECT_FALSE(vehicle.inspect([](sim_vehicle::SimVehicle& v) { return v.drone().state().armed; }));
+  EXPECT_FALSE(f.drone->state().armed);
+  ASSERT_TRUE(end);
+  EXPECT_EQ(end->outcome, mid::Outcome::cancelled);
+}
+
 // PX4 SITL stood disarmed in OFFBOARD after a mission that ended with its NAV_LAND, and
 // refuses to arm there without setpoints ("Arming denied: Resolve system health failures
 // first"). A DEX arms only after its wait for the vehicle's fix, when the vehicle's mode is
