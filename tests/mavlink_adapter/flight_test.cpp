@@ -218,11 +218,14 @@ TEST(MavlinkFlight, AnArmWhoseActionEndedIsNotSentAgain) {
   test::VehicleThread vehicle(25324, kSpeed, o);
   Flight f(25324);
   ASSERT_TRUE(f.drone) << f.created.message;
-  auto arms = [&] { return vehicle.inspect([](sim_vehicle::SimVehicle& v) { return v.received(mavlink::cmd::COMPONENT_ARM_DISARM); }); };
+  auto arms = [&] {
+    return vehicle.inspect([](sim_vehicle::SimVehicle& v) { return v.received(mavlink::cmd::COMPONENT_ARM_DISARM); });
+  };
   std::optional<mid::ActionEnd> end;
   mid::ActionId id = f.drone->start({"Arm", {}}, [&](const mid::ActionEnd& e) { end = e; });
   // The Arm may switch the mode first: wait for its ARM to reach the vehicle.
-  for (double until = f.loop.now() + 5.0; arms() == 0 && f.loop.now() < until;) f.loop.run_until(f.loop.now() + 0.05);
+  for (double until = f.loop.now() + 5.0; arms() == 0 && f.loop.now() < until;)
+    f.loop.run_until(f.loop.now() + 0.05);
   ASSERT_EQ(arms(), 1);
   ASSERT_FALSE(end);
   EXPECT_TRUE(f.drone->cancel(id));
