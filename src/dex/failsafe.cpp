@@ -82,14 +82,13 @@ void FailsafeWait::look() {
 }
 
 void FailsafeWait::fail_over_armed(double now) {
-  std::vector<std::size_t> armed;
+  std::vector<FailsafeDrone> armed;
   for (std::size_t i = 0; i < drones_.size(); ++i)
-    if (!commanded_[i] && drones_[i].drone->state().armed && command_failsafe(*drones_[i].drone, *drones_[i].settings)) {
+    if (!commanded_[i] && drones_[i].drone->state().armed) {
       commanded_[i] = true;
-      armed.push_back(i);
+      armed.push_back(drones_[i]);
     }
-  for (std::size_t i : armed)  // every command out before anything is recorded
-    record_failsafe(*drones_[i].settings, now, "armed after the mission was abandoned", trace_);
+  if (!armed.empty()) abandon_drones(armed, now, "armed after the mission was abandoned", trace_);
 }
 
 }  // namespace eamos::dex
