@@ -144,13 +144,10 @@ class Observer : public dex::RunObserver, public dex::TraceSink {
   }
 
  private:
-  /// The watch of `node`, which drone `drone` runs: nodes are ids into the drone's mission.
+  /// The watch of `node`, which drone `drone` runs: its engine runs setup_.missions[drone],
+  /// so the node's place in that mission's nodes is its id.
   NodeWatch& watch(int drone, const dex::Node& node) {
-    const std::vector<dex::Node>& nodes = setup_.missions[drone].nodes;
-    std::ptrdiff_t index = &node - nodes.data();
-    if (index < 0 || index >= static_cast<std::ptrdiff_t>(nodes.size()))
-      index = setup_.missions[drone].find(node.meg, node.drone);
-    return watch_[drone].at(static_cast<std::size_t>(index));
+    return watch_[drone].at(static_cast<std::size_t>(&node - setup_.missions[drone].nodes.data()));
   }
 
   int drone_index(const std::string& name) const {

@@ -24,7 +24,7 @@ class SeparationSweep {
  public:
   SeparationSweep(const Timeline& flight, const fleet::Separation& sep)
       : tracks_(flight.tracks), steps_(flight.steps), sep_(sep),
-        grid_(sep.horizontal_m * kCellMargin, area_of(flight), static_cast<int>(tracks_.size())), now_(tracks_.size(), nullptr),
+        grid_(sep.horizontal_m * kCellMargin, flight.area, static_cast<int>(tracks_.size())), now_(tracks_.size(), nullptr),
         near_(tracks_.size()), moved_at_(tracks_.size(), -1), seen_(tracks_.size(), -1) {}
 
   std::vector<Approach> run() {
@@ -109,11 +109,20 @@ Timeline timeline(std::vector<const std::vector<dex::Sample>*> tracks) {
   std::size_t samples = 0;
   for (const std::vector<dex::Sample>* track : out.tracks) samples += track->size();
   out.steps.reserve(samples);
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  Area& area = out.area;
+  area = {kInf, kInf, -kInf, -kInf};
   for (std::size_t d = 0; d < out.tracks.size(); ++d) {
-    for (std::size_t i = 0; i < out.tracks[d]->size(); ++i)
-      out.steps.push_back({(*out.tracks[d])[i].t, static_cast<int>(d), static_cast<int>(i)});
+    for (std::size_t i = 0; i < out.tracks[d]->size(); ++i) {
+      const dex::Sample& s = (*out.tracks[d])[i];
+      out.steps.push_back({s.t, static_cast<int>(d), static_cast<int>(i)});
+      if (!finite(s)) continue;
+      area.x0 = std::min(area.x0, s.x), area.y0 = std::min(area.y0, s.y);
+      area.x1 = std::max(area.x1, s.x), area.y1 = std::max(area.y1, s.y);
+    }
     runs.push_back(out.steps.size());
   }
+  if (!(area.x0 <= area.x1)) area = Area{};  // no finite position
   // std::merge takes the first run's element on a tie: the lower-numbered drone comes first.
   auto earlier = [](const Step& a, const Step& b) { return a.t < b.t; };
   std::vector<Step> other(out.steps.size());
@@ -129,18 +138,6 @@ Timeline timeline(std::vector<const std::vector<dex::Sample>*> tracks) {
     runs = std::move(merged_runs);
   }
   return out;
-}
-
-Area area_of(const Timeline& flight) {
-  Area a{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
-         -std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
-  for (const std::vector<dex::Sample>* track : flight.tracks)
-    for (const dex::Sample& s : *track)
-      if (finite(s)) {
-        a.x0 = std::min(a.x0, s.x), a.y0 = std::min(a.y0, s.y);
-        a.x1 = std::max(a.x1, s.x), a.y1 = std::max(a.y1, s.y);
-      }
-  return a.x0 <= a.x1 ? a : Area{};
 }
 
 Grid::Grid(double cell, const Area& area, int drones)
@@ -209,7 +206,7 @@ std::vector<int> standing_near(const Timeline& flight, const std::vector<SpotQue
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return queries[a].t < queries[b].t; });
   std::vector<const dex::Sample*> now(tracks.size(), nullptr);
-  Grid grounded(radius * kCellMargin, area_of(flight), static_cast<int>(tracks.size()));
+  Grid grounded(radius * kCellMargin, flight.area, static_cast<int>(tracks.size()));
   std::vector<int> around;
   std::size_t next = 0;
   for (std::size_t q : order) {

@@ -56,10 +56,9 @@ struct Timeline {
   };
   std::vector<const std::vector<dex::Sample>*> tracks;
   std::vector<Step> steps;
+  Area area;  ///< the extent of every finite position
 };
 Timeline timeline(std::vector<const std::vector<dex::Sample>*> tracks);
-/// The extent of every finite position in `flight`.
-Area area_of(const Timeline& flight);
 
 /// Two drones, both airborne, coming nearer than the separation (horizontally and
 /// vertically) at `t`, after having been apart (or not both seen) just before: a and b

@@ -144,7 +144,7 @@ TEST(SeparationSweep, DronesFarFromTheRestWidenTheCellsAndNothingIsMissed) {
   std::vector<Track> tracks = hundredInALine(41);
   tracks.push_back({at(0.0, 1e6, 0.0, 5.0), at(1.0, 1e6, 3.0, 5.0)});
   tracks.push_back({at(0.0, 1e6 + 1.0, 0.5, 5.0)});
-  Area area = area_of(timelineOf(tracks));
+  Area area = timelineOf(tracks).area;
   ASSERT_GT((area.x1 - area.x0) / (sep.horizontal_m * 1.001) * (area.y1 - area.y0) / (sep.horizontal_m * 1.001),
             Grid::kMaxCells);
   std::vector<std::tuple<int, int, double>> expected = {{41, 42, 3.05}, {100, 101, 0.0}};
