@@ -128,6 +128,10 @@ void MavlinkDrone::on_frame(const ml::Frame& frame) {
   if (auto report = ml::unpack_local_position_ned(frame.message)) clock_.on_report(report->time_boot_ms);
   Changes c = apply_telemetry(vehicle_, frame);
   if (c.rejected) return link_.note_rejected(c.rejected);
+  if (c.armed_unconfirmed)
+    note(std::string("a HEARTBEAT after the autopilot accepted the ") + (vehicle_.armed ? "ARM" : "DISARM") +
+         " still said " + (vehicle_.armed ? "disarmed" : "armed") +
+         " (made before the command took effect, or the vehicle changed at once): the next one decides");
   if (c.armed) on_armed_changed();
   if (c.heartbeat) on_heartbeat();
   if (c.landed && vehicle_.landed()) {

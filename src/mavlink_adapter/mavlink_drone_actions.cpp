@@ -86,6 +86,7 @@ void MavlinkDrone::start_system(ActionId id, const mid::ActionRequest& r) {
     if (!result.accepted) return end_refused(id, result);
     armed_waiting_ = false;
     vehicle_.armed = false;  // the next HEARTBEAT confirms it
+    vehicle_.armed_by_ack = false;
     publish();
     tracker_.end(id, Outcome::succeeded);
   });

@@ -56,6 +56,7 @@ void MavlinkDrone::send_arm(ActionId id, std::function<void()> armed) {
         if (!tracker_.running(id)) return;
         if (!result.accepted) return end_refused(id, result);
         vehicle_.armed = true;  // the next HEARTBEAT (20 Hz) confirms it
+        vehicle_.armed_by_ack = true;
         publish();
         armed();
       },

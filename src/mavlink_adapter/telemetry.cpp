@@ -82,6 +82,11 @@ Changes apply_telemetry(VehicleState& v, const ml::Frame& frame) {
     v.autopilot = hb->autopilot;
     v.custom_mode = hb->custom_mode;
     bool armed = (hb->base_mode & ml::mode_flag::SAFETY_ARMED) != 0;
+    if (v.armed_by_ack) {
+      c.armed_unconfirmed = armed != *v.armed_by_ack;
+      if (c.armed_unconfirmed) armed = *v.armed_by_ack;
+      v.armed_by_ack.reset();
+    }
     c.armed = armed != v.armed;
     v.armed = armed;
   } else if (auto p = ml::unpack_local_position_ned(m)) {

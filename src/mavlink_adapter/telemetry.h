@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <deque>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include "fleet/fleet.h"
@@ -19,6 +20,12 @@ struct VehicleState {
   uint8_t autopilot = 0;          ///< MAV_AUTOPILOT of the HEARTBEAT
   uint32_t custom_mode = 0;       ///< the autopilot's flight mode
   bool armed = false;
+  /// The armed state an accepted ARM or DISARM's COMMAND_ACK gave, until the next HEARTBEAT.
+  /// Nothing in MAVLink orders a HEARTBEAT made before the command took effect ahead of its
+  /// ACK (the autopilot answers from its command handler and reports its state from
+  /// another task; a link may reorder), so the first HEARTBEAT after the ACK that says
+  /// otherwise is not believed; the next one is.
+  std::optional<bool> armed_by_ack;
   uint8_t landed_state = 0;       ///< MAV_LANDED_STATE; 0 until EXTENDED_SYS_STATE arrives
   bool have_position = false;     ///< a LOCAL_POSITION_NED arrived
   fleet::Vec3 ned;                ///< m, north east down, the vehicle's local frame
@@ -62,6 +69,8 @@ struct Changes {
   bool heartbeat = false;
   bool position = false;
   bool armed = false;
+  /// A HEARTBEAT contradicted armed_by_ack and was not believed (VehicleState::armed_by_ack).
+  bool armed_unconfirmed = false;
   bool landed = false;
   bool global_position = false;  ///< a GLOBAL_POSITION_INT was taken
   /// The frame was refused and changed nothing: which message and why (NaN, infinity, a

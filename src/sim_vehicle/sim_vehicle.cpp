@@ -354,8 +354,15 @@ void SimVehicle::start_then_ack(uint16_t command, const std::string& action, std
     last_result_ = result;
     has_last_ = true;
     ack(command, result);
+    if (command == ml::cmd::COMPONENT_ARM_DISARM && result == ml::result::ACCEPTED) send_stale_heartbeats();
     if (after && result == ml::result::ACCEPTED) after();
   });
+}
+
+void SimVehicle::send_stale_heartbeats() {
+  mid::DroneState before = drone_.state();
+  before.armed = !before.armed;
+  for (int i = 0; i < options_.stale_heartbeats_after_arming; ++i) send(heartbeat(before));
 }
 
 void SimVehicle::fly_to_setpoint() {

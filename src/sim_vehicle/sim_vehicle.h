@@ -132,6 +132,10 @@ struct VehicleOptions {
   /// Ignores the first this many ARMs (no ACK, no arming), as a link losing them would; a
   /// resend after the adapter's ACK timeout then arms it.
   int arms_lost = 0;
+  /// Right after the ACK of an ARM or DISARM, this many HEARTBEATs that still show the
+  /// state from before, as an autopilot whose HEARTBEAT was made before the command took
+  /// effect would send (MAVLink promises no order between the two).
+  int stale_heartbeats_after_arming = 0;
   /// Its read back reports each corner this far north of where it was given (degE7): a
   /// vehicle that stored something else than it acknowledged.
   int32_t fence_read_back_shift_e7 = 0;
@@ -213,6 +217,8 @@ class SimVehicle {
   bool requested_mode(const mavlink::CommandLong& c, Mode& out) const;
   /// Runs `action`, then acknowledges `command` with its outcome; `after` runs after an ACCEPTED.
   void start_then_ack(uint16_t command, const std::string& action, std::function<void()> after = nullptr);
+  /// VehicleOptions::stale_heartbeats_after_arming, after an accepted ARM or DISARM.
+  void send_stale_heartbeats();
   void on_setpoint(const mavlink::SetPositionTargetLocalNed& sp);
   void fly_to_setpoint();
   void start(const std::string& action, std::vector<double> args,

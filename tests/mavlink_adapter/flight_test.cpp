@@ -237,6 +237,45 @@ TEST(MavlinkFlight, AnArmWhoseActionEndedIsNotSentAgain) {
   EXPECT_EQ(end->outcome, mid::Outcome::cancelled);
 }
 
+// A HEARTBEAT made before the ARM took effect, arriving after its ACK (MAVLink orders
+// nothing between the two): believed, it would show the drone disarmed on the ground during
+// its Takeoff, which the adapter takes for the auto-disarm and answers with a second ARM and a
+// repeated takeoff (and a real auto-disarm after it would then fail the Takeoff). The same
+// after the DISARM: a stale armed HEARTBEAT would show a drone the mission disarmed armed.
+TEST(MavlinkFlight, AHeartbeatMadeBeforeTheArmOrDisarmTookEffectIsNotBelieved) {
+  sim_vehicle::VehicleOptions o = test::VehicleThread::options(sim_vehicle::px4_dialect(), 1, 100.0, true);
+  o.stale_heartbeats_after_arming = 1;
+  test::VehicleThread vehicle(25326, kSpeed, o);
+  Flight f(25326);
+  ASSERT_TRUE(f.drone) << f.created.message;
+  std::string said;
+  f.drone->set_message_sink([&](const std::string& text) { said += text + "\n"; });
+  int disarmed_states = 0;  // published states saying disarmed between the Arm and the Land
+  bool watching = false;
+  mid::SubscriptionId sub =
+      f.drone->subscribe([&](const mid::DroneState& s) { disarmed_states += watching && !s.armed; });
+  ASSERT_EQ(f.fly("Arm").outcome, mid::Outcome::succeeded) << said;
+  watching = true;
+  mid::ActionEnd up = f.fly("Takeoff", {3});
+  ASSERT_EQ(up.outcome, mid::Outcome::succeeded) << up.reason << "\n" << said;
+  ASSERT_EQ(f.fly("Land").outcome, mid::Outcome::succeeded) << said;
+  watching = false;
+  EXPECT_EQ(disarmed_states, 0) << said;
+  EXPECT_EQ(said.find("disarmed the vehicle"), std::string::npos) << said;  // the auto-disarm notes
+  EXPECT_NE(said.find("after the autopilot accepted the ARM still said disarmed"), std::string::npos) << said;
+  EXPECT_EQ(vehicle.inspect([](sim_vehicle::SimVehicle& v) { return v.received(mavlink::cmd::COMPONENT_ARM_DISARM); }),
+            1);
+
+  ASSERT_EQ(f.fly("Disarm").outcome, mid::Outcome::succeeded) << said;
+  f.drone->unsubscribe(sub);
+  int armed_states = 0;
+  f.drone->subscribe([&](const mid::DroneState& s) { armed_states += s.armed; });
+  f.loop.run_until(f.loop.now() + 1.0);  // every HEARTBEAT the vehicle sends after its ACK
+  EXPECT_EQ(armed_states, 0) << said;
+  EXPECT_FALSE(f.drone->state().armed);
+  EXPECT_NE(said.find("after the autopilot accepted the DISARM still said armed"), std::string::npos) << said;
+}
+
 // PX4 SITL stood disarmed in OFFBOARD after a mission that ended with its NAV_LAND, and
 // refuses to arm there without setpoints ("Arming denied: Resolve system health failures
 // first"). A DEX arms only after its wait for the vehicle's fix, when the vehicle's mode is

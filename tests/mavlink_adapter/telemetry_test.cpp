@@ -50,6 +50,34 @@ TEST(Telemetry, HeartbeatCarriesArmedAndModeAndLandedFollowsExtendedSysState) {
   EXPECT_FALSE(v.landed());
 }
 
+// After an accepted ARM the first HEARTBEAT that still says disarmed may have been made
+// before the command took effect: not believed. The next one is.
+TEST(Telemetry, TheFirstHeartbeatContradictingAnAcceptedArmIsNotBelievedTheNextIs) {
+  VehicleState v;
+  v.armed = true;  // as the adapter sets it on the ACK
+  v.armed_by_ack = true;
+  ml::Heartbeat disarmed;
+  disarmed.autopilot = ml::autopilot::PX4;
+  Changes c = apply_telemetry(v, frame(ml::pack(disarmed)));
+  EXPECT_TRUE(c.heartbeat && c.armed_unconfirmed);
+  EXPECT_FALSE(c.armed);
+  EXPECT_TRUE(v.armed);
+  c = apply_telemetry(v, frame(ml::pack(disarmed)));  // the vehicle really is disarmed
+  EXPECT_TRUE(c.armed && !c.armed_unconfirmed);
+  EXPECT_FALSE(v.armed);
+
+  // A HEARTBEAT that confirms the ACK ends the doubt: a disarm after it is believed at once.
+  ml::Heartbeat armed = disarmed;
+  armed.base_mode = ml::mode_flag::SAFETY_ARMED;
+  v.armed = true;
+  v.armed_by_ack = true;
+  c = apply_telemetry(v, frame(ml::pack(armed)));
+  EXPECT_FALSE(c.armed || c.armed_unconfirmed);
+  c = apply_telemetry(v, frame(ml::pack(disarmed)));
+  EXPECT_TRUE(c.armed);
+  EXPECT_FALSE(v.armed);
+}
+
 ml::LocalPositionNed at(uint32_t ms, float north, float vx) {
   ml::LocalPositionNed p;
   p.time_boot_ms = ms;
