@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iostream>
 #include <map>
 #include <optional>
 #include <mutex>
@@ -453,6 +454,26 @@ bool SitlFleet::restart_instance(int i, std::string& error) {
   return spawn(i, error);
 }
 
+// PX4 SITL once stopped in its start-up script (its log ended after the ground station's
+// MAVLink instance started) and sent nothing for the 120 s of wait_ready(): a boot that
+// normally sends its first HEARTBEAT within 5 s. Such an instance is killed and started
+// again, once, after silent_boot_s, rather than failing its test two minutes later.
+bool SitlFleet::silent_too_long() const {
+  return options_.autopilot == Autopilot::px4 && now_s() - started_s_ > options_.silent_boot_s;
+}
+
+void SitlFleet::hang_instance(int i) {
+  if (instances_.at(i).pid > 0) kill(instances_.at(i).pid, SIGSTOP);
+}
+
+bool SitlFleet::restart_silent_instance(int i, std::string& error) {
+  std::cout << "[sitl] PX4 instance " << i << " sent no HEARTBEAT within " << options_.silent_boot_s
+            << " s of its start: killed and started again. Its log ended with:\n"
+            << log_tail(i) << std::flush;
+  kill_instance(i);
+  return spawn(i, error);
+}
+
 bool SitlFleet::wait_ready(double timeout_s, std::string& error) {
   const double deadline = now_s() + timeout_s;
   if (!wait_ready_with_camera(deadline, error)) return false;
@@ -665,6 +686,7 @@ bool SitlFleet::wait_all_ready(double deadline, bool camera, std::string& error,
     links.push_back(std::move(opened.link));
   }
   ml::Encoder encoder{250, 190, 0};
+  std::vector<bool> restarted(size(), false);
   for (int i = 0; i < size(); ++i) {
     Readiness& r = *state[i];
     std::unique_lock lock(r.mutex);
@@ -673,6 +695,13 @@ bool SitlFleet::wait_all_ready(double deadline, bool camera, std::string& error,
       if (now_s() > deadline) {
         error = "SITL instance " + std::to_string(i) + " not ready: " + r.missing() + "\n" + log_tail(i);
         return false;
+      }
+      if (!r.heartbeat && !restarted[i] && silent_too_long()) {
+        restarted[i] = true;
+        lock.unlock();
+        if (!restart_silent_instance(i, error)) return false;
+        lock.lock();
+        continue;
       }
       lock.unlock();
       for (int k = 0; k < size(); ++k)

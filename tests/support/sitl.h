@@ -48,6 +48,9 @@ struct SitlOptions {
   /// sitl.cpp) uses up in this time (its remaining % counts consumed mAh against
   /// BATT_CAPACITY). 0: the stock models (PX4 60 s, ArduPilot 3300 mAh).
   double battery_drain_s = 0;
+  /// PX4: an instance that sent no HEARTBEAT this long after start() is killed and started
+  /// again, once (a start-up that stopped; sitl.cpp).
+  double silent_boot_s = 20;
 };
 
 /// Where a point of the earth (degE7) lies in the mission frame of the test fleets (x east, y
@@ -89,6 +92,9 @@ class SitlFleet {
                   std::map<std::string, double>& values, std::string& error);
   /// Kills one instance at once (a vehicle whose link is lost mid-flight).
   void kill_instance(int i);
+  /// Stops one instance's process (SIGSTOP) as a start-up that hangs: it sends nothing more
+  /// until it is killed.
+  void hang_instance(int i);
   /// SIGTERM, then SIGKILL after a grace period, for every instance still running.
   void stop();
 
@@ -110,6 +116,10 @@ class SitlFleet {
   bool spawn(int i, std::string& error);
   /// Stops instance i and starts it again in its folder, as a power cycle.
   bool restart_instance(int i, std::string& error);
+  /// PX4 only: the fleet started more than SitlOptions::silent_boot_s ago.
+  bool silent_too_long() const;
+  /// Kills instance i, which never sent a HEARTBEAT, and starts it again in its folder.
+  bool restart_silent_instance(int i, std::string& error);
   int instance_number(int i) const { return first_instance_ + i; }
   std::vector<std::string> command_line(int i, const std::string& binary) const;
   double boot_speedup() const;
