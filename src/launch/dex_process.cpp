@@ -282,6 +282,7 @@ bool DexProcess::ready_when_all_seen() {
   ready.home_x = mission_.settings.home.x;
   ready.home_y = mission_.settings.home.y;
   ready.home_tolerance = mission_.settings.home_tolerance_m;
+  ready.speed = o_.speed;  // the ground refuses to start a fleet whose DEXes run at other speeds
   node_->write(ready);
   out_ << name() << ": ready\n" << std::flush;
   return true;

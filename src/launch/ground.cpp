@@ -30,6 +30,12 @@ using transport::StatusSample;
 using transport::TelemetrySample;
 using transport::TraceSample;
 
+std::string speed_text(double speed) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", speed);
+  return text;
+}
+
 struct DroneEntry {
   std::string name;
   std::string folder;  ///< absolute or relative to the working directory
@@ -37,6 +43,7 @@ struct DroneEntry {
   Child child;
   std::optional<std::uint64_t> ready_nonce;
   mid::HomeReport home;  ///< from its READY: declared home and where its vehicle stands
+  double ready_speed = 0.0;  ///< from its READY: the speed its DEX runs at
   std::optional<StatusSample> final_status;
   std::vector<dex::Sample> track;
   std::optional<mid::DroneState> last_state;  ///< newest telemetry of this run
@@ -146,6 +153,7 @@ class Ground {
   int exit_status();
   void poll_children();
   void watch_barrier();
+  std::string other_speeds() const;
   void watch_flight();
   double mission_now() const { return (unix_ns() - start_at_ns_) / 1e9 * o_.speed; }
   void record_lifecycle(const LifecycleSample& s);
@@ -562,6 +570,7 @@ void Ground::watch_barrier() {
                           " before it was ready; its log (" + d.log + "):\n" + tail_of(d.log, 10));
   bool all = std::all_of(drones_.begin(), drones_.end(), [](const DroneEntry& d) { return d.ready_nonce.has_value(); });
   if (all) {
+    if (std::string slow = other_speeds(); !slow.empty()) return fail_barrier(slow);
     std::vector<mid::HomeReport> homes;
     for (const auto& d : drones_) homes.push_back(d.home);
     if (std::string wrong = mid::compare_homes(homes); !wrong.empty())
@@ -582,6 +591,18 @@ void Ground::watch_barrier() {
     }
     fail_barrier(std::string("start barrier timed out after ") + secs + "; not ready: " + missing);
   }
+}
+
+// A DEX started elsewhere at another --speed would count mission time at another rate than
+// every other drone. Refused here, before the START: refused by that DEX when the START
+// came, its ABORT raced the start instant of the others, which under load had armed first.
+std::string Ground::other_speeds() const {
+  std::string which;
+  for (const DroneEntry& d : drones_)
+    if (d.ready_speed != o_.speed) which += (which.empty() ? "" : ", ") + d.name + " at " + speed_text(d.ready_speed);
+  if (which.empty()) return "";
+  return "a DEX runs at another speed than the ground (--speed " + speed_text(o_.speed) + "): " + which +
+         "; nothing was armed: start it with --speed " + speed_text(o_.speed);
 }
 
 // The flight: done once every drone has its final state (all_done), or when the DEXes
@@ -707,6 +728,7 @@ void Ground::on_lifecycle(const LifecycleSample& s) {
     }
     drones_[s.drone].ready_nonce = s.nonce;
     drones_[s.drone].home = {d.name, {s.home_x, s.home_y, 0.0}, s.fix, s.home_tolerance};
+    drones_[s.drone].ready_speed = s.speed;
     return;
   }
   if (s.run_id != r_.run_id || stage_ != Stage::running) return;

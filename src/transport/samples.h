@@ -41,7 +41,7 @@ struct LifecycleSample {
   std::uint64_t nonce = 0;              ///< ready: the sending process, one per process start
   std::uint64_t launch_id = 0;          ///< ready, start, refused: the launch (0: none)
   std::int64_t start_at_ns = 0;         ///< start: Unix time of mission time 0
-  double speed = 1.0;                   ///< start: mission seconds per wall second
+  double speed = 1.0;                   ///< start, ready: mission seconds per wall second
   double t = 0.0;                       ///< abort, finished: mission time
   std::vector<std::uint64_t> nonces;    ///< start: per drone, the process that was ready
   std::string reason;                   ///< abort, refused
