@@ -308,6 +308,12 @@ void EventLoop::take_posted() {
   if (taken.empty()) return;
   double t = now_;
   if (options_.mode == ClockMode::real_time) t = std::max(now_, wall_mission_time());
+  // Input taken while the loop ran behind the wall clock got the wall's later mission time;
+  // a later run anchors the clock at the loop's own time again (start_wall_anchor), which
+  // would give what is posted then an earlier time than what is still queued. A vehicle's
+  // frames must run in the order they came (an ACK's state before the HEARTBEAT after it).
+  t = std::max(t, last_posted_at_);
+  last_posted_at_ = t;
   for (auto& fn : taken) at(t, std::move(fn));
 }
 

@@ -226,6 +226,9 @@ class EventLoop {
   /// callback is late by the wall time since then or since it was due, whichever is less:
   /// a catch-up of many overdue callbacks in quick succession is not a stall.
   double caught_up_wall_ = 0.0;
+  /// The mission time the last posted callbacks were given: later ones never get an earlier
+  /// one, so posted callbacks run in the order they were posted (take_posted).
+  double last_posted_at_ = 0.0;
 };
 
 }  // namespace eamos::mid

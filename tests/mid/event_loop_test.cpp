@@ -408,6 +408,26 @@ TEST(EventLoop, PostedCallbackRunsOnTheLoopAtTheCurrentTime) {
   EXPECT_EQ(at, (std::vector<double>{2.0, 5.0}));
 }
 
+// Posted while the loop runs behind the wall clock, a callback gets the wall's mission time;
+// the loop stops before it runs, and the next run anchors its clock at the loop's own time.
+// What is posted then still runs after it: input runs in the order it came (a vehicle's
+// HEARTBEAT sent right after an ACK ran after frames the vehicle sent later).
+TEST(EventLoop, PostedCallbacksRunInTheOrderPostedAcrossRuns) {
+  FakeWall wall;
+  EventLoop loop({ClockMode::real_time, 1.0, &wall});
+  std::vector<std::string> order;
+  loop.at(1.0, [&] {
+    wall.t += 0.5;  // a slow callback: the loop falls behind the wall
+    loop.post([&] { order.push_back("posted first"); });
+  });
+  loop.at(1.2, [&] { loop.stop(); });  // due before the posted callback's time (1.5)
+  loop.run_until_idle();
+  ASSERT_TRUE(order.empty());
+  loop.post([&] { order.push_back("posted second"); });
+  loop.run_until_idle();
+  EXPECT_EQ(order, (std::vector<std::string>{"posted first", "posted second"}));
+}
+
 TEST(EventLoop, PostFromAnotherThreadWakesAWaitingRealTimeLoop) {
   EventLoop loop({ClockMode::real_time, 1.0, nullptr});
   bool ran = false;
