@@ -594,8 +594,9 @@ void Ground::watch_barrier() {
 }
 
 // A DEX started elsewhere at another --speed would count mission time at another rate than
-// every other drone. Refused here, before the START: refused by that DEX when the START
-// came, its ABORT raced the start instant of the others, which under load had armed first.
+// every other drone. Refused here, before any START: refused by that DEX at the START, its
+// ABORT would have to reach every other DEX before their start instant, which a loaded host
+// or a slow network does not promise.
 std::string Ground::other_speeds() const {
   std::string which;
   for (const DroneEntry& d : drones_)

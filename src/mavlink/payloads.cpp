@@ -17,8 +17,9 @@ std::string printable(std::string text) {
   return text;
 }
 
-// How a char[N] field is read: PX4 ends a STATUSTEXT with a newline, which is no text.
-enum class Text { as_is, trim_end };
+// How a char[N] field is read: made printable at once, or left raw for unpack_statustext,
+// which first looks at how the text ends.
+enum class Text { printable, raw };
 
 // Pack's side of a message's field list (Layout<M>::fields): struct members into the payload.
 class Writer {
@@ -30,7 +31,7 @@ class Writer {
   void operator()(std::string_view name, const std::array<T, N>& values) {
     for (size_t i = 0; i < N; ++i) w_.set(name, values[i], static_cast<int>(i));
   }
-  void operator()(std::string_view name, const std::string& text, Text = Text::as_is) { w_.set_chars(name, text); }
+  void operator()(std::string_view name, const std::string& text, Text = Text::printable) { w_.set_chars(name, text); }
   /// Fields named prefix1, prefix2, ... (COMMAND_LONG's param1..param7), one per element.
   template <typename T, size_t N>
   void numbered(std::string_view prefix, const std::array<T, N>& values) {
@@ -53,11 +54,8 @@ class Reader {
   void operator()(std::string_view name, std::array<T, N>& values) {
     for (size_t i = 0; i < N; ++i) values[i] = r_.get<T>(name, static_cast<int>(i));
   }
-  void operator()(std::string_view name, std::string& text, Text mode = Text::as_is) {
-    std::string raw = r_.get_chars(name);
-    if (mode == Text::trim_end)
-      while (!raw.empty() && static_cast<unsigned char>(raw.back()) <= 0x20) raw.pop_back();
-    text = printable(std::move(raw));
+  void operator()(std::string_view name, std::string& text, Text mode = Text::printable) {
+    text = mode == Text::raw ? r_.get_chars(name) : printable(r_.get_chars(name));
   }
   template <typename T, size_t N>
   void numbered(std::string_view prefix, std::array<T, N>& values) {
@@ -401,7 +399,7 @@ struct Layout<Statustext> {
   template <typename M, typename V>
   static void fields(M& m, V& v) {
     v("severity", m.severity);
-    v("text", m.text, Text::trim_end);
+    v("text", m.text, Text::raw);
     v("id", m.id);
     v("chunk_seq", m.chunk_seq);
   }
@@ -520,7 +518,18 @@ Message pack(const BatteryStatus& m) { return pack_fields(m); }
 std::optional<BatteryStatus> unpack_battery_status(const Message& m) { return unpack_fields<BatteryStatus>(m); }
 
 Message pack(const Statustext& m) { return pack_fields(m); }
-std::optional<Statustext> unpack_statustext(const Message& m) { return unpack_fields<Statustext>(m); }
+std::optional<Statustext> unpack_statustext(const Message& m) {
+  constexpr std::size_t kStatustextChars = 50;
+  std::optional<Statustext> t = unpack_fields<Statustext>(m);
+  if (!t) return t;
+  t->full = t->text.size() == kStatustextChars;
+  // PX4 ends a text with a newline, which is no text; a full chunk's last blank may be a
+  // blank between two words of a longer text.
+  if (!t->full)
+    while (!t->text.empty() && static_cast<unsigned char>(t->text.back()) <= 0x20) t->text.pop_back();
+  t->text = printable(std::move(t->text));
+  return t;
+}
 
 Message pack(const SetupSigning& m) { return pack_fields(m); }
 std::optional<SetupSigning> unpack_setup_signing(const Message& m) { return unpack_fields<SetupSigning>(m); }

@@ -138,9 +138,12 @@ struct BatteryStatus {
 struct Statustext {
   uint8_t severity = 6;  ///< MAV_SEVERITY: 0 emergency … 3 error, 4 warning, 6 info, 7 debug
   std::string text;      ///< up to 50 characters; not NUL-terminated on the wire when full;
-                         ///< read: printable ASCII only, trailing newline and blanks dropped
-  uint16_t id = 0;       ///< 0: a message of one chunk
+                         ///< read: printable ASCII only; unless full, trailing newline and
+                         ///< blanks dropped (a full chunk's end may be a blank inside a text)
+  uint16_t id = 0;       ///< 0: a message of one chunk (PX4 numbers every text from 0, though)
   uint8_t chunk_seq = 0;
+  /// Read: the text filled its 50 characters (no NUL), so a longer text's next chunk may follow.
+  bool full = false;
 };
 
 /// PX4's camera_trigger module: a picture was triggered (CAMERA_TRIGGER).

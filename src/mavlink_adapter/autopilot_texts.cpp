@@ -6,7 +6,7 @@ namespace {
 
 constexpr std::size_t kTextsKept = 32;
 constexpr std::size_t kMaxTextLength = 50 * 8;  ///< longest text assembled from chunks
-constexpr std::size_t kMaxChunkedTexts = 4;     ///< texts being assembled at once
+constexpr double kChunkWaitS = 1.0;             ///< mission s a text waits for its next chunk
 constexpr uint8_t kSeverityWarning = 4;  ///< MAV_SEVERITY_WARNING: refusals explain at or above it
 
 const char* severity_name(uint8_t s) {
@@ -16,30 +16,46 @@ const char* severity_name(uint8_t s) {
 
 }  // namespace
 
-std::optional<std::string> AutopilotTexts::add(const mavlink::Statustext& t, double now, const char* autopilot) {
-  std::string text = t.text;
-  if (t.id != 0) {
-    // A text longer than 50 characters comes in chunks of one id; a chunk shorter than 50
-    // is the last. Bounded: a sender that never ends a text cannot grow this without limit.
-    std::string& pending = chunks_[t.id];
-    pending += t.text;
-    if (t.text.size() >= 50 && pending.size() < kMaxTextLength && chunks_.size() <= kMaxChunkedTexts)
-      return std::nullopt;
-    text = pending;
-    chunks_.erase(t.id);
+// A text longer than 50 characters comes in chunks of one id, each filling its field but the
+// last. The id is not trusted to say more: PX4 numbers every text from 0, which MAVLink
+// reserves for a text of one chunk, so a full chunk waits for the next whatever its id. A
+// text of another id, or a chunk 0 again, ends the one before.
+std::vector<std::string> AutopilotTexts::add(const mavlink::Statustext& t, double now, const char* autopilot) {
+  std::vector<std::string> whole;
+  if (pending_ && (t.id != pending_id_ || t.chunk_seq == 0)) whole.push_back(finish(autopilot));
+  if (!pending_) {
+    pending_ = Text{now, t.severity, ""};
+    pending_id_ = t.id;
   }
-  texts_.push_back({now, t.severity, text});
+  pending_->text += t.text;
+  if (!t.full || pending_->text.size() >= kMaxTextLength) whole.push_back(finish(autopilot));
+  return whole;
+}
+
+std::vector<std::string> AutopilotTexts::flush(double now, const char* autopilot) {
+  if (!pending_ || now - pending_->t < kChunkWaitS) return {};
+  return {finish(autopilot)};
+}
+
+std::string AutopilotTexts::finish(const char* autopilot) {
+  Text t = std::move(*pending_);
+  pending_.reset();
+  while (!t.text.empty() && t.text.back() == ' ') t.text.pop_back();
+  std::string line = std::string(autopilot) + " " + severity_name(t.severity) + ": " + t.text;
+  texts_.push_back(std::move(t));
   if (texts_.size() > kTextsKept) texts_.pop_front();
-  return std::string(autopilot) + " " + severity_name(t.severity) + ": " + text;
+  return line;
 }
 
 std::string AutopilotTexts::says(double since, const char* autopilot) const {
   std::string said;
-  for (const Text& t : texts_) {
-    if (t.t < since || t.severity > kSeverityWarning) continue;
-    if (said.find(t.text) != std::string::npos) continue;  // the same text repeated
+  auto quote = [&](const Text& t) {
+    if (t.t < since || t.severity > kSeverityWarning) return;
+    if (said.find(t.text) != std::string::npos) return;  // the same text repeated
     said += (said.empty() ? "" : "; ") + t.text;
-  }
+  };
+  for (const Text& t : texts_) quote(t);
+  if (pending_) quote(*pending_);  // its last chunk may still come: what came so far
   return said.empty() ? "" : std::string("; ") + autopilot + " says: " + said;
 }
 

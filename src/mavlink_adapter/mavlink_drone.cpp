@@ -122,7 +122,7 @@ void MavlinkDrone::on_frame(const ml::Frame& frame) {
   if (auto hb = ml::unpack_heartbeat(frame.message); hb && hb->autopilot == ml::autopilot::INVALID)
     return;  // a camera, gimbal or companion of the same system: not the autopilot
   if (auto t = ml::unpack_statustext(frame.message); t && frame.compid == ml::comp::AUTOPILOT1) {
-    if (auto text = texts_.add(*t, loop_.now(), link_.autopilot()->name)) note(*text);
+    for (const std::string& text : texts_.add(*t, loop_.now(), link_.autopilot()->name)) note(text);
     return;
   }
   if (auto report = ml::unpack_local_position_ned(frame.message)) clock_.on_report(report->time_boot_ms);
@@ -146,6 +146,7 @@ void MavlinkDrone::on_frame(const ml::Frame& frame) {
 }
 
 void MavlinkDrone::on_heartbeat() {
+  for (const std::string& text : texts_.flush(loop_.now(), link_.autopilot()->name)) note(text);
   link_.note_foreign();
   watch_.on_heartbeat();
   if (orbit_.on_heartbeat()) return;

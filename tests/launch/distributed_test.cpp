@@ -560,9 +560,8 @@ TEST_F(Distributed, SpeedMismatchAbortsBeforeAnyDroneMoves) {
   ASSERT_GT(remote, 0);
   Output r = eamos("launch " + deploy.string() + " --drones Drone1,Drone3 --speed 5 --domain 35");
   EXPECT_EQ(r.status, 1) << r.out;
-  // Refused at the start barrier, from the speeds in the READYs: no START, so no race between
-  // a start instant and an ABORT (with the refusal at the START, a loaded host armed Drone1
-  // and Drone3 before Drone2's ABORT reached them).
+  // Refused at the start barrier, from the speeds in the READYs: no START, so nothing depends
+  // on an ABORT reaching Drone1 and Drone3 before a start instant.
   EXPECT_NE(r.out.find("a DEX runs at another speed than the ground (--speed 5): Drone2 at 1; nothing was armed"),
             std::string::npos)
       << r.out;

@@ -299,6 +299,20 @@ TEST(RoundTrip, StatustextOfFiftyCharactersAndForeignBytesIsReadSafely) {
   EXPECT_EQ(out->text[10], '?');
   EXPECT_EQ(out->text[20], '?');
   EXPECT_EQ(out->text[49], 'a');
+  EXPECT_TRUE(out->full);
+}
+
+// A chunk that fills its field may end on the blank between two words of a longer text: kept.
+TEST(RoundTrip, AFullStatustextChunkKeepsItsLastBlank) {
+  std::string chunk = std::string(49, 'a') + " ";
+  auto out = unpack_statustext(through_the_wire(pack(Statustext{4, chunk, 3, 0})));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out->text, chunk);
+  EXPECT_TRUE(out->full);
+  auto last = unpack_statustext(through_the_wire(pack(Statustext{4, "end \n", 3, 1})));
+  ASSERT_TRUE(last);
+  EXPECT_EQ(last->text, "end");
+  EXPECT_FALSE(last->full);
 }
 
 }  // namespace

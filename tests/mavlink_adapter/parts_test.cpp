@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "mavlink/enums.h"
 #include "mavlink_adapter/autopilot_texts.h"
@@ -14,21 +15,69 @@ namespace {
 
 namespace ml = eamos::mavlink;
 
-ml::Statustext text(const std::string& s, uint8_t severity = 4, uint16_t id = 0) {
+ml::Statustext text(const std::string& s, uint8_t severity = 4, uint16_t id = 0, uint8_t chunk = 0) {
   ml::Statustext t;
   t.severity = severity;
   t.text = s;
   t.id = id;
+  t.chunk_seq = chunk;
+  t.full = s.size() == 50;  // as unpack_statustext reads it
   return t;
 }
+
+using Lines = std::vector<std::string>;
 
 TEST(AutopilotTexts, AChunkedTextIsTracedWholeOnceItsShortLastChunkCame) {
   AutopilotTexts texts;
   const std::string first(50, 'a');
-  EXPECT_FALSE(texts.add(text(first, 3, 7), 1.0, "ArduPilot"));
-  std::optional<std::string> whole = texts.add(text("end", 3, 7), 1.1, "ArduPilot");
-  ASSERT_TRUE(whole);
-  EXPECT_EQ(*whole, "ArduPilot error: " + first + "end");
+  EXPECT_EQ(texts.add(text(first, 3, 7), 1.0, "ArduPilot"), Lines{});
+  EXPECT_EQ(texts.add(text("end", 3, 7, 1), 1.1, "ArduPilot"), Lines{"ArduPilot error: " + first + "end"});
+}
+
+// PX4 numbers its texts from 0, which MAVLink keeps for a text of one chunk: its first text
+// after start, when longer than 50 characters, still comes whole (read as two, it said
+// "Arming denied: Resolve system health failures firs" and then "t").
+TEST(AutopilotTexts, APx4TextOfTwoChunksUnderIdZeroIsTracedWhole) {
+  AutopilotTexts texts;
+  EXPECT_EQ(texts.add(text("Arming denied: Resolve system health failures firs", 2, 0), 1.0, "PX4"), Lines{});
+  EXPECT_EQ(texts.add(text("t", 2, 0, 1), 1.0, "PX4"),
+            Lines{"PX4 critical: Arming denied: Resolve system health failures first"});
+  EXPECT_EQ(texts.says(0.0, "PX4"), "; PX4 says: Arming denied: Resolve system health failures first");
+}
+
+// A text of exactly 50 characters fills its only chunk, and PX4 sends no empty one after
+// it: the next text ends it, or its wait does.
+TEST(AutopilotTexts, ATextThatFillsItsOnlyChunkIsTracedByTheNextTextOrAfterItsWait) {
+  AutopilotTexts texts;
+  const std::string fifty(50, 'x');
+  EXPECT_EQ(texts.add(text(fifty, 4, 5), 1.0, "PX4"), Lines{});
+  EXPECT_EQ(texts.add(text("Takeoff detected", 6, 6), 1.2, "PX4"),
+            (Lines{"PX4 warning: " + fifty, "PX4 info: Takeoff detected"}));
+  EXPECT_EQ(texts.add(text(fifty, 4, 7), 2.0, "PX4"), Lines{});
+  EXPECT_EQ(texts.says(2.0, "PX4"), "; PX4 says: " + fifty);  // a refusal quotes it meanwhile
+  EXPECT_EQ(texts.flush(2.5, "PX4"), Lines{});
+  EXPECT_EQ(texts.flush(3.0, "PX4"), Lines{"PX4 warning: " + fifty});
+  EXPECT_EQ(texts.flush(9.0, "PX4"), Lines{});
+}
+
+// A chunk may end on the blank between two words: the text keeps it.
+TEST(AutopilotTexts, ABlankAtTheEndOfAChunkStaysBetweenItsWords) {
+  AutopilotTexts texts;
+  const std::string chunk = "Preflight Fail: the vehicle is too far from its   ";  // 50
+  ASSERT_EQ(chunk.size(), 50u);
+  EXPECT_EQ(texts.add(text(chunk, 4, 9), 1.0, "PX4"), Lines{});
+  EXPECT_EQ(texts.add(text("home", 4, 9, 1), 1.0, "PX4"), Lines{"PX4 warning: " + chunk + "home"});
+}
+
+// A sender that never ends a text (every chunk full) cannot grow it without bound.
+TEST(AutopilotTexts, ATextThatNeverEndsIsCutAtEightChunks) {
+  AutopilotTexts texts;
+  Lines said;
+  for (int i = 0; i < 20; ++i)
+    for (const std::string& s : texts.add(text(std::string(50, 'z'), 4, 3, static_cast<uint8_t>(i + 1)), 1.0, "X"))
+      said.push_back(s);
+  ASSERT_EQ(said.size(), 2u);
+  EXPECT_EQ(said[0], "X warning: " + std::string(400, 'z'));
 }
 
 TEST(AutopilotTexts, ARefusalQuotesOnlyWarningsAndWorseSaidSinceItStarted) {

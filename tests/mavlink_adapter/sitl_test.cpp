@@ -383,9 +383,9 @@ void Sitl::fly_refused(const std::string& extra) {
   EXPECT_TRUE(failsafes.contains("Drone1") && failsafes.contains("Drone3")) << f.run.out;
 }
 
-// The fixture's own rescue of a PX4 start-up that stops before its first HEARTBEAT (seen
-// once in make test: the test failed after wait_ready's 120 s): the instance is killed and
-// started again after SitlOptions::silent_boot_s, and the fleet gets ready.
+// The fixture's own rescue of a PX4 start-up that stops before its first HEARTBEAT: the
+// instance is killed and started again after SitlOptions::silent_boot_s, and the fleet gets
+// ready.
 TEST_P(Sitl, AnInstanceSilentAtItsStartIsKilledAndStartedAgain) {
   if (GetParam() != Autopilot::px4) GTEST_SKIP() << "run on PX4 SITL only (ArduPilot's start has not hung)";
   eamos_test::SitlOptions options{GetParam(), {{0, 0}}, kSpeed};

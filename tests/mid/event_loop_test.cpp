@@ -411,7 +411,7 @@ TEST(EventLoop, PostedCallbackRunsOnTheLoopAtTheCurrentTime) {
 // Posted while the loop runs behind the wall clock, a callback gets the wall's mission time;
 // the loop stops before it runs, and the next run anchors its clock at the loop's own time.
 // What is posted then still runs after it: input runs in the order it came (a vehicle's
-// HEARTBEAT sent right after an ACK ran after frames the vehicle sent later).
+// frames in the order the vehicle sent them).
 TEST(EventLoop, PostedCallbacksRunInTheOrderPostedAcrossRuns) {
   FakeWall wall;
   EventLoop loop({ClockMode::real_time, 1.0, &wall});

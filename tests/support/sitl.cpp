@@ -454,10 +454,10 @@ bool SitlFleet::restart_instance(int i, std::string& error) {
   return spawn(i, error);
 }
 
-// PX4 SITL once stopped in its start-up script (its log ended after the ground station's
-// MAVLink instance started) and sent nothing for the 120 s of wait_ready(): a boot that
-// normally sends its first HEARTBEAT within 5 s. Such an instance is killed and started
-// again, once, after silent_boot_s, rather than failing its test two minutes later.
+// PX4 SITL's start-up can stop in its start-up script (its log ends after the ground
+// station's MAVLink instance starts) and send nothing at all, where a boot sends its first
+// HEARTBEAT within 5 s. Such an instance is killed and started again, once, after
+// silent_boot_s, rather than failing its test at the end of wait_ready()'s timeout.
 bool SitlFleet::silent_too_long() const {
   return options_.autopilot == Autopilot::px4 && now_s() - started_s_ > options_.silent_boot_s;
 }
