@@ -523,10 +523,10 @@ std::optional<Statustext> unpack_statustext(const Message& m) {
   std::optional<Statustext> t = unpack_fields<Statustext>(m);
   if (!t) return t;
   t->full = t->text.size() == kStatustextChars;
-  // PX4 ends a text with a newline, which is no text; a full chunk's last blank may be a
-  // blank between two words of a longer text.
-  if (!t->full)
-    while (!t->text.empty() && static_cast<unsigned char>(t->text.back()) <= 0x20) t->text.pop_back();
+  // PX4 ends a text with a newline, which is no text, also when it fills the chunk; a full
+  // chunk's last blank may be the blank between two words of a longer text, so it stays.
+  auto trailing = [&](unsigned char c) { return c < 0x20 || (c == ' ' && !t->full); };
+  while (!t->text.empty() && trailing(static_cast<unsigned char>(t->text.back()))) t->text.pop_back();
   t->text = printable(std::move(t->text));
   return t;
 }

@@ -85,8 +85,7 @@ void MavlinkDrone::start_system(ActionId id, const mid::ActionRequest& r) {
     if (!tracker_.running(id)) return;
     if (!result.accepted) return end_refused(id, result);
     armed_waiting_ = false;
-    vehicle_.armed = false;  // the next HEARTBEAT confirms it
-    vehicle_.armed_by_ack = false;
+    vehicle_.armed_by_command(false);  // the next HEARTBEAT confirms it
     publish();
     tracker_.end(id, Outcome::succeeded);
   });

@@ -55,8 +55,7 @@ void MavlinkDrone::send_arm(ActionId id, std::function<void()> armed) {
       [this, id, armed = std::move(armed)](const CommandResult& result) {
         if (!tracker_.running(id)) return;
         if (!result.accepted) return end_refused(id, result);
-        vehicle_.armed = true;  // the next HEARTBEAT (20 Hz) confirms it
-        vehicle_.armed_by_ack = true;
+        vehicle_.armed_by_command(true);  // the next HEARTBEAT (20 Hz) confirms it
         publish();
         armed();
       },

@@ -26,6 +26,12 @@ struct VehicleState {
   /// another task; a link may reorder), so the first HEARTBEAT after the ACK that says
   /// otherwise is not believed; the next one is.
   std::optional<bool> armed_by_ack;
+  /// An accepted ARM (true) or DISARM (false): armed as its ACK says until a HEARTBEAT
+  /// confirms it, and the first one that does not is not believed.
+  void armed_by_command(bool now_armed) {
+    armed = now_armed;
+    armed_by_ack = now_armed;
+  }
   uint8_t landed_state = 0;       ///< MAV_LANDED_STATE; 0 until EXTENDED_SYS_STATE arrives
   bool have_position = false;     ///< a LOCAL_POSITION_NED arrived
   fleet::Vec3 ned;                ///< m, north east down, the vehicle's local frame

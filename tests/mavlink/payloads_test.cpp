@@ -326,6 +326,11 @@ TEST(RoundTrip, StatustextDropsATrailingNewline) {
   auto out = unpack_statustext(through_the_wire(pack(Statustext{6, "Armed by external command\n", 0, 0})));
   ASSERT_TRUE(out);
   EXPECT_EQ(out->text, "Armed by external command");
+  // Also when the newline fills the chunk's 50th character: no '?' at the end.
+  auto full = unpack_statustext(through_the_wire(pack(Statustext{6, std::string(49, 'b') + "\n", 0, 0})));
+  ASSERT_TRUE(full);
+  EXPECT_EQ(full->text, std::string(49, 'b'));
+  EXPECT_TRUE(full->full);
 }
 
 TEST(RoundTrip, ParamRequestReadKeepsTargetNameAndIndex) {

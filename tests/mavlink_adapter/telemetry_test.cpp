@@ -54,8 +54,7 @@ TEST(Telemetry, HeartbeatCarriesArmedAndModeAndLandedFollowsExtendedSysState) {
 // before the command took effect: not believed. The next one is.
 TEST(Telemetry, TheFirstHeartbeatContradictingAnAcceptedArmIsNotBelievedTheNextIs) {
   VehicleState v;
-  v.armed = true;  // as the adapter sets it on the ACK
-  v.armed_by_ack = true;
+  v.armed_by_command(true);  // as the adapter sets it on the ACK
   ml::Heartbeat disarmed;
   disarmed.autopilot = ml::autopilot::PX4;
   Changes c = apply_telemetry(v, frame(ml::pack(disarmed)));
@@ -69,8 +68,7 @@ TEST(Telemetry, TheFirstHeartbeatContradictingAnAcceptedArmIsNotBelievedTheNextI
   // A HEARTBEAT that confirms the ACK ends the doubt: a disarm after it is believed at once.
   ml::Heartbeat armed = disarmed;
   armed.base_mode = ml::mode_flag::SAFETY_ARMED;
-  v.armed = true;
-  v.armed_by_ack = true;
+  v.armed_by_command(true);
   c = apply_telemetry(v, frame(ml::pack(armed)));
   EXPECT_FALSE(c.armed || c.armed_unconfirmed);
   c = apply_telemetry(v, frame(ml::pack(disarmed)));
