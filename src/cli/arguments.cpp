@@ -12,8 +12,11 @@
 
 #include "diag/diagnostics.h"
 #include "diag/log.h"
+#include "diag/number.h"
 
 namespace eamos::cli {
+
+using diag::number_text;
 
 namespace fs = std::filesystem;
 
@@ -74,12 +77,6 @@ bool parse_whole(const std::string& s, long long& out) {
 }
 
 std::string in_quotes(const std::string& s) { return "'" + s + "'"; }
-
-std::string number_text(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
 
 std::string joined(const std::vector<std::string>& names, const std::string& separator = ", ") {
   std::string out;

@@ -4,13 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <iterator>
 #include <set>
 #include <unordered_map>
 #include <utility>
 
 #include "diag/log.h"
+#include "diag/number.h"
 #include "mid/home_check.h"
 
 namespace eamos::dex {
@@ -487,9 +487,7 @@ void InProcessRun::fly() {
   loop_.run_until(options_.time_limit_s);
   if (!result_.completed && !failed_) {
     finished_at_ = loop_.now();
-    char limit[32];
-    std::snprintf(limit, sizeof limit, "%g", options_.time_limit_s);
-    result_.error = std::string("mission did not complete within ") + limit +
+    result_.error = "mission did not complete within " + diag::number_text(options_.time_limit_s) +
                     " s of mission time; raise --time-limit if it is meant to run longer";
     abandon();
   }

@@ -1,10 +1,10 @@
 // parse_fleet: the fleet file's schema (docs/fleet.md), one function per map in it.
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <optional>
 
+#include "diag/number.h"
 #include "fleet/fleet.h"
 #include "fleet/yaml_reader.h"
 
@@ -43,12 +43,6 @@ std::vector<std::string> standard_action_names() {
 bool is_standard_property(const std::string& name) {
   const auto& props = standard_properties();
   return std::any_of(props.begin(), props.end(), [&](const PropertySpec& p) { return p.name == name; });
-}
-
-std::string format_number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", v);
-  return text;
 }
 
 Failsafe failsafe_from(const std::string& name) {
@@ -504,7 +498,7 @@ void FleetParser::geofence(const YAML::Node& node, const std::string& where, std
   }
   if (g.min_altitude_m && g.max_altitude_m && *g.min_altitude_m >= *g.max_altitude_m) {
     r_.error(*max_node, "max_altitude of " + what + " must be above its min_altitude (" +
-                            describe(*max_node) + " is not above " + format_number(*g.min_altitude_m) +
+                            describe(*max_node) + " is not above " + diag::number_text(*g.min_altitude_m) +
                             "); swap them or widen the band");
     return;
   }

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <map>
 #include <set>
@@ -12,7 +11,11 @@
 #include <string_view>
 #include <tuple>
 
+#include "diag/number.h"
+
 namespace eamos::graph {
+
+using diag::number_text;
 
 namespace {
 
@@ -100,12 +103,6 @@ Abstract combine(Op op, const Abstract& l, const Abstract& r) {
       return truth_of(l.truth == 1 || r.truth == 1 ? 1 : l.truth == 0 && r.truth == 0 ? 0 : -1);
     default: return arithmetic(op, l, r);
   }
-}
-
-std::string metres(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
 }
 
 bool is_wait(ControlKind k) {
@@ -396,7 +393,7 @@ class LogicChecker {
     if (prop.rfind("Sensor", 0) == 0) {
       if (const fleet::SensorRange* r = in_.fleet.sensor_range(name, std::string(prop))) {
         f.value = interval(r->low, r->high);
-        f.why = name + "." + std::string(prop) + "() reads " + metres(r->low) + " to " + metres(r->high) +
+        f.why = name + "." + std::string(prop) + "() reads " + number_text(r->low) + " to " + number_text(r->high) +
                 " (its range in the fleet file)";
       }
       return f;
@@ -425,13 +422,13 @@ class LogicChecker {
       f.why = start + ", so it is still disarmed";
     } else if (prop == "Z") {
       f.value = interval(home.z - kStandingSlack, home.z + kStandingSlack);
-      f.why = start + ", so " + name + ".Z() stays within " + metres(kStandingSlack) + " m of its ground z = " +
-              metres(home.z);
+      f.why = start + ", so " + name + ".Z() stays within " + number_text(kStandingSlack) + " m of its ground z = " +
+              number_text(home.z);
     } else if (home_declared) {  // X, Y: only a declared home says where it stands
       double v = prop == "X" ? home.x : home.y;
       f.value = interval(v - kStandingSlack, v + kStandingSlack);
-      f.why = start + ", so " + name + "." + std::string(prop) + "() stays within " + metres(kStandingSlack) +
-              " m of its home " + (prop == "X" ? "x" : "y") + " = " + metres(v);
+      f.why = start + ", so " + name + "." + std::string(prop) + "() stays within " + number_text(kStandingSlack) +
+              " m of its home " + (prop == "X" ? "x" : "y") + " = " + number_text(v);
     }
     return f;
   }
@@ -448,8 +445,8 @@ class LogicChecker {
       f.why = done + ", so it stays on the ground";
     } else if (prop == "Z") {
       f.value = interval(home.z - kStandingSlack, home.z + kStandingSlack);
-      f.why = done + ", so " + name + ".Z() stays within " + metres(kStandingSlack) + " m of the ground z = " +
-              metres(home.z);
+      f.why = done + ", so " + name + ".Z() stays within " + number_text(kStandingSlack) + " m of the ground z = " +
+              number_text(home.z);
     }
     return f;  // X, Y: it stays where it landed, which is not known here
   }

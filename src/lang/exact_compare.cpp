@@ -1,21 +1,18 @@
 #include "lang/exact_compare.h"
 
-#include <cstdio>
 #include <string>
 #include <utility>
 
+#include "diag/number.h"
+
 namespace eamos::lang {
+
+using diag::number_text;
 namespace {
 
 bool reads_property(const Expr& e) {
   if (e.kind == ExprKind::property) return true;
   return (e.lhs && reads_property(*e.lhs)) || (e.rhs && reads_property(*e.rhs));
-}
-
-std::string number_text(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
 }
 
 // The bounds of a ±0.5 band around the right side: folded when it is a literal.

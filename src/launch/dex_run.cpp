@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "diag/number.h"
 #include "dex/latency.h"
 #include "dex/runner.h"
 #include "launch/dex_state.h"
@@ -173,9 +174,8 @@ void DexProcess::on_lost(const std::string& hash, int drone, std::uint64_t nonce
   if (it != statuses_.end() && (it->second.phase == Phase::completed || it->second.phase == Phase::failed))
     return;  // it finished and left: not lost
   std::string lost = drone >= 0 && drone < static_cast<int>(mission_.fleet.size()) ? mission_.fleet[drone] : "?";
-  char lease[32];
-  std::snprintf(lease, sizeof lease, "%g", o_.dds.lease_s);
-  abandon(lost + " lost: no liveliness for " + lease + " s (its DEX stopped, hung or is unreachable)",
+  abandon(lost + " lost: no liveliness for " + diag::number_text(o_.dds.lease_s) +
+              " s (its DEX stopped, hung or is unreachable)",
           std::nullopt, true);
 }
 

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "diag/number.h"
 #include "launch/inbox.h"
 #include "launch/process_watch.h"
 #include "launch/spawn.h"
@@ -20,6 +21,8 @@
 #include "mid/home_check.h"
 
 namespace eamos::launch {
+
+using diag::number_text;
 
 namespace {
 
@@ -29,12 +32,6 @@ using transport::Phase;
 using transport::StatusSample;
 using transport::TelemetrySample;
 using transport::TraceSample;
-
-std::string speed_text(double speed) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", speed);
-  return text;
-}
 
 struct DroneEntry {
   std::string name;
@@ -288,9 +285,8 @@ bool Ground::choose_barrier_timeout() {
     return true;
   }
   if (!secure || o_.barrier_timeout_s <= kMaxSecureBarrierS) return true;
-  char secs[32];
-  std::snprintf(secs, sizeof secs, "%g", o_.barrier_timeout_s);
-  err_ << "eamos launch: error: --barrier-timeout " << secs << " is longer than DDS Security allows: "
+  err_ << "eamos launch: error: --barrier-timeout " << number_text(o_.barrier_timeout_s)
+       << " is longer than DDS Security allows: "
        << "Cyclone DDS gives up a handshake after " << transport::kHandshakeGiveUpS
        << " s, and Debian 12's build can crash then; use --barrier-timeout " << kMaxSecureBarrierS
        << " or less (a fleet whose handshakes need longer is too large for this host: docs/performance.md)\n";
@@ -600,10 +596,10 @@ void Ground::watch_barrier() {
 std::string Ground::other_speeds() const {
   std::string which;
   for (const DroneEntry& d : drones_)
-    if (d.ready_speed != o_.speed) which += (which.empty() ? "" : ", ") + d.name + " at " + speed_text(d.ready_speed);
+    if (d.ready_speed != o_.speed) which += (which.empty() ? "" : ", ") + d.name + " at " + number_text(d.ready_speed);
   if (which.empty()) return "";
-  return "a DEX runs at another speed than the ground (--speed " + speed_text(o_.speed) + "): " + which +
-         "; nothing was armed: start it with --speed " + speed_text(o_.speed);
+  return "a DEX runs at another speed than the ground (--speed " + number_text(o_.speed) + "): " + which +
+         "; nothing was armed: start it with --speed " + number_text(o_.speed);
 }
 
 // The flight: done once every drone has its final state (all_done), or when the DEXes
@@ -856,10 +852,8 @@ void Ground::on_trace(TraceSample s) {
 }
 
 void Ground::warn_late(const dex::TraceEvent& e) {
-  char bound[32];
-  std::snprintf(bound, sizeof bound, "%g", o_.latency_warn_s);
   err_ << "ground: warning: " << dex::describe_late(dex::late_message(e, r_.fleet))
-       << ", later than --trigger-latency-warn " << bound << " s\n";
+       << ", later than --trigger-latency-warn " << number_text(o_.latency_warn_s) << " s\n";
 }
 
 void Ground::check_latency_bound(const dex::TraceEvent& e) {

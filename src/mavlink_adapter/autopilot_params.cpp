@@ -2,10 +2,13 @@
 
 #include <cmath>
 #include <algorithm>
-#include <cstdio>
 #include <optional>
 
+#include "diag/number.h"
+
 namespace eamos::mavlink_adapter {
+
+using diag::number_text;
 
 namespace {
 
@@ -52,12 +55,6 @@ const char* fleet_key(LimitKind k) {
   return "";
 }
 
-std::string number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", v);
-  return text;
-}
-
 // The slowest value the autopilot gave for `kind`, and which parameter said it.
 struct Slowest {
   std::optional<double> mps;
@@ -94,7 +91,7 @@ void read_return_profile(const Autopilot& a, const std::vector<LimitParam>& para
       continue;
     }
     rtl[p.name] = it->second * p.to_mps;
-    out.summary += std::string(out.summary.empty() ? "" : ", ") + p.name + " " + number(rtl[p.name]);
+    out.summary += std::string(out.summary.empty() ? "" : ", ") + p.name + " " + number_text(rtl[p.name]);
   }
   auto value = [&rtl](const char* name) { return rtl.contains(name) ? rtl[name] : 0.0; };
   ReturnProfile& r = out.rtl;
@@ -130,22 +127,22 @@ FlightLimits combine_limits(const Autopilot& a, const fleet::Limits& fleet,
       for (const LimitParam& p : params)
         if (p.kind == slot.kind) names += std::string(names.empty() ? "" : " or ") + p.name;
       out.warnings.push_back(std::string(a.name) + " did not tell " + names + "; deadlines use the fleet's " +
-                             fleet_key(slot.kind) + " " + number(slot.value) + " m/s");
+                             fleet_key(slot.kind) + " " + number_text(slot.value) + " m/s");
       continue;
     }
-    out.summary += std::string(out.summary.empty() ? "" : ", ") + s.param + " " + number(*s.mps) + " m/s";
+    out.summary += std::string(out.summary.empty() ? "" : ", ") + s.param + " " + number_text(*s.mps) + " m/s";
     // Landing is always slower than a fleet's descent on some autopilot: not worth a warning.
     if (slot.value > *s.mps && slot.kind != LimitKind::land)
-      out.warnings.push_back("the fleet's " + std::string(fleet_key(slot.kind)) + " " + number(slot.value) +
-                             " m/s is above " + a.name + "'s " + s.param + " " + number(*s.mps) +
-                             " m/s: the vehicle flies at most " + number(*s.mps) + " m/s, deadlines use it");
+      out.warnings.push_back("the fleet's " + std::string(fleet_key(slot.kind)) + " " + number_text(slot.value) +
+                             " m/s is above " + a.name + "'s " + s.param + " " + number_text(*s.mps) +
+                             " m/s: the vehicle flies at most " + number_text(*s.mps) + " m/s, deadlines use it");
     slot.value = std::min(slot.value, *s.mps);
   }
   out.land_mps = std::min(out.land_mps, out.motion.max_descent_mps);
   // No warning either way: only the orbit's speed depends on it, and it flies slower.
   if (Slowest a = slowest(params, LimitKind::accel, values); a.mps) {
     out.motion.max_accel_mps2 = std::min(out.motion.max_accel_mps2, *a.mps);
-    out.summary += std::string(out.summary.empty() ? "" : ", ") + a.param + " " + number(*a.mps) + " m/s²";
+    out.summary += std::string(out.summary.empty() ? "" : ", ") + a.param + " " + number_text(*a.mps) + " m/s²";
   }
   // Delays add up; one the autopilot does not have (an older version) is no delay.
   for (const LimitParam& p : params) {
@@ -153,7 +150,8 @@ FlightLimits combine_limits(const Autopilot& a, const fleet::Limits& fleet,
     if (p.kind != LimitKind::takeoff_delay || it == values.end() || !std::isfinite(it->second) || it->second <= 0)
       continue;
     out.takeoff_delay_s += it->second * p.to_mps;
-    out.summary += std::string(out.summary.empty() ? "" : ", ") + p.name + " " + number(it->second * p.to_mps) + " s";
+    out.summary +=
+        std::string(out.summary.empty() ? "" : ", ") + p.name + " " + number_text(it->second * p.to_mps) + " s";
   }
   read_return_profile(a, params, values, out);
   // Unknown (ArduPilot, an older PX4): the autopilot judges the radius when DO_ORBIT comes.

@@ -5,10 +5,13 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "diag/number.h"
 #include "mavlink/enums.h"
 #include "mavlink_adapter/telemetry.h"
 
 namespace eamos::mavlink_adapter {
+
+using diag::number_text;
 
 namespace ml = eamos::mavlink;
 
@@ -64,12 +67,6 @@ double decode(const Autopilot& a, const FenceParam& p, float wire) {
   return i;
 }
 
-std::string number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", v);
-  return text;
-}
-
 std::string degrees(int32_t e7) {
   char text[32];
   std::snprintf(text, sizeof text, "%.7f", e7 / 1e7);
@@ -111,7 +108,8 @@ std::string compare_fence(const std::vector<ml::MissionItemInt>& sent, const std
     if (r.command != s.command)
       return which + " is command " + std::to_string(r.command) + ", " + std::to_string(s.command) + " was sent";
     if (std::lround(r.param[0]) != std::lround(s.param[0]))
-      return which + " says the polygon has " + number(r.param[0]) + " corners, " + number(s.param[0]) + " was sent";
+      return which + " says the polygon has " + number_text(r.param[0]) + " corners, " + number_text(s.param[0]) +
+             " was sent";
     if (std::abs(int64_t{r.x} - s.x) > 1 || std::abs(int64_t{r.y} - s.y) > 1)
       return which + " lies at (" + degrees(r.x) + ", " + degrees(r.y) + "), (" + degrees(s.x) + ", " +
              degrees(s.y) + ") was sent";
@@ -216,7 +214,7 @@ void FenceUpload::on_item(const ml::MissionItemInt& item) {
 void FenceUpload::set_param() {
   if (param_ >= fence_.params.size()) {
     std::string set;
-    for (const FenceParam& p : fence_.params) set += (set.empty() ? "" : ", ") + p.name + " " + number(p.value);
+    for (const FenceParam& p : fence_.params) set += (set.empty() ? "" : ", ") + p.name + " " + number_text(p.value);
     hooks_.note(std::string(autopilot_.name) + " holds the fence itself (" + set + ")");
     return finish("");
   }
@@ -231,8 +229,8 @@ void FenceUpload::on_param(const ml::ParamValue& v) {
   const FenceParam& p = fence_.params[param_];
   double took = decode(autopilot_, p, v.param_value);
   if (std::abs(took - p.value) > 1e-3 * std::max(1.0, std::abs(double{p.value})))
-    return finish(std::string(autopilot_.name) + " kept " + p.name + " at " + number(took) + " when set to " +
-                  number(p.value) + "; is the parameter read-only or out of its range on this firmware?");
+    return finish(std::string(autopilot_.name) + " kept " + p.name + " at " + number_text(took) + " when set to " +
+                  number_text(p.value) + "; is the parameter read-only or out of its range on this firmware?");
   ++param_;
   set_param();
 }
