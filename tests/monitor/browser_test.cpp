@@ -57,26 +57,58 @@ void stop(eamos_test::EamosProcess& p, int& status) {
   status = e.exited ? e.status : -1;
 }
 
+// A folder of its own under the temporary directory for one test, removed when it ends.
+struct ScratchDir {
+  fs::path path;
+  explicit ScratchDir(const std::string& name)
+      : path(fs::temp_directory_path() / ("eamos-monitor-" + name + "-" + std::to_string(getpid()))) {
+    fs::create_directories(path);
+  }
+  ~ScratchDir() { fs::remove_all(path); }
+  std::string operator/(const std::string& file) const { return (path / file).string(); }
+};
+
+// What a browser check of a replay saw: whether `eamos monitor` served a page, whether every
+// check of the script passed (and its output), and how the monitor ended when stopped.
+struct ReplayCheck {
+  bool served = false;
+  bool passed = false;
+  int status = -1;
+  std::string output, seen;
+};
+
+// `eamos monitor TRACE --port 0 EXTRA...` replaying, the browser script's MODE against its
+// page, then the monitor stopped as Ctrl-C stops it.
+ReplayCheck replay_in_browser(const std::string& trace, const std::string& mode,
+                              const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> args = {"monitor", trace, "--port", "0"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  auto monitor = eamos_test::start_eamos(args);
+  ReplayCheck c;
+  if (monitor.pid <= 0) return c;
+  std::string url = read_url(monitor, "replaying");
+  c.served = !url.empty();
+  if (c.served) c.passed = run_browser(mode, url, c.output);
+  stop(monitor, c.status);
+  c.seen = monitor.seen;
+  return c;
+}
+
+void expect_passed(const ReplayCheck& c) {
+  EXPECT_TRUE(c.served) << c.seen;
+  EXPECT_TRUE(c.passed) << c.output;
+  EXPECT_EQ(c.status, 0) << c.seen;
+}
+
 TEST(MonitorBrowser, ReplayOfListing2ShowsLanesTriggerAndNodeStates) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-replay-" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  std::string trace = (dir / "listing2.jsonl").string();
+  ScratchDir dir("replay");
+  std::string trace = dir / "listing2.jsonl";
   auto run = eamos_test::run_eamos("run examples/listing2.eamos -q --trace " + trace);
   ASSERT_EQ(run.status, 0) << run.out;
   // --mission: a trace written before traces carried their mission still gets its graphs.
-  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0", "--mission", "examples/listing2.eamos"});
-  ASSERT_GT(monitor.pid, 0);
-  std::string url = read_url(monitor, "replaying");
-  ASSERT_FALSE(url.empty()) << monitor.seen;
-  std::string output;
-  bool passed = run_browser("replay", url, output);
-  int status = -1;
-  stop(monitor, status);
-  EXPECT_TRUE(passed) << output;
-  EXPECT_EQ(status, 0) << monitor.seen;
+  expect_passed(replay_in_browser(trace, "replay", {"--mission", "examples/listing2.eamos"}));
   EXPECT_TRUE(fs::exists(fs::path(EAMOS_SCREENSHOT_DIR) / "replay-listing2-t5.png"));
-  fs::remove_all(dir);
 }
 
 // A trace as schema v1 (docs/trace.md) has it: the header line with the mission's text, a
@@ -111,86 +143,42 @@ std::string v1_trace(const std::string& real_trace) {
 
 TEST(MonitorBrowser, ReplayOfASchemaV1TraceUsesItsHeaderTelemetryAndMessages) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-v1-" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  std::string real = (dir / "real.jsonl").string(), trace = (dir / "v1.jsonl").string();
+  ScratchDir dir("v1");
+  std::string real = dir / "real.jsonl", trace = dir / "v1.jsonl";
   auto run = eamos_test::run_eamos("run examples/listing2.eamos -q --trace " + real);
   ASSERT_EQ(run.status, 0) << run.out;
   std::ofstream(trace) << v1_trace(real);
-  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0"});
-  ASSERT_GT(monitor.pid, 0);
-  std::string url = read_url(monitor, "replaying");
-  ASSERT_FALSE(url.empty()) << monitor.seen;
-  std::string output;
-  bool passed = run_browser("v1", url, output);
-  int status = -1;
-  stop(monitor, status);
-  EXPECT_TRUE(passed) << output;
-  EXPECT_EQ(status, 0) << monitor.seen;
-  fs::remove_all(dir);
+  expect_passed(replay_in_browser(trace, "v1"));
 }
 
 TEST(MonitorBrowser, ReplayOfAVerifyTraceMarksTheViolationInRedInItsLane) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-verify-" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  std::string trace = (dir / "separation.jsonl").string();
+  ScratchDir dir("verify");
+  std::string trace = dir / "separation.jsonl";
   auto run = eamos_test::run_eamos("verify -q tests/verify/missions/separation.eamos --fleet "
                                    "tests/verify/missions/separation.fleet.yaml --trace " + trace);
   ASSERT_EQ(run.status, 1) << run.out;  // the mission breaks the separation rule
-  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0"});
-  ASSERT_GT(monitor.pid, 0);
-  std::string url = read_url(monitor, "replaying");
-  ASSERT_FALSE(url.empty()) << monitor.seen;
-  std::string output;
-  bool passed = run_browser("violation", url, output);
-  int status = -1;
-  stop(monitor, status);
-  EXPECT_TRUE(passed) << output;
-  EXPECT_EQ(status, 0) << monitor.seen;
-  fs::remove_all(dir);
+  expect_passed(replay_in_browser(trace, "violation"));
 }
 
 TEST(MonitorBrowser, ReplayShowsWhoGaveWayToWhomInItsLane) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-give-way-" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  std::string trace = (dir / "crossing.jsonl").string();
+  ScratchDir dir("give-way");
+  std::string trace = dir / "crossing.jsonl";
   auto run = eamos_test::run_eamos("run -q tests/launch/missions/separation_crossing.eamos --fleet "
                                    "tests/launch/missions/separation_crossing.yaml --trace " + trace);
   ASSERT_EQ(run.status, 0) << run.out;
-  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0"});
-  ASSERT_GT(monitor.pid, 0);
-  std::string url = read_url(monitor, "replaying");
-  ASSERT_FALSE(url.empty()) << monitor.seen;
-  std::string output;
-  bool passed = run_browser("giveway", url, output);
-  int status = -1;
-  stop(monitor, status);
-  EXPECT_TRUE(passed) << output;
-  EXPECT_EQ(status, 0) << monitor.seen;
-  fs::remove_all(dir);
+  expect_passed(replay_in_browser(trace, "giveway"));
 }
 
 TEST(MonitorBrowser, AThousandDroneReplayDrawsItsLanesOnACanvas) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-scale-" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  std::string mission = (dir / "fleet.eamos").string(), trace = (dir / "fleet.jsonl").string();
+  ScratchDir dir("scale");
+  std::string mission = dir / "fleet.eamos", trace = dir / "fleet.jsonl";
   ASSERT_EQ(eamos_test::run_eamos("gen-stress --drones 1000 --nodes 20000 -o " + mission).status, 0);
   auto run = eamos_test::run_eamos("run " + mission + " -q --trace " + trace + " > /dev/null");
   ASSERT_EQ(run.status, 0) << run.out;
-  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0", "--mission", mission});
-  ASSERT_GT(monitor.pid, 0);
-  std::string url = read_url(monitor, "replaying");
-  ASSERT_FALSE(url.empty()) << monitor.seen;
-  std::string output;
-  bool passed = run_browser("scale", url, output);
-  int status = -1;
-  stop(monitor, status);
-  EXPECT_TRUE(passed) << output;
-  EXPECT_EQ(status, 0) << monitor.seen;
-  fs::remove_all(dir);
+  expect_passed(replay_in_browser(trace, "scale", {"--mission", mission}));
 }
 
 // Each drone's altitude line in a `--plot` SVG: drone name -> "#RRGGBB".
@@ -208,11 +196,10 @@ std::map<std::string, std::string> plot_colours(const fs::path& svg_file) {
 // sixteen while the SVGs went on with new hues, so drone 9 had two colours.
 TEST(MonitorBrowser, EachOfTwentyDronesHasTheSameColourInThePageAsInThePlot) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-palette-" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  std::string mission = (dir / "fleet.eamos").string(), trace = (dir / "fleet.jsonl").string();
+  ScratchDir dir("palette");
+  std::string mission = dir / "fleet.eamos", trace = dir / "fleet.jsonl";
   ASSERT_EQ(eamos_test::run_eamos("gen-stress --drones 20 --nodes 60 -o " + mission).status, 0);
-  auto run = eamos_test::run_eamos("run " + mission + " -q --trace " + trace + " --plot " + (dir / "plot.svg").string() +
+  auto run = eamos_test::run_eamos("run " + mission + " -q --trace " + trace + " --plot " + dir / "plot.svg" +
                                    " > /dev/null");
   ASSERT_EQ(run.status, 0) << run.out;
   std::map<std::string, std::string> plot = plot_colours(dir / "plot.svg");
@@ -221,15 +208,9 @@ TEST(MonitorBrowser, EachOfTwentyDronesHasTheSameColourInThePageAsInThePlot) {
   for (const auto& [drone, colour] : plot) distinct.insert(colour);
   EXPECT_EQ(distinct.size(), 20u) << "every drone of the plot has a colour of its own";
 
-  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0", "--mission", mission});
-  ASSERT_GT(monitor.pid, 0);
-  std::string url = read_url(monitor, "replaying");
-  ASSERT_FALSE(url.empty()) << monitor.seen;
-  std::string output;
-  bool passed = run_browser("palette", url, output);
-  int status = -1;
-  stop(monitor, status);
-  ASSERT_TRUE(passed) << output;
+  ReplayCheck c = replay_in_browser(trace, "palette", {"--mission", mission});
+  ASSERT_TRUE(c.served && c.passed) << c.seen << c.output;
+  const std::string& output = c.output;
   std::size_t at = output.find("colours: ");
   ASSERT_NE(at, std::string::npos) << output;
   nlohmann::json page = nlohmann::json::parse(output.substr(at + 9, output.find('\n', at) - at - 9), nullptr, false);
@@ -238,7 +219,6 @@ TEST(MonitorBrowser, EachOfTwentyDronesHasTheSameColourInThePageAsInThePlot) {
     ASSERT_TRUE(page.contains(drone)) << drone << " is not in the page's list: " << output;
     EXPECT_EQ(page[drone].get<std::string>(), colour) << drone;
   }
-  fs::remove_all(dir);
 }
 
 TEST(MonitorBrowser, LiveRunProgressesAndSurvivesReloadAndSecondPage) {
@@ -275,9 +255,8 @@ namespace {
 // real time; the browser measures 800 live events and the run is then stopped.
 TEST(MonitorBrowser, LiveTwentyDronesAreDrawnWithin100msOfEachEvent) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-live20-" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  std::string mission = (dir / "fleet.eamos").string();
+  ScratchDir dir("live20");
+  std::string mission = dir / "fleet.eamos";
   ASSERT_EQ(eamos_test::run_eamos("gen-stress --drones 20 --nodes 120 -o " + mission).status, 0);
   auto run = eamos_test::start_eamos({"run", mission, "-q", "--realtime", "--monitor", "127.0.0.1:0"});
   ASSERT_GT(run.pid, 0);
@@ -293,7 +272,6 @@ TEST(MonitorBrowser, LiveTwentyDronesAreDrawnWithin100msOfEachEvent) {
   eamos_test::Exit e = eamos_test::wait_exit(run);
   EXPECT_TRUE(passed) << output;
   EXPECT_TRUE(e.exited) << run.seen;
-  fs::remove_all(dir);
 }
 
 // Latency at a thousand drones: a show (every drone in every PAR, five fleet-wide barriers)
@@ -309,9 +287,8 @@ TEST(MonitorBrowser, LiveTwentyDronesAreDrawnWithin100msOfEachEvent) {
 // lanes canvas kept in columns of which a frame redraws only those that changed.
 TEST(MonitorBrowser, LiveThousandDronesAreDrawnWithin100msOfEachEvent) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-live1000-" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  std::string mission = (dir / "show.eamos").string();
+  ScratchDir dir("live1000");
+  std::string mission = dir / "show.eamos";
   ASSERT_EQ(eamos_test::run_eamos("gen-stress --shape show --drones 1000 --work 1 --nodes 5200 -o " + mission).status, 0);
   auto run = eamos_test::start_eamos({"run", mission, "-q", "--realtime", "--monitor", "127.0.0.1:0"});
   ASSERT_GT(run.pid, 0);
@@ -326,7 +303,6 @@ TEST(MonitorBrowser, LiveThousandDronesAreDrawnWithin100msOfEachEvent) {
   eamos_test::Exit e = eamos_test::wait_exit(run);
   EXPECT_TRUE(passed) << output;
   EXPECT_TRUE(e.exited) << run.seen;
-  fs::remove_all(dir);
   // Every other check held; the bound was missed on a host loaded by other work.
   std::size_t skip = output.find("skip: ");
   if (passed && skip != std::string::npos) GTEST_SKIP() << output.substr(skip, output.find('\n', skip) - skip);
@@ -340,9 +316,8 @@ namespace {
 // other test), the ground serving the page; the browser watches Listing 2 to its end.
 TEST(MonitorBrowser, LaunchOfADeploymentIsServedLiveToItsEnd) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-launch-" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  std::string deploy = (dir / "deploy").string();
+  ScratchDir dir("launch");
+  std::string deploy = dir / "deploy";
   auto compiled = eamos_test::run_eamos("compile -q --insecure examples/listing2.eamos -o " + deploy);
   ASSERT_EQ(compiled.status, 0) << compiled.out;
   // --speed 2: the 16.7 s mission flies for 8 s, long enough for the browser to join mid-flight.
@@ -362,7 +337,6 @@ TEST(MonitorBrowser, LaunchOfADeploymentIsServedLiveToItsEnd) {
   EXPECT_TRUE(held) << launch.seen;
   EXPECT_EQ(status, 0) << launch.seen;
   EXPECT_NE(launch.seen.find("mission completed"), std::string::npos) << launch.seen;
-  fs::remove_all(dir);
 }
 
 }  // namespace
@@ -394,21 +368,11 @@ TEST(MonitorBrowser, AFailedLiveRunShowsItsFailureAndNoLongerSaysLive) {
 // The end of a four-drone PAR: every drone waits for the slowest; one labelled span per pause.
 TEST(MonitorBrowser, WaitSpansOfAFourDroneParNeitherOverlapNorOverflow) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  fs::path dir = fs::temp_directory_path() / ("eamos-monitor-par4-" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  std::string trace = (dir / "par4.jsonl").string();
+  ScratchDir dir("par4");
+  std::string trace = dir / "par4.jsonl";
   auto run = eamos_test::run_eamos("run tests/monitor/missions/par4.eamos -q --trace " + trace);
   ASSERT_EQ(run.status, 0) << run.out;
-  auto monitor = eamos_test::start_eamos({"monitor", trace, "--port", "0"});
-  std::string url = read_url(monitor, "replaying");
-  ASSERT_FALSE(url.empty()) << monitor.seen;
-  std::string output;
-  bool passed = run_browser("waits", url, output);
-  int status = -1;
-  stop(monitor, status);
-  EXPECT_TRUE(passed) << output;
-  EXPECT_EQ(status, 0) << monitor.seen;
-  fs::remove_all(dir);
+  expect_passed(replay_in_browser(trace, "waits"));
 }
 
 }  // namespace
