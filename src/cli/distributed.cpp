@@ -16,6 +16,7 @@
 #include "cli/arguments.h"
 #include "cli/commands.h"
 #include "cli/progress.h"
+#include "deploy/manifest.h"
 #include "deploy/mission_file.h"
 #include "deploy/synthesize.h"
 #include "dex/trace_writers.h"
@@ -43,14 +44,13 @@ namespace {
 /// when one cannot be read (the ground reports that itself, and the plain log is shown).
 std::vector<dex::Mission> deployed_missions(const std::string& dir) {
   std::vector<dex::Mission> missions;
-  std::ifstream in(dir + "/manifest.json");
-  nlohmann::json manifest = nlohmann::json::parse(in, nullptr, false);
-  if (!manifest.is_object() || !manifest.contains("drones") || !manifest["drones"].is_array()) return {};
-  for (const nlohmann::json& d : manifest["drones"]) {
-    if (!d.is_object() || !d.contains("folder") || !d["folder"].is_string()) return {};
+  deploy::DeploymentManifest manifest;
+  std::string error;
+  if (!deploy::read_manifest(dir, manifest, error)) return {};
+  for (const deploy::DeployedDrone& d : manifest.drones) {
     dex::Mission m;
     std::vector<std::string> defects;
-    if (!deploy::read_mission_file(dir + "/" + d["folder"].get<std::string>() + "/mission.json", m, defects)) return {};
+    if (!deploy::read_mission_file(dir + "/" + d.folder + "/mission.json", m, defects)) return {};
     missions.push_back(std::move(m));
   }
   return missions;

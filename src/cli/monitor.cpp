@@ -10,7 +10,10 @@
 #include "cli/arguments.h"
 #include "cli/commands.h"
 #include "cli/signal_watch.h"
+#include "deploy/manifest.h"
 #include "deploy/mission_file.h"
+#include "diag/file_read.h"
+#include "diag/source.h"
 #include "monitor/mission_view.h"
 #include "monitor/server.h"
 #include "monitor/trace_file.h"
@@ -24,9 +27,9 @@ monitor::SvgRenderer dot_renderer() {
 }
 
 std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return "";
-  return std::string(std::istreambuf_iterator<char>(in), {});
+  std::string text;
+  diag::read_bounded_file(path, kMaxSourceFileBytes, text, diag::Pipes::read);
+  return text;
 }
 
 // The trace's embedded mission (schema v1 header) compiled again, for the graphs.
@@ -161,14 +164,14 @@ nlohmann::json launch_view(const std::string& dir) {
   monitor::ViewInput in;
   in.mission_name = dir;
   in.live = true;
-  nlohmann::json manifest = nlohmann::json::parse(read_text(dir + "/manifest.json"), nullptr, false);
-  if (!manifest.is_object() || !manifest.contains("source") || !manifest["source"].is_string() ||
-      !manifest.contains("mission_hash") || !manifest["mission_hash"].is_string())
+  deploy::DeploymentManifest manifest;
+  std::string error;
+  if (!deploy::read_manifest(dir, manifest, error) || manifest.source.empty())
     return monitor::bare_view(in, "the deployment names no mission source: lanes only");
-  std::string source = manifest["source"];
+  std::string source = manifest.source;
   graph::Compilation c;
   Diagnostics diags;
-  if (!graph::compile_file(source, "", diags, c) || deploy::mission_hash(c) != manifest["mission_hash"])
+  if (!graph::compile_file(source, "", diags, c) || deploy::mission_hash(c) != manifest.mission_hash)
     return monitor::bare_view(in, "'" + source + "' is not the deployed mission any more (or needs its fleet): lanes only");
   in.mission_name = source;
   std::string warnings;
@@ -188,6 +191,12 @@ int cmd_monitor(const MonitorCommandOptions& m) {
   monitor::Endpoint endpoint;
   if (!monitor::parse_endpoint(at, endpoint, error)) {
     std::cerr << "eamos: error: --host " << error << "\n";
+    return 1;
+  }
+  // Read twice (its first line, then the whole): a regular file only.
+  if (std::string why = diag::why_not_readable(m.trace, diag::Pipes::refused); !why.empty()) {
+    std::cerr << error_prefix() << "cannot read trace '" << m.trace << "': " << why
+              << "; give the file `eamos run --trace` wrote\n";
     return 1;
   }
   std::ifstream in(m.trace, std::ios::binary);

@@ -13,7 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "deploy/mission_file.h"
-#include "deploy/regular_file.h"
+#include "diag/file_read.h"
 #include "deploy/sha256.h"
 #include "lang/parser.h"
 
@@ -923,14 +923,14 @@ bool read_compiled_missions(const graph::Compilation& c, std::vector<dex::Missio
 
 bool read_mission_file(const std::string& path, dex::Mission& out, std::vector<std::string>& errors) {
   std::string text;
-  FileRead r = read_regular_file(path, kMaxMissionFileBytes, text);
-  if (r.status == FileRead::ok) return read_mission(text, path, out, errors);
+  diag::FileRead r = diag::read_bounded_file(path, kMaxMissionFileBytes, text);
+  if (r.status == diag::FileRead::ok) return read_mission(text, path, out, errors);
   std::string what;
   switch (r.status) {
-    case FileRead::not_regular:
+    case diag::FileRead::not_regular:
       what = r.detail + ", not a regular file; a mission file is the mission.json `eamos compile` writes";
       break;
-    case FileRead::too_large:
+    case diag::FileRead::too_large:
       what = r.detail + " bytes, more than the " + std::to_string(kMaxMissionFileBytes) +
              " (1 GiB) a mission file may hold; split the mission";
       break;

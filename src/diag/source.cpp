@@ -1,10 +1,8 @@
 #include "diag/source.h"
 
 #include <algorithm>
-#include <cerrno>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
+
+#include "diag/file_read.h"
 
 namespace eamos {
 
@@ -31,21 +29,11 @@ SourceLocation SourceFile::location_of(std::size_t offset) const {
 }
 
 bool read_source_file(const std::string& path, SourceFile& out, std::string& error) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    error = std::strerror(errno);
-    return false;
-  }
   // Read straight into one string: a large mission is read without extra copies.
   std::string text;
-  std::error_code size_error;
-  auto size = std::filesystem::file_size(path, size_error);
-  if (!size_error) text.reserve(size);
-  char buffer[64 * 1024];
-  while (in.read(buffer, sizeof buffer) || in.gcount() > 0)
-    text.append(buffer, static_cast<std::size_t>(in.gcount()));
-  if (in.bad()) {
-    error = "read error";
+  diag::FileRead r = diag::read_bounded_file(path, kMaxSourceFileBytes, text, diag::Pipes::read);
+  if (r.status != diag::FileRead::ok) {
+    error = diag::describe(r, kMaxSourceFileBytes);
     return false;
   }
   out = SourceFile(path, std::move(text));

@@ -36,7 +36,13 @@ std::size_t utf8_sequence_length(std::string_view text, std::size_t pos);
 /// Offset of the first byte in [pos, end) that is not valid UTF-8, or std::string_view::npos.
 std::size_t first_invalid_utf8(std::string_view text, std::size_t pos, std::size_t end);
 
-/// Reads a whole file; returns false and sets `error` (strerror text) on failure.
+/// The most a mission or fleet file may hold: 256 MiB, some 3.7 million statements, far more
+/// than a compile fits in memory; a device such as /dev/zero stops here at the latest.
+constexpr std::size_t kMaxSourceFileBytes = std::size_t{256} << 20;
+
+/// Reads a whole regular file, or a pipe to its end (/dev/stdin, <(...)), of at most
+/// kMaxSourceFileBytes; returns false and sets `error` (the system's reason, or what is wrong
+/// with the file: "a character device, not a regular file") otherwise.
 bool read_source_file(const std::string& path, SourceFile& out, std::string& error);
 
 }  // namespace eamos

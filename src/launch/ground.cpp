@@ -13,7 +13,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "deploy/manifest.h"
+#include "diag/file_read.h"
 #include "diag/number.h"
+#include "diag/source.h"
 #include "launch/inbox.h"
 #include "launch/process_watch.h"
 #include "launch/spawn.h"
@@ -56,28 +59,10 @@ struct DroneEntry {
 };
 
 bool read_manifest(const std::string& dir, std::string& hash, std::vector<DroneEntry>& drones, std::string& error) {
-  std::ifstream in(dir + "/manifest.json");
-  if (!in) {
-    error = "cannot read " + dir + "/manifest.json; is '" + dir + "' a folder written by `eamos compile -o`?";
-    return false;
-  }
-  try {
-    nlohmann::json m = nlohmann::json::parse(in);
-    if (m.value("format", "") != "eamos-deployment") {
-      error = dir + "/manifest.json is not an eamos deployment manifest";
-      return false;
-    }
-    hash = m.at("mission_hash").get<std::string>();
-    for (const auto& d : m.at("drones"))
-      drones.push_back({d.at("name").get<std::string>(), dir + "/" + d.at("folder").get<std::string>()});
-  } catch (const std::exception& e) {
-    error = dir + "/manifest.json: " + e.what();
-    return false;
-  }
-  if (drones.empty()) {
-    error = dir + "/manifest.json lists no drones";
-    return false;
-  }
+  deploy::DeploymentManifest m;
+  if (!deploy::read_manifest(dir, m, error)) return false;
+  hash = m.mission_hash;
+  for (const deploy::DeployedDrone& d : m.drones) drones.push_back({d.name, dir + "/" + d.folder});
   return true;
 }
 
@@ -109,9 +94,13 @@ class Collect : public dex::TraceSink {
 /// manifest alone (no mission or fleet text) when it is missing or not a header.
 nlohmann::ordered_json load_header(const std::string& dir, const std::string& hash,
                                    const std::vector<DroneEntry>& drones, double telemetry_hz, std::ostream& err) {
-  std::ifstream in(dir + "/trace-header.json");
-  nlohmann::ordered_json h = nlohmann::ordered_json::parse(in, nullptr, false);
-  bool usable = in && h.is_object() && h.value("event", "") == "header" && h.value("mission_hash", "") == hash;
+  // It embeds the mission's and the fleet's text, each at most a source file's size.
+  std::string text;
+  diag::FileRead r = diag::read_bounded_file(dir + "/trace-header.json", 3 * kMaxSourceFileBytes, text);
+  nlohmann::ordered_json h = nlohmann::ordered_json::parse(text, nullptr, false);
+  const nlohmann::ordered_json none;
+  bool usable = r.status == diag::FileRead::ok && h.is_object() && h.value("event", none) == "header" &&
+                h.value("mission_hash", none) == hash;
   if (!usable) {
     err << "ground: " << dir << "/trace-header.json is missing or not this mission's; the trace's header will "
         << "not embed the mission and fleet text (compile the deployment again with this eamos)\n";

@@ -7,9 +7,8 @@
 #include <cerrno>
 #include <ctime>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
+#include "diag/file_read.h"
 #include "security/pki.h"
 #include "transport/partitions.h"
 
@@ -35,12 +34,9 @@ bool write_file(const fs::path& path, const std::string& text, bool secret, std:
 }
 
 bool read_file(const fs::path& path, std::string& text) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
-  std::stringstream ss;
-  ss << in.rdbuf();
-  text = ss.str();
-  return true;
+  // A CA's certificate or key in PEM is a few kilobytes.
+  constexpr std::uint64_t kMaxPemBytes = std::uint64_t{1} << 20;
+  return diag::read_bounded_file(path.string(), kMaxPemBytes, text).status == diag::FileRead::ok;
 }
 
 std::string xml_date(std::time_t t) {

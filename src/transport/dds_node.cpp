@@ -5,11 +5,10 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
-#include <fstream>
 #include <filesystem>
-#include <sstream>
 #include <vector>
 
+#include "diag/file_read.h"
 #include "diag/log.h"
 #include "loopback_config.h"
 #include "transport/wire_convert.h"
@@ -173,14 +172,13 @@ bool security_config(const std::string& folder, std::string& xml, std::string& e
 
 bool base_config(const DdsOptions& options, std::string& xml, std::string& error) {
   if (!options.config_file.empty()) {
-    std::ifstream in(options.config_file);
-    if (!in) {
-      error = "cannot read DDS configuration '" + options.config_file + "'";
+    // A Cyclone DDS configuration is a few kilobytes; more is not one.
+    constexpr std::uint64_t kMaxConfigBytes = std::uint64_t{16} << 20;
+    diag::FileRead r = diag::read_bounded_file(options.config_file, kMaxConfigBytes, xml, diag::Pipes::read);
+    if (r.status != diag::FileRead::ok) {
+      error = "cannot read DDS configuration '" + options.config_file + "': " + diag::describe(r, kMaxConfigBytes);
       return false;
     }
-    std::stringstream ss;
-    ss << in.rdbuf();
-    xml = ss.str();
     return true;
   }
   if (is_loopback(options.interface)) {

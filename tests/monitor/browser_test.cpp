@@ -21,10 +21,12 @@
 
 #include "support/eamos_process.h"
 #include "support/run_eamos.h"
+#include "support/scratch_dir.h"
 
 namespace {
 
 namespace fs = std::filesystem;
+using eamos_test::ScratchDir;
 
 bool have_chromium() { return std::string(EAMOS_CHROMIUM).size() > 0 && access(EAMOS_CHROMIUM, X_OK) == 0; }
 
@@ -56,17 +58,6 @@ void stop(eamos_test::EamosProcess& p, int& status) {
   eamos_test::Exit e = eamos_test::wait_exit(p);
   status = e.exited ? e.status : -1;
 }
-
-// A folder of its own under the temporary directory for one test, removed when it ends.
-struct ScratchDir {
-  fs::path path;
-  explicit ScratchDir(const std::string& name)
-      : path(fs::temp_directory_path() / ("eamos-monitor-" + name + "-" + std::to_string(getpid()))) {
-    fs::create_directories(path);
-  }
-  ~ScratchDir() { fs::remove_all(path); }
-  std::string operator/(const std::string& file) const { return (path / file).string(); }
-};
 
 // What a browser check of a replay saw: whether `eamos monitor` served a page, whether every
 // check of the script passed (and its output), and how the monitor ended when stopped.
@@ -102,7 +93,7 @@ void expect_passed(const ReplayCheck& c) {
 
 TEST(MonitorBrowser, ReplayOfListing2ShowsLanesTriggerAndNodeStates) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  ScratchDir dir("replay");
+  ScratchDir dir("monitor-replay");
   std::string trace = dir / "listing2.jsonl";
   auto run = eamos_test::run_eamos("run examples/listing2.eamos -q --trace " + trace);
   ASSERT_EQ(run.status, 0) << run.out;
@@ -143,7 +134,7 @@ std::string v1_trace(const std::string& real_trace) {
 
 TEST(MonitorBrowser, ReplayOfASchemaV1TraceUsesItsHeaderTelemetryAndMessages) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  ScratchDir dir("v1");
+  ScratchDir dir("monitor-v1");
   std::string real = dir / "real.jsonl", trace = dir / "v1.jsonl";
   auto run = eamos_test::run_eamos("run examples/listing2.eamos -q --trace " + real);
   ASSERT_EQ(run.status, 0) << run.out;
@@ -153,7 +144,7 @@ TEST(MonitorBrowser, ReplayOfASchemaV1TraceUsesItsHeaderTelemetryAndMessages) {
 
 TEST(MonitorBrowser, ReplayOfAVerifyTraceMarksTheViolationInRedInItsLane) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  ScratchDir dir("verify");
+  ScratchDir dir("monitor-verify");
   std::string trace = dir / "separation.jsonl";
   auto run = eamos_test::run_eamos("verify -q tests/verify/missions/separation.eamos --fleet "
                                    "tests/verify/missions/separation.fleet.yaml --trace " + trace);
@@ -163,7 +154,7 @@ TEST(MonitorBrowser, ReplayOfAVerifyTraceMarksTheViolationInRedInItsLane) {
 
 TEST(MonitorBrowser, ReplayShowsWhoGaveWayToWhomInItsLane) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  ScratchDir dir("give-way");
+  ScratchDir dir("monitor-give-way");
   std::string trace = dir / "crossing.jsonl";
   auto run = eamos_test::run_eamos("run -q tests/launch/missions/separation_crossing.eamos --fleet "
                                    "tests/launch/missions/separation_crossing.yaml --trace " + trace);
@@ -173,7 +164,7 @@ TEST(MonitorBrowser, ReplayShowsWhoGaveWayToWhomInItsLane) {
 
 TEST(MonitorBrowser, AThousandDroneReplayDrawsItsLanesOnACanvas) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  ScratchDir dir("scale");
+  ScratchDir dir("monitor-scale");
   std::string mission = dir / "fleet.eamos", trace = dir / "fleet.jsonl";
   ASSERT_EQ(eamos_test::run_eamos("gen-stress --drones 1000 --nodes 20000 -o " + mission).status, 0);
   auto run = eamos_test::run_eamos("run " + mission + " -q --trace " + trace + " > /dev/null");
@@ -196,7 +187,7 @@ std::map<std::string, std::string> plot_colours(const fs::path& svg_file) {
 // sixteen while the SVGs went on with new hues, so drone 9 had two colours.
 TEST(MonitorBrowser, EachOfTwentyDronesHasTheSameColourInThePageAsInThePlot) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  ScratchDir dir("palette");
+  ScratchDir dir("monitor-palette");
   std::string mission = dir / "fleet.eamos", trace = dir / "fleet.jsonl";
   ASSERT_EQ(eamos_test::run_eamos("gen-stress --drones 20 --nodes 60 -o " + mission).status, 0);
   auto run = eamos_test::run_eamos("run " + mission + " -q --trace " + trace + " --plot " + dir / "plot.svg" +
@@ -255,7 +246,7 @@ namespace {
 // real time; the browser measures 800 live events and the run is then stopped.
 TEST(MonitorBrowser, LiveTwentyDronesAreDrawnWithin100msOfEachEvent) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  ScratchDir dir("live20");
+  ScratchDir dir("monitor-live20");
   std::string mission = dir / "fleet.eamos";
   ASSERT_EQ(eamos_test::run_eamos("gen-stress --drones 20 --nodes 120 -o " + mission).status, 0);
   auto run = eamos_test::start_eamos({"run", mission, "-q", "--realtime", "--monitor", "127.0.0.1:0"});
@@ -287,7 +278,7 @@ TEST(MonitorBrowser, LiveTwentyDronesAreDrawnWithin100msOfEachEvent) {
 // lanes canvas kept in columns of which a frame redraws only those that changed.
 TEST(MonitorBrowser, LiveThousandDronesAreDrawnWithin100msOfEachEvent) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  ScratchDir dir("live1000");
+  ScratchDir dir("monitor-live1000");
   std::string mission = dir / "show.eamos";
   ASSERT_EQ(eamos_test::run_eamos("gen-stress --shape show --drones 1000 --work 1 --nodes 5200 -o " + mission).status, 0);
   auto run = eamos_test::start_eamos({"run", mission, "-q", "--realtime", "--monitor", "127.0.0.1:0"});
@@ -316,7 +307,7 @@ namespace {
 // other test), the ground serving the page; the browser watches Listing 2 to its end.
 TEST(MonitorBrowser, LaunchOfADeploymentIsServedLiveToItsEnd) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  ScratchDir dir("launch");
+  ScratchDir dir("monitor-launch");
   std::string deploy = dir / "deploy";
   auto compiled = eamos_test::run_eamos("compile -q --insecure examples/listing2.eamos -o " + deploy);
   ASSERT_EQ(compiled.status, 0) << compiled.out;
@@ -368,7 +359,7 @@ TEST(MonitorBrowser, AFailedLiveRunShowsItsFailureAndNoLongerSaysLive) {
 // The end of a four-drone PAR: every drone waits for the slowest; one labelled span per pause.
 TEST(MonitorBrowser, WaitSpansOfAFourDroneParNeitherOverlapNorOverflow) {
   if (!have_chromium()) GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/install-deps.sh does)";
-  ScratchDir dir("par4");
+  ScratchDir dir("monitor-par4");
   std::string trace = dir / "par4.jsonl";
   auto run = eamos_test::run_eamos("run tests/monitor/missions/par4.eamos -q --trace " + trace);
   ASSERT_EQ(run.status, 0) << run.out;
