@@ -11,9 +11,10 @@ if [ ! -f "$BUILD/build.ninja" ]; then
   CC=clang CXX=clang++ cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_UNITY_BUILD=ON \
     -DEAMOS_FUZZ=ON -DEAMOS_TESTS=OFF -DEAMOS_BENCH=OFF >/dev/null
 fi
-targets=(fuzz_frontend fuzz_fleet fuzz_mavlink fuzz_mission fuzz_wire)
+targets=(fuzz_frontend fuzz_fleet fuzz_mavlink fuzz_mission fuzz_wire fuzz_lsp fuzz_trace)
 seeds=("examples/*.eamos tests/lang/diagnostics/*.eamos" "tests/fleet/data/*.yaml examples/*.yaml"
-       "tests/fuzz/mavlink-seeds/*" "tests/fuzz/mission-seeds/*" "tests/fuzz/wire-seeds/*")
+       "tests/fuzz/mavlink-seeds/*" "tests/fuzz/mission-seeds/*" "tests/fuzz/wire-seeds/*" "tests/fuzz/lsp-seeds/*"
+       "tests/fuzz/trace-seeds/*")
 cmake --build "$BUILD" -j "$(nproc)" --target "${targets[@]}"
 
 # One fuzzer per core at a time: each is one process on one core.
