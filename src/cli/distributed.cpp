@@ -22,6 +22,7 @@
 #include "dex/trace_writers.h"
 #include "launch/dex_process.h"
 #include "launch/ground.h"
+#include "launch/stop_signals.h"
 #include "mavlink_adapter/adapter.h"
 #include "monitor/live_sink.h"
 #include "monitor/server.h"
@@ -84,15 +85,14 @@ void on_hold_signal(int) {
   (void)!write(g_hold_pipe[1], &c, 1);  // async-signal-safe; wakes the waiting read
 }
 
-// The ground handles SIGINT/SIGTERM itself while it flies, and its DEX children inherit the
+// The ground handles the stop signals itself while it flies, and its DEX children inherit the
 // signal mask, so no signal is blocked here: a handler wakes a pipe once the mission is over.
 void hold_after_launch(monitor::MonitorServer& server) {
   if (pipe(g_hold_pipe) != 0) return;
   struct sigaction action {};
   action.sa_handler = on_hold_signal;
   sigemptyset(&action.sa_mask);
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
+  for (int s : launch::stop_signals()) sigaction(s, &action, nullptr);
   server.finish();
   std::cout << "eamos: the mission has ended; the monitor shows it at " << server.url() << " until Ctrl-C\n"
             << std::flush;

@@ -14,6 +14,7 @@
 #include "cli/arguments.h"
 #include "cli/commands.h"
 #include "cli/heap_tunables.h"
+#include "launch/stop_signals.h"
 #include "lsp/server.h"
 #include "security/mission_keys.h"
 #include "version.h"
@@ -473,6 +474,8 @@ int fly(const Commands& c, Options& o, char** argv) {
 constexpr eamos::cli::CompileFinisher kFinishCompile{exec_credentials, true};
 #else
 int fly(const Commands& c, Options& o, char**) {
+  // A reader of the log that goes away (`| head`, a pager closed) must not end a flight.
+  eamos::launch::ignore_broken_pipes();
   if (*c.run && o.distributed) {
     o.launch.speed = o.run.speed > 0 ? o.run.speed : 1.0;
     o.launch.time_limit_s = o.run.time_limit;

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "launch/stop_signals.h"
+
 namespace eamos::cli {
 
 namespace {
@@ -13,8 +15,7 @@ namespace {
 sigset_t watched() {
   sigset_t set;
   sigemptyset(&set);
-  sigaddset(&set, SIGINT);
-  sigaddset(&set, SIGTERM);
+  for (int s : launch::stop_signals()) sigaddset(&set, s);
   return set;
 }
 
@@ -40,7 +41,7 @@ void SignalWatch::watch() {
     int signal = 0;
     if (sigwait(&set, &signal) != 0) continue;
     if (stopping_) return;
-    const char* name = signal == SIGINT ? "SIGINT" : "SIGTERM";
+    const char* name = launch::stop_signal_name(signal);
     if (++seen == 1) {
       on_first_(name);  // it says what the first signal does: that depends on when it came
       continue;

@@ -1,6 +1,7 @@
 #pragma once
-// Ctrl-C and SIGTERM during `eamos run`: the first abandons the mission into the failsafe
-// (the run still lands every drone and writes its report), a second exits at once.
+// Ctrl-C, SIGTERM, a hangup or Ctrl-\ during `eamos run` (launch/stop_signals.h): the first
+// abandons the mission into the failsafe (the run still lands every drone and writes its
+// report), a second exits at once.
 #include <atomic>
 #include <functional>
 #include <thread>
@@ -11,7 +12,7 @@ namespace eamos::cli {
 
 class SignalWatch {
  public:
-  /// Blocks SIGINT and SIGTERM in this thread and every thread started after it (so the
+  /// Blocks the stop signals in this thread and every thread started after it (so the
   /// MAVLink and DDS threads never take them) and waits for them on a thread of its own,
   /// which calls `on_first` with the first signal's name ("SIGINT"; it tells the user what
   /// that signal does) and exits the process with 128 + signal on the second. Construct it

@@ -5,6 +5,7 @@
 
 #include "cli/arguments.h"
 #include "cli/commands.h"
+#include "launch/stop_signals.h"
 #include "mavlink/url.h"
 #include "mid/event_loop.h"
 #include "sim_vehicle/sim_vehicle.h"
@@ -47,8 +48,7 @@ int cmd_sim_vehicle(const SimVehicleCommandOptions& o) {
   // The local port: where a second ground station (a test playing a pilot) reaches the vehicle.
   std::cout << "sim-vehicle: system " << o.sysid << " (" << options.dialect->name << "-like) on " << url
             << ", receiving on port " << vehicle.local_port() << std::endl;
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  launch::on_stop_signals(on_signal);
   // Short slices, so a signal is noticed within a quarter of a (mission) second.
   while (!g_stop && (o.duration <= 0 || loop.now() < o.duration))
     loop.run_until(o.duration > 0 ? std::min(o.duration, loop.now() + 0.25) : loop.now() + 0.25);

@@ -11,6 +11,7 @@
 
 #include "deploy/mission_file.h"
 #include "launch/dex_state.h"
+#include "launch/stop_signals.h"
 #include "launch/wall_time.h"
 #include "mid/home_check.h"
 
@@ -39,8 +40,8 @@ volatile std::sig_atomic_t g_dex_signal = 0;
 
 namespace {
 
-// SIGTERM (a service stopped, the ground's clean-up) or Ctrl-C on a DEX run by hand: the
-// loop notices at its next heartbeat and abandons the mission into the failsafe. A second
+// SIGTERM (a service stopped, the ground's clean-up), Ctrl-C on a DEX run by hand or the
+// hangup of the SSH session it was started from (launch/stop_signals.h): the loop notices at its next heartbeat and abandons the mission into the failsafe. A second
 // signal ends the process at once (_exit is async-signal-safe; nothing else is done here).
 void on_dex_signal(int signal) {
   if (g_dex_signal != 0) _exit(128 + signal);
@@ -52,8 +53,7 @@ void on_dex_signal(int signal) {
 int DexProcess::run(const mid::AdapterRegistry& adapters) {
   nonce_ = process_nonce();
   if (!load(adapters) || !check_later_drones() || !open_dds()) return 1;
-  std::signal(SIGINT, on_dex_signal);
-  std::signal(SIGTERM, on_dex_signal);
+  on_stop_signals(on_dex_signal);
   if (!wait_for_start() || !begin()) {
     node_->flush(1.0);
     return 1;
@@ -198,7 +198,7 @@ bool DexProcess::wait_for_start() {
       if (aborts_.count(0)) gave_up = aborts_[0];
     }
     if (g_dex_signal != 0) {
-      err_ << "eamos dex: " << name() << ": interrupted (" << signal_name(g_dex_signal) << ") before the start\n";
+      err_ << "eamos dex: " << name() << ": interrupted (" << stop_signal_name(g_dex_signal) << ") before the start\n";
       return false;
     }
     if (gave_up) {

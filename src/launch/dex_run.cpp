@@ -9,6 +9,7 @@
 #include "dex/latency.h"
 #include "dex/runner.h"
 #include "launch/dex_state.h"
+#include "launch/stop_signals.h"
 #include "launch/wall_time.h"
 
 namespace eamos::launch {
@@ -20,7 +21,7 @@ void DexProcess::heartbeat() {
   // (settle): a drone waiting at a barrier wakes only for this.
   node_->assert_alive();
   if (phase_ == Phase::running && g_dex_signal != 0)
-    abandon(name() + "'s DEX was interrupted (" + signal_name(g_dex_signal) + ")", std::nullopt, true);
+    abandon(name() + "'s DEX was interrupted (" + stop_signal_name(g_dex_signal) + ")", std::nullopt, true);
   check_pending_finished();
   loop_->after(heartbeat_s() * o_.speed, [this] { heartbeat(); });
 }

@@ -71,9 +71,8 @@ class DdsTraceSink : public dex::TraceSink {
 /// having logged; beyond that it stops logging them rather than grow.
 inline constexpr std::size_t kMaxRemembered = 1000;
 
-/// Set by the DEX's SIGINT/SIGTERM handler (dex_process.cpp); 0 until a signal came.
+/// Set by the DEX's handler of the stop signals (dex_process.cpp); 0 until one came.
 extern volatile std::sig_atomic_t g_dex_signal;
-inline const char* signal_name(int signal) { return signal == SIGINT ? "SIGINT" : "SIGTERM"; }
 
 class DexProcess {
  public:

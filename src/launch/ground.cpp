@@ -20,6 +20,7 @@
 #include "launch/inbox.h"
 #include "launch/process_watch.h"
 #include "launch/spawn.h"
+#include "launch/stop_signals.h"
 #include "launch/wall_time.h"
 #include "mid/home_check.h"
 
@@ -326,11 +327,10 @@ bool Ground::open_dds() {
 
 // From the DEX processes' start to their end: the barrier, the run and its end (check).
 bool Ground::fly() {
-  // waitpid needs SIGCHLD at its default; Ctrl-C or a TERM aborts the run (every drone
-  // runs its failsafe) instead of killing the ground in the middle of it.
+  // waitpid needs SIGCHLD at its default; Ctrl-C, a TERM or a hangup aborts the run (every
+  // drone runs its failsafe) instead of killing the ground in the middle of it.
   std::signal(SIGCHLD, SIG_DFL);
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  on_stop_signals(on_signal);
   first_started_at_ = wave_started_at_ = wall_s();
   barrier_deadline_ = first_started_at_ + o_.barrier_timeout_s;
   watch_ = std::make_unique<ProcessWatch>([this] {
@@ -631,7 +631,7 @@ void Ground::on_lost(const std::string& hash, int drone, std::uint64_t nonce) {
 
 void Ground::interrupt() {
   interrupted_ = true;
-  std::string why = std::string("the ground was interrupted (") + (g_signal == SIGINT ? "SIGINT" : "SIGTERM") + ")";
+  std::string why = std::string("the ground was interrupted (") + stop_signal_name(g_signal) + ")";
   g_signal = 0;
   if (stage_ == Stage::barrier) return fail_barrier(why);
   abort_run(why);

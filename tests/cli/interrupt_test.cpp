@@ -1,4 +1,4 @@
-// Ctrl-C and SIGTERM on `eamos run` while drones fly, and its output through a pipe: the
+// Ctrl-C, SIGTERM, a hangup and Ctrl-\ on `eamos run` while drones fly, and its output through a pipe: the
 // real process, signalled the way a terminal or a service manager does. The tests wait for
 // what the process prints (a takeoff succeeded), never for a time.
 #include <gtest/gtest.h>
@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "support/eamos_process.h"
+#include "support/run_eamos.h"
 
 namespace {
 
@@ -55,6 +56,18 @@ class Interrupt : public ::testing::Test {
       if (p_.seen.find(takeoff) != std::string::npos) continue;
       ASSERT_TRUE(eamos_test::read_until(p_, takeoff)) << p_.seen;
     }
+  }
+  /// The run ended on the stop signal `name`: exit 1, every drone landed, the report says why.
+  void expect_landed_after(const std::string& name) {
+    eamos_test::Exit e = eamos_test::wait_exit(p_);
+    ASSERT_TRUE(e.exited) << "killed by signal " << e.status << "\n" << p_.seen;
+    EXPECT_EQ(e.status, 1) << p_.seen;
+    EXPECT_NE(p_.seen.find("interrupted (" + name + ")"), std::string::npos) << p_.seen;
+    std::ifstream summary_file(dir_ / "summary.json");
+    ASSERT_TRUE(summary_file) << p_.seen;
+    nlohmann::json summary = nlohmann::json::parse(summary_file);
+    EXPECT_NE(summary["error"].get<std::string>().find("interrupted (" + name + ")"), std::string::npos);
+    for (const char* d : {"A", "B"}) EXPECT_TRUE(summary["drones"][d]["landed"]) << d;
   }
   fs::path dir_;
   EamosProcess p_;
@@ -113,20 +126,55 @@ TEST_F(Interrupt, CtrlCLandsEveryDroneThenReportsAndExitsNonZero) {
 TEST_F(Interrupt, SigtermAlsoLandsEveryDrone) {
   start_and_wait_until_airborne("10");
   ASSERT_EQ(kill(p_.pid, SIGTERM), 0);
-  eamos_test::Exit e = eamos_test::wait_exit(p_);
-  ASSERT_TRUE(e.exited) << "killed by signal " << e.status << "\n" << p_.seen;
-  EXPECT_EQ(e.status, 1) << p_.seen;
-  std::ifstream summary_file(dir_ / "summary.json");
-  ASSERT_TRUE(summary_file) << p_.seen;
-  nlohmann::json summary = nlohmann::json::parse(summary_file);
-  EXPECT_NE(summary["error"].get<std::string>().find("interrupted (SIGTERM)"), std::string::npos);
-  for (const char* d : {"A", "B"}) EXPECT_TRUE(summary["drones"][d]["landed"]) << d;
+  expect_landed_after("SIGTERM");
+}
+
+// The terminal or the SSH session the run was started from closes: SIGHUP ends the flight as
+// SIGTERM does, not with the default action that ended the process with drones in the air.
+TEST_F(Interrupt, AHangupLandsEveryDroneAsSigtermDoes) {
+  start_and_wait_until_airborne("10");
+  ASSERT_EQ(kill(p_.pid, SIGHUP), 0);
+  expect_landed_after("SIGHUP");
+}
+
+TEST_F(Interrupt, CtrlBackslashLandsEveryDroneAsCtrlCDoes) {
+  start_and_wait_until_airborne("10");
+  ASSERT_EQ(kill(p_.pid, SIGQUIT), 0);
+  expect_landed_after("SIGQUIT");
+}
+
+// `nohup eamos run …`: a SIGHUP ignored when eamos started stays ignored. The SIGTERM sent
+// after it is then the first signal the run takes (a SIGHUP taken would come first: it is
+// the lower signal, and the report names the first).
+TEST_F(Interrupt, AHangupIgnoredWhenTheRunStartedStaysIgnored) {
+  struct sigaction ignore {}, before {};
+  ignore.sa_handler = SIG_IGN;
+  sigaction(SIGHUP, &ignore, &before);  // inherited by the eamos process, as nohup does it
+  start_and_wait_until_airborne("10");
+  sigaction(SIGHUP, &before, nullptr);
+  ASSERT_EQ(kill(p_.pid, SIGHUP), 0);
+  ASSERT_EQ(kill(p_.pid, SIGTERM), 0);
+  expect_landed_after("SIGTERM");
+  EXPECT_EQ(p_.seen.find("SIGHUP"), std::string::npos) << p_.seen;
+}
+
+// `eamos run … | head`: the reader goes away mid-flight and the next line written gets
+// EPIPE, not SIGPIPE's default action: the mission flies to its end and reports it.
+TEST_F(Interrupt, AReaderOfTheLogThatGoesAwayDoesNotEndTheFlight) {
+  fs::path summary = dir_ / "summary.json";
+  auto r = eamos_test::run_program(
+      "bash", "-c '" + std::string(EAMOS_BINARY) + " run examples/listing2.eamos --speed 20 --summary " +
+                  summary.string() + " | head -1; echo \"eamos exited with ${PIPESTATUS[0]}\"'");
+  EXPECT_NE(r.out.find("eamos exited with 0"), std::string::npos) << r.out;
+  std::ifstream summary_file(summary);
+  ASSERT_TRUE(summary_file) << r.out;
+  EXPECT_EQ(nlohmann::json::parse(summary_file)["status"], "completed") << r.out;
 }
 
 // A signal while eamos still reads and compiles the mission (with --monitor it then draws
 // the graphs, seconds on a loaded machine) is eamos' own too, not the default action that
-// killed the process with status 143. The mission file is a FIFO: eamos waits in its open
-// until the test opens the other end, so the signal comes at that known moment.
+// killed the process with status 143. The mission file is a FIFO: eamos waits for its first
+// bytes, which the test writes only after the signal, so the signal comes at that known moment.
 TEST_F(Interrupt, SigtermWhileTheMissionIsReadEndsTheRunBeforeAnyDroneStarts) {
   fs::path fifo = dir_ / "fifo.eamos";
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);

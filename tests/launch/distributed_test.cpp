@@ -676,30 +676,42 @@ TEST_F(Distributed, AbortFromAnUnknownDroneNumberIsDroppedAndTheNextAbortIsObeye
   EXPECT_NE(log.find("valid abort after the bad one"), std::string::npos) << log;
 }
 
-// A DEX stopped with SIGTERM (its service stopped, a shutdown) must not die at once: the
-// others would fail on its lost liveliness, its own drone would stay in the air.
-TEST_F(Distributed, SigtermOnADexLandsItsDroneAndEveryOther) {
+// Lead's DEX gets `signal` once both drones are airborne; every drone must end in its
+// failsafe, and Lead's DEX says why (it was not lost).
+void signal_the_lead_dex_in_flight(const fs::path& dir, int signal, const std::string& name, int domain) {
   std::string mission = std::string(EAMOS_SOURCE_DIR) + "/tests/launch/missions/long_hover.eamos";
-  Output c = eamos("compile -q " + mission + " -o " + (dir_ / "deploy").string());
+  Output c = eamos("compile -q " + mission + " -o " + (dir / "deploy").string());
   ASSERT_EQ(c.status, 0) << c.out;
   int airborne = 0;
   pid_t lead = -1;
-  Output r = eamos("launch " + (dir_ / "deploy").string() + " --speed 5 --domain 38 --trace " +
-                       (dir_ / "trace.jsonl").string() + " --summary " + (dir_ / "summary.json").string(),
+  std::string seen;
+  Output r = eamos("launch " + (dir / "deploy").string() + " --speed 5 --domain " + std::to_string(domain) +
+                       " --trace " + (dir / "trace.jsonl").string() + " --summary " + (dir / "summary.json").string(),
                    [&](const std::string& line) {
-                     static std::string seen;
                      seen += line;
                      if (line.find(".Takeoff(5)  succeeded") != std::string::npos && ++airborne == 2) {
                        lead = dex_pid(seen, "Lead");
                        ASSERT_GT(lead, 0) << seen;
-                       kill(lead, SIGTERM);
+                       kill(lead, signal);
                      }
                    });
   ASSERT_GT(lead, 0) << r.out;
-  ASSERT_NO_FATAL_FAILURE(expect_every_drone_in_failsafe(dir_, r));
-  std::string log = read_text(dir_ / "deploy" / "Lead" / "dex.log");
-  EXPECT_NE(log.find("Lead's DEX was interrupted (SIGTERM)"), std::string::npos) << log;
+  ASSERT_NO_FATAL_FAILURE(expect_every_drone_in_failsafe(dir, r));
+  std::string log = read_text(dir / "deploy" / "Lead" / "dex.log");
+  EXPECT_NE(log.find("Lead's DEX was interrupted (" + name + ")"), std::string::npos) << log;
   EXPECT_EQ(r.out.find("no liveliness"), std::string::npos) << r.out;  // it said why, it was not lost
+}
+
+// A DEX stopped with SIGTERM (its service stopped, a shutdown) must not die at once: the
+// others would fail on its lost liveliness, its own drone would stay in the air.
+TEST_F(Distributed, SigtermOnADexLandsItsDroneAndEveryOther) {
+  signal_the_lead_dex_in_flight(dir_, SIGTERM, "SIGTERM", 38);
+}
+
+// A DEX started by hand in an SSH session that drops gets SIGHUP: the same as SIGTERM, not
+// the default action that ended it with its drone in the air.
+TEST_F(Distributed, HangupOfTheSessionADexWasStartedFromLandsItsDroneAndEveryOther) {
+  signal_the_lead_dex_in_flight(dir_, SIGHUP, "SIGHUP", 39);
 }
 
 TEST_F(Distributed, DexRefusesAFolderWithoutAMission) {
