@@ -474,8 +474,9 @@ int fly(const Commands& c, Options& o, char** argv) {
 constexpr eamos::cli::CompileFinisher kFinishCompile{exec_credentials, true};
 #else
 int fly(const Commands& c, Options& o, char**) {
-  // A reader of the log that goes away (`| head`, a pager closed) must not end a flight.
-  eamos::launch::ignore_broken_pipes();
+  // A reader of the log that goes away (`| head`, a pager closed) or Ctrl-Z must not end or
+  // suspend a flight.
+  eamos::launch::keep_flying_through_the_terminal();
   if (*c.run && o.distributed) {
     o.launch.speed = o.run.speed > 0 ? o.run.speed : 1.0;
     o.launch.time_limit_s = o.run.time_limit;

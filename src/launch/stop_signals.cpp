@@ -34,6 +34,8 @@ void on_stop_signals(void (*handler)(int)) {
   for (int s : stop_signals()) std::signal(s, handler);
 }
 
-void ignore_broken_pipes() { std::signal(SIGPIPE, SIG_IGN); }
+void keep_flying_through_the_terminal() {
+  for (int s : {SIGPIPE, SIGTSTP, SIGTTIN, SIGTTOU}) std::signal(s, SIG_IGN);
+}
 
 }  // namespace eamos::launch

@@ -17,8 +17,11 @@ const char* stop_signal_name(int signal);
 /// Installs `handler` for every stop signal.
 void on_stop_signals(void (*handler)(int));
 
-/// SIGPIPE ignored: a reader of the output that goes away (`| head`, a pager closed) makes a
-/// write fail instead of killing the process; the flight goes on to its end.
-void ignore_broken_pipes();
+/// For a process that flies, what the terminal and the shell may send to stop or kill it
+/// without meaning to end the flight is ignored: SIGPIPE (a reader of the output that went
+/// away, `| head`, a pager closed: the write fails and the flight goes on to its end), SIGTSTP
+/// (Ctrl-Z would suspend it with every drone on its last command), SIGTTIN and SIGTTOU (a
+/// background job that touches the terminal would be suspended too).
+void keep_flying_through_the_terminal();
 
 }  // namespace eamos::launch

@@ -158,6 +158,16 @@ TEST_F(Interrupt, AHangupIgnoredWhenTheRunStartedStaysIgnored) {
   EXPECT_EQ(p_.seen.find("SIGHUP"), std::string::npos) << p_.seen;
 }
 
+// Ctrl-Z would suspend eamos with every drone on its last command (a MAVLink vehicle flying
+// on to its target, nobody watching): the commands that fly are not suspended. A stopped
+// process would leave the SIGTERM pending and never end; this one lands its drones.
+TEST_F(Interrupt, CtrlZDoesNotSuspendAFlight) {
+  start_and_wait_until_airborne("10");
+  ASSERT_EQ(kill(p_.pid, SIGTSTP), 0);
+  ASSERT_EQ(kill(p_.pid, SIGTERM), 0);
+  expect_landed_after("SIGTERM");
+}
+
 // `eamos run … | head`: the reader goes away mid-flight and the next line written gets
 // EPIPE, not SIGPIPE's default action: the mission flies to its end and reports it.
 TEST_F(Interrupt, AReaderOfTheLogThatGoesAwayDoesNotEndTheFlight) {
