@@ -57,7 +57,8 @@ bool compile_file(const std::string& path, const std::string& fleet_path, Diagno
   auto source = std::make_shared<SourceFile>();
   std::string error;
   if (!read_source_file(path, *source, error)) {
-    diags.error(nullptr, {}, "cannot read mission file '" + path + "': " + error + "; give the path of the mission's .eamos file");
+    diags.error(nullptr, {},
+                "cannot read mission file '" + path + "': " + error + "; give the path of the mission's .eamos file");
     return false;
   }
   bool fleet_ok = !diags.has_errors();

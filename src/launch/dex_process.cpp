@@ -41,8 +41,9 @@ volatile std::sig_atomic_t g_dex_signal = 0;
 namespace {
 
 // SIGTERM (a service stopped, the ground's clean-up), Ctrl-C on a DEX run by hand or the
-// hangup of the SSH session it was started from (launch/stop_signals.h): the loop notices at its next heartbeat and abandons the mission into the failsafe. A second
-// signal ends the process at once (_exit is async-signal-safe; nothing else is done here).
+// hangup of the SSH session it was started from (launch/stop_signals.h): the loop notices
+// at its next heartbeat and abandons the mission into the failsafe. A second signal ends
+// the process at once (_exit is async-signal-safe; nothing else is done here).
 void on_dex_signal(int signal) {
   if (g_dex_signal != 0) _exit(128 + signal);
   g_dex_signal = signal;
