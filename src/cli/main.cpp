@@ -330,7 +330,7 @@ CLI::App* add_sim_vehicle(CLI::App& app, Options& o) {
       ->check(eamos::cli::whole_number(1, 65535));
   simv->add_option("--gcs", v.ground_station,
                    "Also stream to a ground station so QGroundControl shows the vehicle, e.g. udpout://127.0.0.1:14550");
-  simv->add_option("--connection", v.connection, "Any link URL instead: udp://:PORT, udpout://HOST:PORT or tcp://HOST:PORT")
+  simv->add_option("--connection", v.connection, "Any link URL instead: udp://:PORT, udpout://HOST:PORT, tcp://HOST:PORT or serial://DEVICE:RATE")
       ->excludes(udp);
   simv->add_option("--sysid", v.sysid, "MAVLink system id")->check(eamos::cli::whole_number(1, 255));
   simv->add_option("--autopilot", v.autopilot, "Whose modes and rules to play: px4 (OFFBOARD) or ardupilot (Copter, GUIDED)")

@@ -365,11 +365,12 @@ void FleetParser::range(const YAML::Node& node, const std::string& what, std::op
 
 // The port of a connection URL (udp://[HOST]:PORT, udpout://HOST:PORT, tcp://HOST:PORT) is
 // checked here, so that `eamos check` reports it at its line; the mavlink adapter parses the
-// rest of the URL when it connects (src/mavlink/url.h).
+// rest of the URL, and a serial:// URL's rate, when it connects (src/mavlink/url.h).
 void FleetParser::check_connection_port(const YAML::Node& node, const std::string& what, const std::string& url) {
   std::size_t scheme = url.find("://");
   std::size_t colon = url.rfind(':');
   if (scheme == std::string::npos || colon == std::string::npos || colon < scheme + 3) return;
+  if (url.compare(0, scheme, "serial") == 0) return;
   std::string port = url.substr(colon + 1);
   bool digits = !port.empty() && port.size() <= 6 && port.find_first_not_of("0123456789") == std::string::npos;
   if (digits && std::stol(port) >= 1 && std::stol(port) <= 65535) return;

@@ -4,7 +4,10 @@
 #include <fcntl.h>
 #include <netdb.h>
 #include <poll.h>
+#include <sys/ioctl.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
+#include <termios.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -79,27 +82,73 @@ bool connect_within(int fd, const sockaddr_in& to, int timeout_ms, std::string& 
   return true;
 }
 
-}  // namespace
+speed_t termios_speed(unsigned baud) {
+  switch (baud) {
+    case 9600: return B9600;
+    case 19200: return B19200;
+    case 38400: return B38400;
+    case 57600: return B57600;
+    case 115200: return B115200;
+    case 230400: return B230400;
+    case 460800: return B460800;
+    case 500000: return B500000;
+    case 576000: return B576000;
+    case 921600: return B921600;
+    case 1000000: return B1000000;
+    case 1500000: return B1500000;
+    case 2000000: return B2000000;
+    default: return B3000000;  // parse_url lets no other rate through
+  }
+}
 
-OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame, double reconnect_s,
-                      const std::optional<SigningKey>& verify, bool require_signed) {
-  auto fail = [&](const std::string& why) {
-    return OpenResult{nullptr, "connection '" + endpoint.url + "': " + why};
-  };
-  sockaddr_in addr{};
-  std::string error;
-  if (!resolve(endpoint.host, endpoint.port, addr, error)) return fail(error);
+/// Opens a serial port raw (8N1, no flow control, no echo, no line discipline) at `baud`;
+/// -1 with `error` when it is no serial port or cannot be set so. Exclusive (TIOCEXCL): a
+/// second program opening the port would take half of the autopilot's bytes.
+int open_serial(const Endpoint& e, std::string& error) {
+  int fd = ::open(e.device.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    error = sys_error("open " + e.device);
+    return -1;
+  }
+  struct stat st {};
+  termios tio{};
+  if (fstat(fd, &st) != 0 || !S_ISCHR(st.st_mode) || tcgetattr(fd, &tio) != 0) {
+    error = e.device + " is not a serial port";
+    close(fd);
+    return -1;
+  }
+  cfmakeraw(&tio);
+  tio.c_cflag |= CLOCAL | CREAD;
+  tio.c_cflag &= ~(CSTOPB | CRTSCTS);
+  tio.c_cc[VMIN] = 1;
+  tio.c_cc[VTIME] = 0;
+  if (cfsetispeed(&tio, termios_speed(e.baud)) != 0 || cfsetospeed(&tio, termios_speed(e.baud)) != 0 ||
+      tcsetattr(fd, TCSANOW, &tio) != 0 || ioctl(fd, TIOCEXCL) != 0) {
+    error = sys_error("set " + e.device + " to " + std::to_string(e.baud) + " baud");
+    close(fd);
+    return -1;
+  }
+  tcflush(fd, TCIOFLUSH);  // what an earlier program left unread is no frame of this link
+  int flags = fcntl(fd, F_GETFL, 0);
+  fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
+  return fd;
+}
 
+/// A bound socket (udp://, udpout://) or a connected one (tcp://); -1 with `error`.
+int open_socket(const Endpoint& endpoint, const sockaddr_in& addr, std::string& error) {
   bool tcp = endpoint.kind == LinkKind::tcp_client;
   int fd = socket(AF_INET, tcp ? SOCK_STREAM : SOCK_DGRAM, 0);
-  if (fd < 0) return fail(sys_error("socket"));
+  if (fd < 0) {
+    error = sys_error("socket");
+    return -1;
+  }
   if (endpoint.kind == LinkKind::udp_listen) {
     // No SO_REUSEADDR: on Linux it would let a second program share the port and steal
     // half of the vehicle's datagrams; a clear "in use" error is better.
-    if (bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
-      error = sys_error("bind to port " + std::to_string(endpoint.port));
+    if (bind(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0) {
+      error = sys_error("bind to port " + std::to_string(endpoint.port)) + " (is another program listening there?)";
       close(fd);
-      return fail(error + " (is another program listening there?)");
+      return -1;
     }
   } else if (endpoint.kind == LinkKind::udp_out) {
     sockaddr_in any{};
@@ -107,12 +156,29 @@ OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame, double re
     if (bind(fd, reinterpret_cast<sockaddr*>(&any), sizeof any) != 0) {
       error = sys_error("bind");
       close(fd);
-      return fail(error);
+      return -1;
     }
   } else if (!connect_within(fd, addr, 5000, error)) {
+    error += " (is the autopilot or SITL serving TCP there?)";
     close(fd);
-    return fail(error + " (is the autopilot or SITL serving TCP there?)");
+    return -1;
   }
+  return fd;
+}
+
+}  // namespace
+
+OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame, double reconnect_s,
+                      const std::optional<SigningKey>& verify, bool require_signed) {
+  auto fail = [&](const std::string& why) {
+    return OpenResult{nullptr, "connection '" + endpoint.url + "': " + why};
+  };
+  bool serial = endpoint.kind == LinkKind::serial;
+  sockaddr_in addr{};
+  std::string error;
+  if (!serial && !resolve(endpoint.host, endpoint.port, addr, error)) return fail(error);
+  int fd = serial ? open_serial(endpoint, error) : open_socket(endpoint, addr, error);
+  if (fd < 0) return fail(error);
   int pipe_fds[2];
   if (pipe(pipe_fds) != 0) {
     close(fd);
@@ -125,7 +191,7 @@ OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame, double re
     link->parser_.require_signed(require_signed);
   }
   if (endpoint.kind != LinkKind::udp_listen) {
-    link->peer_ = addr;
+    link->peer_ = addr;  // serial: unused; the port itself is the peer
     link->has_peer_ = true;
   }
   link->thread_ = std::thread([l = link.get()] {
@@ -167,10 +233,10 @@ Link::~Link() {
 bool Link::send(std::span<const uint8_t> bytes) {
   std::lock_guard lock(mutex_);
   if (!has_peer_ || closed_) return false;
-  ssize_t n = endpoint_.kind == LinkKind::tcp_client
-                  ? ::send(fd_, bytes.data(), bytes.size(), MSG_NOSIGNAL)
-                  : sendto(fd_, bytes.data(), bytes.size(), 0,
-                           reinterpret_cast<const sockaddr*>(&peer_), sizeof peer_);
+  ssize_t n = endpoint_.kind == LinkKind::tcp_client ? ::send(fd_, bytes.data(), bytes.size(), MSG_NOSIGNAL)
+              : endpoint_.kind == LinkKind::serial   ? ::write(fd_, bytes.data(), bytes.size())
+                                                     : sendto(fd_, bytes.data(), bytes.size(), 0,
+                                                              reinterpret_cast<const sockaddr*>(&peer_), sizeof peer_);
   return n == static_cast<ssize_t>(bytes.size());
 }
 
@@ -191,10 +257,13 @@ void Link::receive_loop() {
     if (fds[0].revents == 0) continue;
     sockaddr_in from{};
     socklen_t from_len = sizeof from;
-    ssize_t n = recvfrom(fd_, buffer.data(), buffer.size(), 0,
-                         reinterpret_cast<sockaddr*>(&from), &from_len);
+    bool stream = endpoint_.kind == LinkKind::tcp_client || endpoint_.kind == LinkKind::serial;
+    ssize_t n = endpoint_.kind == LinkKind::serial
+                    ? ::read(fd_, buffer.data(), buffer.size())
+                    : recvfrom(fd_, buffer.data(), buffer.size(), 0, reinterpret_cast<sockaddr*>(&from), &from_len);
+    if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
     if (n <= 0) {
-      if (endpoint_.kind != LinkKind::tcp_client) continue;  // UDP: e.g. ICMP port unreachable
+      if (!stream) continue;     // UDP: e.g. ICMP port unreachable
       if (!reconnect()) return;  // the destructor came first
       continue;
     }
@@ -210,8 +279,9 @@ void Link::receive_loop() {
 }
 
 bool Link::reconnect() {
-  // The TCP peer hung up (a SITL restarted, a radio dropped out). Heartbeats stop meanwhile,
-  // so the adapter sees a lost link; try again until it is back.
+  // The TCP peer hung up (a SITL restarted, a radio dropped out), or the serial port went
+  // away (a USB autopilot unplugged or rebooted). Heartbeats stop meanwhile, so the adapter
+  // sees a lost link; try again until it is back.
   {
     std::lock_guard lock(mutex_);
     closed_ = true;
@@ -222,9 +292,9 @@ bool Link::reconnect() {
   for (;;) {
     pollfd wake{wake_read_, POLLIN, 0};
     if (poll(&wake, 1, reconnect_ms_) != 0) return false;
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
     std::string error;
-    if (fd >= 0 && connect_within(fd, peer_, 1000, error)) {
+    int fd = endpoint_.kind == LinkKind::serial ? open_serial(endpoint_, error) : socket(AF_INET, SOCK_STREAM, 0);
+    if (fd >= 0 && (endpoint_.kind == LinkKind::serial || connect_within(fd, peer_, 1000, error))) {
       std::lock_guard lock(mutex_);
       fd_ = fd;
       closed_ = false;

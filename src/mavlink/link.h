@@ -1,9 +1,10 @@
 #pragma once
-// A MAVLink connection over UDP or TCP (url.h) with its own receive thread. The thread reads
+// A MAVLink connection over UDP, TCP or a serial port (url.h) with its own receive thread. The thread reads
 // bytes, runs them through the Parser and hands each good frame to the FrameHandler — on the
 // link's thread, so the handler must only pass the frame on (the adapter posts it to its event
 // loop) and never touch state the loop's thread owns. send() may be called from any thread.
-// A TCP connection the peer closes is reopened (every second by default) until it is back.
+// A TCP connection the peer closes, or a serial port that goes away (USB unplugged), is
+// reopened (every second by default) until it is back.
 #include <netinet/in.h>
 
 #include <atomic>
@@ -26,8 +27,8 @@ struct OpenResult;
 
 class Link {
  public:
-  /// Opens the socket (binds, or connects for TCP) and starts the receive thread.
-  /// `reconnect_s`: TCP only, the pause between attempts to reopen a closed connection.
+  /// Opens the socket (binds, or connects for TCP) or the serial port and starts the receive
+  /// thread. `reconnect_s`: TCP and serial, the pause between attempts to reopen.
   /// `verify`: check signed frames against this key from the first datagram on, and drop
   /// unsigned ones when `require_signed` (see verify_with).
   static OpenResult open(const Endpoint& endpoint, FrameHandler on_frame, double reconnect_s = 1.0,
@@ -88,7 +89,7 @@ class Link {
   std::atomic<bool> locked_{false};        ///< udp://: peer_ is the vehicle's, for good
   std::atomic<uint64_t> foreign_datagrams_{0};
   sockaddr_in last_from_{};     ///< udp://: sender of the previous datagram (receive thread only)
-  bool closed_ = false;         ///< TCP: the peer closed the connection; not yet reconnected
+  bool closed_ = false;         ///< TCP, serial: the connection closed or the port went away; not yet reopened
   ParserStats stats_;
   /// Signing changes asked for from another thread, applied by the receive thread (which
   /// alone touches parser_) before its next datagram; guarded by mutex_.

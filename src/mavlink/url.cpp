@@ -6,18 +6,39 @@ namespace eamos::mavlink {
 
 namespace {
 
-const char* kExamples = "udp://:14540, udpout://127.0.0.1:14550 or tcp://127.0.0.1:5760";
+const char* kExamples =
+    "udp://:14540, udpout://127.0.0.1:14550, tcp://127.0.0.1:5760 or serial:///dev/ttyAMA0:921600";
 
 EndpointResult bad(std::string_view url, const std::string& why) {
   return {std::nullopt, "connection '" + std::string(url) + "': " + why + " (examples: " +
                             kExamples + ")"};
 }
 
+// serial:///dev/ttyAMA0:921600: an absolute device path and a rate termios knows.
+EndpointResult parse_serial(std::string_view url, std::string_view rest, Endpoint e) {
+  size_t colon = rest.rfind(':');
+  if (rest.empty() || rest.front() != '/' || colon == std::string_view::npos || colon == 0)
+    return bad(url, "write the device's absolute path and its rate, serial:///dev/ttyAMA0:921600");
+  e.device = std::string(rest.substr(0, colon));
+  std::string_view baud = rest.substr(colon + 1);
+  unsigned value = 0;
+  auto [end, ec] = std::from_chars(baud.data(), baud.data() + baud.size(), value);
+  bool standard = false;
+  for (unsigned b : kSerialBauds) standard = standard || b == value;
+  if (baud.empty() || ec != std::errc() || end != baud.data() + baud.size() || !standard)
+    return bad(url, "rate '" + std::string(baud) +
+                        "' is not a serial rate; give the autopilot port's rate (its SERIALn_BAUD or "
+                        "SER_TELn_BAUD): 57600, 115200, 921600, …");
+  e.baud = value;
+  return {e, ""};
+}
+
 }  // namespace
 
 EndpointResult parse_url(std::string_view url) {
   size_t sep = url.find("://");
-  if (sep == std::string_view::npos) return bad(url, "no scheme; start with udp://, udpout:// or tcp://");
+  if (sep == std::string_view::npos)
+    return bad(url, "no scheme; start with udp://, udpout://, tcp:// or serial://");
   std::string_view scheme = url.substr(0, sep);
   std::string_view rest = url.substr(sep + 3);
   Endpoint e;
@@ -25,7 +46,9 @@ EndpointResult parse_url(std::string_view url) {
   if (scheme == "udp") e.kind = LinkKind::udp_listen;
   else if (scheme == "udpout") e.kind = LinkKind::udp_out;
   else if (scheme == "tcp") e.kind = LinkKind::tcp_client;
-  else return bad(url, "unknown scheme '" + std::string(scheme) + "'; use udp, udpout or tcp");
+  else if (scheme == "serial") e.kind = LinkKind::serial;
+  else return bad(url, "unknown scheme '" + std::string(scheme) + "'; use udp, udpout, tcp or serial");
+  if (e.kind == LinkKind::serial) return parse_serial(url, rest, e);
 
   size_t colon = rest.rfind(':');
   if (colon == std::string_view::npos) return bad(url, "no port; write HOST:PORT or :PORT");

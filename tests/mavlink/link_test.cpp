@@ -4,6 +4,10 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <fcntl.h>
+#include <pty.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -248,6 +252,91 @@ TEST(TcpLink, ReconnectsAfterThePeerClosed) {
   ASSERT_TRUE(adapter_side.wait_for(1));
   EXPECT_EQ(adapter_side.frames[0].sysid, 3);
   close(second);
+}
+
+// A serial port: the kernel's pseudo-terminal, a real tty with termios (openpty). The test
+// holds the master side, where the autopilot's UART would be.
+struct Pty {
+  int master = -1;
+  std::string slave_path;
+  Pty() {
+    int slave = -1;
+    char name[256] = {};
+    if (openpty(&master, &slave, name, nullptr, nullptr) == 0) {
+      slave_path = name;
+      close(slave);  // the link opens it by its path, as a user's URL names it
+    }
+  }
+  ~Pty() {
+    if (master >= 0) close(master);
+  }
+};
+
+TEST(SerialLink, CarriesFramesBothWaysOverATerminalInRawMode) {
+  Pty pty;
+  ASSERT_GE(pty.master, 0);
+  Mailbox adapter_side;
+  OpenResult r = Link::open(endpoint("serial://" + pty.slave_path + ":921600"), adapter_side.handler());
+  ASSERT_TRUE(r.link) << r.error;
+
+  // Bytes a line discipline would change (CR, NL, ^C, ^D, 0xFF) arrive untouched: raw mode.
+  Encoder vehicle{3, 1};
+  std::vector<uint8_t> bytes = vehicle.encode(pack(Statustext{6, "\r\n\x03\x04\xff", 0, 0}));
+  std::vector<uint8_t> second = vehicle.encode(pack(Heartbeat{}));
+  bytes.insert(bytes.end(), second.begin(), second.end());
+  ASSERT_EQ(write(pty.master, bytes.data(), 7), 7);
+  ASSERT_EQ(write(pty.master, bytes.data() + 7, bytes.size() - 7), ssize_t(bytes.size() - 7));
+  ASSERT_TRUE(adapter_side.wait_for(2));
+  EXPECT_EQ(adapter_side.frames[1].sysid, 3);
+  EXPECT_EQ(r.link->stats().bad_crc, 0u);
+
+  std::vector<uint8_t> ack = Encoder{3, 191}.encode(pack(CommandAck{22, 0}));
+  ASSERT_TRUE(r.link->send(ack));
+  std::vector<uint8_t> got(ack.size());
+  size_t have = 0;
+  while (have < got.size()) {
+    ssize_t n = read(pty.master, got.data() + have, got.size() - have);
+    ASSERT_GT(n, 0);
+    have += static_cast<size_t>(n);
+  }
+  EXPECT_EQ(got, ack);
+}
+
+// The errno of opening `path` read-write as user `uid` (root may open a port held
+// exclusively, another user may not), from a child process that becomes that user.
+int open_errno_as(const std::string& path, uid_t uid) {
+  pid_t child = fork();
+  if (child == 0) {
+    if (setgid(uid) != 0 || setuid(uid) != 0) _exit(255);
+    int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY);
+    _exit(fd >= 0 ? 0 : errno);
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// A port is the link's alone: a second program opening it would take half of the bytes.
+TEST(SerialLink, ASecondOpenOfThePortIsRefusedWhileTheLinkHoldsIt) {
+  Pty pty;
+  ASSERT_GE(pty.master, 0);
+  ASSERT_EQ(chmod(pty.slave_path.c_str(), 0666), 0);
+  const uid_t nobody = 65534;
+  ASSERT_EQ(open_errno_as(pty.slave_path, nobody), 0) << "before the link holds it, anyone may open it";
+  Mailbox a;
+  OpenResult link = Link::open(endpoint("serial://" + pty.slave_path + ":57600"), a.handler());
+  ASSERT_TRUE(link.link) << link.error;
+  EXPECT_EQ(open_errno_as(pty.slave_path, nobody), EBUSY);
+}
+
+TEST(SerialLink, AFileThatIsNoSerialPortIsRefusedByName) {
+  Mailbox a;
+  OpenResult null = Link::open(endpoint("serial:///dev/null:57600"), a.handler());
+  EXPECT_FALSE(null.link);
+  EXPECT_NE(null.error.find("/dev/null is not a serial port"), std::string::npos) << null.error;
+  OpenResult missing = Link::open(endpoint("serial:///dev/ttyEAMOS9:57600"), a.handler());
+  EXPECT_FALSE(missing.link);
+  EXPECT_NE(missing.error.find("No such file or directory"), std::string::npos) << missing.error;
 }
 
 TEST(TcpLink, RefusedConnectionNamesTheUrl) {
