@@ -101,9 +101,9 @@ speed_t termios_speed(unsigned baud) {
   }
 }
 
-/// Opens a serial port raw (8N1, no flow control, no echo, no line discipline) at `baud`;
-/// -1 with `error` when it is no serial port or cannot be set so. Exclusive (TIOCEXCL): a
-/// second program opening the port would take half of the autopilot's bytes.
+/// Opens a serial port raw (8N1, no flow control, no echo, no line discipline) at `baud`,
+/// non-blocking; -1 with `error` when it is no serial port or cannot be set so. Exclusive
+/// (TIOCEXCL): a second program opening the port would take half of the autopilot's bytes.
 int open_serial(const Endpoint& e, std::string& error) {
   int fd = ::open(e.device.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) {
@@ -129,8 +129,9 @@ int open_serial(const Endpoint& e, std::string& error) {
     return -1;
   }
   tcflush(fd, TCIOFLUSH);  // what an earlier program left unread is no frame of this link
-  int flags = fcntl(fd, F_GETFL, 0);
-  fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
+  // It stays non-blocking: a port whose other end stopped reading (a hung autopilot, a USB
+  // bridge) fills its buffer, and a blocking write would stall the event loop that sends.
+  // The frame is then dropped (send() is false); reads wait in poll().
   return fd;
 }
 

@@ -302,6 +302,22 @@ TEST(SerialLink, CarriesFramesBothWaysOverATerminalInRawMode) {
   EXPECT_EQ(got, ack);
 }
 
+// The autopilot's end stops reading (hung, a USB bridge stalled): once the port's buffer is
+// full a frame is dropped and send() says so at once, instead of blocking the event loop
+// that sends it. A blocking port would hang here.
+TEST(SerialLink, AFullPortDropsAFrameInsteadOfBlockingTheSender) {
+  Pty pty;
+  ASSERT_GE(pty.master, 0);
+  Mailbox a;
+  OpenResult r = Link::open(endpoint("serial://" + pty.slave_path + ":57600"), a.handler());
+  ASSERT_TRUE(r.link) << r.error;
+  std::vector<uint8_t> frame = Encoder{3, 191}.encode(pack(Heartbeat{}));
+  int sent = 0;
+  while (sent < 1000000 && r.link->send(frame)) ++sent;
+  EXPECT_LT(sent, 1000000) << "every frame went out although nobody read the port";
+  EXPECT_GT(sent, 0);
+}
+
 // The errno of opening `path` read-write as user `uid` (root may open a port held
 // exclusively, another user may not), from a child process that becomes that user.
 int open_errno_as(const std::string& path, uid_t uid) {
