@@ -43,7 +43,7 @@ endfunction()
 
 eamos_export(eamos_vocab vocab vocab kinds.h)
 eamos_export(eamos_diag diag diag source.h diagnostics.h)
-eamos_export(eamos_fleet fleet fleet catalog.h fleet.h)
+eamos_export(eamos_fleet fleet fleet catalog.h fleet.h link_url.h)
 eamos_export(eamos_lang lang lang ast.h token.h lexer.h parser.h checker.h)
 eamos_export(eamos_graph graph graph amt.h meg.h mdg.h pipeline.h export.h)
 eamos_export(eamos_deploy deploy deploy mission_file.h synthesize.h drone_package.h)
@@ -54,7 +54,7 @@ eamos_export(eamos_dex dex dex bridge.h engine.h expr.h failsafe.h failure.h lat
 eamos_export(eamos_trace trace trace plot.h trace_schema.h)
 eamos_export(eamos_sim sim sim battery.h motion.h sim_adapter.h sim_drone.h)
 eamos_export(eamos_mavlink mavlink mavlink crc.h enums.h field_def.h fields.h frame.h link.h messages.h payloads.h
-             signing.h url.h)
+             signing.h)
 eamos_export(eamos_mavlink_adapter mavlink_adapter mavlink_adapter adapter.h autopilot.h autopilot_params.h
              autopilot_texts.h camera.h command_sender.h link_watch.h mavlink_drone.h mavlink_options.h
              fence_upload.h mode_commands.h orbit_flight.h setpoint_pacer.h setpoint_stream.h telemetry.h vehicle_clock.h

@@ -5,8 +5,9 @@
 
 #include "cli/arguments.h"
 #include "cli/commands.h"
+#include "diag/printable.h"
+#include "fleet/link_url.h"
 #include "launch/stop_signals.h"
-#include "mavlink/url.h"
 #include "mid/event_loop.h"
 #include "sim_vehicle/sim_vehicle.h"
 
@@ -20,9 +21,9 @@ void on_signal(int) { g_stop = 1; }
 int cmd_sim_vehicle(const SimVehicleCommandOptions& o) {
   std::string url = o.connection;
   if (url.empty()) url = "udpout://127.0.0.1:" + std::to_string(o.udp_port);
-  mavlink::EndpointResult endpoint = mavlink::parse_url(url);
+  fleet::EndpointResult endpoint = fleet::parse_link_url(url);
   if (!endpoint.endpoint) {
-    std::cerr << error_prefix() << "" << endpoint.error << "\n";
+    std::cerr << error_prefix() << "connection '" << diag::printable(url, 120) << "': " << endpoint.error << "\n";
     return 1;
   }
   mid::EventLoop loop({mid::ClockMode::real_time, o.speed});
@@ -38,8 +39,8 @@ int cmd_sim_vehicle(const SimVehicleCommandOptions& o) {
     return 1;
   }
   if (!o.ground_station.empty()) {
-    mavlink::EndpointResult gcs = mavlink::parse_url(o.ground_station);
-    std::string error = gcs.endpoint ? vehicle.open_ground_station(*gcs.endpoint) : gcs.error;
+    fleet::EndpointResult gcs = fleet::parse_link_url(o.ground_station);
+    std::string error = gcs.endpoint ? vehicle.open_ground_station(*gcs.endpoint) : "'" + diag::printable(o.ground_station, 120) + "': " + gcs.error;
     if (!error.empty()) {
       std::cerr << error_prefix() << "--gcs " << error << "\n";
       return 1;

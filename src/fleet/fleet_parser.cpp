@@ -6,6 +6,7 @@
 
 #include "diag/number.h"
 #include "fleet/fleet.h"
+#include "fleet/link_url.h"
 #include "fleet/yaml_reader.h"
 
 namespace eamos::fleet {
@@ -70,7 +71,7 @@ class FleetParser {
               std::optional<SensorRange>& range);
   void range(const YAML::Node& node, const std::string& what, std::optional<SensorRange>& out);
   void safety(const YAML::Node& node);
-  void check_connection_port(const YAML::Node& node, const std::string& what, const std::string& url);
+  void check_connection(const YAML::Node& node, const std::string& what, const std::string& url);
   void separation(const YAML::Node& node, Separation& out);
   void tolerance(const YAML::Node& node, const std::string& where, GoalTolerance& out);
   /// A map of positive numbers, `keys[k]` read into `*fields[k]` (`shape` shows the map in
@@ -244,7 +245,7 @@ void FleetParser::drone(const std::string& name, const YAML::Node& node) {
       if (key == "failsafe" && r_.choice(v, "failsafe", kFailsafes, failsafe))
         s.failsafe = failsafe_from(failsafe);
       if (key == "adapter") o.adapter = r_.choice(v, "adapter", kAdapters, s.adapter);
-      if (key == "connection" && r_.text(v, what, s.connection)) check_connection_port(v, what, s.connection);
+      if (key == "connection" && r_.text(v, what, s.connection)) check_connection(v, what, s.connection);
       long long sysid = 0;
       if (key == "sysid" && r_.whole_number(v, what, sysid)) {
         if (sysid >= 1 && sysid <= 255) s.sysid = static_cast<int>(sysid);
@@ -363,19 +364,11 @@ void FleetParser::range(const YAML::Node& node, const std::string& what, std::op
   out = r;
 }
 
-// The port of a connection URL (udp://[HOST]:PORT, udpout://HOST:PORT, tcp://HOST:PORT) is
-// checked here, so that `eamos check` reports it at its line; the mavlink adapter parses the
-// rest of the URL, and a serial:// URL's rate, when it connects (src/mavlink/url.h).
-void FleetParser::check_connection_port(const YAML::Node& node, const std::string& what, const std::string& url) {
-  std::size_t scheme = url.find("://");
-  std::size_t colon = url.rfind(':');
-  if (scheme == std::string::npos || colon == std::string::npos || colon < scheme + 3) return;
-  if (url.compare(0, scheme, "serial") == 0) return;
-  std::string port = url.substr(colon + 1);
-  bool digits = !port.empty() && port.size() <= 6 && port.find_first_not_of("0123456789") == std::string::npos;
-  if (digits && std::stol(port) >= 1 && std::stol(port) <= 65535) return;
-  r_.error(node, what + " has port '" + port + "', which is not a port number from 1 to 65535; write e.g. " +
-                     url.substr(0, scheme) + "://" + url.substr(scheme + 3, colon - scheme - 3) + ":14540");
+// The whole URL is checked here (the parser the mavlink adapter connects with), so that
+// `eamos check` reports a wrong scheme, port, device or serial rate at its line.
+void FleetParser::check_connection(const YAML::Node& node, const std::string& what, const std::string& url) {
+  EndpointResult parsed = parse_link_url(url);
+  if (!parsed.endpoint) r_.error(node, what + ": " + parsed.error);
 }
 
 void FleetParser::safety(const YAML::Node& node) {

@@ -6,6 +6,8 @@
 
 #include <yaml-cpp/eventhandler.h>
 
+#include "diag/printable.h"
+
 namespace eamos::fleet {
 
 SourceLocation location_of(const YAML::Mark& mark) {
@@ -14,20 +16,6 @@ SourceLocation location_of(const YAML::Mark& mark) {
 }
 
 namespace {
-
-// Messages may quote garbage: control bytes would garble the terminal, and a long value
-// buries the point of the message.
-std::string printable(const std::string& text) {
-  const std::size_t kMax = 40;
-  std::string out;
-  for (unsigned char c : text.substr(0, kMax)) out += c < 0x20 || c == 0x7f ? '?' : char(c);
-  if (text.size() > kMax) {
-    while (!out.empty() && (static_cast<unsigned char>(out.back()) & 0xc0) == 0x80) out.pop_back();
-    if (!out.empty() && static_cast<unsigned char>(out.back()) >= 0xc0) out.pop_back();
-    out += "...";
-  }
-  return out;
-}
 
 bool is_identifier(const std::string& s) {
   auto alpha = [](char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_'; };
@@ -45,7 +33,7 @@ bool quoted(const YAML::Node& node) { return node.Tag() == "!"; }
 std::string describe(const YAML::Node& node) {
   if (node.IsSequence()) return "a list";
   if (node.IsMap()) return "a map";
-  if (node.IsScalar()) return "'" + printable(node.Scalar()) + "'";
+  if (node.IsScalar()) return "'" + diag::printable(node.Scalar()) + "'";
   return "nothing";
 }
 
@@ -95,7 +83,7 @@ bool load_one_document(const std::string& text, YAML::Node& out, const SourceFil
     if (starts[i].pos != starts[i - 1].pos) continue;
     std::size_t pos = static_cast<std::size_t>(std::max(starts[i].pos, 0));
     diags.error(file, location_of(starts[i]),
-                "YAML syntax error: unexpected '" + printable(text.substr(pos, 1)) +
+                "YAML syntax error: unexpected '" + diag::printable(text.substr(pos, 1)) +
                     "'; remove it or quote the text it belongs to");
     return false;
   }
@@ -132,7 +120,7 @@ std::string YamlReader::key(const YAML::Node& key, std::set<std::string>& seen,
   }
   const std::string& text = key.Scalar();
   if (!seen.insert(text).second) {
-    error(key, "'" + printable(text) + "' appears twice in " + where + "; remove one of them");
+    error(key, "'" + diag::printable(text) + "' appears twice in " + where + "; remove one of them");
     return "";
   }
   return text;
@@ -143,7 +131,7 @@ std::string YamlReader::field(const YAML::Node& k, const std::vector<std::string
   std::string text = key(k, seen, where);
   if (text.empty() || std::find(allowed.begin(), allowed.end(), text) != allowed.end()) return text;
   std::string near = closest_match(text, allowed);
-  error(k, "unknown key '" + printable(text) + "' in " + where +
+  error(k, "unknown key '" + diag::printable(text) + "' in " + where +
                (near.empty() ? "; expected " + one_of(allowed) : "; did you mean '" + near + "'?"));
   return "";
 }
@@ -152,7 +140,7 @@ std::string YamlReader::name(const YAML::Node& k, std::set<std::string>& seen,
                              const std::string& where) {
   std::string text = key(k, seen, where);
   if (text.empty() || is_identifier(text)) return text;
-  error(k, "'" + printable(text) + "' in " + where +
+  error(k, "'" + diag::printable(text) + "' in " + where +
                " cannot be written in a mission; use letters, digits and '_', not starting with a digit");
   return "";
 }
@@ -209,7 +197,7 @@ bool YamlReader::choice(const YAML::Node& node, const std::string& what,
     return true;
   }
   std::string near = closest_match(value, choices);
-  error(node, "unknown " + what + " '" + printable(value) + "'; " +
+  error(node, "unknown " + what + " '" + diag::printable(value) + "'; " +
                   (near.empty() ? "use " + one_of(choices) : "did you mean '" + near + "'?"));
   return false;
 }

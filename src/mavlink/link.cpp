@@ -97,14 +97,14 @@ speed_t termios_speed(unsigned baud) {
     case 1000000: return B1000000;
     case 1500000: return B1500000;
     case 2000000: return B2000000;
-    default: return B3000000;  // parse_url lets no other rate through
+    default: return B3000000;  // parse_link_url lets no other rate through
   }
 }
 
 /// Opens a serial port raw (8N1, no flow control, no echo, no line discipline) at `baud`,
 /// non-blocking; -1 with `error` when it is no serial port or cannot be set so. Exclusive
 /// (TIOCEXCL): a second program opening the port would take half of the autopilot's bytes.
-int open_serial(const Endpoint& e, std::string& error) {
+int open_serial(const fleet::Endpoint& e, std::string& error) {
   int fd = ::open(e.device.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) {
     error = sys_error("open " + e.device);
@@ -136,14 +136,14 @@ int open_serial(const Endpoint& e, std::string& error) {
 }
 
 /// A bound socket (udp://, udpout://) or a connected one (tcp://); -1 with `error`.
-int open_socket(const Endpoint& endpoint, const sockaddr_in& addr, std::string& error) {
-  bool tcp = endpoint.kind == LinkKind::tcp_client;
+int open_socket(const fleet::Endpoint& endpoint, const sockaddr_in& addr, std::string& error) {
+  bool tcp = endpoint.kind == fleet::LinkKind::tcp_client;
   int fd = socket(AF_INET, tcp ? SOCK_STREAM : SOCK_DGRAM, 0);
   if (fd < 0) {
     error = sys_error("socket");
     return -1;
   }
-  if (endpoint.kind == LinkKind::udp_listen) {
+  if (endpoint.kind == fleet::LinkKind::udp_listen) {
     // No SO_REUSEADDR: on Linux it would let a second program share the port and steal
     // half of the vehicle's datagrams; a clear "in use" error is better.
     if (bind(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0) {
@@ -151,7 +151,7 @@ int open_socket(const Endpoint& endpoint, const sockaddr_in& addr, std::string& 
       close(fd);
       return -1;
     }
-  } else if (endpoint.kind == LinkKind::udp_out) {
+  } else if (endpoint.kind == fleet::LinkKind::udp_out) {
     sockaddr_in any{};
     any.sin_family = AF_INET;  // port 0: an ephemeral port, where the replies come back
     if (bind(fd, reinterpret_cast<sockaddr*>(&any), sizeof any) != 0) {
@@ -169,12 +169,12 @@ int open_socket(const Endpoint& endpoint, const sockaddr_in& addr, std::string& 
 
 }  // namespace
 
-OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame, double reconnect_s,
+OpenResult Link::open(const fleet::Endpoint& endpoint, FrameHandler on_frame, double reconnect_s,
                       const std::optional<SigningKey>& verify, bool require_signed) {
   auto fail = [&](const std::string& why) {
     return OpenResult{nullptr, "connection '" + endpoint.url + "': " + why};
   };
-  bool serial = endpoint.kind == LinkKind::serial;
+  bool serial = endpoint.kind == fleet::LinkKind::serial;
   sockaddr_in addr{};
   std::string error;
   if (!serial && !resolve(endpoint.host, endpoint.port, addr, error)) return fail(error);
@@ -191,7 +191,7 @@ OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame, double re
     link->parser_.verify_with(*verify);
     link->parser_.require_signed(require_signed);
   }
-  if (endpoint.kind != LinkKind::udp_listen) {
+  if (endpoint.kind != fleet::LinkKind::udp_listen) {
     link->peer_ = addr;  // serial: unused; the port itself is the peer
     link->has_peer_ = true;
   }
@@ -209,7 +209,7 @@ OpenResult Link::open(const Endpoint& endpoint, FrameHandler on_frame, double re
   return {std::move(link), ""};
 }
 
-Link::Link(Endpoint endpoint, int fd, int wake_read, int wake_write, FrameHandler on_frame)
+Link::Link(fleet::Endpoint endpoint, int fd, int wake_read, int wake_write, FrameHandler on_frame)
     : endpoint_(std::move(endpoint)),
       fd_(fd),
       wake_read_(wake_read),
@@ -234,8 +234,8 @@ Link::~Link() {
 bool Link::send(std::span<const uint8_t> bytes) {
   std::lock_guard lock(mutex_);
   if (!has_peer_ || closed_) return false;
-  ssize_t n = endpoint_.kind == LinkKind::tcp_client ? ::send(fd_, bytes.data(), bytes.size(), MSG_NOSIGNAL)
-              : endpoint_.kind == LinkKind::serial   ? ::write(fd_, bytes.data(), bytes.size())
+  ssize_t n = endpoint_.kind == fleet::LinkKind::tcp_client ? ::send(fd_, bytes.data(), bytes.size(), MSG_NOSIGNAL)
+              : endpoint_.kind == fleet::LinkKind::serial   ? ::write(fd_, bytes.data(), bytes.size())
                                                      : sendto(fd_, bytes.data(), bytes.size(), 0,
                                                               reinterpret_cast<const sockaddr*>(&peer_), sizeof peer_);
   return n == static_cast<ssize_t>(bytes.size());
@@ -258,8 +258,8 @@ void Link::receive_loop() {
     if (fds[0].revents == 0) continue;
     sockaddr_in from{};
     socklen_t from_len = sizeof from;
-    bool stream = endpoint_.kind == LinkKind::tcp_client || endpoint_.kind == LinkKind::serial;
-    ssize_t n = endpoint_.kind == LinkKind::serial
+    bool stream = endpoint_.kind == fleet::LinkKind::tcp_client || endpoint_.kind == fleet::LinkKind::serial;
+    ssize_t n = endpoint_.kind == fleet::LinkKind::serial
                     ? ::read(fd_, buffer.data(), buffer.size())
                     : recvfrom(fd_, buffer.data(), buffer.size(), 0, reinterpret_cast<sockaddr*>(&from), &from_len);
     if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
@@ -268,7 +268,7 @@ void Link::receive_loop() {
       if (!reconnect()) return;  // the destructor came first
       continue;
     }
-    bool listen = endpoint_.kind == LinkKind::udp_listen;
+    bool listen = endpoint_.kind == fleet::LinkKind::udp_listen;
     try {
       handle_bytes(std::span(buffer.data(), static_cast<size_t>(n)), listen ? &from : nullptr);
     } catch (const std::exception& e) {  // drop this datagram, keep the link
@@ -294,8 +294,8 @@ bool Link::reconnect() {
     pollfd wake{wake_read_, POLLIN, 0};
     if (poll(&wake, 1, reconnect_ms_) != 0) return false;
     std::string error;
-    int fd = endpoint_.kind == LinkKind::serial ? open_serial(endpoint_, error) : socket(AF_INET, SOCK_STREAM, 0);
-    if (fd >= 0 && (endpoint_.kind == LinkKind::serial || connect_within(fd, peer_, 1000, error))) {
+    int fd = endpoint_.kind == fleet::LinkKind::serial ? open_serial(endpoint_, error) : socket(AF_INET, SOCK_STREAM, 0);
+    if (fd >= 0 && (endpoint_.kind == fleet::LinkKind::serial || connect_within(fd, peer_, 1000, error))) {
       std::lock_guard lock(mutex_);
       fd_ = fd;
       closed_ = false;

@@ -1,8 +1,8 @@
 #pragma once
-// A MAVLink connection over UDP, TCP or a serial port (url.h) with its own receive thread. The thread reads
-// bytes, runs them through the Parser and hands each good frame to the FrameHandler — on the
-// link's thread, so the handler must only pass the frame on (the adapter posts it to its event
-// loop) and never touch state the loop's thread owns. send() may be called from any thread.
+// A MAVLink connection over UDP, TCP or a serial port (fleet/link_url.h) with its own receive
+// thread. The thread reads bytes, runs them through the Parser and hands each good frame to
+// the FrameHandler — on the link's thread, so the handler must only pass the frame on (the
+// adapter posts it to its event loop) and never touch state the loop's thread owns. send() may be called from any thread.
 // A TCP connection the peer closes, or a serial port that goes away (USB unplugged), is
 // reopened (every second by default) until it is back.
 #include <netinet/in.h>
@@ -17,7 +17,7 @@
 #include <thread>
 
 #include "mavlink/frame.h"
-#include "mavlink/url.h"
+#include "fleet/link_url.h"
 
 namespace eamos::mavlink {
 
@@ -31,7 +31,7 @@ class Link {
   /// thread. `reconnect_s`: TCP and serial, the pause between attempts to reopen.
   /// `verify`: check signed frames against this key from the first datagram on, and drop
   /// unsigned ones when `require_signed` (see verify_with).
-  static OpenResult open(const Endpoint& endpoint, FrameHandler on_frame, double reconnect_s = 1.0,
+  static OpenResult open(const fleet::Endpoint& endpoint, FrameHandler on_frame, double reconnect_s = 1.0,
                          const std::optional<SigningKey>& verify = std::nullopt, bool require_signed = false);
   /// Stops and joins the receive thread, then closes the socket: after it returns the
   /// handler is never called again.
@@ -44,7 +44,7 @@ class Link {
   bool send(std::span<const uint8_t> bytes);
   /// The local UDP/TCP port (useful when udpout:// picked an ephemeral one).
   uint16_t local_port() const { return local_port_; }
-  const Endpoint& endpoint() const { return endpoint_; }
+  const fleet::Endpoint& endpoint() const { return endpoint_; }
   /// Parser counters so far (garbage, bad CRCs), copied under the lock.
   ParserStats stats() const;
   /// udp:// only. 0 (the default, before the vehicle is known): replies go to whoever last
@@ -66,7 +66,7 @@ class Link {
   void require_signed(bool required);
 
  private:
-  Link(Endpoint endpoint, int fd, int wake_read, int wake_write, FrameHandler on_frame);
+  Link(fleet::Endpoint endpoint, int fd, int wake_read, int wake_write, FrameHandler on_frame);
   void receive_loop();
   /// TCP: reconnects after the peer closed; false when the link is being destroyed.
   bool reconnect();
@@ -74,7 +74,7 @@ class Link {
   void handle_bytes(std::span<const uint8_t> bytes, const sockaddr_in* from);
   void follow_sender(const std::vector<Frame>& frames, const sockaddr_in& from);
 
-  Endpoint endpoint_;
+  fleet::Endpoint endpoint_;
   int fd_ = -1;
   int wake_read_ = -1;   ///< self-pipe: the destructor writes to wake the receive thread
   int wake_write_ = -1;

@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <memory>
 
-#include "mavlink/url.h"
+#include "diag/printable.h"
+#include "fleet/link_url.h"
 
 namespace eamos::mavlink_adapter {
 
@@ -21,8 +22,8 @@ void register_adapter(mid::AdapterRegistry& registry, MavlinkOptions options) {
                         "time: run with --realtime (or --speed 1)");
         if (settings.connection.empty())
           return failed("no `connection:` in the fleet file, e.g. connection: udp://:14540");
-        mavlink::EndpointResult url = mavlink::parse_url(settings.connection);
-        if (!url.endpoint) return failed(url.error);
+        fleet::EndpointResult url = fleet::parse_link_url(settings.connection);
+        if (!url.endpoint) return failed("connection '" + diag::printable(settings.connection, 120) + "': " + url.error);
         MavlinkOptions scaled = options;  // wall-clock budgets into mission seconds
         scaled.link_timeout_s = std::max(options.link_timeout_s, options.link_timeout_min_wall_s * options.speed);
         scaled.commands.ack_timeout_s *= options.speed;

@@ -1,6 +1,6 @@
 #pragma once
 // Registers the MAVLink adapter in an Adapter Space registry under the name "mavlink". A
-// drone's `connection:` (a URL, mavlink/url.h) and `sysid:` come from the fleet file.
+// drone's `connection:` (a URL, fleet/link_url.h) and `sysid:` come from the fleet file.
 #include "mavlink_adapter/mavlink_drone.h"
 #include "mid/adapter_registry.h"
 

@@ -75,7 +75,7 @@ Camera::Hooks MavlinkDrone::camera_hooks() {
           .note = [this](const std::string& text) { note(text); }};
 }
 
-std::string MavlinkDrone::connect(const ml::Endpoint& endpoint) {
+std::string MavlinkDrone::connect(const fleet::Endpoint& endpoint) {
   if (std::string error = link_.connect(endpoint); !error.empty()) return error;
   watch_.start();
   const auto& fence = settings_.site.geofence;

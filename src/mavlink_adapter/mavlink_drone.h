@@ -62,7 +62,7 @@ class MavlinkDrone final : public mid::AdapterDrone {
 
   /// Opens the link and waits (blocking, up to connect_timeout_s) for the vehicle's first
   /// HEARTBEAT; "" on success, else what went wrong and what to check.
-  std::string connect(const mavlink::Endpoint& endpoint);
+  std::string connect(const fleet::Endpoint& endpoint);
 
   const std::string& name() const override { return settings_.name; }
   std::optional<double> progress(mid::ActionId id) const override;

@@ -103,7 +103,7 @@ std::function<void(ml::Frame)> VehicleLink::receiver(std::shared_ptr<FirstHeartb
   };
 }
 
-std::string VehicleLink::connect(const ml::Endpoint& endpoint) {
+std::string VehicleLink::connect(const fleet::Endpoint& endpoint) {
   auto first = std::make_shared<FirstHeartbeat>();
   const uint8_t wanted = static_cast<uint8_t>(settings_.sysid);
   std::optional<ml::SigningKey> key;
@@ -136,7 +136,7 @@ std::string VehicleLink::connect(const ml::Endpoint& endpoint) {
   return "";
 }
 
-std::string VehicleLink::no_heartbeat(const ml::Endpoint& endpoint, uint8_t wanted, bool signing) const {
+std::string VehicleLink::no_heartbeat(const fleet::Endpoint& endpoint, uint8_t wanted, bool signing) const {
   char text[64];
   std::snprintf(text, sizeof text, "%.0f s", options_.connect_timeout_s);
   std::string who = wanted ? "system " + std::to_string(wanted) : std::string("any autopilot");
@@ -149,7 +149,7 @@ std::string VehicleLink::no_heartbeat(const ml::Endpoint& endpoint, uint8_t want
 }
 
 std::string VehicleLink::identify(FirstHeartbeat& first, std::unique_lock<std::mutex>& lock,
-                                  const ml::Endpoint& endpoint, const std::optional<ml::SigningKey>& key) {
+                                  const fleet::Endpoint& endpoint, const std::optional<ml::SigningKey>& key) {
   sysid_ = first.sysid;
   autopilot_ = autopilot_for(first.autopilot);
   if (!autopilot_)

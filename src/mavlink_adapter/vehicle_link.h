@@ -34,7 +34,7 @@ class VehicleLink {
   /// Opens the link and waits (blocking, up to connect_timeout_s) for the vehicle's first
   /// HEARTBEAT; "" on success, else what went wrong and what to check. On success our own
   /// HEARTBEAT has started.
-  std::string connect(const mavlink::Endpoint& endpoint);
+  std::string connect(const fleet::Endpoint& endpoint);
   /// Joins the receive thread: no frame is posted after it. Says how many datagrams from
   /// other addresses were ignored, if any.
   void close();
@@ -58,10 +58,10 @@ class VehicleLink {
  private:
   /// Runs on the link's thread: notes the first HEARTBEAT and parameters, posts the frame.
   std::function<void(mavlink::Frame)> receiver(std::shared_ptr<FirstHeartbeat> first, uint8_t wanted);
-  std::string no_heartbeat(const mavlink::Endpoint& endpoint, uint8_t wanted, bool signing) const;
+  std::string no_heartbeat(const fleet::Endpoint& endpoint, uint8_t wanted, bool signing) const;
   /// After the first HEARTBEAT: the autopilot row, signing, the speed parameters.
   std::string identify(FirstHeartbeat& first, std::unique_lock<std::mutex>& lock,
-                       const mavlink::Endpoint& endpoint, const std::optional<mavlink::SigningKey>& key);
+                       const fleet::Endpoint& endpoint, const std::optional<mavlink::SigningKey>& key);
   /// fleet `signing: {setup: true}`: gives the vehicle the key at connect.
   std::string give_key(FirstHeartbeat& first, std::unique_lock<std::mutex>& lock, const mavlink::SigningKey& key);
   void read_limits(FirstHeartbeat& first, std::unique_lock<std::mutex>& lock);

@@ -102,7 +102,7 @@ SimVehicle::~SimVehicle() {
 }
 
 // Frames cross from the link's receive thread to the loop, and only while the vehicle lives.
-ml::OpenResult SimVehicle::open_link(const ml::Endpoint& endpoint) {
+ml::OpenResult SimVehicle::open_link(const fleet::Endpoint& endpoint) {
   std::weak_ptr<bool> alive = alive_;
   mid::EventLoop* loop = &loop_;
   return ml::Link::open(endpoint, [this, alive, loop](ml::Frame f) {
@@ -112,7 +112,7 @@ ml::OpenResult SimVehicle::open_link(const ml::Endpoint& endpoint) {
   });
 }
 
-std::string SimVehicle::open(const ml::Endpoint& endpoint) {
+std::string SimVehicle::open(const fleet::Endpoint& endpoint) {
   ml::OpenResult opened = open_link(endpoint);
   if (!opened.link) return opened.error;
   link_ = std::move(opened.link);
@@ -122,7 +122,7 @@ std::string SimVehicle::open(const ml::Endpoint& endpoint) {
   return "";
 }
 
-std::string SimVehicle::open_ground_station(const ml::Endpoint& endpoint) {
+std::string SimVehicle::open_ground_station(const fleet::Endpoint& endpoint) {
   ml::OpenResult opened = open_link(endpoint);
   if (!opened.link) return opened.error;
   ground_station_ = std::move(opened.link);

@@ -151,11 +151,11 @@ class SimVehicle {
   SimVehicle& operator=(const SimVehicle&) = delete;
 
   /// Opens the link and starts heartbeats and telemetry; "" on success, else why not.
-  std::string open(const mavlink::Endpoint& endpoint);
+  std::string open(const fleet::Endpoint& endpoint);
   /// A second link, to a ground station (QGroundControl on udpout://127.0.0.1:14550): it gets
   /// every frame the vehicle sends, and what it sends is handled as from the first link, as
   /// an autopilot with a telemetry radio beside its companion computer does.
-  std::string open_ground_station(const mavlink::Endpoint& endpoint);
+  std::string open_ground_station(const fleet::Endpoint& endpoint);
 
   Mode mode() const { return mode_; }
   /// The local port it receives on (anyone may send there, as a second GCS could).
@@ -243,7 +243,7 @@ class SimVehicle {
   mavlink::Message orbit_status(const mid::DroneState& s) const;
   mavlink::Message heartbeat(const mid::DroneState& s) const;
   void send(const mavlink::Message& m);
-  mavlink::OpenResult open_link(const mavlink::Endpoint& endpoint);
+  mavlink::OpenResult open_link(const fleet::Endpoint& endpoint);
 
   mid::EventLoop& loop_;
   VehicleOptions options_;

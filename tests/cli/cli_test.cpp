@@ -130,6 +130,25 @@ TEST_F(Cli, WerrorTurnsWarningsIntoFailure) {
   EXPECT_EQ(eamos("check -q " + kListing2).out.find("warning"), std::string::npos);
 }
 
+// A fleet whose autopilot link could never open is refused before anything is compiled or
+// flown, at the line of each wrong URL, all in one pass.
+TEST_F(Cli, AConnectionTheAdapterCouldNotOpenIsAnErrorAtItsLineBeforeAnyFlight) {
+  fs::path fleet = dir_ / "fleet.yaml";
+  std::ofstream(fleet) << "drones:\n  Drone1:\n    adapter: mavlink\n    connection: serail:///dev/ttyS0:57600\n"
+                          "  Drone2:\n    adapter: mavlink\n    connection: serial:///dev/ttyUSB0:12345\n"
+                          "  Drone3:\n    adapter: mavlink\n    connection: tcp://127.0.0.1:5760\n";
+  for (const std::string& command : {std::string("check "), "compile -o " + (dir_ / "deploy").string() + " "}) {
+    Output r = eamos(command + kListing2 + " --fleet " + fleet.string());
+    EXPECT_EQ(r.status, 1) << command << r.out;
+    EXPECT_NE(r.out.find(fleet.string() + ":4:17: error: connection of drone 'Drone1': unknown scheme 'serail'"),
+              std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(fleet.string() + ":7:17: error: connection of drone 'Drone2': rate '12345' is not a serial rate"),
+              std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("2 errors"), std::string::npos) << r.out;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "deploy"));
+}
+
 TEST_F(Cli, MissingFileIsAClearErrorNotACrash) {
   Output r = eamos("check " + (dir_ / "nope.eamos").string());
   EXPECT_EQ(r.status, 1);

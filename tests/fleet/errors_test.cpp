@@ -333,10 +333,10 @@ drones:
 }
 
 TEST(Errors, GarbageInsideAValidShapeIsAnErrorNotACrash) {
-  auto p = parse(std::string("drones:\n  Drone1:\n    connection: \"\x01\x02\"\n    battery: \"\xff\xfe\"\n"));
+  auto p = parse(std::string("drones:\n  Drone1:\n    connection: \"\x01://\x02:\x03\"\n    battery: \"\xff\xfe\"\n"));
   EXPECT_FALSE(p.ok);
-  EXPECT_EQ(p.diags.error_count(), 1u) << p.diags.format();
-  EXPECT_EQ(p.diags.format().find('\x01'), std::string::npos);
+  EXPECT_EQ(p.diags.error_count(), 2u) << p.diags.format();  // no link URL, no number
+  for (char control : {'\x01', '\x02', '\x03'}) EXPECT_EQ(p.diags.format().find(control), std::string::npos);
 }
 
 TEST(Errors, DeeplyNestedInputIsAnErrorNotACrash) {

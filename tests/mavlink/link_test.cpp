@@ -42,7 +42,7 @@ struct Mailbox {
   }
 };
 
-Endpoint endpoint(const std::string& url) { return *parse_url(url).endpoint; }
+fleet::Endpoint endpoint(const std::string& url) { return *fleet::parse_link_url(url).endpoint; }
 
 TEST(UdpLink, ListenerRepliesToTheLastSender) {
   Mailbox vehicle_side, adapter_side;

@@ -23,7 +23,7 @@
 #include "mavlink/frame.h"
 #include "mavlink/link.h"
 #include "mavlink/payloads.h"
-#include "mavlink/url.h"
+#include "fleet/link_url.h"
 #include "support/eamos_process.h"
 
 extern char** environ;
@@ -148,7 +148,7 @@ TEST(MavlinkFailureReasons, APilotsModeSwitchIsPilotTookOverWithTheModeAsDetail)
     // switch that arrives before the adapter's own OFFBOARD request would be undone by it.
     pilot = std::thread([&switched, vehicle_port] {
       auto gcs = eamos::mavlink::Link::open(
-          *eamos::mavlink::parse_url("udpout://127.0.0.1:" + std::to_string(vehicle_port)).endpoint,
+          *eamos::fleet::parse_link_url("udpout://127.0.0.1:" + std::to_string(vehicle_port)).endpoint,
           [](eamos::mavlink::Frame) {});
       if (!gcs.link) return;
       eamos::mavlink::CommandLong c;

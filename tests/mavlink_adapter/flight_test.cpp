@@ -20,7 +20,7 @@ using test::kSpeed;
 // A second ground station on the same vehicle (its own address), as a pilot's or a
 // stranger's would be.
 mavlink::OpenResult ground_station_on(int port) {
-  return mavlink::Link::open(*mavlink::parse_url("udpout://127.0.0.1:" + std::to_string(port)).endpoint,
+  return mavlink::Link::open(*eamos::fleet::parse_link_url("udpout://127.0.0.1:" + std::to_string(port)).endpoint,
                              [](mavlink::Frame) {});
 }
 
@@ -395,7 +395,7 @@ TEST(MavlinkFlight, ForgedFramesWithTheVehiclesSystemIdFromAnotherPortAreIgnored
   f.drone->set_message_sink([&](const std::string& m) { messages.push_back(m); });
   // An attacker on the adapter's port: DENIED for every arm command and HEARTBEATs, all with
   // the vehicle's system id, while the mission arms and takes off.
-  auto forger = mavlink::Link::open(*mavlink::parse_url("udpout://127.0.0.1:25396").endpoint, [](mavlink::Frame) {});
+  auto forger = mavlink::Link::open(*eamos::fleet::parse_link_url("udpout://127.0.0.1:25396").endpoint, [](mavlink::Frame) {});
   ASSERT_TRUE(forger.link) << forger.error;
   std::atomic<bool> stop{false};
   std::thread attack([&] {

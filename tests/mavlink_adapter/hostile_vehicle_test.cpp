@@ -27,7 +27,7 @@ namespace ml = eamos::mavlink;
 class RawLink {
  public:
   RawLink(int port, std::function<void(ml::Frame)> on_frame) {
-    auto opened = ml::Link::open(*ml::parse_url("udpout://127.0.0.1:" + std::to_string(port)).endpoint,
+    auto opened = ml::Link::open(*eamos::fleet::parse_link_url("udpout://127.0.0.1:" + std::to_string(port)).endpoint,
                                  std::move(on_frame));
     if (!opened.link) throw std::runtime_error(opened.error);
     link_ = std::move(opened.link);

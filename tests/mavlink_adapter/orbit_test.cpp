@@ -353,7 +353,7 @@ TEST(MavlinkOrbit, APilotsModeSwitchFailsAPx4Orbit) {
   ASSERT_NO_FATAL_FAILURE(take_off_and_orbit(f, o, 4.0));
   ASSERT_FALSE(o.end);
   // A ground station on the same vehicle switches to POSCTL, as a pilot's switch would.
-  auto gcs = ml::Link::open(*ml::parse_url("udpout://127.0.0.1:" + std::to_string(vehicle.port())).endpoint,
+  auto gcs = ml::Link::open(*eamos::fleet::parse_link_url("udpout://127.0.0.1:" + std::to_string(vehicle.port())).endpoint,
                             [](ml::Frame) {});
   ASSERT_TRUE(gcs.link) << gcs.error;
   ml::CommandLong c;

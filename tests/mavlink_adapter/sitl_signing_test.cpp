@@ -50,7 +50,7 @@ class Probe {
   Probe(const std::string& url, uint8_t vehicle) : vehicle_(vehicle) {
     std::string error;
     auto key = ml::parse_signing_key(kKey, error);
-    auto opened = ml::Link::open(*ml::parse_url(url).endpoint, [this](ml::Frame f) { on_frame(f); }, 0.2, key, false);
+    auto opened = ml::Link::open(*eamos::fleet::parse_link_url(url).endpoint, [this](ml::Frame f) { on_frame(f); }, 0.2, key, false);
     link_ = std::move(opened.link);
     error_ = opened.error;
   }

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "mavlink/url.h"
+#include "fleet/link_url.h"
 #include "mid/event_loop.h"
 #include "sim_vehicle/sim_vehicle.h"
 
@@ -21,7 +21,7 @@ class VehicleThread {
   VehicleThread(int port, double speed, const sim_vehicle::VehicleOptions& options)
       : loop_({mid::ClockMode::real_time, speed}), vehicle_(loop_, options) {
     std::string url = "udpout://127.0.0.1:" + std::to_string(port);
-    if (std::string e = vehicle_.open(*mavlink::parse_url(url).endpoint); !e.empty())
+    if (std::string e = vehicle_.open(*eamos::fleet::parse_link_url(url).endpoint); !e.empty())
       throw std::runtime_error(e);
     thread_ = std::thread([this] {
       while (!stop_) loop_.run_until(loop_.now() + 1.0);

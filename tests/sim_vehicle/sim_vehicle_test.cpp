@@ -27,7 +27,7 @@ constexpr double kSpeed = 4.0;
 class Companion {
  public:
   explicit Companion(int port) {
-    ml::OpenResult r = ml::Link::open(*ml::parse_url("udp://127.0.0.1:" + std::to_string(port)).endpoint,
+    ml::OpenResult r = ml::Link::open(*eamos::fleet::parse_link_url("udp://127.0.0.1:" + std::to_string(port)).endpoint,
                                       [this](ml::Frame f) {
                                         std::lock_guard lock(m_);
                                         frames_.push_back(std::move(f));

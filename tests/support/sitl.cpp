@@ -27,7 +27,7 @@
 #include "mavlink/link.h"
 #include "mavlink/messages.h"
 #include "mavlink/payloads.h"
-#include "mavlink/url.h"
+#include "fleet/link_url.h"
 
 namespace eamos_test {
 namespace fs = std::filesystem;
@@ -534,7 +534,7 @@ bool SitlFleet::set_param(int i, const std::string& name, float value, uint8_t t
   ParamEchoes cs;
   const uint8_t vehicle = static_cast<uint8_t>(sysid(i));
   ml::OpenResult opened = ml::Link::open(
-      *ml::parse_url(connection(i)).endpoint,
+      *eamos::fleet::parse_link_url(connection(i)).endpoint,
       [&cs, vehicle](ml::Frame f) {
         if (f.sysid != vehicle || f.compid != 1) return;
         auto p = ml::unpack_param_value(f.message);
@@ -607,7 +607,7 @@ bool SitlFleet::read_fence(int i, const std::vector<std::string>& params, const 
   FenceRead r;
   const uint8_t vehicle = static_cast<uint8_t>(sysid(i));
   ml::OpenResult opened = ml::Link::open(
-      *ml::parse_url(connection(i)).endpoint,
+      *eamos::fleet::parse_link_url(connection(i)).endpoint,
       [&r, vehicle](ml::Frame f) {
         if (f.sysid != vehicle || f.compid != 1) return;
         std::lock_guard lock(r.mutex);
@@ -675,7 +675,7 @@ bool SitlFleet::wait_all_ready(double deadline, bool camera, std::string& error,
     // ArduPilot opens its TCP port a moment after it starts: try again until the deadline.
     ml::OpenResult opened;
     while (!opened.link && now_s() < deadline) {
-      opened = ml::Link::open(*ml::parse_url(connection(i)).endpoint,
+      opened = ml::Link::open(*eamos::fleet::parse_link_url(connection(i)).endpoint,
                               [r, vehicle](ml::Frame f) { on_probe_frame(*r, vehicle, f); }, 0.2);
       if (!opened.link) usleep(100000);
     }
@@ -764,7 +764,7 @@ SitlWatch::SitlWatch(const SitlFleet& fleet, int i) : state_(std::make_unique<St
   std::string url = fleet.autopilot() == Autopilot::ardupilot ? "tcp://127.0.0.1:" + std::to_string(5762 + 10 * n)
                                                               : "udpout://127.0.0.1:" + std::to_string(18570 + n);
   State* st = state_.get();
-  auto opened = ml::Link::open(*ml::parse_url(url).endpoint, [st, vehicle](ml::Frame f) {
+  auto opened = ml::Link::open(*eamos::fleet::parse_link_url(url).endpoint, [st, vehicle](ml::Frame f) {
     if (f.sysid != vehicle || f.compid != 1) return;
     std::lock_guard lock(st->mutex);
     if (auto hb = ml::unpack_heartbeat(f.message)) {

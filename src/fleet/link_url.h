@@ -7,13 +7,14 @@
 //   tcp://HOST:PORT          connect to a TCP server (ArduPilot SITL serves 5760 + 10·instance)
 //   serial:///dev/TTY:BAUD   a serial port (an autopilot's TELEM port wired to the companion
 //                            computer's UART, or its USB port) at BAUD bits per second
-// Parsing is separate from opening so a fleet file's URL is checked before any socket exists.
+// Parsing is separate from opening, and lives with the fleet file, so that `eamos check` (and
+// an editor) reports a wrong URL at its line, long before the mavlink adapter opens a socket.
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
 
-namespace eamos::mavlink {
+namespace eamos::fleet {
 
 enum class LinkKind { udp_listen, udp_out, tcp_client, serial };
 
@@ -32,9 +33,11 @@ inline constexpr unsigned kSerialBauds[] = {9600,   19200,  38400,   57600,   11
 
 struct EndpointResult {
   std::optional<Endpoint> endpoint;  ///< set when the URL is valid
-  std::string error;                 ///< what is wrong and what a valid URL looks like
+  /// What is wrong and what a valid URL looks like, without the URL itself: the caller says
+  /// where it came from ("connection of drone 'A': …", "connection 'udp:14540': …").
+  std::string error;
 };
 
-EndpointResult parse_url(std::string_view url);
+EndpointResult parse_link_url(std::string_view url);
 
-}  // namespace eamos::mavlink
+}  // namespace eamos::fleet
