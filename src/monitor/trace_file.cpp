@@ -14,6 +14,36 @@ constexpr std::size_t max_events = 5'000'000;
 // are kept, so some room, but a bound: parsing is iterative, serialising again is not.
 constexpr int max_nesting = 64;
 
+struct TraceLine {
+  bool got = false;       ///< false at the end of the input
+  bool too_long = false;  ///< longer than max_line_bytes: skipped to its end, `text` empty
+  bool newline = false;   ///< it ended with '\n' (a run killed mid-write leaves one without)
+};
+
+/// The next line of `in` into `text`, holding at most max_line_bytes of it: a corrupt file of
+/// one endless line costs that much memory, not the file's size.
+TraceLine next_line(std::istream& in, std::string& text) {
+  TraceLine r;
+  text.clear();
+  std::streambuf* buf = in.rdbuf();
+  for (int c = buf->sbumpc(); c != std::char_traits<char>::eof(); c = buf->sbumpc()) {
+    r.got = true;
+    if (c == '\n') {
+      r.newline = true;
+      break;
+    }
+    if (r.too_long) continue;
+    if (text.size() == max_line_bytes) {
+      r.too_long = true;
+      text.clear();
+      text.shrink_to_fit();
+      continue;
+    }
+    text.push_back(static_cast<char>(c));
+  }
+  return r;
+}
+
 /// True when brackets outside strings nest deeper than `limit` in `line`: looked at before
 /// the line is parsed, so that nothing deeper is ever built.
 bool nests_deeper_than(const std::string& line, int limit) {
@@ -101,14 +131,14 @@ LoadedTrace read_trace(const std::string& name, std::istream& in, std::size_t ma
     if (max_errors == 0 || out.errors.size() < max_errors)
       out.errors.push_back(name + ":" + std::to_string(at) + ": error: " + what);
   };
-  while (std::getline(in, line)) {
+  for (TraceLine read; (read = next_line(in, line)).got;) {
     ++number;
-    bool last_without_newline = in.eof();
-    if (line.empty()) continue;
-    if (line.size() > max_line_bytes) {
+    bool last_without_newline = !read.newline;
+    if (read.too_long) {
       error(number, "line longer than 64 MiB; this is not an eamos trace");
       continue;
     }
+    if (line.empty()) continue;
     if (nests_deeper_than(line, max_nesting)) {
       error(number, "nested more than " + std::to_string(max_nesting) +
                         " levels deep; an eamos trace line nests a few (docs/trace.md)");

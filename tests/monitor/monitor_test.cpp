@@ -5,9 +5,11 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -111,6 +113,57 @@ TEST(MonitorTrace, AValueNestedTooDeeplyIsAnErrorOfItsLineNotACrash) {
   EXPECT_NE(r.out.find(path + ":2: error: nested more than 64 levels deep"), std::string::npos) << r.out.substr(0, 300);
   EXPECT_EQ(r.out.find(":1: error"), std::string::npos) << r.out.substr(0, 300);
   fs::remove(path);
+}
+
+/// A file of one line of `bytes` 'a's and then a valid event, made as it is read: the test
+/// itself never holds the long line.
+class OneLongLine : public std::streambuf {
+ public:
+  explicit OneLongLine(std::size_t bytes) : left_(bytes) {}
+
+ protected:
+  int_type underflow() override {
+    if (left_ > 0) {
+      std::size_t n = std::min(left_, sizeof chunk_);
+      std::fill_n(chunk_, n, 'a');
+      left_ -= n;
+      setg(chunk_, chunk_, chunk_ + n);
+    } else if (!tail_done_) {
+      tail_done_ = true;
+      std::size_t n = tail_.copy(chunk_, sizeof chunk_);
+      setg(chunk_, chunk_, chunk_ + n);
+    } else {
+      return traits_type::eof();
+    }
+    return traits_type::to_int_type(*gptr());
+  }
+
+ private:
+  std::size_t left_;
+  bool tail_done_ = false;
+  std::string tail_ = "\n{\"t\":1,\"event\":\"start\",\"drone\":\"D\"}\n";
+  char chunk_[1 << 16];
+};
+
+long peak_rss_kb() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_maxrss;
+}
+
+// A corrupt trace of one line of hundreds of megabytes: an error at its line, read past with
+// at most the line limit (64 MiB) held, and the lines after it still replayed.
+TEST(MonitorTrace, AnEndlessLineIsAnErrorReadPastWithoutHoldingIt) {
+  OneLongLine source(300u << 20);
+  std::istream in(&source);
+  long before = peak_rss_kb();
+  eamos::monitor::LoadedTrace t = eamos::monitor::read_trace("x.jsonl", in);
+  long grew_mb = (peak_rss_kb() - before) / 1024;
+  ASSERT_EQ(t.errors.size(), 1u);
+  EXPECT_NE(t.errors[0].find("x.jsonl:1: error: line longer than 64 MiB"), std::string::npos) << t.errors[0];
+  ASSERT_EQ(t.events.size(), 1u);
+  EXPECT_NE(t.events[0].find("\"start\""), std::string::npos);
+  EXPECT_LT(grew_mb, 200) << "the 300 MiB line was held";
 }
 
 TEST(MonitorTrace, ACutOffLastLineIsAWarningNotAnError) {
