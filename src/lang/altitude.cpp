@@ -53,6 +53,10 @@ class AltitudeCheck {
     double ground = bounds.ground;
     double z = takeoff ? ground + *value : *value;
     double ceiling = bounds.ceiling;
+    if (z <= ground + 1e-9) {
+      report_floor(s, arg, takeoff, *value, ground);
+      return;
+    }
     if (z > ground + ceiling + 1e-9) {
       std::string over = takeoff ? "takeoff altitude " + metres(*value) : "target z = " + metres(z);
       report(s, arg,
@@ -92,6 +96,21 @@ class AltitudeCheck {
     ++settings_made_;
     b = {true, settings.home.z, settings.limits.max_altitude_m, fleet_.geofence_for(decl.name)};
     return b;
+  }
+
+  /// The drone refuses a Takeoff to a height that is not positive, and a FlyTo to a z that is
+  /// not above its home's (mid::uniform_refusal): a landing is Land's job.
+  void report_floor(const Statement& s, const Expr* arg, bool takeoff, double value, double ground) {
+    std::string who = std::string(s.drone) + "." + std::string(s.callee) + ": ";
+    if (takeoff)
+      diags_.error(m_.file, arg->loc, who + "takeoff altitude " + metres(value) +
+                                          " is not above the ground, and the drone refuses it; give the height "
+                                          "over its home to climb to, e.g. 5");
+    else
+      diags_.error(m_.file, arg->loc, who + "target z = " + metres(value) + " is not above " + std::string(s.drone) +
+                                          "'s home (z = " + metres(ground) +
+                                          "), and the drone refuses it; fly above z = " + metres(ground) +
+                                          ", or use Land to land");
   }
 
   void report(const Statement& s, const Expr* arg, std::string message, std::optional<SourceLocation> at,
