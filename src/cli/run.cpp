@@ -13,6 +13,7 @@
 #include "cli/signal_watch.h"
 #include "deploy/mission_file.h"
 #include "deploy/synthesize.h"
+#include "diag/number.h"
 #include "trace/plot.h"
 #include "dex/runner.h"
 #include "dex/trace_writers.h"
@@ -204,6 +205,24 @@ void hold_monitor(monitor::MonitorServer& server, MonitorHold& hold) {
   hold.wait_for_signal();
 }
 
+namespace {
+
+// On real time, work that takes no mission time (a loop's next iteration, input) runs at the
+// mission time the wall clock shows: a host that cannot follow --speed moves the mission's
+// timeline, and at a speed far beyond it changes its outcome. Less than a tenth of a second
+// is the jitter of any run on a busy host.
+void warn_of_lag(const RunCommandOptions& r, double max_lag_s) {
+  if (!(max_lag_s > 0.1)) return;
+  std::string pace = r.speed > 0 ? "--speed " + diag::number_text(r.speed) : std::string("--realtime");
+  char lag[32];
+  std::snprintf(lag, sizeof lag, "%.2f", max_lag_s);
+  std::cerr << "eamos: warning: the host could not keep up with " << pace << ": events ran up to " << lag
+            << " s of mission time late, and this run's timing strays from the plan's by as much; use a lower "
+            << "--speed, or leave it out to run on virtual time (the plan's timing, as fast as the host can)\n";
+}
+
+}  // namespace
+
 bool report_run(const RunCommandOptions& r, const dex::RunResult& result, const std::vector<dex::TraceEvent>& events) {
   if (!r.summary.empty() && !write_output(r.summary, summary_json(result).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n")) return false;
   if (!r.plot.empty() && !write_output(r.plot, trace::plot_svg(result, events))) return false;
@@ -214,7 +233,9 @@ bool report_run(const RunCommandOptions& r, const dex::RunResult& result, const 
     std::cerr << "eamos: mission failed: " << result.error << "\n";
   else  // a launch that stopped before the flight: its reason is already on standard error
     std::cerr << "eamos: mission failed (see the error above)\n";
+  warn_of_lag(r, result.max_lag);
   return true;
 }
+
 
 }  // namespace eamos::cli

@@ -393,6 +393,7 @@ RunResult InProcessRun::run(const mid::AdapterRegistry& adapters) {
   seed_boards();
   subscribe_drones();
   fly();
+  result_.max_lag = loop_.max_lag();
   summarise();
   trace_mission_end(trace_, result_);
   return result_;

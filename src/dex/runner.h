@@ -92,6 +92,8 @@ struct RunResult {
   std::uint64_t set_delivery_steps = 0;
   /// Distributed runs: how late the messages between drones were (in process they take no time).
   std::optional<MessageLatency> latency;
+  /// In process on real time: the most mission seconds an event ran late (mid::EventLoop::max_lag).
+  double max_lag = 0.0;
 };
 
 /// The event a trace ends with: `mission`, outcome `completed` or `failed` (reason: the

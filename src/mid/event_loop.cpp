@@ -235,6 +235,7 @@ std::size_t EventLoop::run(double limit, bool bounded) {
     const double next_time = front_time();
     if (!wait_for(next_time)) continue;
     if (real && stalled_before(next_time)) continue;  // the handler may have cancelled it
+    if (real) max_lag_ = std::max(max_lag_, wall_mission_time() - next_time);
     pop();
     if (!live(next.slot, next.gen)) continue;
     // Take the callback out first: it may schedule or cancel timers, growing the slots.

@@ -109,6 +109,12 @@ class EventLoop {
     on_stall_ = std::move(handler);
   }
 
+  /// Real time only: the most mission time by which a callback ran later than its time,
+  /// because the loop was still busy when the wall clock reached it (the host cannot follow
+  /// `speed`) or stalled; 0 on virtual time. Work deferred meanwhile (defer, post) takes the
+  /// wall's mission time, so this much is how far a run's timing may stray from the plan's.
+  double max_lag() const { return max_lag_; }
+
   /// Callbacks run since construction (a cost measure: idle drones must not add to it).
   std::uint64_t events_run() const { return events_run_; }
   /// Entries the queue holds, cancelled ones included (they leave it when due, or all at
@@ -226,6 +232,7 @@ class EventLoop {
   /// callback is late by the wall time since then or since it was due, whichever is less:
   /// a catch-up of many overdue callbacks in quick succession is not a stall.
   double caught_up_wall_ = 0.0;
+  double max_lag_ = 0.0;  ///< see max_lag()
   /// The mission time the last posted callbacks were given: later ones never get an earlier
   /// one, so posted callbacks run in the order they were posted (take_posted).
   double last_posted_at_ = 0.0;

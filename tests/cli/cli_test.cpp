@@ -315,6 +315,19 @@ std::vector<nlohmann::json> trace_lines(const fs::path& p) {
   return out;
 }
 
+// At a speed no host follows (a wall microsecond is a mission second), the run's timeline is
+// not the plan's: Listing 2 ran for minutes of mission time, or failed with an empty battery,
+// and said nothing about it. Now it says how late its events ran and what to do.
+TEST_F(Cli, ARunAtASpeedTheHostCannotFollowSaysItsTimingIsNotThePlans) {
+  Output r = eamos("run -q " + kListing2 + " --speed 1e6");
+  EXPECT_NE(r.out.find("eamos: warning: the host could not keep up with --speed 1e+06: events ran up to "),
+            std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("leave it out to run on virtual time"), std::string::npos) << r.out;
+  Output planned = eamos("run -q " + kListing2);
+  EXPECT_EQ(planned.status, 0) << planned.out;
+  EXPECT_EQ(planned.out.find("could not keep up"), std::string::npos) << planned.out;
+}
+
 TEST_F(Cli, RunReportsCompletionWhenTheLastAsyncWorkEndsAndTheTraceEndsWithIt) {
   Output r = eamos("run -q " + mission("async_last.eamos") + " --trace " + (dir_ / "t.jsonl").string());
   ASSERT_EQ(r.status, 0) << r.out;

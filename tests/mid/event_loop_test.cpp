@@ -305,6 +305,26 @@ TEST(EventLoop, RealTimeDoesNotWaitForLateEvents) {
   EXPECT_EQ(wall.sleeps, (std::vector<double>{101.0}));
 }
 
+// A callback that keeps the loop busy past the next one's wall time: that one runs late, by
+// the busy wall time times the speed in mission time, and max_lag says so. On time, no lag.
+TEST(EventLoop, MaxLagIsTheMostMissionTimeACallbackRanLate) {
+  FakeWall wall;
+  EventLoop loop({ClockMode::real_time, 10.0, &wall});
+  loop.at(1.0, [] {});
+  loop.at(2.0, [] {});
+  loop.run_until_idle();
+  EXPECT_NEAR(loop.max_lag(), 0.0, 1e-9);  // each ran at its time (up to rounding)
+  loop.at(3.0, [&] { wall.t += 0.25; });  // busy for a quarter of a wall second
+  loop.at(4.0, [] {});                    // due 0.1 wall s after 3.0: runs 0.15 wall s late
+  loop.at(9.0, [] {});
+  loop.run_until_idle();
+  EXPECT_NEAR(loop.max_lag(), 1.5, 1e-9);  // 0.15 wall s at ten times the wall
+  EventLoop virtual_time;
+  virtual_time.at(1.0, [] {});
+  virtual_time.run_until_idle();
+  EXPECT_EQ(virtual_time.max_lag(), 0.0);
+}
+
 // A process stopped (SIGSTOP) for longer than the bound: the stall handler runs before any
 // overdue callback, at the mission time the wall clock shows (not back-dated), and what it
 // cancels never runs. Before on_stall the overdue timer ran 4.75 wall seconds late.
