@@ -148,6 +148,7 @@ py::dict result_dict(const dex::RunResult& r) {
   out["duration"] = r.duration;
   out["error"] = utf8(r.error);
   out["activations"] = r.activations;
+  out["max_lag"] = r.max_lag;
   py::object failure = py::none();
   if (r.failure) {
     py::dict f;

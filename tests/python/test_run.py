@@ -130,6 +130,14 @@ def test_bad_options_are_refused_before_anything_flies(options, error, words):
     assert events == []
 
 
+def test_a_run_at_a_speed_the_host_cannot_follow_warns_that_its_timing_is_not_the_plans():
+    # A wall microsecond is a mission second at 1e6: no host follows that.
+    with pytest.warns(RuntimeWarning, match=r"could not keep up with speed=1e\+06: events ran up to [0-9.]+ s"):
+        r = eamos.run(LISTING2, speed=1e6, telemetry_hz=0)
+    assert r.max_lag > 0.1
+    assert eamos.run(LISTING2, telemetry_hz=0).max_lag == 0.0
+
+
 def test_a_fleet_file_changes_the_flight_as_it_does_for_eamos_run(tmp_path, eamos_bin):
     fleet = LISTING2.parent / "listing2-right.yaml"
     summary = tmp_path / "s.json"

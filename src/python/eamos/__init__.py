@@ -13,6 +13,7 @@ docs/python.md describes every call.
 from __future__ import annotations
 
 import os
+import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any, Callable, Dict, List, Optional
@@ -140,7 +141,15 @@ class Compilation:
         raw = _core.run(self._core, on_event, time_limit=float(time_limit), telemetry_hz=float(telemetry_hz),
                         speed=None if speed is None else float(speed),
                         trace=None if trace is None else os.fspath(trace), tracks=bool(tracks))
-        return RunResult._from_core(raw)
+        result = RunResult._from_core(raw)
+        if speed is not None and result.max_lag > 0.1:
+            # As eamos run says it: on real time, work that takes no mission time runs at the
+            # wall's mission time, so a host (or an on_event) slower than `speed` moves the timeline.
+            warnings.warn(f"the host could not keep up with speed={speed:g}: events ran up to "
+                          f"{result.max_lag:.2f} s of mission time late, and this run's timing strays from "
+                          "the plan's by as much; use a lower speed, or speed=None for virtual time",
+                          RuntimeWarning, stacklevel=2)
+        return result
 
     def _drone_name(self, drone: str | int) -> str:
         if isinstance(drone, int):
@@ -184,7 +193,8 @@ class DroneRun:
 @dataclass(frozen=True)
 class RunResult:
     """What a run did: `completed`, `duration` (mission seconds), the `failure` that ended it
-    (or None), `error` (the reason in words, "" when completed) and each drone's summary."""
+    (or None), `error` (the reason in words, "" when completed), each drone's summary, and on
+    real time `max_lag`: the most mission seconds an event ran late (0 on virtual time)."""
 
     completed: bool
     duration: float
@@ -192,12 +202,14 @@ class RunResult:
     failure: Optional[Failure]
     drones: Dict[str, DroneRun]
     activations: int  # node activations over all drones
+    max_lag: float = 0.0  # real time: the most mission seconds an event ran late
 
     @classmethod
     def _from_core(cls, raw: Dict[str, Any]) -> "RunResult":
         failure = Failure(**raw["failure"]) if raw["failure"] else None
         drones = {d["name"]: DroneRun(**d) for d in raw["drones"]}
-        return cls(raw["completed"], raw["duration"], raw["error"], failure, drones, raw["activations"])
+        return cls(raw["completed"], raw["duration"], raw["error"], failure, drones, raw["activations"],
+                   raw["max_lag"])
 
 
 def compile(path: str | os.PathLike, fleet: Optional[str | os.PathLike] = None) -> Compilation:
