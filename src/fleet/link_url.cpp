@@ -28,8 +28,8 @@ EndpointResult parse_serial(std::string_view rest, Endpoint e) {
   for (unsigned b : kSerialBauds) standard = standard || b == value;
   if (baud.empty() || ec != std::errc() || end != baud.data() + baud.size() || !standard)
     return bad("rate '" + diag::printable(baud) +
-                        "' is not a serial rate; give the autopilot port's rate (its SERIALn_BAUD or "
-                        "SER_TELn_BAUD): 57600, 115200, 921600, …");
+               "' is not a serial rate; give the autopilot port's rate (its SERIALn_BAUD or "
+               "SER_TELn_BAUD): 57600, 115200, 921600, …");
   e.baud = value;
   return {e, ""};
 }
