@@ -163,7 +163,11 @@ TEST(MonitorTrace, AnEndlessLineIsAnErrorReadPastWithoutHoldingIt) {
   EXPECT_NE(t.errors[0].find("x.jsonl:1: error: line longer than 64 MiB"), std::string::npos) << t.errors[0];
   ASSERT_EQ(t.events.size(), 1u);
   EXPECT_NE(t.events[0].find("\"start\""), std::string::npos);
+#ifndef EAMOS_SANITIZED  // a sanitizer's quarantine keeps every freed block of the growing line
   EXPECT_LT(grew_mb, 200) << "the 300 MiB line was held";
+#else
+  (void)grew_mb;
+#endif
 }
 
 TEST(MonitorTrace, ACutOffLastLineIsAWarningNotAnError) {
