@@ -15,6 +15,7 @@
 #include "deploy/synthesize.h"
 #include "diag/number.h"
 #include "trace/plot.h"
+#include "dex/failsafe.h"
 #include "dex/runner.h"
 #include "dex/trace_writers.h"
 #include "graph/pipeline.h"
@@ -221,14 +222,35 @@ void warn_of_lag(const RunCommandOptions& r, double max_lag_s) {
             << "--speed, or leave it out to run on virtual time (the plan's timing, as fast as the host can)\n";
 }
 
+// A completed mission may leave a drone in the air or armed: nothing in it lands or disarms
+// that drone, and on a real vehicle what happens next is the autopilot's to decide (PX4 and
+// ArduPilot each have their own failsafe for a lost offboard or guided controller).
+void warn_of_end_states(const dex::RunResult& result) {
+  for (const dex::DroneSummary& d : result.drones) {
+    if (!d.final || dex::down_and_disarmed(d.state)) continue;
+    if (!d.state.landed) {
+      char z[32];
+      std::snprintf(z, sizeof z, "%.1f", d.state.z);
+      std::cerr << "eamos: warning: " << d.name << " is still in the air when the mission ends (z = " << z
+                << " m) and nothing lands it; end its part with " << d.name << ".Land() and " << d.name
+                << ".Disarm() (eamos verify reports this as airborne_at_end)\n";
+    } else {
+      std::cerr << "eamos: warning: " << d.name << " is still armed on the ground when the mission ends; end its part with "
+                << d.name << ".Disarm() (eamos verify reports this as armed_at_end)\n";
+    }
+  }
+}
+
 }  // namespace
 
 bool report_run(const RunCommandOptions& r, const dex::RunResult& result, const std::vector<dex::TraceEvent>& events) {
   if (!r.summary.empty() && !write_output(r.summary, summary_json(result).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n")) return false;
   if (!r.plot.empty() && !write_output(r.plot, trace::plot_svg(result, events))) return false;
   if (result.latency) print_latency(*result.latency);
-  if (result.completed)
-    std::cout << "mission completed in " << result.duration << " s (mission time)\n";
+  if (result.completed) {
+    std::cout << "mission completed in " << result.duration << " s (mission time)\n" << std::flush;
+    warn_of_end_states(result);
+  }
   else if (!result.error.empty())
     std::cerr << "eamos: mission failed: " << result.error << "\n";
   else  // a launch that stopped before the flight: its reason is already on standard error

@@ -315,6 +315,27 @@ std::vector<nlohmann::json> trace_lines(const fs::path& p) {
   return out;
 }
 
+// A mission that completes with a drone still up (no Land) or still armed (no Disarm) used to
+// end with "mission completed" and nothing else; eamos verify reported it, eamos run did not.
+TEST_F(Cli, ARunThatLeavesADroneInTheAirOrArmedSaysSo) {
+  fs::path m = dir_ / "ends.eamos";
+  std::ofstream(m) << "var A Quad\nvar B Quad\nvar C Quad\nfunc INIT() { PAR_x() }\n"
+                      "func PAR_x() { SEQ_a(); SEQ_b(); SEQ_c() }\n"
+                      "func SEQ_a() { A.Arm(); A.Takeoff(5) }\n"
+                      "func SEQ_b() { B.Arm(); B.Takeoff(5); B.Land() }\n"
+                      "func SEQ_c() { C.Arm(); C.Takeoff(5); C.Land(); C.Disarm() }\n";
+  Output r = eamos("run -q " + m.string());
+  EXPECT_EQ(r.status, 0) << r.out;  // it did complete
+  EXPECT_NE(r.out.find("eamos: warning: A is still in the air when the mission ends (z = 5.0 m) and nothing lands "
+                       "it; end its part with A.Land() and A.Disarm()"),
+            std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("eamos: warning: B is still armed on the ground when the mission ends; end its part with "
+                       "B.Disarm()"),
+            std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("warning: C "), std::string::npos) << r.out;
+  EXPECT_EQ(eamos("run -q " + kListing2).out.find("when the mission ends"), std::string::npos);
+}
+
 // At a speed no host follows (a wall microsecond is a mission second), the run's timeline is
 // not the plan's: Listing 2 ran for minutes of mission time, or failed with an empty battery,
 // and said nothing about it. Now it says how late its events ran and what to do.
