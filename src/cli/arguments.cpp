@@ -487,7 +487,12 @@ std::string check_outputs(CLI::App& sub, const std::vector<std::string>& args, c
   for (const OutputPath& o : outputs) {
     if (!o.option || o.option->count() == 0) continue;
     std::string path = o.option->as<std::string>();
-    if (path.empty() || (!o.folder && path == "-")) continue;
+    if (path.empty()) {  // given, but as "" (an unset shell variable): never the working folder
+      out += argument_error(args, option_spot(o.option, args, path), display(o.option, "") + ": an empty path; " +
+                            (o.folder ? "name a folder (made if missing)" : "name a file, or leave the option out"));
+      continue;
+    }
+    if (!o.folder && path == "-") continue;
     ArgSpot at = option_spot(o.option, args, path);
     std::string name = display(o.option, "");
     std::error_code ec;

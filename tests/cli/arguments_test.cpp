@@ -115,6 +115,21 @@ TEST_F(Arguments, EveryOutputPathIsCheckedBeforeAnythingFlies) {
   EXPECT_FALSE(fs::exists(dir_ / "s.json"));
 }
 
+// `-o "$OUT"` with OUT unset: the compile wrote nowhere useful, and --trace "" was taken as no
+// trace at all. An empty path is refused at its option, as any unusable output is.
+TEST_F(Arguments, AnEmptyOutputPathIsRefusedAtItsOption) {
+  Output r = eamos_in_source_dir("compile examples/listing2.eamos -o ''");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("eamos: error: --output: an empty path; name a folder (made if missing)"), std::string::npos)
+      << r.out;
+  r = eamos_in_source_dir("run examples/listing2.eamos --trace ''");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("eamos: error: --trace: an empty path; name a file, or leave the option out"),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("mission completed"), std::string::npos) << r.out;  // nothing flew
+}
+
 TEST_F(Arguments, TwoOutputsToOneFileAndAnOutputOverTheMissionAreRefused) {
   std::string same = (dir_ / "out.json").string();
   Output r = eamos_in_source_dir("run examples/listing2.eamos --trace " + same + " --summary " + same);
