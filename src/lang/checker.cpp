@@ -11,6 +11,7 @@
 #include "lang/arming.h"
 #include "lang/concurrency.h"
 #include "lang/exact_compare.h"
+#include "lang/literal_arguments.h"
 #include "lang/loop_time.h"
 
 namespace eamos::lang {
@@ -216,7 +217,10 @@ CheckedMission Checker::run() {
     for (auto& s : f.body) check_statement(f, s);
   check_call_graph();
   check_loops_take_time(m_, diags_);
-  if (!diags_.has_errors()) check_literal_altitudes(m_, fleet_, diags_);
+  if (!diags_.has_errors()) {
+    check_literal_altitudes(m_, fleet_, diags_);
+    check_literal_arguments(m_, diags_);
+  }
   if (!diags_.has_errors()) {
     check_unused();
     warn_concurrent_motion(m_, out_.drone_types, diags_);
