@@ -250,14 +250,13 @@ bool report_run(const RunCommandOptions& r, const dex::RunResult& result, const 
   if (result.completed) {
     std::cout << "mission completed in " << result.duration << " s (mission time)\n" << std::flush;
     warn_of_end_states(result);
-  }
-  else if (!result.error.empty())
+  } else if (!result.error.empty()) {
     std::cerr << "eamos: mission failed: " << result.error << "\n";
-  else  // a launch that stopped before the flight: its reason is already on standard error
+  } else {  // a launch that stopped before the flight: its reason is already on standard error
     std::cerr << "eamos: mission failed (see the error above)\n";
+  }
   warn_of_lag(r, result.max_lag);
   return true;
 }
-
 
 }  // namespace eamos::cli
