@@ -8,14 +8,6 @@
 namespace eamos::lang {
 namespace {
 
-std::optional<double> literal(const Expr* e) {
-  if (!e) return std::nullopt;
-  if (e->kind == ExprKind::number) return e->number;
-  if (e->kind == ExprKind::unary && e->op == Op::neg)
-    if (auto v = literal(e->lhs)) return -*v;
-  return std::nullopt;
-}
-
 std::string metres(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g m", v);
@@ -46,7 +38,7 @@ class AltitudeCheck {
     bool fly_to = s.callee == "FlyTo" && s.args.size() == 3;
     if (!takeoff && !fly_to) return;
     const Expr* arg = s.args.back();
-    std::optional<double> value = literal(arg);
+    std::optional<double> value = literal_number(arg);
     if (!value) return;
     const DroneDecl& drone = m_.drones[s.drone_index];
     const Bounds& bounds = bounds_of(s.drone_index);

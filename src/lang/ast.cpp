@@ -135,4 +135,12 @@ std::string expr_text(const Expr& e) {
 
 void append_expr_text(std::string& out, const Expr& e) { append_text(out, e, 0); }
 
+std::optional<double> literal_number(const Expr* e) {
+  if (!e) return std::nullopt;
+  if (e->kind == ExprKind::number) return e->number;
+  if (e->kind == ExprKind::unary && e->op == Op::neg)
+    if (auto v = literal_number(e->lhs)) return -*v;
+  return std::nullopt;
+}
+
 }  // namespace eamos::lang

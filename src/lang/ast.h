@@ -4,6 +4,7 @@
 // structs owned by a Mission; later stages point into it and never copy expressions.
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -128,5 +129,8 @@ struct Mission {
 std::string expr_text(const Expr& e);
 /// expr_text appended to `out`: a writer labelling every node reuses one string.
 void append_expr_text(std::string& out, const Expr& e);
+/// The value of a number written out (`5`, `-3.5`), for the rules that check what a drone
+/// would refuse; nothing for anything computed (or null).
+std::optional<double> literal_number(const Expr* e);
 
 }  // namespace eamos::lang

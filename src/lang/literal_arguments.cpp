@@ -8,19 +8,11 @@
 namespace eamos::lang {
 namespace {
 
-std::optional<double> literal(const Expr* e) {
-  if (!e) return std::nullopt;
-  if (e->kind == ExprKind::number) return e->number;
-  if (e->kind == ExprKind::unary && e->op == Op::neg)
-    if (auto v = literal(e->lhs)) return -*v;
-  return std::nullopt;
-}
-
 void check(const Mission& m, const Statement& s, Diagnostics& diags) {
   if (s.kind != StatementKind::action || s.drone_index < 0 || s.args.size() != 1) return;
   bool orbit = s.callee == "Orbit", hover = s.callee == "Hover";
   if (!orbit && !hover) return;
-  std::optional<double> value = literal(s.args[0]);
+  std::optional<double> value = literal_number(s.args[0]);
   if (!value || (orbit && *value > 0) || (hover && *value >= 0)) return;
   std::string call = std::string(s.drone) + "." + std::string(s.callee) + ": ";
   std::string v = diag::number_text(*value);
