@@ -6,6 +6,7 @@ import os
 import signal
 import subprocess
 import sys
+import warnings
 
 import pytest
 
@@ -136,6 +137,20 @@ def test_a_run_at_a_speed_the_host_cannot_follow_warns_that_its_timing_is_not_th
         r = eamos.run(LISTING2, speed=1e6, telemetry_hz=0)
     assert r.max_lag > 0.1
     assert eamos.run(LISTING2, telemetry_hz=0).max_lag == 0.0
+
+
+def test_a_completed_run_that_leaves_a_drone_in_the_air_or_armed_warns_as_eamos_run_does():
+    c = eamos.compile_text("var A Quad\nvar B Quad\nfunc INIT() { PAR_x() }\nfunc PAR_x() { SEQ_a(); SEQ_b() }\n"
+                           "func SEQ_a() { A.Arm(); A.Takeoff(5) }\nfunc SEQ_b() { B.Arm(); B.Takeoff(5); B.Land() }\n")
+    with pytest.warns(RuntimeWarning) as seen:
+        r = c.run(telemetry_hz=0)
+    assert r.completed
+    messages = [str(w.message) for w in seen]
+    assert any(m.startswith("A is still in the air when the mission ends (z = 5.0 m)") for m in messages), messages
+    assert any(m.startswith("B is still armed on the ground when the mission ends") for m in messages), messages
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # Listing 2 ends with every drone down and disarmed: no warning
+        assert eamos.run(LISTING2, telemetry_hz=0).completed
 
 
 def test_a_fleet_file_changes_the_flight_as_it_does_for_eamos_run(tmp_path, eamos_bin):
