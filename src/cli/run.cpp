@@ -15,7 +15,6 @@
 #include "deploy/synthesize.h"
 #include "diag/number.h"
 #include "trace/plot.h"
-#include "dex/failsafe.h"
 #include "dex/runner.h"
 #include "dex/trace_writers.h"
 #include "graph/pipeline.h"
@@ -206,56 +205,19 @@ void hold_monitor(monitor::MonitorServer& server, MonitorHold& hold) {
   hold.wait_for_signal();
 }
 
-namespace {
-
-// On real time, work that takes no mission time (a loop's next iteration, input) runs at the
-// mission time the wall clock shows: a host that cannot follow --speed moves the mission's
-// timeline, and at a speed far beyond it changes its outcome. Less than a tenth of a second
-// is the jitter of any run on a busy host.
-void warn_of_lag(const RunCommandOptions& r, double max_lag_s) {
-  if (!(max_lag_s > 0.1)) return;
-  std::string pace = r.speed > 0 ? "--speed " + diag::number_text(r.speed) : std::string("--realtime");
-  char lag[32];
-  std::snprintf(lag, sizeof lag, "%.2f", max_lag_s);
-  std::cerr << "eamos: warning: the host could not keep up with " << pace << ": events ran up to " << lag
-            << " s of mission time late, and this run's timing strays from the plan's by as much; use a lower "
-            << "--speed, or leave it out to run on virtual time (the plan's timing, as fast as the host can)\n";
-}
-
-// A completed mission may leave a drone in the air or armed: nothing in it lands or disarms
-// that drone, and on a real vehicle what happens next is the autopilot's to decide (PX4 and
-// ArduPilot each have their own failsafe for a lost offboard or guided controller).
-void warn_of_end_states(const dex::RunResult& result) {
-  for (const dex::DroneSummary& d : result.drones) {
-    if (!d.final || dex::down_and_disarmed(d.state)) continue;
-    if (!d.state.landed) {
-      char z[32];
-      std::snprintf(z, sizeof z, "%.1f", d.state.z);
-      std::cerr << "eamos: warning: " << d.name << " is still in the air when the mission ends (z = " << z
-                << " m) and nothing lands it; end its part with " << d.name << ".Land() and " << d.name
-                << ".Disarm() (eamos verify reports this as airborne_at_end)\n";
-    } else {
-      std::cerr << "eamos: warning: " << d.name << " is still armed on the ground when the mission ends; end its part with "
-                << d.name << ".Disarm() (eamos verify reports this as armed_at_end)\n";
-    }
-  }
-}
-
-}  // namespace
-
 bool report_run(const RunCommandOptions& r, const dex::RunResult& result, const std::vector<dex::TraceEvent>& events) {
   if (!r.summary.empty() && !write_output(r.summary, summary_json(result).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n")) return false;
   if (!r.plot.empty() && !write_output(r.plot, trace::plot_svg(result, events))) return false;
   if (result.latency) print_latency(*result.latency);
   if (result.completed) {
     std::cout << "mission completed in " << result.duration << " s (mission time)\n" << std::flush;
-    warn_of_end_states(result);
   } else if (!result.error.empty()) {
     std::cerr << "eamos: mission failed: " << result.error << "\n";
   } else {  // a launch that stopped before the flight: its reason is already on standard error
     std::cerr << "eamos: mission failed (see the error above)\n";
   }
-  warn_of_lag(r, result.max_lag);
+  std::string pace = r.speed > 0 ? "--speed " + diag::number_text(r.speed) : std::string("--realtime");
+  for (const std::string& w : dex::run_warnings(result, pace)) std::cerr << "eamos: warning: " << w << "\n";
   return true;
 }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iterator>
 #include <set>
 #include <unordered_map>
@@ -274,6 +275,30 @@ bool TelemetryRecorder::due(const std::string& name, double t) {
   if (t < next) return false;
   next = (std::floor(t * hz_ + 1e-9) + 1) / hz_;
   return true;
+}
+
+std::vector<std::string> run_warnings(const RunResult& r, const std::string& pace) {
+  std::vector<std::string> out;
+  char text[32];
+  for (const DroneSummary& d : r.drones) {
+    if (!r.completed || !d.final || down_and_disarmed(d.state)) continue;
+    if (!d.state.landed) {
+      std::snprintf(text, sizeof text, "%.1f", d.state.z);
+      out.push_back(d.name + " is still in the air when the mission ends (z = " + text + " m) and nothing lands it; " +
+                    "end its part with " + d.name + ".Land() and " + d.name +
+                    ".Disarm() (eamos verify reports this as airborne_at_end)");
+    } else {
+      out.push_back(d.name + " is still armed on the ground when the mission ends; end its part with " + d.name +
+                    ".Disarm() (eamos verify reports this as armed_at_end)");
+    }
+  }
+  if (r.max_lag > 0.1) {  // less is the jitter of any run on a busy host
+    std::snprintf(text, sizeof text, "%.2f", r.max_lag);
+    out.push_back("the host could not keep up with " + pace + ": events ran up to " + text +
+                  " s of mission time late, and this run's timing strays from the plan's by as much; use a lower "
+                  "speed, or leave it out to run on virtual time (the plan's timing, as fast as the host can)");
+  }
+  return out;
 }
 
 TraceEvent mission_end_event(const RunResult& r) {

@@ -96,6 +96,14 @@ struct RunResult {
   double max_lag = 0.0;
 };
 
+/// What a run says of itself beyond its outcome, in the words `eamos run` prints after
+/// "warning: " and the Python module gives as RuntimeWarnings: for a completed mission, each
+/// drone it leaves in the air or armed (whose final state is known); on real time, how far
+/// the run fell behind `pace` (the speed as the caller names it: "--speed 5", "speed=5") when
+/// an event ran more than a tenth of a mission second late, since work that takes no mission
+/// time then runs at the wall's mission time and the run's timing strays from the plan's.
+std::vector<std::string> run_warnings(const RunResult& r, const std::string& pace);
+
 /// The event a trace ends with: `mission`, outcome `completed` or `failed` (reason: the
 /// error), at the mission time the mission ended (RunResult::duration). Every runner, in
 /// process or distributed, writes it last.

@@ -12,6 +12,7 @@
 #include "deploy/synthesize.h"
 #include "dex/runner.h"
 #include "dex/trace_writers.h"
+#include "diag/number.h"
 #include "mavlink_adapter/adapter.h"
 #include "sim/sim_adapter.h"
 
@@ -220,7 +221,12 @@ py::dict run(const CompiledMission& m, const RunArgs& a) {
     if (!trace_file) throw py::value_error("could not finish writing trace '" + *a.trace + "' (disk full?)");
   }
   sink.rethrow();
-  return result_dict(result);
+  py::dict out = result_dict(result);
+  py::list warnings;
+  for (const std::string& w : dex::run_warnings(result, "speed=" + diag::number_text(a.speed.value_or(1.0))))
+    warnings.append(utf8(w));
+  out["warnings"] = warnings;
+  return out;
 }
 
 }  // namespace

@@ -142,15 +142,8 @@ class Compilation:
                         speed=None if speed is None else float(speed),
                         trace=None if trace is None else os.fspath(trace), tracks=bool(tracks))
         result = RunResult._from_core(raw)
-        if speed is not None and result.max_lag > 0.1:
-            # As eamos run says it: on real time, work that takes no mission time runs at the
-            # wall's mission time, so a host (or an on_event) slower than `speed` moves the timeline.
-            warnings.warn(f"the host could not keep up with speed={speed:g}: events ran up to "
-                          f"{result.max_lag:.2f} s of mission time late, and this run's timing strays from "
-                          "the plan's by as much; use a lower speed, or speed=None for virtual time",
-                          RuntimeWarning, stacklevel=2)
-        if result.completed:
-            _warn_of_end_states(result)
+        for what in raw["warnings"]:  # eamos run's warnings, in its words (dex::run_warnings)
+            warnings.warn(what, RuntimeWarning, stacklevel=2)
         return result
 
     def _drone_name(self, drone: str | int) -> str:
@@ -166,19 +159,6 @@ class Compilation:
         if self.ok:
             return f"<eamos.Compilation ok: {len(self.drones)} drones, {len(self.warnings)} warnings>"
         return f"<eamos.Compilation failed: {len(self.errors)} errors, {len(self.warnings)} warnings>"
-
-
-def _warn_of_end_states(result: "RunResult") -> None:
-    """As eamos run says it: a completed mission that leaves a drone in the air or armed."""
-    for d in result.drones.values():
-        if not d.final or (d.state["landed"] and not d.state["armed"]):
-            continue
-        if not d.state["landed"]:
-            what = (f"{d.name} is still in the air when the mission ends (z = {d.state['z']:.1f} m) and nothing "
-                    f"lands it; end its part with {d.name}.Land() and {d.name}.Disarm()")
-        else:
-            what = f"{d.name} is still armed on the ground when the mission ends; end its part with {d.name}.Disarm()"
-        warnings.warn(what, RuntimeWarning, stacklevel=3)
 
 
 @dataclass(frozen=True)
